@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geom/surface.hpp"
+#include "model/model.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::app {
+
+// A figure the experiment expects, checked after the run: either a value
+// with an absolute tolerance, or bounds.
+struct ExpectedFigure {
+  std::string figure;                     // e.g. "max_displacement", "position.0.x"
+  std::optional<double> value;
+  double tolerance = 0.0;                 // |actual - value| <= tolerance
+  std::optional<double> at_most, at_least;
+  Eigen::MatrixXd matrix;                 // for matrix figures ("system_matrix")
+  std::string note;                       // where the number comes from
+};
+
+// One run of a sweep: a label and the stepping options it uses.
+struct Variant {
+  std::string name;
+  solve::SteppingOptions stepping;
+};
+
+struct OutputOptions {
+  bool vtk = true;   // one .vtu per load step and a .pvd series
+  bool obj = true;   // final.obj, the deformed surface in input vertex order
+  int every = 1;     // write every k-th step's .vtu (the last always)
+};
+
+// A named surface for an "areas" experiment (the paper's Table 1).
+struct NamedSurface {
+  std::string name;
+  geom::Surface surface;
+};
+
+// A parsed and validated experiment file.
+struct Experiment {
+  enum class Kind { Simulate, Areas };
+  Kind kind = Kind::Simulate;
+  std::string name;
+  std::string description;
+  std::filesystem::path source;  // the JSON file
+
+  // Simulate: the surface as given (input vertex order), the model on its
+  // used vertices, and the map between the two.
+  geom::Surface input_surface;
+  std::vector<int> model_to_input;
+  model::Model model;
+  std::vector<Variant> variants;  // one unless the file sweeps
+  OutputOptions output;
+
+  // Areas:
+  std::vector<NamedSurface> area_surfaces;
+
+  std::vector<ExpectedFigure> expected;
+  std::vector<std::string> warnings;  // e.g. from the mesh reader
+};
+
+// Reads and validates an experiment file. Throws InputError naming the file
+// and the field (e.g. "sphere.json: material.Y: expected a positive number")
+// for an unknown field, a wrong type, a missing or bad mesh, a selection that
+// selects nothing; nothing is written.
+Experiment load_experiment(const std::filesystem::path& path);
+
+// Reads a mesh file and checks it (closed, manifold, outward, ...), optionally
+// flipping an inward mesh first. Throws InputError naming the file.
+geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
+                                   std::vector<std::string>* warnings);
+
+}  // namespace fiberfluid::app

@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/runner.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "geom/area_vectors.hpp"
+#include "model/assembly.hpp"
+#include "model/boundary_conditions.hpp"
+
+namespace fiberfluid::app {
+namespace {
+
+const char* kRunFigures[] = {"max_displacement",  "final_pressure",
+                             "final_volume",      "initial_volume",
+                             "volume_change_relative", "mean_displacement_over_diagonal",
+                             "surface_area",      "steps",
+                             "factorizations"};
+
+// "position.12.y" -> (12, 1); nothing when the form does not match.
+std::optional<std::pair<int, int>> vertex_axis(const std::string& rest, int dim) {
+  const size_t dot = rest.find('.');
+  if (dot == std::string::npos || dot + 2 != rest.size()) return std::nullopt;
+  const int axis = rest.back() - 'x';
+  if (axis < 0 || axis >= dim) return std::nullopt;
+  try {
+    size_t used = 0;
+    const int index = std::stoi(rest.substr(0, dot), &used);
+    if (used != dot || index < 0) return std::nullopt;
+    return std::make_pair(index, axis);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+void add_area_figures(const Experiment& ex, ExperimentResult& result) {
+  for (const NamedSurface& s : ex.area_surfaces) {
+    const geom::VertexAreaVectors areas = geom::vertex_area_vectors(s.surface.V, s.surface.F);
+    result.figures[s.name + ".vertices"] = s.surface.num_vertices();
+    result.figures[s.name + ".faces"] = s.surface.num_faces();
+    result.figures[s.name + ".area_faces"] = areas.surface_area;         // sum |A_f|
+    result.figures[s.name + ".area_vertices"] = areas.magnitude.sum();   // sum |S_i|
+    result.figures[s.name + ".volume"] = geom::enclosed_volume(s.surface.V, s.surface.F);
+  }
+}
+
+// Splits "variant.figure" when the prefix names a run; a single run also
+// answers unprefixed names.
+const RunResult* run_for(const ExperimentResult& result, const std::string& name,
+                         std::string* figure) {
+  for (const RunResult& run : result.runs) {
+    if (!run.variant.empty() && name.rfind(run.variant + ".", 0) == 0) {
+      *figure = name.substr(run.variant.size() + 1);
+      return &run;
+    }
+  }
+  *figure = name;
+  return result.runs.size() == 1 ? &result.runs.front() : nullptr;
+}
+
+FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
+                         const ExpectedFigure& expected) {
+  FigureCheck check;
+  check.expected = expected;
+  std::string figure;
+  const RunResult* run = run_for(result, expected.figure, &figure);
+  if (expected.matrix.size() > 0) {
+    if (run == nullptr || figure != "system_matrix") return check;
+    const Eigen::MatrixXd A = constrained_system_matrix(ex, *run);
+    check.found = A.rows() == expected.matrix.rows() && A.cols() == expected.matrix.cols();
+    if (!check.found) return check;
+    check.actual = (A - expected.matrix).cwiseAbs().maxCoeff();
+    check.passed = check.actual <= expected.tolerance;
+    return check;
+  }
+  std::optional<double> value;
+  auto it = result.figures.find(expected.figure);
+  if (it != result.figures.end()) value = it->second;
+  else if (run != nullptr) value = run_figure(ex, *run, figure);
+  if (!value) return check;
+  check.found = true;
+  check.actual = *value;
+  check.passed = std::isfinite(*value);
+  if (expected.value) check.passed &= std::abs(*value - *expected.value) <= expected.tolerance;
+  if (expected.at_most) check.passed &= *value <= *expected.at_most;
+  if (expected.at_least) check.passed &= *value >= *expected.at_least;
+  return check;
+}
+
+}  // namespace
+
+std::string FigureCheck::Describe() const {
+  std::ostringstream out;
+  out.precision(10);
+  out << (passed ? "pass" : "FAIL") << "  " << expected.figure << " = ";
+  if (!found) {
+    out << "(no such figure)";
+    return out.str();
+  }
+  if (expected.matrix.size() > 0) {
+    out << "matrix, largest difference " << actual << " (tolerance " << expected.tolerance << ")";
+    return out.str();
+  }
+  out << actual;
+  if (expected.value) out << ", expected " << *expected.value << " +- " << expected.tolerance;
+  if (expected.at_most) out << ", at most " << *expected.at_most;
+  if (expected.at_least) out << ", at least " << *expected.at_least;
+  return out.str();
+}
+
+bool ExperimentResult::runs_succeeded() const {
+  for (const RunResult& run : runs)
+    if (!run.summary.success) return false;
+  return true;
+}
+
+bool ExperimentResult::checks_passed() const {
+  for (const FigureCheck& c : checks)
+    if (!c.passed) return false;
+  return true;
+}
+
+Eigen::MatrixXd input_positions(const Experiment& ex, const Eigen::VectorXd& unknowns) {
+  Eigen::MatrixXd X = ex.input_surface.V;
+  const Eigen::MatrixXd model_X = model::positions(ex.model, unknowns);
+  for (size_t m = 0; m < ex.model_to_input.size(); ++m)
+    X.row(ex.model_to_input[m]) = model_X.row(static_cast<Eigen::Index>(m));
+  return X;
+}
+
+std::optional<double> run_figure(const Experiment& ex, const RunResult& run,
+                                 const std::string& name) {
+  const model::Model& m = ex.model;
+  const Eigen::VectorXd& x = run.summary.unknowns;
+  const Eigen::MatrixXd U = model::displacements(m, x);
+  const Eigen::MatrixXd X = m.surface.V + U;
+  const double initial_volume = geom::enclosed_volume(m.surface.V, m.surface.F);
+  const double final_volume = geom::enclosed_volume(X, m.surface.F);
+  if (name == "max_displacement") return U.rowwise().norm().maxCoeff();
+  if (name == "final_pressure") return x[m.pressure_dof()];
+  if (name == "final_volume") return final_volume;
+  if (name == "initial_volume") return initial_volume;
+  if (name == "volume_change_relative") return (final_volume - initial_volume) / initial_volume;
+  if (name == "mean_displacement_over_diagonal")  // the paper's Eq. 9
+    return U.rowwise().norm().mean() / geom::bounding_box_diagonal(m.surface.V);
+  if (name == "surface_area") return geom::surface_area(m.surface.V, m.surface.F);
+  if (name == "steps") return static_cast<double>(run.summary.steps.size());
+  if (name == "factorizations") return run.summary.factorizations;
+
+  for (const std::string prefix : {"position.", "displacement."}) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    const auto va = vertex_axis(name.substr(prefix.size()), m.dim());
+    if (!va || va->first >= ex.input_surface.num_vertices()) return std::nullopt;
+    const Eigen::MatrixXd P = input_positions(ex, x);
+    const double position = P(va->first, va->second);
+    return prefix == "position." ? position
+                                 : position - ex.input_surface.V(va->first, va->second);
+  }
+  return std::nullopt;
+}
+
+Eigen::MatrixXd constrained_system_matrix(const Experiment& ex, const RunResult& run) {
+  Eigen::MatrixXd A = model::system_matrix(ex.model, ex.model.surface.V);
+  const model::DofPartition partition = model::partition_dofs(ex.model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(partition.constrained.size());
+  if (run.stepping.boundary_method == model::BoundaryMethod::Penalty) {
+    Eigen::VectorXd B = Eigen::VectorXd::Zero(A.rows());
+    model::apply_penalty(partition, zero, run.stepping.penalty, A, B);
+    return A;
+  }
+  Eigen::MatrixXd A_free;
+  Eigen::VectorXd B_free;
+  model::reduce_system(partition, zero, A, Eigen::VectorXd::Zero(A.rows()), A_free, B_free);
+  return A_free;
+}
+
+ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer) {
+  ExperimentResult result;
+  if (ex.kind == Experiment::Kind::Areas) {
+    add_area_figures(ex, result);
+  } else {
+    for (size_t r = 0; r < ex.variants.size(); ++r) {
+      RunResult run;
+      run.variant = ex.variants[r].name;
+      run.stepping = ex.variants[r].stepping;
+      solve::StepObserver step_observer;
+      if (observer)
+        step_observer = [&](const solve::StepRecord& record, const Eigen::VectorXd& x) {
+          observer(r, record, x);
+        };
+      run.summary = solve::solve_load_steps(ex.model, run.stepping, step_observer);
+      const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
+      if (run.summary.success)
+        for (const char* name : kRunFigures)
+          result.figures[prefix + name] = *run_figure(ex, run, name);
+      result.runs.push_back(std::move(run));
+    }
+  }
+  for (const ExpectedFigure& expected : ex.expected)
+    result.checks.push_back(check_figure(ex, result, expected));
+  return result;
+}
+
+}  // namespace fiberfluid::app

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/experiment.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::app {
+
+struct RunResult {
+  std::string variant;
+  solve::SteppingOptions stepping;
+  solve::SteppingSummary summary;
+};
+
+struct FigureCheck {
+  ExpectedFigure expected;
+  double actual = 0.0;  // for a matrix: the largest entry-wise difference
+  bool found = false;
+  bool passed = false;
+  std::string Describe() const;
+};
+
+struct ExperimentResult {
+  std::vector<RunResult> runs;
+  std::map<std::string, double> figures;  // headline figures, "variant.figure" for sweeps
+  std::vector<FigureCheck> checks;
+  bool runs_succeeded() const;
+  bool checks_passed() const;
+};
+
+// Observes each load step of a run: (run index, record, unknowns).
+using RunObserver =
+    std::function<void(size_t run, const solve::StepRecord&, const Eigen::VectorXd&)>;
+
+// Runs every variant of a simulation (or measures the surfaces of an areas
+// experiment), then computes the figures and checks the expected ones.
+ExperimentResult run_experiment(const Experiment& experiment, const RunObserver& observer = {});
+
+// Positions of every input vertex (input order and count; vertices that are
+// in no face stay where they are) for a model unknown vector.
+Eigen::MatrixXd input_positions(const Experiment& experiment, const Eigen::VectorXd& unknowns);
+
+// A named figure of one run, or nothing when the name is unknown:
+//   max_displacement, final_pressure, final_volume, initial_volume,
+//   volume_change_relative, mean_displacement_over_diagonal (the paper's
+//   Eq. 9), surface_area, steps, factorizations,
+//   position.I.x / displacement.I.y (I an input vertex index).
+std::optional<double> run_figure(const Experiment& experiment, const RunResult& run,
+                                 const std::string& name);
+
+// The paper's A for a run with its boundary conditions applied by penalty
+// (the rows and columns of every unknown) or by elimination (free unknowns).
+Eigen::MatrixXd constrained_system_matrix(const Experiment& experiment, const RunResult& run);
+
+}  // namespace fiberfluid::app

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "geom/area_vectors.hpp"
+
+#include <Eigen/Geometry>
+
+namespace fiberfluid::geom {
+
+Eigen::MatrixXd face_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  Eigen::MatrixXd A(F.rows(), V.cols());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (V.cols() == 3) {
+      const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      A.row(f) = 0.5 * (b - a).cross(c - a);
+    } else {
+      const Eigen::Vector2d d = V.row(F(f, 1)) - V.row(F(f, 0));
+      A.row(f) << d.y(), -d.x();  // right of the direction of travel: outward for CCW
+    }
+  }
+  return A;
+}
+
+Eigen::MatrixXd summed_face_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  const Eigen::MatrixXd A = face_area_vectors(V, F);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(V.rows(), V.cols());
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (Eigen::Index k = 0; k < F.cols(); ++k) sum.row(F(f, k)) += A.row(f);
+  return sum;
+}
+
+VertexAreaVectors vertex_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  VertexAreaVectors out;
+  const Eigen::MatrixXd sum = summed_face_area_vectors(V, F);
+  out.surface_area = face_area_vectors(V, F).rowwise().norm().sum();
+  const double denominator = sum.rowwise().norm().sum();
+  out.C = denominator > 0.0 ? out.surface_area / denominator : 0.0;
+  out.S = out.C * sum;
+  out.magnitude = out.S.rowwise().norm();
+  return out;
+}
+
+double surface_area(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  return face_area_vectors(V, F).rowwise().norm().sum();
+}
+
+double enclosed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  double volume = 0.0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (V.cols() == 3) {
+      const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      volume += a.dot(b.cross(c)) / 6.0;
+    } else {
+      const Eigen::Vector2d a = V.row(F(f, 0)), b = V.row(F(f, 1));
+      volume += 0.5 * (a.x() * b.y() - b.x() * a.y());
+    }
+  }
+  return volume;
+}
+
+}  // namespace fiberfluid::geom

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+
+namespace fiberfluid::geom {
+
+// Outward face area vectors A_f (paper Eq. 1). 3D: half the cross product of
+// two edges, |A_f| = triangle area. 2D: the edge's outward normal times its
+// length, for a counter-clockwise polygon.
+// V: #V by dim positions; F: #F by dim indices. Returns #F by dim.
+Eigen::MatrixXd face_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+// Sum of the area vectors of the faces touching each vertex: #V by dim.
+// Equals dim times the gradient of the enclosed volume (area in 2D).
+Eigen::MatrixXd summed_face_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+// Vertex area vectors S_i = C sum_{f at i} A_f (paper Eq. 2), with C chosen so
+// that sum_i |S_i| equals the surface area (perimeter in 2D).
+struct VertexAreaVectors {
+  Eigen::MatrixXd S;          // #V by dim
+  Eigen::VectorXd magnitude;  // #V, |S_i|
+  double C = 0.0;             // the normalisation constant
+  double surface_area = 0.0;  // sum_f |A_f|
+};
+VertexAreaVectors vertex_area_vectors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+// Sum of face areas (perimeter in 2D).
+double surface_area(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+// Signed enclosed volume (signed area in 2D); positive for outward faces.
+double enclosed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+}  // namespace fiberfluid::geom

@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/boundary_conditions.hpp"
+
+#include <algorithm>
+#include <map>
+#include <regex>
+
+#include "geom/error.hpp"
+
+namespace fiberfluid::model {
+
+const char* to_string(BoundaryMethod method) {
+  return method == BoundaryMethod::Penalty ? "penalty" : "elimination";
+}
+
+HalfSpace parse_half_space(const std::string& text, int dim) {
+  static const std::regex form(
+      R"(^\s*([xyz])\s*(>=|<=|>|<)\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*$)");
+  std::smatch match;
+  if (!std::regex_match(text, match, form))
+    throw InputError("'" + text + "' is not a half-space: expected e.g. \"z >= 0.8\"");
+  HalfSpace h;
+  h.axis = match[1].str()[0] - 'x';
+  if (h.axis >= dim)
+    throw InputError("'" + text + "' uses axis " + match[1].str() + " in a " +
+                     std::to_string(dim) + "D problem");
+  const std::string op = match[2].str();
+  h.greater = op[0] == '>';
+  h.inclusive = op.size() == 2;
+  h.threshold = std::stod(match[3].str());
+  return h;
+}
+
+std::vector<int> select_half_space(const Eigen::MatrixXd& X, const HalfSpace& h) {
+  std::vector<int> selected;
+  for (int i = 0; i < X.rows(); ++i) {
+    const double c = X(i, h.axis);
+    const bool inside = h.greater ? (h.inclusive ? c >= h.threshold : c > h.threshold)
+                                  : (h.inclusive ? c <= h.threshold : c < h.threshold);
+    if (inside) selected.push_back(i);
+  }
+  return selected;
+}
+
+std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min,
+                            const Eigen::VectorXd& max) {
+  std::vector<int> selected;
+  for (int i = 0; i < X.rows(); ++i) {
+    const Eigen::VectorXd p = X.row(i).transpose();
+    if ((p.array() >= min.array()).all() && (p.array() <= max.array()).all())
+      selected.push_back(i);
+  }
+  return selected;
+}
+
+std::string singular_setup_reason(const Model& model) {
+  if (model.constraints.empty())
+    return "no supports: nothing holds the body, so rigid motion makes the system singular; "
+           "fix some vertices";
+  const char* names = "xyz";
+  for (int a = 0; a < model.dim(); ++a) {
+    const bool held = std::any_of(model.constraints.begin(), model.constraints.end(),
+                                  [a](const Constraint& c) { return c.axis == a; });
+    if (!held)
+      return std::string("no support along ") + names[a] + ": the body can translate along " +
+             names[a] + ", so the system is singular";
+    const double stiffness =
+        model.material.young_modulus[a] + model.material.surface_tension;
+    if (!(stiffness > 0.0))
+      return std::string("no stiffness along ") + names[a] +
+             ": Y and gamma are both zero, so the system is singular";
+  }
+  return {};
+}
+
+DofPartition partition_dofs(const Model& model) {
+  std::map<int, int> constraint_at;  // unknown -> constraint index
+  for (size_t c = 0; c < model.constraints.size(); ++c) {
+    const Constraint& constraint = model.constraints[c];
+    const int d = model.dof(constraint.vertex, constraint.axis);
+    auto [it, inserted] = constraint_at.emplace(d, static_cast<int>(c));
+    if (inserted) continue;
+    const Constraint& other = model.constraints[static_cast<size_t>(it->second)];
+    if (other.value != constraint.value || other.schedule.kind != constraint.schedule.kind)
+      throw InputError("vertex " + std::to_string(constraint.vertex) + " axis " +
+                       std::string(1, "xyz"[constraint.axis]) +
+                       " is given two different prescribed displacements");
+  }
+  DofPartition p;
+  for (int d = 0; d < model.num_unknowns(); ++d) {
+    auto it = constraint_at.find(d);
+    if (it == constraint_at.end()) {
+      p.free.push_back(d);
+    } else {
+      p.constrained.push_back(d);
+      p.constraint_of.push_back(it->second);
+    }
+  }
+  return p;
+}
+
+Eigen::VectorXd constrained_values(const Model& model, const DofPartition& partition, int step,
+                                   int steps) {
+  Eigen::VectorXd values(static_cast<Eigen::Index>(partition.constrained.size()));
+  for (size_t k = 0; k < partition.constrained.size(); ++k) {
+    const Constraint& c = model.constraints[static_cast<size_t>(partition.constraint_of[k])];
+    values[static_cast<Eigen::Index>(k)] = c.value * c.schedule.factor(step, steps);
+  }
+  return values;
+}
+
+void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
+                   Eigen::MatrixXd& A, Eigen::VectorXd& B) {
+  for (size_t k = 0; k < partition.constrained.size(); ++k) {
+    const int d = partition.constrained[k];
+    A(d, d) = penalty;
+    B[d] = penalty * values[static_cast<Eigen::Index>(k)];
+  }
+}
+
+Eigen::VectorXd reduce_rhs(const DofPartition& partition, const Eigen::VectorXd& values,
+                           const Eigen::MatrixXd& A, const Eigen::VectorXd& B) {
+  const auto nf = static_cast<Eigen::Index>(partition.free.size());
+  Eigen::VectorXd B_free(nf);
+  for (Eigen::Index r = 0; r < nf; ++r) {
+    const int row = partition.free[static_cast<size_t>(r)];
+    double b = B[row];
+    for (size_t k = 0; k < partition.constrained.size(); ++k)
+      b -= A(row, partition.constrained[k]) * values[static_cast<Eigen::Index>(k)];
+    B_free[r] = b;
+  }
+  return B_free;
+}
+
+void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
+                   const Eigen::MatrixXd& A, const Eigen::VectorXd& B, Eigen::MatrixXd& A_free,
+                   Eigen::VectorXd& B_free) {
+  const auto nf = static_cast<Eigen::Index>(partition.free.size());
+  A_free.resize(nf, nf);
+  for (Eigen::Index c = 0; c < nf; ++c)
+    for (Eigen::Index r = 0; r < nf; ++r)
+      A_free(r, c) = A(partition.free[static_cast<size_t>(r)], partition.free[static_cast<size_t>(c)]);
+  B_free = reduce_rhs(partition, values, A, B);
+}
+
+Eigen::VectorXd expand_solution(const DofPartition& partition, const Eigen::VectorXd& free,
+                                const Eigen::VectorXd& values, int num_unknowns) {
+  Eigen::VectorXd x(num_unknowns);
+  for (size_t k = 0; k < partition.free.size(); ++k)
+    x[partition.free[k]] = free[static_cast<Eigen::Index>(k)];
+  for (size_t k = 0; k < partition.constrained.size(); ++k)
+    x[partition.constrained[k]] = values[static_cast<Eigen::Index>(k)];
+  return x;
+}
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace fiberfluid::model {
+
+enum class BoundaryMethod {
+  Elimination,  // fixed unknowns removed from the system (default)
+  Penalty,      // the paper's: the diagonal entry replaced by a large number
+};
+const char* to_string(BoundaryMethod method);
+
+// ---------------------------------------------------------------- selection
+// A half-space written as "z >= 0.8", "x < 0", "y<=1.5".
+struct HalfSpace {
+  int axis = 0;
+  bool greater = true;     // >= (or >) versus <= (or <)
+  bool inclusive = true;   // >= or <= versus > or <
+  double threshold = 0.0;
+};
+// Throws InputError quoting `text` when it is not of that form.
+HalfSpace parse_half_space(const std::string& text, int dim);
+
+// Vertices of X (#V by dim) in the half-space, or in the closed box.
+std::vector<int> select_half_space(const Eigen::MatrixXd& X, const HalfSpace& half_space);
+std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min,
+                            const Eigen::VectorXd& max);
+
+// ---------------------------------------------------------------- checking
+// Empty when the constraints remove rigid motion; otherwise why the system
+// is singular (e.g. no axis-x constraint: the body can translate along x).
+std::string singular_setup_reason(const Model& model);
+
+// ---------------------------------------------------------------- reduction
+// The constrained and free unknowns of the paper's layout (P is always free).
+// Throws InputError when one unknown is given two different displacements.
+struct DofPartition {
+  std::vector<int> free;         // ascending
+  std::vector<int> constrained;  // ascending
+  std::vector<int> constraint_of;  // per constrained unknown: an index into model.constraints
+};
+DofPartition partition_dofs(const Model& model);
+
+// Values of the constrained unknowns after step k of n (in partition order).
+Eigen::VectorXd constrained_values(const Model& model, const DofPartition& partition, int step,
+                                   int steps);
+
+// The paper's penalty: A(d, d) = penalty and B(d) = penalty * value for each
+// constrained unknown d; the rest of the row is kept.
+void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
+                   Eigen::MatrixXd& A, Eigen::VectorXd& B);
+
+// Elimination: A_ff x_f = B_f - A_fc values.
+void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
+                   const Eigen::MatrixXd& A, const Eigen::VectorXd& B, Eigen::MatrixXd& A_free,
+                   Eigen::VectorXd& B_free);
+Eigen::VectorXd reduce_rhs(const DofPartition& partition, const Eigen::VectorXd& values,
+                           const Eigen::MatrixXd& A, const Eigen::VectorXd& B);
+
+// The full unknown vector from the free part and the constrained values.
+Eigen::VectorXd expand_solution(const DofPartition& partition, const Eigen::VectorXd& free,
+                                const Eigen::VectorXd& values, int num_unknowns);
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/loads.hpp"
+
+#include <cassert>
+
+namespace fiberfluid::model {
+
+double Schedule::factor(int step, int steps) const {
+  assert(steps >= 1 && step >= 0 && step <= steps);
+  if (step == 0) return 0.0;
+  switch (kind) {
+    case Kind::Ramp:
+      return static_cast<double>(step) / steps;
+    case Kind::Final:
+      return step == steps ? 1.0 : 0.0;
+    case Kind::UpDown: {
+      const double half = steps / 2.0;
+      return step <= half ? step / half : (steps - step) / half;
+    }
+    case Kind::Table:
+      return values.at(static_cast<size_t>(step - 1));
+  }
+  return 0.0;
+}
+
+Eigen::VectorXd hydrostatic_depths(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration) {
+  const double magnitude = acceleration.norm();
+  if (magnitude == 0.0) return Eigen::VectorXd::Zero(X.rows());
+  const Eigen::VectorXd direction = acceleration.head(X.cols()) / magnitude;
+  const Eigen::VectorXd along = X * direction;
+  return along.array() - along.minCoeff();
+}
+
+Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X,
+                            const Eigen::MatrixXd& S, const std::vector<double>& factors) {
+  const int n = model.num_vertices(), dim = model.dim();
+  Eigen::VectorXd B = Eigen::VectorXd::Zero(model.num_unknowns());
+  for (size_t l = 0; l < model.loads.size(); ++l) {
+    const Load& load = model.loads[l];
+    const double f = factors[l];
+    if (f == 0.0) continue;
+    if (load.kind == Load::Kind::Point) {
+      for (int a = 0; a < dim; ++a) B[model.dof(load.vertex, a)] += f * load.force[a];
+      continue;
+    }
+    // The fluid pushes outward on each vertex with rho |a| h_i S_i; over a
+    // closed surface these sum to the fluid's weight rho a V.
+    const Eigen::VectorXd h = hydrostatic_depths(X, load.acceleration);
+    const double scale = f * load.density * load.acceleration.norm();
+    for (int a = 0; a < dim; ++a) B.segment(a * n, n) += scale * h.cwiseProduct(S.col(a));
+  }
+  return B;
+}
+
+std::vector<double> load_factors(const Model& model, int step, int steps) {
+  std::vector<double> factors;
+  for (const Load& load : model.loads) factors.push_back(load.schedule.factor(step, steps));
+  return factors;
+}
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "geom/surface.hpp"
+
+namespace fiberfluid::model {
+
+// Linear material of the paper: one Young's modulus per axis (the x block of
+// the system uses Y.x(), and so on) and a surface tension on mesh edges.
+struct Material {
+  Eigen::Vector3d young_modulus = Eigen::Vector3d::Ones();  // Y per axis, force per area (Pa)
+  double surface_tension = 0.0;                             // gamma, force per length (N/m)
+};
+
+// How a load or a prescribed displacement grows over the load steps: the
+// factor f(k) multiplying its full value after step k of n (f(0) = 0).
+struct Schedule {
+  enum class Kind {
+    Ramp,    // k / n
+    Final,   // 0 until the last step, then 1 (the sphere's point force)
+    UpDown,  // up to 1 at step n/2, back to 0 at step n (load then unload)
+    Table,   // values[k - 1], one per step
+  };
+  Kind kind = Kind::Ramp;
+  std::vector<double> values;  // Table only
+
+  double factor(int step, int steps) const;
+};
+
+struct Load {
+  enum class Kind {
+    Point,        // a force on one vertex
+    Hydrostatic,  // rho a h_i S_i: the fluid's weight under an acceleration
+  };
+  Kind kind = Kind::Point;
+  std::string label;
+  int vertex = -1;                                 // Point: the vertex (model index)
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(); // Point: force at full load (N)
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero(); // Hydrostatic, at full load (m/s^2)
+  double density = 0.0;                            // Hydrostatic: fluid density (kg/m^3)
+  Schedule schedule;
+};
+
+// One degree of freedom held at a displacement (0 for a support).
+struct Constraint {
+  int vertex = -1;    // model index
+  int axis = 0;       // 0, 1, 2 = x, y, z
+  double value = 0.0; // displacement at full load
+  Schedule schedule;  // how the displacement is reached
+};
+
+// Everything the equations need: the reference surface (every vertex used by
+// a face), the material, the loads and the constraints.
+struct Model {
+  geom::Surface surface;
+  Material material;
+  std::vector<Load> loads;
+  std::vector<Constraint> constraints;
+
+  int dim() const { return surface.dim; }
+  int num_vertices() const { return surface.num_vertices(); }
+  // Unknowns of the paper's layout: all x displacements, all y, (all z), P.
+  int num_unknowns() const { return dim() * num_vertices() + 1; }
+  int dof(int vertex, int axis) const { return axis * num_vertices() + vertex; }
+  int pressure_dof() const { return dim() * num_vertices(); }
+};
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "model/boundary_conditions.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::solve {
+
+// The paper's incremental scheme (model.md section 6): at step k,
+//   A(x_{k-1}) dx_k = B(x_{k-1}, f_k) - B(x_{k-1}, f_{k-1}),
+// a forward-Euler walk along the load path.
+struct SteppingOptions {
+  int steps = 1;                  // number of load steps n
+  bool rebuild_matrix = false;    // rebuild A (lengths, area vectors) from x_{k-1} each step
+  bool update_load_geometry = true;  // loads from x_{k-1} (the paper) or from the reference
+  model::BoundaryMethod boundary_method = model::BoundaryMethod::Elimination;
+  double penalty = 1e9;           // the paper's diagonal value, for BoundaryMethod::Penalty
+
+  bool IsValid(std::string* why) const;
+};
+
+struct StepRecord {
+  int step = 0;                       // 1..n
+  std::vector<double> load_factors;   // one per load, after this step
+  double pressure = 0.0;              // P after this step
+  double volume = 0.0;                // enclosed volume (area in 2D) after this step
+  double max_displacement = 0.0;      // max_i |u_i|
+  double seconds = 0.0;               // wall time of this step
+};
+
+struct SteppingSummary {
+  bool success = false;
+  std::string message;                // why it failed, or "" on success
+  std::vector<StepRecord> steps;
+  Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
+  int factorizations = 0;
+  double assemble_seconds = 0.0;
+  double factorize_seconds = 0.0;
+  double solve_seconds = 0.0;
+  double total_seconds = 0.0;
+
+  std::string BriefReport() const;
+};
+
+// Called after each step with its record and the unknowns reached.
+using StepObserver = std::function<void(const StepRecord&, const Eigen::VectorXd&)>;
+
+// Runs the load steps. Expected numerical failures (a singular setup, a
+// singular matrix) come back as success = false with a message.
+SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
+                                 const StepObserver& observer = {});
+
+}  // namespace fiberfluid::solve
