@@ -1,1 +1,83 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "geom/generators.hpp"
+
 #include <gtest/gtest.h>
+
+#include "geom/area_vectors.hpp"
+#include "geom/error.hpp"
+#include "geom/mesh_check.hpp"
+
+namespace fiberfluid::geom {
+namespace {
+
+void expect_closed_outward(const Surface& s, int genus = 0) {
+  const MeshReport r = inspect(s);
+  EXPECT_TRUE(r.ok()) << (r.problems.empty() ? "" : r.problems.front());
+  EXPECT_TRUE(r.closed && r.manifold && r.consistently_oriented && r.outward);
+  if (s.dim == 3) EXPECT_EQ(r.genus, genus);
+}
+
+TEST(Generators, EverySolidIsClosedAndOutward) {
+  expect_closed_outward(tetrahedron());
+  expect_closed_outward(octahedron());
+  expect_closed_outward(icosahedron());
+  for (int s = 0; s <= 4; ++s) expect_closed_outward(icosphere(s, 2.0));
+  expect_closed_outward(cube());
+  expect_closed_outward(box({-1, 0, 2}, {1, 0.5, 3}, {4, 2, 3}));
+  expect_closed_outward(dome({0.07, 0.07, 0.06}, 2));
+  expect_closed_outward(rectangle({0, 0}, {1, 1}, 4, 3));
+}
+
+TEST(Generators, Counts) {
+  EXPECT_EQ(icosphere(2).num_vertices(), 162);  // the paper's sphere
+  EXPECT_EQ(icosphere(2).num_faces(), 320);
+  EXPECT_EQ(icosphere(6).num_vertices(), 40962);
+  const Surface b = box({0, 0, 0}, {1, 1, 1}, {2, 3, 4});
+  // Surface lattice points: all minus interior ones; faces: 2 per square.
+  EXPECT_EQ(b.num_vertices(), 3 * 4 * 5 - 1 * 2 * 3);
+  EXPECT_EQ(b.num_faces(), 4 * (2 * 3 + 3 * 4 + 2 * 4));
+  EXPECT_EQ(rectangle({0, 0}, {1, 1}, 4, 3).num_vertices(), 14);
+}
+
+TEST(Generators, VerticesLieOnTheCircumsphere) {
+  for (const Surface& s : {tetrahedron(2.5), octahedron(2.5), icosahedron(2.5), icosphere(3, 2.5)})
+    EXPECT_NEAR((s.V.rowwise().norm().array() - 2.5).abs().maxCoeff(), 0.0, 1e-12);
+}
+
+TEST(Generators, DomeHasAFlatOutwardChestWall) {
+  const Surface s = dome({0.07, 0.07, 0.06}, 2);
+  const Eigen::MatrixXd A = face_area_vectors(s.V, s.F);
+  int wall_faces = 0;
+  for (int f = 0; f < s.num_faces(); ++f) {
+    const bool on_wall = s.V(s.F(f, 0), 2) == 0 && s.V(s.F(f, 1), 2) == 0 && s.V(s.F(f, 2), 2) == 0;
+    if (!on_wall) continue;
+    ++wall_faces;
+    EXPECT_LT(A(f, 2), 0.0) << "wall face " << f << " must point down, out of the body";
+    EXPECT_NEAR(A.row(f).head<2>().norm(), 0.0, 1e-15);
+  }
+  EXPECT_GT(wall_faces, 40);
+  EXPECT_NEAR(s.V.col(2).maxCoeff(), 0.06, 1e-12);
+  EXPECT_GE(s.V.col(2).minCoeff(), 0.0);
+  // Close to half an ellipsoid: 2/3 pi a b c, within the faceting error.
+  EXPECT_NEAR(enclosed_volume(s.V, s.F), 2.0 / 3.0 * M_PI * 0.07 * 0.07 * 0.06, 0.05 * 6.2e-4);
+}
+
+TEST(Generators, PolygonIsOrientedCounterClockwiseWhateverTheInputOrder) {
+  Eigen::MatrixXd clockwise(4, 2);
+  clockwise << 15, 20, 15, -20, -15, -20, -15, 20;
+  const Surface s = polygon(clockwise);
+  EXPECT_EQ(s.V, clockwise);  // vertex order kept
+  EXPECT_NEAR(enclosed_volume(s.V, s.F), 1200.0, 1e-12);
+  expect_closed_outward(s);
+}
+
+TEST(Generators, RejectBadParameters) {
+  EXPECT_THROW(icosphere(-1), InputError);
+  EXPECT_THROW(icosphere(2, 0.0), InputError);
+  EXPECT_THROW(box({0, 0, 0}, {1, 0, 1}), InputError);
+  EXPECT_THROW(rectangle({0, 0}, {1, 1}, 0, 1), InputError);
+  EXPECT_THROW(polygon(Eigen::MatrixXd::Zero(2, 2)), InputError);
+}
+
+}  // namespace
+}  // namespace fiberfluid::geom
