@@ -1,1 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/boundary_conditions.hpp"
+
 #include <gtest/gtest.h>
+
+#include "geom/error.hpp"
+#include "model/model_fixtures.hpp"
+
+namespace fiberfluid::model {
+namespace {
+
+TEST(BoundaryConditions, ParsesHalfSpaces) {
+  const HalfSpace h = parse_half_space("z >= 0.8", 3);
+  EXPECT_EQ(h.axis, 2);
+  EXPECT_TRUE(h.greater && h.inclusive);
+  EXPECT_DOUBLE_EQ(h.threshold, 0.8);
+  const HalfSpace g = parse_half_space("x<-1e-3", 2);
+  EXPECT_EQ(g.axis, 0);
+  EXPECT_FALSE(g.greater || g.inclusive);
+  EXPECT_DOUBLE_EQ(g.threshold, -1e-3);
+  EXPECT_THROW(parse_half_space("z => 1", 3), InputError);
+  EXPECT_THROW(parse_half_space("w >= 1", 3), InputError);
+  EXPECT_THROW(parse_half_space("z >= 1", 2), InputError);
+  EXPECT_THROW(parse_half_space("z >= one", 3), InputError);
+}
+
+TEST(BoundaryConditions, SelectsByHalfSpaceAndBox) {
+  Eigen::MatrixXd X(4, 2);
+  X << 0, 0, 1, 0, 1, 1, 0, 1;
+  EXPECT_EQ(select_half_space(X, parse_half_space("x >= 1", 2)), (std::vector<int>{1, 2}));
+  EXPECT_EQ(select_half_space(X, parse_half_space("y < 1", 2)), (std::vector<int>{0, 1}));
+  EXPECT_EQ(select_box(X, Eigen::Vector2d(-0.5, 0.5), Eigen::Vector2d(0.5, 1.5)),
+            (std::vector<int>{3}));
+}
+
+TEST(BoundaryConditions, SingularSetupsAreNamed) {
+  Model m = testing::paper_rectangle_model();
+  EXPECT_EQ(singular_setup_reason(m), "");
+  m.constraints.pop_back();
+  m.constraints.erase(m.constraints.begin() + 1);  // only x of v3 left
+  EXPECT_NE(singular_setup_reason(m).find("no support along y"), std::string::npos);
+  m.constraints.clear();
+  EXPECT_NE(singular_setup_reason(m).find("no supports"), std::string::npos);
+  Model soft = testing::paper_rectangle_model();
+  soft.material.young_modulus.setZero();
+  EXPECT_NE(singular_setup_reason(soft).find("no stiffness"), std::string::npos);
+}
+
+TEST(BoundaryConditions, PartitionMergesRepeatsAndRejectsConflicts) {
+  Model m = testing::paper_rectangle_model();
+  m.constraints.push_back({2, 0, 0.0, {}});  // the same support twice
+  const DofPartition p = partition_dofs(m);
+  EXPECT_EQ(p.constrained, (std::vector<int>{2, 5, 6}));
+  EXPECT_EQ(p.free.size(), 6u);
+  m.constraints.push_back({2, 0, 1.0, {}});
+  EXPECT_THROW(partition_dofs(m), InputError);
+}
+
+TEST(BoundaryConditions, ReductionAndExpansionRoundTrip) {
+  Eigen::MatrixXd A(3, 3);
+  A << 4, 1, 0, 1, 3, 1, 0, 1, 2;
+  DofPartition p;
+  p.free = {0, 2};
+  p.constrained = {1};
+  Eigen::MatrixXd A_free;
+  Eigen::VectorXd B_free;
+  const Eigen::VectorXd values = Eigen::VectorXd::Constant(1, 2.0);
+  reduce_system(p, values, A, Eigen::Vector3d(1, 0, 1), A_free, B_free);
+  EXPECT_EQ(A_free, (Eigen::Matrix2d() << 4, 0, 0, 2).finished());
+  EXPECT_EQ(B_free, Eigen::Vector2d(-1, -1));
+  EXPECT_EQ(expand_solution(p, Eigen::Vector2d(7, 8), values, 3), Eigen::Vector3d(7, 2, 8));
+}
+
+}  // namespace
+}  // namespace fiberfluid::model

@@ -1,1 +1,198 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "solve/load_stepper.hpp"
+
 #include <gtest/gtest.h>
+
+#include <Eigen/LU>
+
+#include "geom/area_vectors.hpp"
+#include "geom/generators.hpp"
+#include "model/assembly.hpp"
+#include "model/model_fixtures.hpp"
+#include "solve/dense_lu.hpp"
+
+namespace fiberfluid::solve {
+namespace {
+
+using model::BoundaryMethod;
+
+SteppingOptions options(int steps, BoundaryMethod method = BoundaryMethod::Elimination) {
+  SteppingOptions o;
+  o.steps = steps;
+  o.boundary_method = method;
+  return o;
+}
+
+double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).norm() / b.norm();
+}
+
+TEST(LoadStepper, PaperRectangleExactWithElimination) {
+  const SteppingSummary s = solve_load_steps(testing::paper_rectangle_model(), options(1));
+  ASSERT_TRUE(s.success) << s.message;
+  Eigen::VectorXd expected(9);  // u1x = u2x = -4, u1y = u4y = 16/3, P = 32
+  expected << -4, -4, 0, 0, 16.0 / 3.0, 0, 0, 16.0 / 3.0, 32;
+  EXPECT_NEAR((s.unknowns - expected).cwiseAbs().maxCoeff(), 0.0, 1e-11);
+}
+
+TEST(LoadStepper, PaperRectangleWithPenaltyAsInThePaper) {
+  const SteppingSummary s =
+      solve_load_steps(testing::paper_rectangle_model(), options(1, BoundaryMethod::Penalty));
+  ASSERT_TRUE(s.success) << s.message;
+  EXPECT_NEAR(15 + s.unknowns[0], 11.0, 1e-5);          // right corners at x = 11
+  EXPECT_NEAR(20 + s.unknowns[4], 25.0 + 1.0 / 3, 1e-5);  // top corners at y = 25.33
+  EXPECT_NEAR(s.unknowns[8], 32.0, 1e-5);
+  EXPECT_LT(std::abs(s.unknowns[2]), 1e-5);  // "fixed" only up to the penalty
+}
+
+// An independent solve: the bordered system with its constrained rows and
+// columns removed, by Eigen's full-pivot LU instead of LAPACK.
+Eigen::VectorXd eigen_reference_solution(const model::Model& m, const std::vector<double>& f) {
+  const Eigen::MatrixXd A = model::system_matrix(m, m.surface.V);
+  const Eigen::VectorXd B = model::right_hand_side(m, m.surface.V, f);
+  std::vector<char> fixed(static_cast<size_t>(m.num_unknowns()), 0);
+  for (const model::Constraint& c : m.constraints) fixed[static_cast<size_t>(m.dof(c.vertex, c.axis))] = 1;
+  std::vector<int> free;
+  for (int d = 0; d < m.num_unknowns(); ++d)
+    if (!fixed[static_cast<size_t>(d)]) free.push_back(d);
+  const Eigen::MatrixXd A_free = A(free, free);
+  const Eigen::VectorXd x_free = A_free.fullPivLu().solve(B(free));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m.num_unknowns());
+  x(free) = x_free;
+  return x;
+}
+
+TEST(LoadStepper, OneStepAgreesWithAnIndependentSolveAndBothBoundaryMethods) {
+  const model::Model m = testing::paper_sphere_model();
+  const Eigen::VectorXd reference = eigen_reference_solution(m, {1.0, 1.0});
+  const SteppingSummary eliminated = solve_load_steps(m, options(1));
+  const SteppingSummary penalised = solve_load_steps(m, options(1, BoundaryMethod::Penalty));
+  ASSERT_TRUE(eliminated.success && penalised.success);
+  EXPECT_LT(relative_difference(eliminated.unknowns, reference), 1e-10);
+  // Penalty 1e9 against stiffness ~1e3: agreement to about 1e-6.
+  EXPECT_LT(relative_difference(penalised.unknowns, reference), 1e-5);
+}
+
+TEST(LoadStepper, WithoutGeometryUpdatesNStepsGiveTheSameAnswerAsOne) {
+  model::Model m = testing::paper_sphere_model();
+  m.loads[1].schedule.kind = model::Schedule::Kind::Ramp;
+  SteppingOptions fixed_geometry = options(10);
+  fixed_geometry.update_load_geometry = false;
+  const SteppingSummary ten = solve_load_steps(m, fixed_geometry);
+  fixed_geometry.steps = 1;
+  const SteppingSummary one = solve_load_steps(m, fixed_geometry);
+  ASSERT_TRUE(ten.success && one.success);
+  EXPECT_LT(relative_difference(ten.unknowns, one.unknowns), 1e-12);
+  EXPECT_EQ(ten.factorizations, 1);
+  EXPECT_EQ(ten.steps.size(), 10u);
+}
+
+TEST(LoadStepper, UniformPressureLoadIsCarriedByTheFluidAlone) {
+  // Forces c S_i on every vertex are balanced by P = c with u = 0.
+  model::Model m = testing::paper_sphere_model();
+  const Eigen::MatrixXd S = geom::vertex_area_vectors(m.surface.V, m.surface.F).S;
+  m.loads.clear();
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    model::Load load;
+    load.vertex = i;
+    load.force = 250.0 * S.row(i).transpose();
+    m.loads.push_back(load);
+  }
+  const SteppingSummary s = solve_load_steps(m, options(1));
+  ASSERT_TRUE(s.success);
+  EXPECT_NEAR(s.unknowns[m.pressure_dof()], 250.0, 1e-9);
+  EXPECT_LT(s.unknowns.head(m.pressure_dof()).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(LoadStepper, OneStepKeepsTheLinearisedVolume) {
+  const model::Model m = testing::paper_sphere_model();
+  const SteppingSummary s = solve_load_steps(m, options(1));
+  ASSERT_TRUE(s.success);
+  const Eigen::MatrixXd S = geom::vertex_area_vectors(m.surface.V, m.surface.F).S;
+  const Eigen::MatrixXd U = model::displacements(m, s.unknowns);
+  EXPECT_NEAR((S.array() * U.array()).sum(), 0.0, 1e-12 * S.norm() * U.norm());
+}
+
+TEST(LoadStepper, ResponseIsLinearInTheLoad) {
+  model::Model m = testing::paper_sphere_model();
+  const SteppingSummary once = solve_load_steps(m, options(1));
+  for (model::Load& load : m.loads) {
+    load.force *= 2.5;
+    load.density *= 2.5;
+  }
+  const SteppingSummary scaled = solve_load_steps(m, options(1));
+  EXPECT_LT(relative_difference(scaled.unknowns, 2.5 * once.unknowns), 1e-12);
+}
+
+TEST(LoadStepper, PrescribedDisplacementIsReachedExactly) {
+  model::Model m = testing::paper_rectangle_model();
+  m.loads.clear();
+  m.constraints.push_back({0, 1, 3.0, {}});  // v1 pulled up by 3, ramped over 4 steps
+  const SteppingSummary s = solve_load_steps(m, options(4));
+  ASSERT_TRUE(s.success);
+  EXPECT_NEAR(s.unknowns[m.dof(0, 1)], 3.0, 1e-12);
+  EXPECT_NEAR(s.unknowns[m.dof(2, 0)], 0.0, 1e-15);
+}
+
+TEST(LoadStepper, RoundTripReturnsOnlyWithoutGeometryUpdatesAndErrorFallsAsOneOverN) {
+  model::Model m = testing::paper_sphere_model();
+  m.loads.pop_back();
+  m.loads[0].schedule.kind = model::Schedule::Kind::UpDown;
+  auto round_trip_error = [&](int n, bool update) {
+    SteppingOptions o = options(2 * n);
+    o.update_load_geometry = update;
+    const SteppingSummary s = solve_load_steps(m, o);
+    EXPECT_TRUE(s.success);
+    return model::displacements(m, s.unknowns).rowwise().norm().mean();
+  };
+  EXPECT_LT(round_trip_error(1, false), 1e-12);
+  const double e1 = round_trip_error(1, true), e10 = round_trip_error(10, true),
+               e100 = round_trip_error(100, true);
+  EXPECT_GT(e1, 1e-4);
+  EXPECT_GT(e1 / e10, 9.0);
+  EXPECT_NEAR(e10 / e100, 10.0, 0.5);  // forward Euler: error ~ 1/n asymptotically
+}
+
+TEST(LoadStepper, RebuiltMatrixIsFactoredEveryStep) {
+  SteppingOptions o = options(3);
+  o.rebuild_matrix = true;
+  int observed = 0;
+  const SteppingSummary s = solve_load_steps(
+      testing::paper_sphere_model(), o,
+      [&](const StepRecord& r, const Eigen::VectorXd&) { EXPECT_EQ(r.step, ++observed); });
+  ASSERT_TRUE(s.success);
+  EXPECT_EQ(s.factorizations, 3);
+  EXPECT_EQ(observed, 3);
+}
+
+TEST(LoadStepper, SingularSetupsFailWithAMessage) {
+  model::Model m = testing::paper_sphere_model();
+  m.constraints.clear();
+  SteppingSummary s = solve_load_steps(m, options(1));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("no supports"), std::string::npos) << s.message;
+
+  m = testing::paper_sphere_model();
+  for (auto& c : m.constraints) c.axis = c.axis == 2 ? 0 : c.axis;  // nothing holds z
+  s = solve_load_steps(m, options(1));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("along z"), std::string::npos) << s.message;
+
+  SteppingOptions bad = options(0);
+  s = solve_load_steps(testing::paper_sphere_model(), bad);
+  EXPECT_FALSE(s.success);
+}
+
+TEST(DenseLU, ReportsASingularMatrix) {
+  DenseLU lu;
+  Eigen::Matrix3d A;
+  A << 1, 2, 3, 2, 4, 6, 1, 0, 1;
+  EXPECT_FALSE(lu.factorize(A).ok);
+  A(1, 1) = 5;
+  ASSERT_TRUE(lu.factorize(A).ok);
+  const Eigen::Vector3d b(1, 2, 3);
+  EXPECT_NEAR((A * lu.solve(b) - b).norm(), 0.0, 1e-14);
+}
+
+}  // namespace
+}  // namespace fiberfluid::solve

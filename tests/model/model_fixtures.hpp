@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Models used by several tests: the paper's rectangle and sphere.
+#pragma once
+
+#include "geom/generators.hpp"
+#include "model/boundary_conditions.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::testing {
+
+// model.md section 8: v3 fixed, v2 held in y, 1680 upward on v1 and v4.
+inline model::Model paper_rectangle_model() {
+  model::Model m;
+  Eigen::MatrixXd P(4, 2);
+  P << 15, 20, 15, -20, -15, -20, -15, 20;
+  m.surface = geom::polygon(P);
+  m.material.young_modulus.setConstant(360.0);
+  m.constraints = {{2, 0, 0.0, {}}, {2, 1, 0.0, {}}, {1, 1, 0.0, {}}};
+  for (int v : {0, 3}) {
+    model::Load load;
+    load.vertex = v;
+    load.force = {0.0, 1680.0, 0.0};
+    m.loads.push_back(load);
+  }
+  return m;
+}
+
+// model.md section 9: the paper's sphere (SI units).
+inline model::Model paper_sphere_model() {
+  model::Model m;
+  m.surface = geom::icosphere(2, 1.0);
+  m.material.young_modulus.setConstant(3000.0);
+  m.material.surface_tension = 3000.0;
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.8", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  model::Load gravity;
+  gravity.kind = model::Load::Kind::Hydrostatic;
+  gravity.acceleration = {0.0, 0.0, -10.0};
+  gravity.density = 1000.0;
+  model::Load pull;
+  pull.vertex = 0;
+  pull.force = {-300.0, -300.0, -300.0};
+  pull.schedule.kind = model::Schedule::Kind::Final;
+  m.loads = {gravity, pull};
+  return m;
+}
+
+}  // namespace fiberfluid::testing
