@@ -207,7 +207,12 @@ geom::Surface read_surface_spec(Fields& f, const std::filesystem::path& folder,
   if (f.has("file")) {
     std::filesystem::path path = f.string("file");
     if (path.is_relative()) path = folder / path;
-    surface = load_checked_surface(path, f.boolean("flip", false), warnings);
+    const bool flip = f.boolean("flip", false);
+    try {
+      surface = load_checked_surface(path, flip, warnings);
+    } catch (const InputError& e) {
+      f.fail("file", e.what());  // names the experiment field as well as the mesh
+    }
   } else {
     surface = read_generator(f);
     const geom::MeshReport report = geom::inspect(surface);

@@ -1,1 +1,194 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/experiment.hpp"
+
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/outputs.hpp"
+#include "app/runner.hpp"
+#include "geom/error.hpp"
+#include "geom/mesh_io.hpp"
+#include "test_support.hpp"
+
+namespace fiberfluid::app {
+namespace {
+
+using testing::ScratchDir;
+
+// Every experiment file carries its expected figures; each is a regression test.
+class ExperimentFile : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
+  const Experiment ex = load_experiment(testing::experiment_file(GetParam()));
+  const ExperimentResult result = run_experiment(ex);
+  EXPECT_TRUE(result.runs_succeeded());
+  EXPECT_FALSE(result.checks.empty()) << GetParam() << " expects nothing";
+  for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
+}
+
+INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
+                         ::testing::Values("rectangle.json", "areas.json", "sphere.json",
+                                           "round_trip.json", "liver_gravity.json"));
+
+// A minimal valid experiment, edited by each bad-config case.
+nlohmann::json base_config() {
+  return nlohmann::json::parse(R"({
+    "name": "tiny",
+    "surface": {"generator": "icosphere", "subdivisions": 1, "radius": 1.0},
+    "material": {"Y": 1000, "gamma": 10},
+    "supports": [{"where": "z >= 0.5"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 2}
+  })");
+}
+
+std::filesystem::path write_config(const ScratchDir& dir, const nlohmann::json& config) {
+  return dir.write("experiment.json", config.dump(2));
+}
+
+void expect_config_error(const ScratchDir& dir, const nlohmann::json& config,
+                         const std::string& part) {
+  const auto file = write_config(dir, config);
+  try {
+    load_experiment(file);
+    ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(part), std::string::npos) << message;
+    EXPECT_EQ(message.rfind(file.string(), 0), 0u) << "must name the file: " << message;
+  }
+}
+
+TEST(ExperimentConfig, BaseConfigIsValid) {
+  ScratchDir dir;
+  const Experiment ex = load_experiment(write_config(dir, base_config()));
+  EXPECT_EQ(ex.model.num_vertices(), 42);
+  EXPECT_EQ(ex.variants.size(), 1u);
+  EXPECT_EQ(ex.variants[0].stepping.steps, 2);
+  EXPECT_EQ(ex.model.loads[0].density, 1000.0);  // the default
+  EXPECT_FALSE(ex.model.constraints.empty());
+}
+
+TEST(ExperimentConfig, BadFieldsAreNamed) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"]["Yx"] = 3;
+  expect_config_error(dir, c, "material.Yx: unknown field");
+
+  c = base_config();
+  c["stepping"]["steps"] = "ten";
+  expect_config_error(dir, c, "stepping.steps: expected a whole number");
+
+  c = base_config();
+  c["material"]["Y"] = -1;
+  expect_config_error(dir, c, "material.Y: expected a number >= 0");
+
+  c = base_config();
+  c.erase("material");
+  expect_config_error(dir, c, "material: missing");
+
+  c = base_config();
+  c["surface"] = {{"file", "no_such_mesh.obj"}};
+  expect_config_error(dir, c, "no_such_mesh.obj: cannot open");
+
+  c = base_config();
+  c["supports"][0]["where"] = "z >= 5";
+  expect_config_error(dir, c, "supports[0].where: \"z >= 5\" selects no vertex");
+
+  c = base_config();
+  c["supports"][0]["where"] = "height > 1";
+  expect_config_error(dir, c, "is not a half-space");
+
+  c = base_config();
+  c["supports"][0]["axes"] = "xw";
+  expect_config_error(dir, c, "supports[0].axes");
+
+  c = base_config();
+  c["loads"][0] = {{"type", "point"}, {"vertex", 99}, {"force", {1, 0, 0}}};
+  expect_config_error(dir, c, "loads[0].vertex: expected a whole number from 0 to 41");
+
+  c = base_config();
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  expect_config_error(dir, c, "loads[0].acceleration: expected a list of 3 numbers");
+
+  c = base_config();
+  c["loads"][0]["schedule"] = {0.5, 1.0, 1.5};
+  expect_config_error(dir, c, "the schedule lists 3 factors but run \"\" has 2 steps");
+
+  c = base_config();
+  c["loads"][0]["type"] = "wind";
+  expect_config_error(dir, c, "loads[0].type: expected one of gravity, point");
+
+  c = base_config();
+  c["stepping"]["boundary_method"] = "lagrange";
+  expect_config_error(dir, c, "stepping.boundary_method");
+
+  expect_config_error(dir, nlohmann::json::array(), "expected an object");
+  const auto broken = dir.write("broken.json", "{\"name\": ");
+  EXPECT_THROW(load_experiment(broken), InputError);
+}
+
+TEST(ExperimentConfig, InvertedMeshNeedsFlip) {
+  ScratchDir dir;
+  geom::Surface inward = geom::read_surface(testing::shared_mesh("icosahedron.obj")).surface;
+  geom::flip_orientation(inward);
+  geom::write_obj(dir.path() / "inward.obj", inward);
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", "inward.obj"}};
+  c["supports"][0]["where"] = "z >= 0.8";
+  expect_config_error(dir, c, "inverted");
+  c["surface"]["flip"] = true;
+  EXPECT_NO_THROW(load_experiment(write_config(dir, c)));
+}
+
+TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", testing::shared_mesh("liver.obj").string()}};
+  c["supports"][0] = {{"vertices", {0, 1, 2, 3, 4, 5}}};  // liver's vertices 0..5 are used
+  c["loads"][0]["acceleration"] = {0, -9.81, 0};
+  c["output"] = {{"vtk", true}, {"every", 1}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  EXPECT_EQ(ex.input_surface.num_vertices(), 181);
+  EXPECT_EQ(ex.model.num_vertices(), 139);
+
+  OutputWriter writer(ex, dir.path() / "out");
+  writer.begin();
+  const ExperimentResult result =
+      run_experiment(ex, [&](size_t run, const solve::StepRecord& r, const Eigen::VectorXd& x) {
+        writer.on_step(run, r, x);
+      });
+  writer.finish(result);
+  ASSERT_TRUE(result.runs_succeeded());
+
+  const geom::Surface final_surface = geom::read_surface(dir.path() / "out" / "final.obj").surface;
+  EXPECT_EQ(final_surface.num_vertices(), 181);
+  EXPECT_EQ(final_surface.F, ex.input_surface.F);
+  for (int i = 0; i < 181; ++i) {
+    if (ex.input_surface.F.cwiseEqual(i).any()) continue;  // unused vertices stay in place
+    EXPECT_NEAR((final_surface.V.row(i) - ex.input_surface.V.row(i)).norm(), 0.0, 1e-12);
+  }
+  for (const char* file : {"summary.json", "series.pvd", "vtk/step_0000.vtu", "vtk/step_0002.vtu"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / file)) << file;
+
+  std::ifstream summary_file(dir.path() / "out" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  ASSERT_EQ(summary["runs"].size(), 1u);
+  const auto& steps = summary["runs"][0]["steps"];
+  ASSERT_EQ(steps.size(), 2u);
+  for (const char* key : {"pressure", "volume", "max_displacement", "seconds", "load_factors"})
+    EXPECT_TRUE(steps[1].contains(key)) << key;
+  EXPECT_DOUBLE_EQ(steps[1]["max_displacement"].get<double>(),
+                   summary["figures"]["max_displacement"].get<double>());
+
+  std::ifstream vtu(dir.path() / "out" / "vtk" / "step_0002.vtu");
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  for (const char* part : {"NumberOfPoints=\"181\"", "Name=\"displacement\"",
+                           "Name=\"displacement_magnitude\"", "Name=\"area_vector\""})
+    EXPECT_NE(text.find(part), std::string::npos) << part;
+}
+
+}  // namespace
+}  // namespace fiberfluid::app

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs the Debian packages fiberfluid builds with (as root, or with sudo).
+# Does nothing when they are all present already.
+set -euo pipefail
+
+packages=(
+  build-essential cmake
+  libeigen3-dev libopenblas-dev liblapack-dev
+  nlohmann-json3-dev libcli11-dev libgtest-dev
+  python3 python3-matplotlib   # plots of the experiments
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+sudo_cmd=()
+[ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+echo "installing: ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
