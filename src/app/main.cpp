@@ -114,5 +114,8 @@ int main(int argc, char** argv) {
   } catch (const std::filesystem::filesystem_error& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "error: out of memory; use a coarser mesh\n";
+    return kSolverFailed;
   }
 }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <unistd.h>
 
 #include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
@@ -61,6 +62,23 @@ class ConstrainedSystem {
   DenseLU lu_;
 };
 
+// Dense LU keeps three copies of the (dN+1)-square system (assembled, with
+// boundary conditions, factors): refuse up front when they cannot fit in
+// this machine's memory, rather than die in the allocator.
+std::string dense_memory_problem(const model::Model& model) {
+  const double unknowns = model.num_unknowns();
+  const double needed = 3.0 * 8.0 * unknowns * unknowns;
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  if (physical <= 0.0 || needed < 0.8 * physical) return {};
+  std::ostringstream out;
+  out.precision(3);
+  out << "the dense LU of " << model.num_unknowns() << " unknowns needs about "
+      << needed / (1u << 30) << " GiB, more than this machine's " << physical / (1u << 30)
+      << " GiB; use a coarser mesh";
+  return out.str();
+}
+
 }  // namespace
 
 bool SteppingOptions::IsValid(std::string* why) const {
@@ -91,6 +109,8 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   std::string why;
   if (!options.IsValid(&why)) return fail(why);
   why = model::singular_setup_reason(model);
+  if (!why.empty()) return fail(why);
+  why = dense_memory_problem(model);
   if (!why.empty()) return fail(why);
 
   const model::DofPartition partition = model::partition_dofs(model);

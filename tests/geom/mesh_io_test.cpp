@@ -196,6 +196,61 @@ TEST(MeshIO, PlyAsciiAndBinary) {
   }
 }
 
+// Test-side writers, so that every reader sees every shared mesh.
+std::string as_off(const Surface& s) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "OFF\n" << s.num_vertices() << ' ' << s.num_faces() << " 0\n";
+  for (int i = 0; i < s.num_vertices(); ++i)
+    out << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << s.V(i, 2) << "\n";
+  for (int f = 0; f < s.num_faces(); ++f)
+    out << "3 " << s.F(f, 0) << ' ' << s.F(f, 1) << ' ' << s.F(f, 2) << "\n";
+  return out.str();
+}
+
+std::string as_binary_ply(const Surface& s) {
+  std::ostringstream out;
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << s.num_vertices()
+      << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
+      << s.num_faces() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < s.num_vertices(); ++i)
+    for (int a = 0; a < 3; ++a) out.write(reinterpret_cast<const char*>(&s.V(i, a)), 8);
+  for (int f = 0; f < s.num_faces(); ++f) {
+    const char three = 3;
+    out.write(&three, 1);
+    for (int c = 0; c < 3; ++c) out.write(reinterpret_cast<const char*>(&s.F(f, c)), 4);
+  }
+  return out.str();
+}
+
+TEST(MeshIO, EveryReaderReadsEverySharedMesh) {
+  ScratchDir dir;
+  for (const char* name :
+       {"cube.obj", "icosahedron.obj", "liver.obj", "sphere_02b.obj", "torus.obj", "Bunny.stl"}) {
+    SCOPED_TRACE(name);
+    const Surface original =
+        remove_unused_vertices(read_surface(testing::shared_mesh(name)).surface).surface;
+    const double area = surface_area(original.V, original.F);
+    const double volume = enclosed_volume(original.V, original.F);
+    write_obj(dir.path() / "mesh.obj", original);
+    const Surface from_obj = read_surface(dir.path() / "mesh.obj").surface;
+    const Surface from_off = read_surface(dir.write("mesh.off", as_off(original))).surface;
+    const Surface from_ply = read_surface(dir.write("mesh.ply", as_binary_ply(original))).surface;
+    for (const Surface* s : {&from_obj, &from_off, &from_ply}) {
+      EXPECT_EQ(s->F, original.F);
+      EXPECT_NEAR((s->V - original.V).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+    }
+    // STL stores floats and no indices: compare what survives.
+    const Surface from_stl =
+        read_surface(dir.write("mesh.stl", binary_stl(original, original.num_faces()))).surface;
+    EXPECT_EQ(from_stl.num_vertices(), original.num_vertices());
+    EXPECT_EQ(from_stl.num_faces(), original.num_faces());
+    EXPECT_NEAR(surface_area(from_stl.V, from_stl.F), area, 1e-6 * area);
+    EXPECT_NEAR(enclosed_volume(from_stl.V, from_stl.F), volume, 1e-6 * volume);
+    EXPECT_TRUE(inspect(from_stl).ok());
+  }
+}
+
 TEST(MeshIO, ObjRoundTripKeepsVertexOrderIn3DAnd2D) {
   ScratchDir dir;
   for (const Surface& original : {icosphere(2, 1.5), rectangle({0, 0}, {3, 2}, 3, 2)}) {
