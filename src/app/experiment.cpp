@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/experiment.hpp"
 
+#include "app/json_fields.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -18,141 +20,6 @@ namespace fiberfluid::app {
 namespace {
 
 using nlohmann::json;
-
-// Reads the fields of one JSON object, naming "file: path.to.field" in every
-// error, and rejects fields nobody asked for.
-class Fields {
- public:
-  Fields(const json& object, std::string path, std::string file)
-      : object_(object), path_(std::move(path)), file_(std::move(file)) {
-    if (!object_.is_object()) fail("", "expected an object");
-  }
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw InputError(file_ + ": " + name(key) + (name(key).empty() ? "" : ": ") + what);
-  }
-  std::string name(const std::string& key) const {
-    if (key.empty()) return path_;
-    return path_.empty() ? key : path_ + "." + key;
-  }
-  bool has(const std::string& key) const { return object_.contains(key); }
-
-  const json& raw(const std::string& key) {
-    seen_.insert(key);
-    if (!has(key)) fail(key, "missing (required)");
-    return object_.at(key);
-  }
-  Fields object(const std::string& key) { return Fields(raw(key), name(key), file_); }
-
-  double number(const std::string& key) {
-    const json& v = raw(key);
-    if (!v.is_number()) fail(key, "expected a number, got " + v.dump());
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) fail(key, "expected a finite number");
-    return x;
-  }
-  double number(const std::string& key, double fallback) {
-    return has(key) ? number(key) : (seen_.insert(key), fallback);
-  }
-  double positive(const std::string& key, double fallback) {
-    const double x = number(key, fallback);
-    if (!(x > 0.0)) fail(key, "expected a positive number, got " + std::to_string(x));
-    return x;
-  }
-  double non_negative(const std::string& key, double fallback) {
-    const double x = number(key, fallback);
-    if (x < 0.0) fail(key, "expected a number >= 0, got " + std::to_string(x));
-    return x;
-  }
-  int integer(const std::string& key, int fallback, int min, int max) {
-    if (!has(key)) return seen_.insert(key), fallback;
-    const json& v = raw(key);
-    if (!v.is_number_integer()) fail(key, "expected a whole number, got " + v.dump());
-    const long long x = v.get<long long>();
-    if (x < min || x > max)
-      fail(key, "expected a whole number from " + std::to_string(min) + " to " +
-                    std::to_string(max) + ", got " + std::to_string(x));
-    return static_cast<int>(x);
-  }
-  bool boolean(const std::string& key, bool fallback) {
-    if (!has(key)) return seen_.insert(key), fallback;
-    const json& v = raw(key);
-    if (!v.is_boolean()) fail(key, "expected true or false, got " + v.dump());
-    return v.get<bool>();
-  }
-  std::string string(const std::string& key) {
-    const json& v = raw(key);
-    if (!v.is_string()) fail(key, "expected a string, got " + v.dump());
-    return v.get<std::string>();
-  }
-  std::string string(const std::string& key, const std::string& fallback) {
-    return has(key) ? string(key) : (seen_.insert(key), fallback);
-  }
-  std::string choice(const std::string& key, const std::string& fallback,
-                     const std::vector<std::string>& allowed) {
-    const std::string s = string(key, fallback);
-    if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
-      fail(key, "expected one of " + join(allowed) + ", got \"" + s + "\"");
-    return s;
-  }
-  // A list of `size` numbers (any size when size < 0).
-  Eigen::VectorXd vector(const std::string& key, int size) {
-    const json& v = raw(key);
-    const std::string want = size < 0 ? "a list of numbers"
-                                      : "a list of " + std::to_string(size) + " numbers";
-    if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size))
-      fail(key, "expected " + want + ", got " + v.dump());
-    Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
-    for (size_t k = 0; k < v.size(); ++k) {
-      if (!v[k].is_number() || !std::isfinite(v[k].get<double>()))
-        fail(key, "expected " + want + ", got " + v.dump());
-      out[static_cast<Eigen::Index>(k)] = v[k].get<double>();
-    }
-    return out;
-  }
-  std::vector<int> indices(const std::string& key) {
-    const json& v = raw(key);
-    if (!v.is_array() || v.empty()) fail(key, "expected a non-empty list of vertex indices");
-    std::vector<int> out;
-    for (const json& item : v) {
-      if (!item.is_number_integer() || item.get<long long>() < 0)
-        fail(key, "expected vertex indices (whole numbers from 0), got " + item.dump());
-      out.push_back(static_cast<int>(item.get<long long>()));
-    }
-    return out;
-  }
-  std::vector<Fields> objects(const std::string& key) {
-    std::vector<Fields> out;
-    if (!has(key)) return seen_.insert(key), out;
-    const json& v = raw(key);
-    if (!v.is_array()) fail(key, "expected a list of objects");
-    for (size_t k = 0; k < v.size(); ++k)
-      out.emplace_back(v[k], name(key) + "[" + std::to_string(k) + "]", file_);
-    return out;
-  }
-
-  // Every field of the object must have been read.
-  void finish() const {
-    for (auto it = object_.begin(); it != object_.end(); ++it)
-      if (!seen_.count(it.key()))
-        fail(it.key(), "unknown field (expected one of " + join(known()) + ")");
-  }
-
-  const std::string& file() const { return file_; }
-
- private:
-  std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }
-  static std::string join(const std::vector<std::string>& words) {
-    std::string out;
-    for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
-    return out;
-  }
-
-  const json& object_;
-  std::string path_, file_;
-  std::set<std::string> seen_;
-};
-
 
 // ------------------------------------------------------------ surfaces
 geom::Surface read_generator(Fields& f) {
