@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake
-  libeigen3-dev libopenblas-dev liblapack-dev
+  libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
   python3 python3-matplotlib   # plots of the experiments
 )

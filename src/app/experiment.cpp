@@ -230,6 +230,11 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   options.boundary_method = method == "penalty" ? model::BoundaryMethod::Penalty
                                                 : model::BoundaryMethod::Elimination;
   options.penalty = f.positive("penalty", options.penalty);
+  const std::string solver = f.choice("solver", solve::to_string(options.solver),
+                                      {"auto", "dense-lu", "block-cholesky", "cholmod", "pcg"});
+  options.solver = *solve::solver_kind_from_string(solver);
+  options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
+  options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
   f.finish();
   return options;
 }

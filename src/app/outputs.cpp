@@ -18,7 +18,10 @@ json stepping_json(const solve::SteppingOptions& s) {
           {"rebuild_matrix", s.rebuild_matrix},
           {"update_load_geometry", s.update_load_geometry},
           {"boundary_method", model::to_string(s.boundary_method)},
-          {"penalty", s.penalty}};
+          {"penalty", s.penalty},
+          {"solver", solve::to_string(s.solver)},
+          {"tolerance", s.pcg.tolerance},
+          {"max_iterations", s.pcg.max_iterations}};
 }
 
 json run_json(const Experiment& ex, const ExperimentResult& result, const RunResult& run) {
@@ -39,7 +42,9 @@ json run_json(const Experiment& ex, const ExperimentResult& result, const RunRes
   for (const auto& [name, value] : result.figures)
     if (name.rfind(prefix, 0) == 0) final_figures[name.substr(prefix.size())] = value;
   return {{"variant", run.variant},
-          {"solver", "dense-lu"},
+          {"solver", solve::to_string(run.summary.solver)},
+          {"pcg_iterations", run.summary.solver_statistics.iterations},
+          {"factorization_flops", run.summary.solver_statistics.factorization_flops},
           {"stepping", stepping_json(run.stepping)},
           {"success", run.summary.success},
           {"message", run.summary.message},

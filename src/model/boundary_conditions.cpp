@@ -64,9 +64,9 @@ std::string singular_setup_reason(const Model& model) {
     if (!held)
       return std::string("no support along ") + names[a] + ": the body can translate along " +
              names[a] + ", so the system is singular";
-    const double stiffness =
-        model.material.young_modulus[a] + model.material.surface_tension;
-    if (!(stiffness > 0.0))
+    // Zero stiffness is singular; a negative one is left to the solvers,
+    // which report a matrix that is not positive definite.
+    if (model.material.young_modulus[a] == 0.0 && model.material.surface_tension == 0.0)
       return std::string("no stiffness along ") + names[a] +
              ": Y and gamma are both zero, so the system is singular";
   }

@@ -3,13 +3,15 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <sstream>
-#include <unistd.h>
 
 #include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
-#include "solve/dense_lu.hpp"
+#include "geom/error.hpp"
+#include "model/fiber_system.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -20,78 +22,23 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The system of one load step with its boundary conditions applied, factored.
-class ConstrainedSystem {
- public:
-  ConstrainedSystem(const model::DofPartition& partition, const SteppingOptions& options)
-      : partition_(partition), options_(options) {}
-
-  Status factorize(Eigen::MatrixXd A) {
-    A_ = std::move(A);
-    if (options_.boundary_method == model::BoundaryMethod::Penalty) {
-      Eigen::MatrixXd penalised = A_;
-      Eigen::VectorXd unused = Eigen::VectorXd::Zero(A_.rows());
-      model::apply_penalty(partition_, Eigen::VectorXd::Zero(partition_.constrained.size()),
-                           options_.penalty, penalised, unused);
-      return lu_.factorize(penalised);
-    }
-    Eigen::MatrixXd A_free;
-    Eigen::VectorXd unused;
-    model::reduce_system(partition_, Eigen::VectorXd::Zero(partition_.constrained.size()), A_,
-                         Eigen::VectorXd::Zero(A_.rows()), A_free, unused);
-    return lu_.factorize(A_free);
-  }
-
-  // The increment of every unknown for a load increment dB and increments
-  // of the prescribed displacements.
-  Eigen::VectorXd solve(const Eigen::VectorXd& dB, const Eigen::VectorXd& d_values) const {
-    if (options_.boundary_method == model::BoundaryMethod::Penalty) {
-      Eigen::VectorXd B = dB;
-      for (size_t k = 0; k < partition_.constrained.size(); ++k)
-        B[partition_.constrained[k]] = options_.penalty * d_values[static_cast<Eigen::Index>(k)];
-      return lu_.solve(B);
-    }
-    const Eigen::VectorXd free = lu_.solve(model::reduce_rhs(partition_, d_values, A_, dB));
-    return model::expand_solution(partition_, free, d_values, static_cast<int>(A_.rows()));
-  }
-
- private:
-  const model::DofPartition& partition_;
-  const SteppingOptions& options_;
-  Eigen::MatrixXd A_;  // before boundary conditions (elimination needs A_fc)
-  DenseLU lu_;
-};
-
-// Dense LU keeps three copies of the (dN+1)-square system (assembled, with
-// boundary conditions, factors): refuse up front when they cannot fit in
-// this machine's memory, rather than die in the allocator.
-std::string dense_memory_problem(const model::Model& model) {
-  const double unknowns = model.num_unknowns();
-  const double needed = 3.0 * 8.0 * unknowns * unknowns;
-  const double physical =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
-  if (physical <= 0.0 || needed < 0.8 * physical) return {};
-  std::ostringstream out;
-  out.precision(3);
-  out << "the dense LU of " << model.num_unknowns() << " unknowns needs about "
-      << needed / (1u << 30) << " GiB, more than this machine's " << physical / (1u << 30)
-      << " GiB; use a coarser mesh";
-  return out.str();
-}
-
 }  // namespace
 
 bool SteppingOptions::IsValid(std::string* why) const {
   if (steps < 1) return *why = "steps must be at least 1", false;
   if (!(penalty > 0.0) || !std::isfinite(penalty))
     return *why = "penalty must be a positive number", false;
+  if (!(pcg.tolerance > 0.0) || pcg.max_iterations < 1)
+    return *why = "pcg tolerance must be positive and max_iterations at least 1", false;
   return true;
 }
 
 std::string SteppingSummary::BriefReport() const {
   std::ostringstream out;
-  out << (success ? "success" : "failure") << ": " << steps.size() << " steps, "
-      << factorizations << " factorizations, " << total_seconds << " s";
+  out << (success ? "success" : "failure") << ": " << to_string(solver) << ", " << steps.size()
+      << " steps, " << factorizations << " factorizations";
+  if (solver == SolverKind::PCG) out << ", " << solver_statistics.iterations << " pcg iterations";
+  out << ", " << total_seconds << " s";
   if (!success) out << ": " << message;
   return out.str();
 }
@@ -110,13 +57,11 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   if (!options.IsValid(&why)) return fail(why);
   why = model::singular_setup_reason(model);
   if (!why.empty()) return fail(why);
-  why = dense_memory_problem(model);
-  if (!why.empty()) return fail(why);
 
-  const model::DofPartition partition = model::partition_dofs(model);
-  ConstrainedSystem system(partition, options);
   const int n = options.steps;
   const Eigen::MatrixXd& reference = model.surface.V;
+  std::optional<model::FiberSystem> system;  // outlives its factorisation
+  std::unique_ptr<LinearSolver> solver;
 
   for (int k = 1; k <= n; ++k) {
     const Clock::time_point step_start = Clock::now();
@@ -124,12 +69,25 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
 
     if (k == 1 || options.rebuild_matrix) {
       Clock::time_point t = Clock::now();
-      Eigen::MatrixXd A = model::system_matrix(model, options.rebuild_matrix ? X : reference);
+      try {
+        system.emplace(model, options.rebuild_matrix ? X : reference, options.boundary_method,
+                       options.penalty);
+      } catch (const InputError& e) {  // e.g. two vertices pressed onto each other
+        return fail("step " + std::to_string(k) + ": " + e.what());
+      }
       summary.assemble_seconds += seconds_since(t);
+      if (!solver) {
+        summary.solver = options.solver == SolverKind::Auto ? choose_solver(*system)
+                                                            : options.solver;
+        solver = make_linear_solver(summary.solver, options.pcg);
+        const Status status = solver->analyze_pattern(*system);
+        if (!status.ok) return fail(status.message);
+      }
       t = Clock::now();
-      const Status status = system.factorize(std::move(A));
+      const Status status = solver->factorize(*system);
       summary.factorize_seconds += seconds_since(t);
       ++summary.factorizations;
+      summary.solver_statistics = solver->statistics();
       if (!status.ok) return fail("step " + std::to_string(k) + ": " + status.message);
     }
 
@@ -140,13 +98,18 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     for (size_t l = 0; l < now.size(); ++l) increment[l] = now[l] - before[l];
     const Eigen::VectorXd dB =
         model::right_hand_side(model, options.update_load_geometry ? X : reference, increment);
-    const Eigen::VectorXd d_values = model::constrained_values(model, partition, k, n) -
-                                     model::constrained_values(model, partition, k - 1, n);
+    const Eigen::VectorXd dU_c = model::constrained_displacements(model, k, n) -
+                                 model::constrained_displacements(model, k - 1, n);
+    const Eigen::VectorXd rhs = system->reduce_rhs(dB.head(dB.size() - 1), dU_c);
     summary.assemble_seconds += seconds_since(t);
 
     t = Clock::now();
-    summary.unknowns += system.solve(dB, d_values);
+    Eigen::VectorXd increment_reduced;
+    const Status status = solver->solve(rhs, &increment_reduced);
     summary.solve_seconds += seconds_since(t);
+    summary.solver_statistics = solver->statistics();
+    if (!status.ok) return fail("step " + std::to_string(k) + ": " + status.message);
+    summary.unknowns += system->expand(increment_reduced, dU_c);
     if (!summary.unknowns.allFinite())
       return fail("step " + std::to_string(k) + ": the solution is not finite");
 

@@ -8,6 +8,7 @@
 
 #include "model/boundary_conditions.hpp"
 #include "model/model.hpp"
+#include "solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 
@@ -20,6 +21,8 @@ struct SteppingOptions {
   bool update_load_geometry = true;  // loads from x_{k-1} (the paper) or from the reference
   model::BoundaryMethod boundary_method = model::BoundaryMethod::Elimination;
   double penalty = 1e9;           // the paper's diagonal value, for BoundaryMethod::Penalty
+  SolverKind solver = SolverKind::Auto;  // the linear backend; Auto chooses by size
+  PcgOptions pcg;                 // for SolverKind::PCG
 
   bool IsValid(std::string* why) const;
 };
@@ -38,6 +41,8 @@ struct SteppingSummary {
   std::string message;                // why it failed, or "" on success
   std::vector<StepRecord> steps;
   Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
+  SolverKind solver = SolverKind::Auto;  // the backend that ran
+  SolverStatistics solver_statistics;
   int factorizations = 0;
   double assemble_seconds = 0.0;
   double factorize_seconds = 0.0;

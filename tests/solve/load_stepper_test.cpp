@@ -205,9 +205,13 @@ TEST(LoadStepper, RefusesADenseSystemLargerThanMemory) {
   m.surface = geom::icosphere(7, 1.0);  // 163842 vertices: ~1.4 TB as a dense system
   m.material.young_modulus.setConstant(1.0);
   for (int a = 0; a < 3; ++a) m.constraints.push_back({0, a, 0.0, {}});
-  const SteppingSummary s = solve_load_steps(m, SteppingOptions{});
-  EXPECT_FALSE(s.success);
-  EXPECT_NE(s.message.find("GiB"), std::string::npos) << s.message;
+  for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod}) {
+    SteppingOptions o;
+    o.solver = kind;
+    const SteppingSummary s = solve_load_steps(m, o);
+    EXPECT_FALSE(s.success);
+    EXPECT_NE(s.message.find("GiB"), std::string::npos) << s.message;
+  }
 }
 
 }  // namespace

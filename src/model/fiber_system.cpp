@@ -1,0 +1,305 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/fiber_system.hpp"
+
+#include <cmath>
+
+#include "geom/area_vectors.hpp"
+#include "geom/error.hpp"
+
+namespace fiberfluid::model {
+namespace {
+
+Eigen::SparseMatrix<double> build_surface_laplacian(const Eigen::MatrixXd& X,
+                                              const Eigen::VectorXd& area,
+                                              const Eigen::MatrixXi& edges) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(4 * edges.rows()));
+  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
+    const int i = edges(e, 0), k = edges(e, 1);
+    const double length2 = (X.row(i) - X.row(k)).squaredNorm();
+    if (!(length2 > 0.0))
+      throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(k) +
+                       " coincide: the fiber between them has zero length");
+    const double w = (area[i] + area[k]) / (2.0 * length2);
+    entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
+  }
+  Eigen::SparseMatrix<double> L(X.rows(), X.rows());
+  L.setFromTriplets(entries.begin(), entries.end());
+  return L;
+}
+
+// Column-major copies of the coordinates, so the pair loops vectorise.
+struct Coordinates {
+  std::vector<double> c[3];
+  explicit Coordinates(const Eigen::MatrixXd& X) {
+    for (int a = 0; a < 3; ++a) {
+      c[a].assign(static_cast<size_t>(X.rows()), 0.0);
+      if (a < X.cols())
+        for (Eigen::Index i = 0; i < X.rows(); ++i) c[a][static_cast<size_t>(i)] = X(i, a);
+    }
+  }
+};
+
+}  // namespace
+
+FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
+                         double penalty)
+    : dim_(model.dim()),
+      n_(model.num_vertices()),
+      X_(X),
+      young_(model.material.young_modulus),
+      gamma_(model.material.surface_tension),
+      method_(method),
+      penalty_(penalty) {
+  const geom::VertexAreaVectors areas = geom::vertex_area_vectors(X, model.surface.F);
+  area_ = areas.magnitude;
+  S_ = areas.S;
+  surface_ = build_surface_laplacian(X, area_, geom::unique_edges(model.surface));
+
+  const DofPartition partition = partition_dofs(model);
+  std::vector<std::vector<char>> fixed(static_cast<size_t>(dim_),
+                                       std::vector<char>(static_cast<size_t>(n_), 0));
+  for (int d : partition.constrained) fixed[static_cast<size_t>(d / n_)][static_cast<size_t>(d % n_)] = 1;
+  active_.resize(static_cast<size_t>(dim_));
+  penalised_.resize(static_cast<size_t>(dim_));
+  constrained_.resize(static_cast<size_t>(dim_));
+  offsets_.assign(1, 0);
+  for (int a = 0; a < dim_; ++a) {
+    for (int i = 0; i < n_; ++i) {
+      const bool is_fixed = fixed[static_cast<size_t>(a)][static_cast<size_t>(i)];
+      if (is_fixed) constrained_[static_cast<size_t>(a)].push_back(i);
+      if (method == BoundaryMethod::Penalty) {
+        if (is_fixed)
+          penalised_[static_cast<size_t>(a)].push_back(
+              static_cast<int>(active_[static_cast<size_t>(a)].size()));
+        active_[static_cast<size_t>(a)].push_back(i);
+      } else if (!is_fixed) {
+        active_[static_cast<size_t>(a)].push_back(i);
+      }
+    }
+    offsets_.push_back(offsets_.back() + static_cast<int>(active_[static_cast<size_t>(a)].size()));
+  }
+}
+
+bool FiberSystem::blocks_equal() const {
+  for (int a = 1; a < dim_; ++a)
+    if (active(a) != active(0) || penalised(a) != penalised(0) || young(a) != young(0))
+      return false;
+  return true;
+}
+
+Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
+  const std::vector<int>& act = active(axis);
+  const auto m = static_cast<Eigen::Index>(act.size());
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(m, m);
+  const double y = young(axis) * bulk_scale();
+  if (y != 0.0) {
+    const Coordinates x(X_);
+    // Off-diagonal entries: -Y_a w_ij.
+#pragma omp parallel for schedule(dynamic, 16)
+    for (Eigen::Index c = 0; c < m; ++c) {
+      const size_t j = static_cast<size_t>(act[static_cast<size_t>(c)]);
+      for (Eigen::Index r = 0; r < m; ++r) {
+        const size_t i = static_cast<size_t>(act[static_cast<size_t>(r)]);
+        if (i == j) continue;
+        const double dx = x.c[0][i] - x.c[0][j], dy = x.c[1][i] - x.c[1][j],
+                     dz = x.c[2][i] - x.c[2][j];
+        K(r, c) = -y * (area_[static_cast<Eigen::Index>(i)] + area_[static_cast<Eigen::Index>(j)]) /
+                  std::sqrt(dx * dx + dy * dy + dz * dz);
+      }
+    }
+    // The diagonal gathers the weights to every vertex, active or not.
+    const Eigen::VectorXd& diagonal = bulk_diagonal();
+    for (Eigen::Index r = 0; r < m; ++r)
+      K(r, r) = young(axis) * diagonal[act[static_cast<size_t>(r)]];
+  }
+  if (gamma_ != 0.0) {
+    std::vector<int> position(static_cast<size_t>(n_), -1);
+    for (size_t k = 0; k < act.size(); ++k) position[static_cast<size_t>(act[k])] = static_cast<int>(k);
+    for (int col = 0; col < surface_.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it) {
+        const int r = position[static_cast<size_t>(it.row())], c = position[static_cast<size_t>(it.col())];
+        if (r >= 0 && c >= 0) K(r, c) += gamma_ * it.value();
+      }
+  }
+  for (int k : penalised(axis)) K(k, k) = penalty_;
+  return K;
+}
+
+const Eigen::VectorXd& FiberSystem::bulk_diagonal() const {
+  if (bulk_diagonal_.size() != n_) bulk_diagonal_ = compute_bulk_diagonal();
+  return bulk_diagonal_;
+}
+
+Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
+  const Coordinates x(X_);
+  Eigen::VectorXd diagonal(n_);
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < n_; ++i) {
+    const size_t u = static_cast<size_t>(i);
+    double sum = 0.0;
+    for (size_t j = 0; j < static_cast<size_t>(n_); ++j) {
+      if (j == u) continue;
+      const double dx = x.c[0][u] - x.c[0][j], dy = x.c[1][u] - x.c[1][j],
+                   dz = x.c[2][u] - x.c[2][j];
+      sum += (area_[i] + area_[static_cast<Eigen::Index>(j)]) / std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
+    diagonal[i] = bulk_scale() * sum;
+  }
+  return diagonal;
+}
+
+Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
+  // (L v)_i = sum_j w_ij (v_i - v_j), with w_ij = s (a_i + a_j) / r_ij:
+  // one pass over the pairs, all columns at once.
+  const Coordinates x(X_);
+  const int k = static_cast<int>(V.cols());
+  Eigen::MatrixXd out(n_, k);
+  const double* a = area_.data();
+#pragma omp parallel
+  {
+    std::vector<double> acc(static_cast<size_t>(k));
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n_; ++i) {
+      const size_t u = static_cast<size_t>(i);
+      std::fill(acc.begin(), acc.end(), 0.0);
+      for (int col = 0; col < k; ++col) {
+        const double* v = V.col(col).data();
+        const double vi = v[i];
+        double sum = 0.0;
+        for (size_t j = 0; j < static_cast<size_t>(n_); ++j) {
+          const double dx = x.c[0][u] - x.c[0][j], dy = x.c[1][u] - x.c[1][j],
+                       dz = x.c[2][u] - x.c[2][j];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          // j == i contributes (v_i - v_i) = 0; guard the division only.
+          const double inverse = j == u ? 0.0 : 1.0 / std::sqrt(r2);
+          sum += (a[i] + a[j]) * inverse * (vi - v[j]);
+        }
+        acc[static_cast<size_t>(col)] = sum;
+      }
+      for (int col = 0; col < k; ++col) out(i, col) = bulk_scale() * acc[static_cast<size_t>(col)];
+    }
+  }
+  return out;
+}
+
+Eigen::SparseMatrix<double> FiberSystem::sparse_block(int axis, bool include_bulk) const {
+  const std::vector<int>& act = active(axis);
+  std::vector<int> position(static_cast<size_t>(n_), -1);
+  for (size_t k = 0; k < act.size(); ++k) position[static_cast<size_t>(act[k])] = static_cast<int>(k);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int col = 0; col < surface_.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it) {
+      const int r = position[static_cast<size_t>(it.row())], c = position[static_cast<size_t>(it.col())];
+      if (r >= 0 && c >= 0) entries.emplace_back(r, c, gamma_ * it.value());
+    }
+  const auto m = static_cast<Eigen::Index>(act.size());
+  Eigen::SparseMatrix<double> K(m, m);
+  K.setFromTriplets(entries.begin(), entries.end());
+  if (include_bulk && young(axis) != 0.0) {
+    const Eigen::MatrixXd bulk = dense_block(axis) - Eigen::MatrixXd(K);
+    K += bulk.sparseView();
+  }
+  for (int k : penalised(axis)) K.coeffRef(k, k) = penalty_;
+  K.makeCompressed();
+  return K;
+}
+
+Eigen::MatrixXd FiberSystem::dense_matrix() const {
+  const int total = num_unknowns(), p = total - 1;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(total, total);
+  const Eigen::VectorXd s = border();
+  for (int a = 0; a < dim_; ++a) {
+    const auto m = static_cast<Eigen::Index>(active(a).size());
+    A.block(offset(a), offset(a), m, m) = dense_block(a);
+  }
+  A.col(p).head(p) = s;
+  A.row(p).head(p) = s.transpose();
+  return A;
+}
+
+Eigen::VectorXd FiberSystem::border() const {
+  Eigen::VectorXd s(offsets_.back());
+  for (int a = 0; a < dim_; ++a)
+    for (size_t k = 0; k < active(a).size(); ++k)
+      s[offset(a) + static_cast<Eigen::Index>(k)] = S_(active(a)[k], a);
+  return s;
+}
+
+Eigen::VectorXd FiberSystem::apply_K(const Eigen::VectorXd& u) const {
+  // Scatter to full length per axis, apply both Laplacians, gather back.
+  Eigen::MatrixXd full = Eigen::MatrixXd::Zero(n_, dim_);
+  for (int a = 0; a < dim_; ++a)
+    for (size_t k = 0; k < active(a).size(); ++k)
+      full(active(a)[k], a) = u[offset(a) + static_cast<Eigen::Index>(k)];
+  const Eigen::MatrixXd bulk = bulk_product(full);
+  const Eigen::MatrixXd surface = surface_ * full;
+  Eigen::VectorXd out(u.size());
+  for (int a = 0; a < dim_; ++a) {
+    for (size_t k = 0; k < active(a).size(); ++k) {
+      const int i = active(a)[k];
+      out[offset(a) + static_cast<Eigen::Index>(k)] =
+          young(a) * bulk(i, a) + gamma_ * surface(i, a);
+    }
+    // The penalty replaces the diagonal entry: K_kk u_k becomes penalty u_k.
+    for (int k : penalised(a)) {
+      const Eigen::Index row = offset(a) + k;
+      const int i = active(a)[static_cast<size_t>(k)];
+      const double diagonal = young(a) * bulk_diagonal()[i] + gamma_ * surface_.coeff(i, i);
+      out[row] += (penalty_ - diagonal) * u[row];
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXd FiberSystem::reduce_rhs(const Eigen::VectorXd& F, const Eigen::VectorXd& U_c) const {
+  Eigen::VectorXd rhs(num_unknowns());
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n_, dim_);
+  for (int a = 0; a < dim_; ++a) U.col(a) = U_c.segment(a * n_, n_);
+  const bool moving = U.cwiseAbs().maxCoeff() > 0.0;
+  if (method_ == BoundaryMethod::Penalty) {
+    for (int a = 0; a < dim_; ++a) {
+      rhs.segment(offset(a), n_) = F.segment(a * n_, n_);
+      for (int k : penalised(a)) rhs[offset(a) + k] = penalty_ * U(active(a)[static_cast<size_t>(k)], a);
+    }
+    rhs[num_unknowns() - 1] = 0.0;
+    return rhs;
+  }
+  // Elimination: move the prescribed displacements to the right: f - K_fc u_c, -s_c . u_c.
+  Eigen::MatrixXd KU = Eigen::MatrixXd::Zero(n_, dim_);
+  if (moving) {
+    const Eigen::MatrixXd bulk = bulk_product(U);
+    const Eigen::MatrixXd surface = surface_ * U;
+    for (int a = 0; a < dim_; ++a) KU.col(a) = young(a) * bulk.col(a) + gamma_ * surface.col(a);
+  }
+  double c = 0.0;
+  for (int a = 0; a < dim_; ++a) {
+    for (size_t k = 0; k < active(a).size(); ++k) {
+      const int i = active(a)[k];
+      rhs[offset(a) + static_cast<Eigen::Index>(k)] = F[a * n_ + i] - KU(i, a);
+    }
+    for (int i : constrained_[static_cast<size_t>(a)]) c -= S_(i, a) * U(i, a);
+  }
+  rhs[num_unknowns() - 1] = c;
+  return rhs;
+}
+
+Eigen::VectorXd FiberSystem::expand(const Eigen::VectorXd& reduced,
+                                    const Eigen::VectorXd& U_c) const {
+  Eigen::VectorXd x(dim_ * n_ + 1);
+  x.head(dim_ * n_) = U_c;
+  for (int a = 0; a < dim_; ++a)
+    for (size_t k = 0; k < active(a).size(); ++k)
+      x[a * n_ + active(a)[k]] = reduced[offset(a) + static_cast<Eigen::Index>(k)];
+  x[dim_ * n_] = reduced[num_unknowns() - 1];
+  return x;
+}
+
+Eigen::VectorXd constrained_displacements(const Model& model, int step, int steps) {
+  Eigen::VectorXd U_c = Eigen::VectorXd::Zero(model.dim() * model.num_vertices());
+  for (const Constraint& c : model.constraints)
+    U_c[model.dof(c.vertex, c.axis)] = c.value * c.schedule.factor(step, steps);
+  return U_c;
+}
+
+}  // namespace fiberfluid::model

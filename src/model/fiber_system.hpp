@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "model/boundary_conditions.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::model {
+
+// The paper's A at a configuration X with the boundary conditions applied,
+// kept in the structure that the solvers exploit (model.md section 5):
+//
+//   [ K    s ] [u]   [f]     K = blockdiag(K_x, K_y, K_z)
+//   [ s^T  0 ] [P] = [c]     K_a = Y_a L_bulk + gamma L_surf on axis a's active vertices
+//
+// The reduced unknowns are, axis by axis, the active vertices of the axis
+// (its free vertices with elimination; all vertices with the penalty, whose
+// constrained diagonal entries become the penalty), then P.
+//
+// The dense N x N bulk Laplacian is never stored here: dense_block() forms
+// one block on request and bulk_product() applies it on the fly.
+class FiberSystem {
+ public:
+  FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
+              double penalty);
+
+  int dim() const { return dim_; }
+  int num_vertices() const { return n_; }
+  int num_unknowns() const { return offsets_.back() + 1; }  // reduced, with P
+  int offset(int axis) const { return offsets_[static_cast<size_t>(axis)]; }
+  const std::vector<int>& active(int axis) const { return active_[static_cast<size_t>(axis)]; }
+  // Positions within active(axis) whose diagonal is the penalty (penalty method only).
+  const std::vector<int>& penalised(int axis) const {
+    return penalised_[static_cast<size_t>(axis)];
+  }
+  // Every axis has the same active and penalised vertices and the same Y, so
+  // one factor of K_x serves all blocks.
+  bool blocks_equal() const;
+
+  double young(int axis) const { return young_[axis]; }
+  double surface_tension() const { return gamma_; }
+  double penalty() const { return penalty_; }
+
+  // Bulk Laplacian weights w_ij = (|S_i| + |S_j|) / (2 (N-1) |x_i - x_j|).
+  const Eigen::MatrixXd& positions() const { return X_; }
+  const Eigen::VectorXd& area() const { return area_; }
+  double bulk_scale() const { return 1.0 / (2.0 * (n_ - 1)); }
+  const Eigen::SparseMatrix<double>& surface_laplacian() const { return surface_; }
+
+  // K_a over the active vertices, dense.
+  Eigen::MatrixXd dense_block(int axis) const;
+  // The sparse part of K_a over the active vertices: gamma L_surf plus the
+  // bulk fibers when include_bulk (all pairs: N^2 entries), with the penalty.
+  Eigen::SparseMatrix<double> sparse_block(int axis, bool include_bulk) const;
+  // The whole reduced bordered matrix, dense (the paper's method).
+  Eigen::MatrixXd dense_matrix() const;
+  // Diagonal of L_bulk (#V), computed on first use (one pass over the pairs).
+  const Eigen::VectorXd& bulk_diagonal() const;
+  // L_bulk V for #V by k vectors, computed pair by pair without storing L_bulk.
+  Eigen::MatrixXd bulk_product(const Eigen::MatrixXd& V) const;
+  // K u over the reduced unknowns except P, matrix-free.
+  Eigen::VectorXd apply_K(const Eigen::VectorXd& u) const;
+
+  // The border s over the reduced unknowns except P.
+  Eigen::VectorXd border() const;
+
+  // The reduced right-hand side [f; c] for loads F (dim N, the paper's
+  // layout) and constrained displacements U_c (dim N, zero where free).
+  Eigen::VectorXd reduce_rhs(const Eigen::VectorXd& F, const Eigen::VectorXd& U_c) const;
+  // The full unknown vector (dim N + 1) from a reduced solution.
+  Eigen::VectorXd expand(const Eigen::VectorXd& reduced, const Eigen::VectorXd& U_c) const;
+
+ private:
+  Eigen::VectorXd compute_bulk_diagonal() const;  // one pass over the pairs
+
+  int dim_ = 3, n_ = 0;
+  Eigen::MatrixXd X_;
+  Eigen::VectorXd area_;
+  Eigen::MatrixXd S_;
+  Eigen::SparseMatrix<double> surface_;
+  mutable Eigen::VectorXd bulk_diagonal_;  // empty until first asked for
+  Eigen::Vector3d young_;
+  double gamma_ = 0.0;
+  BoundaryMethod method_;
+  double penalty_ = 0.0;
+  std::vector<std::vector<int>> active_, penalised_, constrained_;
+  std::vector<int> offsets_;  // per axis, then the total
+};
+
+// Constrained displacements of the model after step k of n as a dim N
+// vector in the paper's layout (zero on free unknowns).
+Eigen::VectorXd constrained_displacements(const Model& model, int step, int steps);
+
+}  // namespace fiberfluid::model

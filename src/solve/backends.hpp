@@ -1,0 +1,16 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Factories of the linear backends; make_linear_solver() picks among them.
+#pragma once
+
+#include <memory>
+
+#include "solve/linear_solver.hpp"
+
+namespace fiberfluid::solve {
+
+std::unique_ptr<LinearSolver> make_dense_lu_solver();
+std::unique_ptr<LinearSolver> make_block_cholesky_solver();
+std::unique_ptr<LinearSolver> make_cholmod_solver();
+std::unique_ptr<LinearSolver> make_pcg_solver(const PcgOptions& options);
+
+}  // namespace fiberfluid::solve

@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// block-cholesky: one dense Cholesky (LAPACK dpotrf) per axis block, shared
+// when the blocks are equal, and the Schur complement on P.
+#include <vector>
+
+#include "solve/backends.hpp"
+#include "solve/schur_solver.hpp"
+
+extern "C" {
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info, std::size_t);
+void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
+             double* b, const int* ldb, int* info, std::size_t);
+}
+
+namespace fiberfluid::solve {
+namespace {
+
+class BlockCholeskySolver final : public SchurSolver {
+ public:
+  SolverKind kind() const override { return SolverKind::BlockCholesky; }
+
+  Status analyze_pattern(const model::FiberSystem& system) override {
+    const double n = system.num_vertices();
+    const int factors = system.blocks_equal() ? 1 : system.dim();
+    return require_memory(8.0 * n * n * (factors + 1),
+                          "block Cholesky with " + std::to_string(factors) + " dense " +
+                              std::to_string(system.num_vertices()) + "-square factors");
+  }
+
+ protected:
+  Status factorize_K(const model::FiberSystem& system) override {
+    const int count = system.blocks_equal() ? 1 : system.dim();
+    factors_.clear();
+    offsets_.clear();
+    for (int a = 0; a < system.dim(); ++a) offsets_.push_back(system.offset(a));
+    offsets_.push_back(system.num_unknowns() - 1);
+    for (int a = 0; a < count; ++a) {
+      Eigen::MatrixXd K = system.dense_block(a);
+      const int n = static_cast<int>(K.rows());
+      int info = 0;
+      const char lower = 'L';
+      if (n > 0) dpotrf_(&lower, &n, K.data(), &n, &info, 1);
+      if (info > 0)
+        return Status::failure(std::string("block-cholesky: the ") + "xyz"[a] +
+                               " block is not positive definite (leading minor " +
+                               std::to_string(info) + ")");
+      statistics_.factorization_flops += static_cast<double>(n) * n * n / 3.0;
+      factors_.push_back(std::move(K));
+    }
+    return {};
+  }
+
+  Status solve_K(const Eigen::VectorXd& f, Eigen::VectorXd* w) override {
+    *w = f;
+    const char lower = 'L';
+    const int nrhs = 1;
+    for (size_t a = 0; a + 1 < offsets_.size(); ++a) {
+      const Eigen::MatrixXd& L = factors_[factors_.size() == 1 ? 0 : a];
+      const int n = offsets_[a + 1] - offsets_[a];
+      int info = 0;
+      if (n > 0) dpotrs_(&lower, &n, &nrhs, L.data(), &n, w->data() + offsets_[a], &n, &info, 1);
+    }
+    return {};
+  }
+
+ private:
+  std::vector<Eigen::MatrixXd> factors_;
+  std::vector<int> offsets_;  // block starts, then the end
+};
+
+}  // namespace
+
+std::unique_ptr<LinearSolver> make_block_cholesky_solver() {
+  return std::make_unique<BlockCholeskySolver>();
+}
+
+}  // namespace fiberfluid::solve

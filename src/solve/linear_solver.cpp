@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "solve/linear_solver.hpp"
+
+#include <sstream>
+#include <unistd.h>
+
+#include "solve/backends.hpp"
+
+namespace fiberfluid::solve {
+
+const char* to_string(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::Auto: return "auto";
+    case SolverKind::DenseLU: return "dense-lu";
+    case SolverKind::BlockCholesky: return "block-cholesky";
+    case SolverKind::Cholmod: return "cholmod";
+    case SolverKind::PCG: return "pcg";
+  }
+  return "?";
+}
+
+std::optional<SolverKind> solver_kind_from_string(const std::string& name) {
+  for (SolverKind kind : {SolverKind::Auto, SolverKind::DenseLU, SolverKind::BlockCholesky,
+                          SolverKind::Cholmod, SolverKind::PCG})
+    if (name == to_string(kind)) return kind;
+  return std::nullopt;
+}
+
+std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptions& pcg) {
+  switch (kind) {
+    case SolverKind::DenseLU: return make_dense_lu_solver();
+    case SolverKind::BlockCholesky: return make_block_cholesky_solver();
+    case SolverKind::Cholmod: return make_cholmod_solver();
+    case SolverKind::PCG: return make_pcg_solver(pcg);
+    case SolverKind::Auto: break;
+  }
+  return nullptr;
+}
+
+SolverKind choose_solver(const model::FiberSystem& system) {
+  const double n = system.num_vertices();
+  if (n <= 600) return SolverKind::DenseLU;  // the paper's method, well within a second
+  const int factors = system.blocks_equal() ? 1 : system.dim();
+  if (8.0 * n * n * (factors + 1) < 0.3 * physical_memory_bytes())
+    return SolverKind::BlockCholesky;
+  return SolverKind::PCG;
+}
+
+double physical_memory_bytes() {
+  return static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+Status require_memory(double bytes, const std::string& what) {
+  const double physical = physical_memory_bytes();
+  if (physical <= 0.0 || bytes < 0.8 * physical) return {};
+  std::ostringstream out;
+  out.precision(3);
+  out << what << " needs about " << bytes / (1u << 30) << " GiB, more than this machine's "
+      << physical / (1u << 30) << " GiB; use the pcg solver or a coarser mesh";
+  return Status::failure(out.str());
+}
+
+}  // namespace fiberfluid::solve

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "model/fiber_system.hpp"
+#include "solve/dense_lu.hpp"
+
+namespace fiberfluid::solve {
+
+// The linear backends for the bordered system of a model::FiberSystem.
+enum class SolverKind {
+  Auto,           // chosen by size: choose_solver()
+  DenseLU,        // the paper's method: LU of the whole reduced system (LAPACK)
+  BlockCholesky,  // Schur complement on P, one dense Cholesky per axis block (LAPACK)
+  Cholmod,        // Schur complement on P, sparse Cholesky per axis block (SuiteSparse)
+  PCG,            // Schur complement on P, matrix-free preconditioned conjugate gradients
+};
+const char* to_string(SolverKind kind);
+std::optional<SolverKind> solver_kind_from_string(const std::string& name);
+
+struct PcgOptions {
+  double tolerance = 1e-10;   // stop at |r| <= tolerance |b| (relative residual)
+  int max_iterations = 1000;  // then fail with a status
+};
+
+// What a backend did, for the summaries.
+struct SolverStatistics {
+  int factorizations = 0;
+  double factorization_flops = 0.0;  // dense paths: the LAPACK factorisation's flop count
+  int iterations = 0;                // pcg: iterations over all solves
+  int solves = 0;
+};
+
+// analyze_pattern once per structure, factorize per matrix, solve per
+// right-hand side. Expected numerical failures (not positive definite, no
+// convergence, a system too large for memory) come back as a Status.
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  virtual SolverKind kind() const = 0;
+  virtual Status analyze_pattern(const model::FiberSystem& system) = 0;
+  // The system must outlive the factorisation (pcg applies it in solve()).
+  virtual Status factorize(const model::FiberSystem& system) = 0;
+  // rhs = [f; c] over the system's reduced unknowns; requires factorize().
+  virtual Status solve(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) = 0;
+  const SolverStatistics& statistics() const { return statistics_; }
+
+ protected:
+  SolverStatistics statistics_;
+};
+
+std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptions& pcg = {});
+
+// The default by size: the paper's dense LU for small systems, block
+// Cholesky while a dense N x N block fits easily in memory, pcg beyond.
+SolverKind choose_solver(const model::FiberSystem& system);
+
+// Physical memory of this machine in bytes.
+double physical_memory_bytes();
+// A failure when `bytes` would not fit in 80% of the physical memory.
+Status require_memory(double bytes, const std::string& what);
+
+}  // namespace fiberfluid::solve

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "solve/sparse_cholesky.hpp"
+
+#include <Eigen/CholmodSupport>
+
+namespace fiberfluid::solve {
+
+struct SparseCholesky::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  bool analyzed = false;
+};
+
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::~SparseCholesky() = default;
+SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
+SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
+
+void SparseCholesky::analyze_pattern(const Eigen::SparseMatrix<double>& A) {
+  impl_->llt.analyzePattern(A);
+  impl_->analyzed = true;
+}
+
+Status SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
+  if (!impl_->analyzed) analyze_pattern(A);
+  impl_->llt.factorize(A);
+  if (impl_->llt.info() != Eigen::Success)
+    return Status::failure("CHOLMOD: the matrix is not positive definite");
+  return {};
+}
+
+Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
+  return impl_->llt.solve(b);
+}
+
+}  // namespace fiberfluid::solve

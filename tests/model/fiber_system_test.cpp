@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/fiber_system.hpp"
+
+#include <gtest/gtest.h>
+
+#include "geom/mesh_io.hpp"
+#include "model/assembly.hpp"
+#include "model/model_fixtures.hpp"
+#include "test_support.hpp"
+
+namespace fiberfluid::model {
+namespace {
+
+// The structured system against the straightforward full assembly of
+// assembly.cpp with the boundary conditions applied there: two
+// implementations of the same matrix.
+void expect_same_as_full_assembly(const Model& m, BoundaryMethod method) {
+  const FiberSystem system(m, m.surface.V, method, 1e9);
+  Eigen::MatrixXd A = system_matrix(m, m.surface.V);
+  const DofPartition partition = partition_dofs(m);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(partition.constrained.size());
+  Eigen::MatrixXd expected;
+  if (method == BoundaryMethod::Penalty) {
+    Eigen::VectorXd B = Eigen::VectorXd::Zero(A.rows());
+    apply_penalty(partition, zero, 1e9, A, B);
+    expected = A;
+  } else {
+    Eigen::VectorXd B_free;
+    reduce_system(partition, zero, A, Eigen::VectorXd::Zero(A.rows()), expected, B_free);
+  }
+  const Eigen::MatrixXd structured = system.dense_matrix();
+  ASSERT_EQ(structured.rows(), expected.rows());
+  const double scale = expected.topLeftCorner(expected.rows() - 1, expected.rows() - 1)
+                           .diagonal().cwiseAbs().minCoeff();
+  EXPECT_LT((structured - expected).cwiseAbs().maxCoeff(), 1e-11 * std::max(scale, 1.0));
+
+  // Matrix-free products agree with the dense blocks.
+  const int m_unknowns = system.num_unknowns() - 1;
+  const Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(m_unknowns, -1.0, 2.0);
+  const Eigen::VectorXd dense = structured.topLeftCorner(m_unknowns, m_unknowns) * u;
+  EXPECT_LT((system.apply_K(u) - dense).norm(), 1e-12 * dense.norm());
+}
+
+TEST(FiberSystem, MatchesTheFullAssemblyWithBothBoundaryMethods) {
+  Model sphere = testing::paper_sphere_model();
+  sphere.material.young_modulus = {3000, 2000, 1000};  // distinct blocks
+  for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
+    expect_same_as_full_assembly(testing::paper_rectangle_model(), method);
+    expect_same_as_full_assembly(testing::paper_sphere_model(), method);
+    expect_same_as_full_assembly(sphere, method);
+  }
+}
+
+TEST(FiberSystem, EqualBlocksAreRecognised) {
+  Model m = testing::paper_sphere_model();
+  EXPECT_TRUE(FiberSystem(m, m.surface.V, BoundaryMethod::Elimination, 1e9).blocks_equal());
+  m.material.young_modulus.z() = 1.0;
+  EXPECT_FALSE(FiberSystem(m, m.surface.V, BoundaryMethod::Elimination, 1e9).blocks_equal());
+  Model partial = testing::paper_sphere_model();
+  partial.constraints.push_back({100, 0, 0.0, {}});  // x only: the x block loses a vertex
+  EXPECT_FALSE(
+      FiberSystem(partial, partial.surface.V, BoundaryMethod::Elimination, 1e9).blocks_equal());
+}
+
+TEST(FiberSystem, PrescribedDisplacementsMoveToTheRightHandSide) {
+  Model m = testing::paper_sphere_model();
+  const FiberSystem system(m, m.surface.V, BoundaryMethod::Elimination, 1e9);
+  Eigen::VectorXd U_c = Eigen::VectorXd::Zero(3 * m.num_vertices());
+  const Constraint& c = m.constraints.front();
+  U_c[m.dof(c.vertex, c.axis)] = 0.01;
+  const Eigen::VectorXd rhs = system.reduce_rhs(Eigen::VectorXd::Zero(U_c.size()), U_c);
+  // Against the full matrix: -A_fc u_c on the free rows, -s_c . u_c in the volume row.
+  const Eigen::MatrixXd A = system_matrix(m, m.surface.V);
+  const DofPartition p = partition_dofs(m);
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(m.num_unknowns());
+  full.head(U_c.size()) = U_c;
+  const Eigen::VectorXd moved = -(A * full);
+  Eigen::VectorXd expected(p.free.size());
+  for (size_t k = 0; k < p.free.size(); ++k) expected[static_cast<Eigen::Index>(k)] = moved[p.free[k]];
+  EXPECT_LT((rhs - expected).norm(), 1e-12 * expected.norm());
+}
+
+}  // namespace
+}  // namespace fiberfluid::model

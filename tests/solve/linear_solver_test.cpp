@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "solve/linear_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include "geom/mesh_io.hpp"
+#include "model/boundary_conditions.hpp"
+#include "model/model_fixtures.hpp"
+#include "solve/load_stepper.hpp"
+#include "test_support.hpp"
+
+namespace fiberfluid::solve {
+namespace {
+
+using model::BoundaryMethod;
+
+model::Model mesh_model(const char* file, const char* support) {
+  model::Model m;
+  m.surface = geom::remove_unused_vertices(
+                  geom::read_surface(testing::shared_mesh(file)).surface)
+                  .surface;
+  m.material.young_modulus.setConstant(5000.0);
+  m.material.surface_tension = 20.0;
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space(support, 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  model::Load gravity;
+  gravity.kind = model::Load::Kind::Hydrostatic;
+  gravity.acceleration = {0.0, -9.81, -3.0};
+  gravity.density = 1000.0;
+  model::Load pull;
+  pull.vertex = m.num_vertices() / 2;
+  pull.force = {50.0, 20.0, -10.0};
+  m.loads = {gravity, pull};
+  return m;
+}
+
+model::Model cube_with_prescribed_corner() {
+  model::Model m = mesh_model("cube.obj", "z <= -0.9");
+  // A top corner pulled sideways, and an axis-only support: unequal blocks.
+  int top = 0;
+  for (int i = 0; i < m.num_vertices(); ++i)
+    if (m.surface.V(i, 2) > 0.9) top = i;
+  m.constraints.push_back({top, 0, 0.05, {}});
+  m.material.young_modulus = {5000.0, 4000.0, 3000.0};
+  return m;
+}
+
+struct Case {
+  const char* name;
+  model::Model (*make)();
+};
+
+const Case kCases[] = {
+    {"rectangle", [] { return testing::paper_rectangle_model(); }},
+    {"sphere", [] { return testing::paper_sphere_model(); }},
+    {"liver", [] { return mesh_model("liver.obj", "y >= 4.75"); }},
+    {"cube", [] { return cube_with_prescribed_corner(); }},
+};
+
+using Param = std::tuple<size_t, SolverKind, BoundaryMethod>;
+
+class EveryBackend : public ::testing::TestWithParam<Param> {};
+
+TEST_P(EveryBackend, AgreesWithDenseLU) {
+  const auto [case_index, kind, method] = GetParam();
+  const model::Model m = kCases[case_index].make();
+  SteppingOptions options;
+  options.steps = 3;
+  options.boundary_method = method;
+  options.solver = SolverKind::DenseLU;
+  const SteppingSummary reference = solve_load_steps(m, options);
+  ASSERT_TRUE(reference.success) << reference.message;
+  options.solver = kind;
+  options.pcg.tolerance = 1e-12;
+  const SteppingSummary s = solve_load_steps(m, options);
+  ASSERT_TRUE(s.success) << s.message;
+  EXPECT_EQ(s.solver, kind);
+  const double scale = reference.unknowns.head(reference.unknowns.size() - 1).norm();
+  const double difference =
+      (s.unknowns - reference.unknowns).head(reference.unknowns.size() - 1).norm() / scale;
+  // Direct solvers to 1e-8; pcg to its tolerance (times the conditioning it meets).
+  EXPECT_LT(difference, kind == SolverKind::PCG ? 1e-8 : 1e-8) << kCases[case_index].name;
+  const double P = reference.unknowns.tail(1)[0];
+  EXPECT_NEAR(s.unknowns.tail(1)[0], P, 1e-8 * std::abs(P) + 1e-12);
+}
+
+std::string param_name(const ::testing::TestParamInfo<Param>& info) {
+  std::string name = std::string(kCases[std::get<0>(info.param)].name) + "_" +
+                     to_string(std::get<1>(info.param)) + "_" +
+                     model::to_string(std::get<2>(info.param));
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Backends, EveryBackend,
+    ::testing::Combine(::testing::Values(0u, 1u, 2u, 3u),
+                       ::testing::Values(SolverKind::DenseLU, SolverKind::BlockCholesky,
+                                         SolverKind::Cholmod, SolverKind::PCG),
+                       ::testing::Values(BoundaryMethod::Elimination, BoundaryMethod::Penalty)),
+    param_name);
+
+// Failures come back as a status with a message, for setups built to cause them.
+SteppingSummary run(model::Model m, SolverKind kind, PcgOptions pcg = {}) {
+  SteppingOptions options;
+  options.solver = kind;
+  options.pcg = pcg;
+  return solve_load_steps(m, options);
+}
+
+void expect_failure(const SteppingSummary& s, const std::string& part) {
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find(part), std::string::npos) << s.message;
+}
+
+TEST(BackendFailures, NotPositiveDefinite) {
+  model::Model m = testing::paper_sphere_model();
+  m.material.young_modulus.setConstant(-3000.0);  // the input reader forbids this
+  m.material.surface_tension = 0.0;
+  expect_failure(run(m, SolverKind::BlockCholesky), "not positive definite");
+  expect_failure(run(m, SolverKind::Cholmod), "not positive definite");
+  expect_failure(run(m, SolverKind::PCG), "not positive definite");
+}
+
+TEST(BackendFailures, PcgWithoutConvergence) {
+  PcgOptions tight;
+  tight.tolerance = 1e-15;
+  tight.max_iterations = 1;
+  expect_failure(run(testing::paper_sphere_model(), SolverKind::PCG, tight), "no convergence in 1");
+}
+
+TEST(BackendFailures, SingularSetupForEveryBackend) {
+  model::Model m = testing::paper_sphere_model();
+  m.constraints.clear();
+  for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod,
+                          SolverKind::PCG})
+    expect_failure(run(m, kind), "no supports");
+}
+
+TEST(BackendChoice, BySize) {
+  const model::Model small = testing::paper_sphere_model();
+  const model::FiberSystem system(small, small.surface.V, BoundaryMethod::Elimination, 1e9);
+  EXPECT_EQ(choose_solver(system), SolverKind::DenseLU);
+  model::Model large;
+  large.surface = geom::icosphere(5);  // 10242 vertices
+  large.constraints = {{0, 0, 0.0, {}}, {0, 1, 0.0, {}}, {0, 2, 0.0, {}}};
+  const model::FiberSystem big(large, large.surface.V, BoundaryMethod::Elimination, 1e9);
+  EXPECT_EQ(choose_solver(big), SolverKind::BlockCholesky);
+  EXPECT_EQ(solver_kind_from_string("pcg"), SolverKind::PCG);
+  EXPECT_FALSE(solver_kind_from_string("gauss-seidel"));
+}
+
+}  // namespace
+}  // namespace fiberfluid::solve
