@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "model/fiber_system.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "geom/area_vectors.hpp"
@@ -94,20 +95,28 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(m, m);
   const double y = young(axis) * bulk_scale();
   if (y != 0.0) {
-    const Coordinates x(X_);
-    // Off-diagonal entries: -Y_a w_ij.
+    // Active vertices' coordinates and areas, gathered so the loops vectorise.
+    std::vector<double> gx[3], ga(static_cast<size_t>(m));
+    for (int d = 0; d < 3; ++d) gx[d].resize(static_cast<size_t>(m), 0.0);
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const int i = act[static_cast<size_t>(r)];
+      for (int d = 0; d < dim_; ++d) gx[d][static_cast<size_t>(r)] = X_(i, d);
+      ga[static_cast<size_t>(r)] = area_[i];
+    }
+    const double *x0 = gx[0].data(), *x1 = gx[1].data(), *x2 = gx[2].data(), *a = ga.data();
+    // Off-diagonal entries -Y_a w_ij, lower triangle, then mirrored.
 #pragma omp parallel for schedule(dynamic, 16)
     for (Eigen::Index c = 0; c < m; ++c) {
-      const size_t j = static_cast<size_t>(act[static_cast<size_t>(c)]);
-      for (Eigen::Index r = 0; r < m; ++r) {
-        const size_t i = static_cast<size_t>(act[static_cast<size_t>(r)]);
-        if (i == j) continue;
-        const double dx = x.c[0][i] - x.c[0][j], dy = x.c[1][i] - x.c[1][j],
-                     dz = x.c[2][i] - x.c[2][j];
-        K(r, c) = -y * (area_[static_cast<Eigen::Index>(i)] + area_[static_cast<Eigen::Index>(j)]) /
-                  std::sqrt(dx * dx + dy * dy + dz * dz);
+      double* column = K.col(c).data();
+      const size_t j = static_cast<size_t>(c);
+#pragma omp simd
+      for (Eigen::Index r = c + 1; r < m; ++r) {
+        const size_t i = static_cast<size_t>(r);
+        const double dx = x0[i] - x0[j], dy = x1[i] - x1[j], dz = x2[i] - x2[j];
+        column[r] = -y * (a[i] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz);
       }
     }
+    K.triangularView<Eigen::StrictlyUpper>() = K.transpose();
     // The diagonal gathers the weights to every vertex, active or not.
     const Eigen::VectorXd& diagonal = bulk_diagonal();
     for (Eigen::Index r = 0; r < m; ++r)
@@ -133,51 +142,58 @@ const Eigen::VectorXd& FiberSystem::bulk_diagonal() const {
 
 Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
   const Coordinates x(X_);
+  const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data(), *a = area_.data();
+  const size_t n = static_cast<size_t>(n_);
   Eigen::VectorXd diagonal(n_);
-#pragma omp parallel for schedule(dynamic, 16)
+#pragma omp parallel for schedule(dynamic, 32)
   for (int i = 0; i < n_; ++i) {
     const size_t u = static_cast<size_t>(i);
     double sum = 0.0;
-    for (size_t j = 0; j < static_cast<size_t>(n_); ++j) {
-      if (j == u) continue;
-      const double dx = x.c[0][u] - x.c[0][j], dy = x.c[1][u] - x.c[1][j],
-                   dz = x.c[2][u] - x.c[2][j];
-      sum += (area_[i] + area_[static_cast<Eigen::Index>(j)]) / std::sqrt(dx * dx + dy * dy + dz * dz);
+#pragma omp simd reduction(+ : sum)
+    for (size_t j = 0; j < n; ++j) {
+      const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+      // The j == i term is (a_i + a_i) / 1 with r2 forced to 1: subtracted below.
+      const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
+      sum += (a[u] + a[j]) / std::sqrt(r2);
     }
-    diagonal[i] = bulk_scale() * sum;
+    diagonal[i] = bulk_scale() * (sum - 2.0 * a[u]);
   }
   return diagonal;
 }
 
 Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
-  // (L v)_i = sum_j w_ij (v_i - v_j), with w_ij = s (a_i + a_j) / r_ij:
-  // one pass over the pairs, all columns at once.
+  // (L v)_i = sum_j w_ij (v_i - v_j), w_ij = s (a_i + a_j) / r_ij. Each pair's
+  // distance is computed once and serves every column (up to three at a time).
   const Coordinates x(X_);
   const int k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
   const double* a = area_.data();
-#pragma omp parallel
-  {
-    std::vector<double> acc(static_cast<size_t>(k));
-#pragma omp for schedule(dynamic, 16)
+  const size_t n = static_cast<size_t>(n_);
+  for (int first = 0; first < k; first += 3) {
+    const int width = std::min(3, k - first);
+    // Unused columns read zeros, so one loop body serves widths 1 to 3.
+    const std::vector<double> zeros(n, 0.0);
+    const double* v0 = V.col(first).data();
+    const double* v1 = width > 1 ? V.col(first + 1).data() : zeros.data();
+    const double* v2 = width > 2 ? V.col(first + 2).data() : zeros.data();
+    const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data();
+#pragma omp parallel for schedule(dynamic, 32)
     for (int i = 0; i < n_; ++i) {
       const size_t u = static_cast<size_t>(i);
-      std::fill(acc.begin(), acc.end(), 0.0);
-      for (int col = 0; col < k; ++col) {
-        const double* v = V.col(col).data();
-        const double vi = v[i];
-        double sum = 0.0;
-        for (size_t j = 0; j < static_cast<size_t>(n_); ++j) {
-          const double dx = x.c[0][u] - x.c[0][j], dy = x.c[1][u] - x.c[1][j],
-                       dz = x.c[2][u] - x.c[2][j];
-          const double r2 = dx * dx + dy * dy + dz * dz;
-          // j == i contributes (v_i - v_i) = 0; guard the division only.
-          const double inverse = j == u ? 0.0 : 1.0 / std::sqrt(r2);
-          sum += (a[i] + a[j]) * inverse * (vi - v[j]);
-        }
-        acc[static_cast<size_t>(col)] = sum;
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+#pragma omp simd reduction(+ : s0, s1, s2)
+      for (size_t j = 0; j < n; ++j) {
+        const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+        // j == i contributes (v_i - v_i) = 0; r2 = 1 there only avoids 1/0.
+        const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
+        const double w = (a[u] + a[j]) / std::sqrt(r2);
+        s0 += w * (v0[u] - v0[j]);
+        s1 += w * (v1[u] - v1[j]);
+        s2 += w * (v2[u] - v2[j]);
       }
-      for (int col = 0; col < k; ++col) out(i, col) = bulk_scale() * acc[static_cast<size_t>(col)];
+      out(i, first) = bulk_scale() * s0;
+      if (width > 1) out(i, first + 1) = bulk_scale() * s1;
+      if (width > 2) out(i, first + 2) = bulk_scale() * s2;
     }
   }
   return out;

@@ -31,6 +31,7 @@ struct PcgOptions {
 struct SolverStatistics {
   int factorizations = 0;
   double factorization_flops = 0.0;  // dense paths: the LAPACK factorisation's flop count
+  double factorization_kernel_seconds = 0.0;  // time inside that LAPACK routine
   int iterations = 0;                // pcg: iterations over all solves
   int solves = 0;
 };

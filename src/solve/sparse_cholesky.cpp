@@ -10,7 +10,9 @@ struct SparseCholesky::Impl {
   bool analyzed = false;
 };
 
-SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {
+  impl_->llt.cholmod().print = 0;  // failures come back as a Status, not as printed text
+}
 SparseCholesky::~SparseCholesky() = default;
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;

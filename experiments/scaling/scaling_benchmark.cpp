@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// One case of the scaling benchmark: the sphere experiment (its material,
+// supports and loads, experiments/sphere.json) on an icosphere with the given
+// subdivisions, solved by one backend. Prints one JSON line with the timings,
+// the peak memory of this process and the factorisation rate; run.py runs
+// one process per case, so that each peak is its own.
+//   fiberfluid_scaling --subdivisions 4 --solver block-cholesky [--save u.bin]
+//   fiberfluid_scaling --gemm-peak     (this machine's BLAS dgemm rate)
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/experiment.hpp"
+#include "app/runner.hpp"
+
+extern "C" void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k,
+                       const double* alpha, const double* a, const int* lda, const double* b,
+                       const int* ldb, const double* beta, double* c, const int* ldc,
+                       std::size_t, std::size_t);
+
+namespace {
+
+double peak_memory_mib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // kilobytes on Linux
+}
+
+// The best of three n x n dgemm runs, in GFLOP/s: the machine's dense peak.
+double gemm_gflops(int n) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n), b = Eigen::MatrixXd::Random(n, n);
+  Eigen::MatrixXd c(n, n);
+  const double one = 1.0, zero = 0.0;
+  double best = 0.0;
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto start = std::chrono::steady_clock::now();
+    dgemm_("N", "N", &n, &n, &n, &one, a.data(), &n, b.data(), &n, &zero, c.data(), &n, 1, 1);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, 2.0 * n * n * n / seconds / 1e9);
+  }
+  return best;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"fiberfluid scaling benchmark: one case"};
+  int subdivisions = 2;
+  std::string solver = "dense-lu", save;
+  bool gemm_peak = false;
+  cli.add_option("--subdivisions", subdivisions, "icosphere subdivisions (2: 162 vertices)");
+  cli.add_option("--solver", solver, "dense-lu, block-cholesky, cholmod or pcg");
+  cli.add_option("--save", save, "write the final unknowns as raw doubles");
+  cli.add_flag("--gemm-peak", gemm_peak, "measure this machine's dgemm GFLOP/s");
+  CLI11_PARSE(cli, argc, argv);
+
+  if (gemm_peak) {
+    std::cout << nlohmann::json{{"gemm_gflops", gemm_gflops(3000)}}.dump() << std::endl;
+    return 0;
+  }
+  // The sphere experiment with another resolution and backend.
+  std::ifstream in(FIBERFLUID_SPHERE_EXPERIMENT);
+  nlohmann::json config = nlohmann::json::parse(in);
+  config["surface"]["subdivisions"] = subdivisions;
+  config["stepping"]["solver"] = solver;
+  config["expected"] = nlohmann::json::array();
+  const std::string path = "/tmp/fiberfluid_scaling_" + std::to_string(getpid()) + ".json";
+  std::ofstream(path) << config.dump();
+  const fiberfluid::app::Experiment ex = fiberfluid::app::load_experiment(path);
+  std::remove(path.c_str());
+
+  const fiberfluid::app::ExperimentResult result = fiberfluid::app::run_experiment(ex);
+  const fiberfluid::app::RunResult& run = result.runs.front();
+  const auto& s = run.summary;
+  double slowest_step = 0.0;
+  for (const auto& step : s.steps) slowest_step = std::max(slowest_step, step.seconds);
+  nlohmann::json line = {
+      {"vertices", ex.model.num_vertices()},
+      {"solver", solver},
+      {"success", s.success},
+      {"message", s.message},
+      {"assemble_s", s.assemble_seconds},
+      {"factorize_s", s.factorize_seconds},
+      {"solve_s", s.solve_seconds},
+      {"run_s", s.total_seconds},
+      {"slowest_step_s", slowest_step},
+      {"peak_mib", peak_memory_mib()},
+      {"factorization_gflops",
+       s.solver_statistics.factorization_kernel_seconds > 0
+           ? s.solver_statistics.factorization_flops /
+                 s.solver_statistics.factorization_kernel_seconds / 1e9
+           : 0.0},
+      {"pcg_iterations", s.solver_statistics.iterations},
+      {"max_displacement", s.success ? result.figures.at("max_displacement") : 0.0}};
+  std::cout << line.dump() << std::endl;
+  if (!save.empty() && s.success)
+    std::ofstream(save, std::ios::binary)
+        .write(reinterpret_cast<const char*>(s.unknowns.data()),
+               static_cast<std::streamsize>(sizeof(double) * s.unknowns.size()));
+  return s.success ? 0 : 2;
+}
