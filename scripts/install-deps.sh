@@ -7,7 +7,7 @@ packages=(
   build-essential cmake
   libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
-  python3 python3-matplotlib   # plots of the experiments
+  python3 python3-matplotlib python3-numpy   # plots and the scaling driver
 )
 
 missing=()
