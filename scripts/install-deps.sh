@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake
-  libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev
+  libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
 )

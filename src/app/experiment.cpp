@@ -11,6 +11,7 @@
 #include <set>
 
 #include "geom/error.hpp"
+#include "geom/fiber_pruning.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
@@ -285,6 +286,50 @@ std::vector<ExpectedFigure> read_expected(Fields& root) {
   return expected;
 }
 
+// Reads "fibers" and prunes the fibers that leave a concave body.
+void read_fibers(Fields& root, Experiment& ex) {
+  std::string mode = "auto", count = "symmetric";
+  if (root.has("fibers")) {
+    Fields f = root.object("fibers");
+    mode = f.choice("pruning", "auto", {"auto", "off"});
+    count = f.choice("connection_count", "symmetric", {"symmetric", "global"});
+    ex.fibers.write = f.choice("write", "none", {"none", "kept", "pruned"});
+    f.finish();
+  }
+  model::Model& m = ex.model;
+  m.connection_count =
+      count == "global" ? model::ConnectionCount::Global : model::ConnectionCount::Symmetric;
+  FiberReport& report = ex.fibers;
+  report.pruning = mode == "auto";
+  const int n = m.num_vertices();
+  report.pairs = static_cast<long long>(n) * (n - 1) / 2;
+  report.kept = report.pairs;
+  report.min_per_vertex = report.max_per_vertex = n - 1;
+  report.mean_per_vertex = n - 1;
+  if (!report.pruning) return;
+  report.convex = geom::is_convex(m.surface);
+  if (report.convex) return;
+  constexpr int kLargestPruned = 20000;  // N^2 pair tests and an N^2 byte table
+  if (n > kLargestPruned)
+    root.fail("fibers.pruning", "a concave body of " + std::to_string(n) +
+                                    " vertices is beyond exact pruning (at most " +
+                                    std::to_string(kLargestPruned) + "); set \"off\"");
+  geom::PruningResult pruned = geom::prune_fibers(m.surface);
+  report.seconds = pruned.seconds;
+  report.exact_fallbacks = pruned.exact_fallbacks;
+  report.kept = pruned.mask.num_kept();
+  const std::vector<int> per_vertex = pruned.mask.kept_per_vertex();
+  report.min_per_vertex = *std::min_element(per_vertex.begin(), per_vertex.end());
+  report.max_per_vertex = *std::max_element(per_vertex.begin(), per_vertex.end());
+  report.mean_per_vertex = 2.0 * report.kept / n;
+  if (report.min_per_vertex == 0)
+    root.fail("fibers.pruning", "vertex " +
+                                    std::to_string(std::find(per_vertex.begin(), per_vertex.end(), 0) -
+                                                   per_vertex.begin()) +
+                                    " keeps no fiber: is the mesh self-intersecting?");
+  m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
+}
+
 void read_simulation(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
   Fields surface = root.object("surface");
   ex.input_surface = read_surface_spec(surface, folder, &ex.warnings);
@@ -296,6 +341,7 @@ void read_simulation(Fields& root, const std::filesystem::path& folder, Experime
   ex.model.material = read_material(root.object("material"), dim);
   ex.model.loads = read_loads(root, ex.model.surface, compact.from_input);
   ex.model.constraints = read_constraints(root, ex.model.surface, compact.from_input);
+  read_fibers(root, ex);
 
   solve::SteppingOptions base;
   if (root.has("stepping")) base = read_stepping(root.object("stepping"), base);

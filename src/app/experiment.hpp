@@ -35,6 +35,19 @@ struct OutputOptions {
   int every = 1;     // write every k-th step's .vtu (the last always)
 };
 
+// What the fiber pruning did (issue 4), for the summary.
+struct FiberReport {
+  bool pruning = true;         // "fibers.pruning": "auto" (prune a concave body) or "off"
+  bool convex = false;         // the fast path: nothing to prune
+  long long pairs = 0;         // fibers in all, N (N-1) / 2
+  long long kept = 0;
+  int min_per_vertex = 0, max_per_vertex = 0;
+  double mean_per_vertex = 0.0;
+  double seconds = 0.0;
+  long long exact_fallbacks = 0;  // pairs decided by exact constructions
+  std::string write = "none";     // "kept" or "pruned": DIR/fibers.vtu
+};
+
 // A named surface for an "areas" experiment (the paper's Table 1).
 struct NamedSurface {
   std::string name;
@@ -56,6 +69,7 @@ struct Experiment {
   model::Model model;
   std::vector<Variant> variants;  // one unless the file sweeps
   OutputOptions output;
+  FiberReport fibers;
 
   // Areas:
   std::vector<NamedSurface> area_surfaces;

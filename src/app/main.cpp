@@ -54,6 +54,13 @@ int run_command(const std::string& path, std::string output, bool check_expected
   writer.finish(result);
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
+  if (ex.kind == app::Experiment::Kind::Simulate) {
+    const app::FiberReport& f = ex.fibers;
+    std::cout << "  fibers: " << f.kept << " kept of " << f.pairs << " ("
+              << (!f.pruning ? "pruning off" : f.convex ? "convex" : "pruned exactly")
+              << "; per vertex " << f.min_per_vertex << " / " << f.mean_per_vertex << " / "
+              << f.max_per_vertex << "; " << f.seconds << " s)\n";
+  }
   for (const app::RunResult& run : result.runs)
     std::cout << "  " << (run.variant.empty() ? "run" : run.variant) << ": "
               << run.summary.BriefReport() << "\n";

@@ -71,6 +71,18 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
                       {"vertices", ex.input_surface.num_vertices()},
                       {"used_vertices", ex.model.num_vertices()},
                       {"faces", ex.input_surface.num_faces()}};
+    const FiberReport& f = ex.fibers;
+    doc["fibers"] = {{"pruning", f.pruning ? "auto" : "off"},
+                     {"convex", f.convex},
+                     {"connection_count", model::to_string(ex.model.connection_count)},
+                     {"in_all", f.pairs},
+                     {"kept", f.kept},
+                     {"pruned", f.pairs - f.kept},
+                     {"kept_per_vertex", {{"min", f.min_per_vertex},
+                                          {"mean", f.mean_per_vertex},
+                                          {"max", f.max_per_vertex}}},
+                     {"pruning_seconds", f.seconds},
+                     {"exact_fallbacks", f.exact_fallbacks}};
     json runs = json::array();
     for (const RunResult& run : result.runs) runs.push_back(run_json(ex, result, run));
     doc["runs"] = runs;
@@ -100,11 +112,25 @@ void OutputWriter::begin() {
   std::filesystem::create_directories(folder_);
   if (experiment_.kind != Experiment::Kind::Simulate) return;
   series_.assign(experiment_.variants.size(), {});
+  write_fibers();
   for (size_t r = 0; r < experiment_.variants.size(); ++r) {
     if (!experiment_.output.vtk) continue;
     std::filesystem::create_directories(run_folder(r) / "vtk");
     write_state(r, 0, Eigen::VectorXd::Zero(experiment_.model.num_unknowns()));
   }
+}
+
+void OutputWriter::write_fibers() const {
+  const std::string& which = experiment_.fibers.write;
+  if (which == "none") return;
+  const model::Model& m = experiment_.model;
+  std::vector<std::pair<int, int>> lines;
+  for (int i = 0; i < m.num_vertices(); ++i)
+    for (int j = i + 1; j < m.num_vertices(); ++j) {
+      const bool kept = !m.fibers || m.fibers->kept(i, j);
+      if (kept == (which == "kept")) lines.emplace_back(i, j);
+    }
+  geom::write_lines_vtu(folder_ / "fibers.vtu", m.surface.V, lines);
 }
 
 void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns) {

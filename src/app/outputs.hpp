@@ -18,7 +18,7 @@ namespace fiberfluid::app {
 nlohmann::json summary_json(const Experiment& experiment, const ExperimentResult& result);
 
 // Writes an experiment's files into a folder as the run goes:
-//   summary.json, and per run (in a subfolder named after the variant when
+//   summary.json, fibers.vtu when asked, and per run (in a subfolder named after the variant when
 //   the experiment sweeps): final.obj, series.pvd and vtk/step_NNNN.vtu with
 //   point data displacement, displacement_magnitude and area_vector.
 // Every file is written whole or not at all (temporary file and rename).
@@ -36,6 +36,7 @@ class OutputWriter {
  private:
   std::filesystem::path run_folder(size_t run) const;
   void write_state(size_t run, int step, const Eigen::VectorXd& unknowns);
+  void write_fibers() const;  // fibers.vtu: the kept or pruned fibers, if asked
 
   const Experiment& experiment_;
   std::filesystem::path folder_;

@@ -179,6 +179,9 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
   } else {
+    result.figures["fibers.in_all"] = static_cast<double>(ex.fibers.pairs);
+    result.figures["fibers.kept"] = static_cast<double>(ex.fibers.kept);
+    result.figures["fibers.pruned"] = static_cast<double>(ex.fibers.pairs - ex.fibers.kept);
     for (size_t r = 0; r < ex.variants.size(); ++r) {
       RunResult run;
       run.variant = ex.variants[r].name;

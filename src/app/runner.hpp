@@ -28,7 +28,8 @@ struct FigureCheck {
 
 struct ExperimentResult {
   std::vector<RunResult> runs;
-  std::map<std::string, double> figures;  // headline figures, "variant.figure" for sweeps
+  std::map<std::string, double> figures;  // headline figures, "variant.figure" for sweeps,
+                                          // and fibers.in_all / kept / pruned
   std::vector<FigureCheck> checks;
   bool runs_succeeded() const;
   bool checks_passed() const;

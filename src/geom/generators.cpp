@@ -165,6 +165,30 @@ Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions) {
   return s;
 }
 
+Surface torus(double R, double r, int around, int tube) {
+  require_positive(r, "torus tube radius");
+  if (!(R > r)) throw InputError("torus: the ring radius must exceed the tube radius");
+  if (around < 3 || tube < 3) throw InputError("torus: at least 3 segments each way");
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> faces;
+  auto index = [&](int u, int v) { return (u % around) * tube + (v % tube); };
+  for (int u = 0; u < around; ++u)
+    for (int v = 0; v < tube; ++v) {
+      const double a = 2 * M_PI * u / around, b = 2 * M_PI * v / tube;
+      vertices.emplace_back((R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a),
+                            r * std::sin(b));
+    }
+  for (int u = 0; u < around; ++u)
+    for (int v = 0; v < tube; ++v) {
+      const int p00 = index(u, v), p10 = index(u + 1, v), p11 = index(u + 1, v + 1),
+                p01 = index(u, v + 1);
+      faces.insert(faces.end(), {{p00, p10, p11}, {p00, p11, p01}});
+    }
+  Surface s = from_lists(vertices, faces);
+  if (enclosed_volume(s.V, s.F) < 0.0) flip_orientation(s);
+  return s;
+}
+
 Surface polygon(const Eigen::MatrixXd& points) {
   if (points.cols() != 2 || points.rows() < 3)
     throw InputError("polygon: expected at least 3 points with 2 coordinates each");

@@ -29,6 +29,10 @@ Surface cube(double edge = 1.0);
 // semi-axes. The wall vertices have z = 0 exactly.
 Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions);
 
+// Torus around the z axis: tube centre radius R, tube radius r, with
+// `around` segments along the ring and `tube` around the tube (genus 1).
+Surface torus(double R, double r, int around, int tube);
+
 // 2D: closed polygon through `points` (#P by 2), in either winding; the edges
 // are oriented counter-clockwise (outward normals to the right).
 Surface polygon(const Eigen::MatrixXd& points);

@@ -37,7 +37,7 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
       << "      <Points>\n"
       << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (int i = 0; i < n; ++i)
-    out << "          " << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << (s.dim == 3 ? s.V(i, 2) : 0.0)
+    out << "          " << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << (s.V.cols() == 3 ? s.V(i, 2) : 0.0)
         << '\n';
   out << "        </DataArray>\n"
       << "      </Points>\n"
@@ -53,7 +53,7 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
   for (int f = 0; f < s.num_faces(); ++f) out << "          " << (f + 1) * s.F.cols() << '\n';
   out << "        </DataArray>\n"
       << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  const int cell_type = s.dim == 3 ? 5 : 3;  // VTK_TRIANGLE, VTK_LINE
+  const int cell_type = s.F.cols() == 3 ? 5 : 3;  // VTK_TRIANGLE, VTK_LINE
   for (int f = 0; f < s.num_faces(); ++f) out << "          " << cell_type << '\n';
   out << "        </DataArray>\n"
       << "      </Cells>\n"
@@ -61,6 +61,17 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
       << "  </UnstructuredGrid>\n"
       << "</VTKFile>\n";
   write_text_file(path, out.str());
+}
+
+void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X,
+                     const std::vector<std::pair<int, int>>& lines) {
+  Surface segments;
+  segments.dim = static_cast<int>(X.cols());
+  segments.V = X;
+  segments.F.resize(static_cast<Eigen::Index>(lines.size()), 2);
+  for (size_t k = 0; k < lines.size(); ++k)
+    segments.F.row(static_cast<Eigen::Index>(k)) << lines[k].first, lines[k].second;
+  write_vtu(path, segments, {});
 }
 
 void write_pvd(const std::filesystem::path& path,

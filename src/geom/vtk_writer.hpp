@@ -22,6 +22,11 @@ struct PointField {
 void write_vtu(const std::filesystem::path& path, const Surface& surface,
                const std::vector<PointField>& fields);
 
+// Writes line segments between vertices of X (#V by dim) as a .vtu of
+// VTK_LINE cells: the bulk fibers, for a look in ParaView.
+void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X,
+                     const std::vector<std::pair<int, int>>& lines);
+
 // Writes a ParaView collection (.pvd) listing (time, file) pairs; file names
 // are written relative to the .pvd's folder.
 void write_pvd(const std::filesystem::path& path,

@@ -22,7 +22,8 @@ Eigen::MatrixXd system_matrix(const Model& model, const Eigen::MatrixXd& X) {
   const int n = model.num_vertices(), dim = model.dim();
   const geom::VertexAreaVectors areas = geom::vertex_area_vectors(X, model.surface.F);
   const FiberLaplacians laplacians =
-      fiber_laplacians(X, areas.magnitude, geom::unique_edges(model.surface));
+      fiber_laplacians(X, areas.magnitude, geom::unique_edges(model.surface), model.fibers.get(),
+                       model.connection_count);
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(model.num_unknowns(), model.num_unknowns());
   const int p = model.pressure_dof();
   for (int a = 0; a < dim; ++a) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "model/fiber_network.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "geom/error.hpp"
@@ -25,18 +26,52 @@ double fiber_length(const Eigen::MatrixXd& X, int i, int j) {
 
 }  // namespace
 
+const char* to_string(ConnectionCount count) {
+  return count == ConnectionCount::Global ? "global" : "symmetric";
+}
+
+PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices)
+    : fibers_(fibers), count_(count), n_(num_vertices) {
+  // The paper divides by N-1, the fibers per vertex, so that Y does not
+  // depend on the discretisation; with pruning, by the fibers that exist.
+  global_ = n_ - 1;
+  if (fibers_ == nullptr) return;
+  const std::vector<int> kept = fibers_->kept_per_vertex();
+  kept_.assign(kept.begin(), kept.end());
+  double sum = 0.0;
+  for (double k : kept_) sum += k;
+  global_ = n_ > 0 ? sum / n_ : 0.0;
+}
+
+void PairFactors::row(int i, double* row) const {
+  if (fibers_ == nullptr) {
+    std::fill(row, row + n_, 0.5 / global_);
+  } else {
+    const uint8_t* kept = fibers_->row(i);
+    for (int j = 0; j < n_; ++j)
+      row[j] = kept[j] == 0 ? 0.0
+               : count_ == ConnectionCount::Global
+                   ? 0.5 / global_
+                   : 1.0 / (kept_[static_cast<size_t>(i)] + kept_[static_cast<size_t>(j)]);
+  }
+  row[i] = 0.0;
+}
+
 FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
-                                 const Eigen::MatrixXi& edges) {
+                                 const Eigen::MatrixXi& edges, const geom::FiberMask* fibers,
+                                 ConnectionCount count) {
   const int n = static_cast<int>(X.rows());
   FiberLaplacians out;
   out.bulk = Eigen::MatrixXd::Zero(n, n);
   out.surface = Eigen::MatrixXd::Zero(n, n);
-  // The paper divides by N-1, the fibers per vertex, so that Y does not
-  // depend on the discretisation.
-  const double connections = n - 1;
-  for (int i = 0; i < n; ++i)
+  const PairFactors factors(fibers, count, n);
+  std::vector<double> h(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    factors.row(i, h.data());
     for (int j = i + 1; j < n; ++j)
-      add_fiber(out.bulk, i, j, (area[i] + area[j]) / (2.0 * connections * fiber_length(X, i, j)));
+      if (h[static_cast<size_t>(j)] != 0.0)
+        add_fiber(out.bulk, i, j, h[static_cast<size_t>(j)] * (area[i] + area[j]) / fiber_length(X, i, j));
+  }
   for (Eigen::Index e = 0; e < edges.rows(); ++e) {
     const int i = edges(e, 0), k = edges(e, 1);
     const double length = fiber_length(X, i, k);

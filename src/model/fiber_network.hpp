@@ -17,11 +17,30 @@ struct FiberLaplacians {
   Eigen::MatrixXd surface;  // N x N, nonzero on mesh edges only
 };
 
+// The factor h_ij = kept_ij / (2 c_ij) of every bulk fiber at one vertex, so
+// that w_ij = h_ij (|S_i| + |S_j|) / |x_i - x_j|; c_ij is N-1 when every pair
+// is kept, else the model's connection count. h_ii = 0.
+class PairFactors {
+ public:
+  PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices);
+  // Fills row (length N) with h_ij for j = 0..N-1.
+  void row(int i, double* row) const;
+
+ private:
+  const geom::FiberMask* fibers_;
+  ConnectionCount count_;
+  int n_;
+  std::vector<double> kept_;  // n_i
+  double global_ = 0.0;       // the count for ConnectionCount::Global or a full body
+};
+
 // X: #V by dim positions giving the fiber lengths; area: #V vertex area
-// magnitudes |S_i|; edges: #E by 2 mesh edges. Throws InputError when two
-// vertices coincide (a fiber of zero length).
+// magnitudes |S_i|; edges: #E by 2 mesh edges; fibers and count as in the
+// Model. Throws InputError when two vertices coincide (a fiber of zero length).
 FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
-                                 const Eigen::MatrixXi& edges);
+                                 const Eigen::MatrixXi& edges,
+                                 const geom::FiberMask* fibers = nullptr,
+                                 ConnectionCount count = ConnectionCount::Symmetric);
 
 // Y_axis * bulk + gamma * surface.
 Eigen::MatrixXd axis_block(const FiberLaplacians& laplacians, const Material& material, int axis);

@@ -6,6 +6,7 @@
 
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
+#include "model/fiber_network.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -48,6 +49,8 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryM
     : dim_(model.dim()),
       n_(model.num_vertices()),
       X_(X),
+      fibers_(model.fibers),
+      factors_(model.fibers.get(), model.connection_count, model.num_vertices()),
       young_(model.material.young_modulus),
       gamma_(model.material.surface_tension),
       method_(method),
@@ -93,7 +96,7 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   const std::vector<int>& act = active(axis);
   const auto m = static_cast<Eigen::Index>(act.size());
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(m, m);
-  const double y = young(axis) * bulk_scale();
+  const double y = young(axis);
   if (y != 0.0) {
     // Active vertices' coordinates and areas, gathered so the loops vectorise.
     std::vector<double> gx[3], ga(static_cast<size_t>(m));
@@ -105,15 +108,23 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
     }
     const double *x0 = gx[0].data(), *x1 = gx[1].data(), *x2 = gx[2].data(), *a = ga.data();
     // Off-diagonal entries -Y_a w_ij, lower triangle, then mirrored.
-#pragma omp parallel for schedule(dynamic, 16)
-    for (Eigen::Index c = 0; c < m; ++c) {
-      double* column = K.col(c).data();
-      const size_t j = static_cast<size_t>(c);
+#pragma omp parallel
+    {
+      std::vector<double> full(static_cast<size_t>(n_)), h(static_cast<size_t>(m));
+#pragma omp for schedule(dynamic, 16)
+      for (Eigen::Index c = 0; c < m; ++c) {
+        double* column = K.col(c).data();
+        const size_t j = static_cast<size_t>(c);
+        factors_.row(act[j], full.data());
+        for (Eigen::Index r = c + 1; r < m; ++r)
+          h[static_cast<size_t>(r)] = full[static_cast<size_t>(act[static_cast<size_t>(r)])];
+        const double* hc = h.data();
 #pragma omp simd
-      for (Eigen::Index r = c + 1; r < m; ++r) {
-        const size_t i = static_cast<size_t>(r);
-        const double dx = x0[i] - x0[j], dy = x1[i] - x1[j], dz = x2[i] - x2[j];
-        column[r] = -y * (a[i] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz);
+        for (Eigen::Index r = c + 1; r < m; ++r) {
+          const size_t i = static_cast<size_t>(r);
+          const double dx = x0[i] - x0[j], dy = x1[i] - x1[j], dz = x2[i] - x2[j];
+          column[r] = -y * hc[i] * (a[i] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz);
+        }
       }
     }
     K.triangularView<Eigen::StrictlyUpper>() = K.transpose();
@@ -145,24 +156,30 @@ Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
   const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data(), *a = area_.data();
   const size_t n = static_cast<size_t>(n_);
   Eigen::VectorXd diagonal(n_);
-#pragma omp parallel for schedule(dynamic, 32)
-  for (int i = 0; i < n_; ++i) {
-    const size_t u = static_cast<size_t>(i);
-    double sum = 0.0;
+#pragma omp parallel
+  {
+    std::vector<double> row(n);
+#pragma omp for schedule(dynamic, 32)
+    for (int i = 0; i < n_; ++i) {
+      const size_t u = static_cast<size_t>(i);
+      factors_.row(i, row.data());
+      const double* h = row.data();
+      double sum = 0.0;
 #pragma omp simd reduction(+ : sum)
-    for (size_t j = 0; j < n; ++j) {
-      const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-      // The j == i term is (a_i + a_i) / 1 with r2 forced to 1: subtracted below.
-      const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-      sum += (a[u] + a[j]) / std::sqrt(r2);
+      for (size_t j = 0; j < n; ++j) {
+        const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+        // h_ii = 0; r2 = 1 there only avoids 1/0.
+        const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
+        sum += h[j] * (a[u] + a[j]) / std::sqrt(r2);
+      }
+      diagonal[i] = sum;
     }
-    diagonal[i] = bulk_scale() * (sum - 2.0 * a[u]);
   }
   return diagonal;
 }
 
 Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
-  // (L v)_i = sum_j w_ij (v_i - v_j), w_ij = s (a_i + a_j) / r_ij. Each pair's
+  // (L v)_i = sum_j w_ij (v_i - v_j), w_ij = h_ij (a_i + a_j) / r_ij. Each pair's
   // distance is computed once and serves every column (up to three at a time).
   const Coordinates x(X_);
   const int k = static_cast<int>(V.cols());
@@ -177,23 +194,29 @@ Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
     const double* v1 = width > 1 ? V.col(first + 1).data() : zeros.data();
     const double* v2 = width > 2 ? V.col(first + 2).data() : zeros.data();
     const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data();
-#pragma omp parallel for schedule(dynamic, 32)
-    for (int i = 0; i < n_; ++i) {
-      const size_t u = static_cast<size_t>(i);
-      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+#pragma omp parallel
+    {
+      std::vector<double> row(n);
+#pragma omp for schedule(dynamic, 32)
+      for (int i = 0; i < n_; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        factors_.row(i, row.data());
+        const double* h = row.data();
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
 #pragma omp simd reduction(+ : s0, s1, s2)
-      for (size_t j = 0; j < n; ++j) {
-        const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-        // j == i contributes (v_i - v_i) = 0; r2 = 1 there only avoids 1/0.
-        const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-        const double w = (a[u] + a[j]) / std::sqrt(r2);
-        s0 += w * (v0[u] - v0[j]);
-        s1 += w * (v1[u] - v1[j]);
-        s2 += w * (v2[u] - v2[j]);
+        for (size_t j = 0; j < n; ++j) {
+          const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+          // j == i contributes (v_i - v_i) = 0; r2 = 1 there only avoids 1/0.
+          const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
+          const double w = h[j] * (a[u] + a[j]) / std::sqrt(r2);
+          s0 += w * (v0[u] - v0[j]);
+          s1 += w * (v1[u] - v1[j]);
+          s2 += w * (v2[u] - v2[j]);
+        }
+        out(i, first) = s0;
+        if (width > 1) out(i, first + 1) = s1;
+        if (width > 2) out(i, first + 2) = s2;
       }
-      out(i, first) = bulk_scale() * s0;
-      if (width > 1) out(i, first + 1) = bulk_scale() * s1;
-      if (width > 2) out(i, first + 2) = bulk_scale() * s2;
     }
   }
   return out;

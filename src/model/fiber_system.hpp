@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "model/boundary_conditions.hpp"
+#include "model/fiber_network.hpp"
 #include "model/model.hpp"
 
 namespace fiberfluid::model {
@@ -44,10 +45,10 @@ class FiberSystem {
   double surface_tension() const { return gamma_; }
   double penalty() const { return penalty_; }
 
-  // Bulk Laplacian weights w_ij = (|S_i| + |S_j|) / (2 (N-1) |x_i - x_j|).
+  // Bulk Laplacian weights w_ij = h_ij (|S_i| + |S_j|) / |x_i - x_j|, with
+  // h_ij = 1 / (2 (N-1)), or kept_ij / (2 c_ij) for pruned fibers (PairFactors).
   const Eigen::MatrixXd& positions() const { return X_; }
   const Eigen::VectorXd& area() const { return area_; }
-  double bulk_scale() const { return 1.0 / (2.0 * (n_ - 1)); }
   const Eigen::SparseMatrix<double>& surface_laplacian() const { return surface_; }
 
   // K_a over the active vertices, dense.
@@ -78,6 +79,8 @@ class FiberSystem {
 
   int dim_ = 3, n_ = 0;
   Eigen::MatrixXd X_;
+  std::shared_ptr<const geom::FiberMask> fibers_;  // keeps factors_'s mask alive
+  PairFactors factors_;
   Eigen::VectorXd area_;
   Eigen::MatrixXd S_;
   Eigen::SparseMatrix<double> surface_;

@@ -2,9 +2,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "geom/fiber_pruning.hpp"
 #include "geom/surface.hpp"
 
 namespace fiberfluid::model {
@@ -53,6 +55,14 @@ struct Constraint {
   Schedule schedule;  // how the displacement is reached
 };
 
+// How the bulk fibers are normalised once some are pruned: the paper divides
+// by N-1, "the number of effective connections" for a concave body.
+enum class ConnectionCount {
+  Symmetric,  // (n_i + n_j) / 2 for the pair, n_i = kept fibers at i (default)
+  Global,     // one count for all pairs: the mean of n_i (the paper's reading)
+};
+const char* to_string(ConnectionCount count);
+
 // Everything the equations need: the reference surface (every vertex used by
 // a face), the material, the loads and the constraints.
 struct Model {
@@ -60,6 +70,9 @@ struct Model {
   Material material;
   std::vector<Load> loads;
   std::vector<Constraint> constraints;
+  // The bulk fibers that exist: null means every pair (a convex body).
+  std::shared_ptr<const geom::FiberMask> fibers;
+  ConnectionCount connection_count = ConnectionCount::Symmetric;
 
   int dim() const { return surface.dim; }
   int num_vertices() const { return surface.num_vertices(); }

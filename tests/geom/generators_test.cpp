@@ -14,7 +14,9 @@ void expect_closed_outward(const Surface& s, int genus = 0) {
   const MeshReport r = inspect(s);
   EXPECT_TRUE(r.ok()) << (r.problems.empty() ? "" : r.problems.front());
   EXPECT_TRUE(r.closed && r.manifold && r.consistently_oriented && r.outward);
-  if (s.dim == 3) EXPECT_EQ(r.genus, genus);
+  if (s.dim == 3) {
+    EXPECT_EQ(r.genus, genus);
+  }
 }
 
 TEST(Generators, EverySolidIsClosedAndOutward) {

@@ -63,7 +63,9 @@ TEST_P(AssemblyOnMeshes, FiberBlocksAreSymmetricLaplaciansAndIgnoreTranslation) 
     EXPECT_NEAR((K * Eigen::VectorXd::Ones(n)).cwiseAbs().maxCoeff(), 0.0, 1e-12 * scale);
     EXPECT_GT(K.diagonal().minCoeff(), 0.0);
     for (int b = 0; b < 3; ++b)
-      if (b != a) EXPECT_EQ(A.block(a * n, b * n, n, n).cwiseAbs().maxCoeff(), 0.0);
+      if (b != a) {
+        EXPECT_EQ(A.block(a * n, b * n, n, n).cwiseAbs().maxCoeff(), 0.0);
+      }
   }
   // The blocks differ only by their Y: (K_y - K_x) = (Y_y - Y_x) L_bulk.
   const geom::VertexAreaVectors areas = geom::vertex_area_vectors(m.surface.V, m.surface.F);
