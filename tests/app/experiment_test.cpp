@@ -30,7 +30,8 @@ TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
 
 INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                          ::testing::Values("rectangle.json", "areas.json", "sphere.json",
-                                           "round_trip.json", "liver_gravity.json"));
+                                           "round_trip.json", "liver_gravity.json",
+                                           "bunny_gravity.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
@@ -128,6 +129,49 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   expect_config_error(dir, nlohmann::json::array(), "expected an object");
   const auto broken = dir.write("broken.json", "{\"name\": ");
   EXPECT_THROW(load_experiment(broken), InputError);
+}
+
+TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  EXPECT_TRUE(load_experiment(write_config(dir, c)).fibers.convex);  // an icosphere
+
+  // The paper's 2D L: three pairs see each other across the re-entrant corner.
+  c["surface"] = {{"generator", "polygon"},
+                  {"points", {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}}};
+  c["supports"][0] = {{"where", "y <= 0"}};
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  c["fibers"] = {{"write", "pruned"}, {"connection_count", "global"}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  EXPECT_FALSE(ex.fibers.convex);
+  EXPECT_EQ(ex.fibers.pairs, 15);
+  EXPECT_EQ(ex.fibers.kept, 12);
+  EXPECT_EQ(ex.model.connection_count, model::ConnectionCount::Global);
+  ASSERT_TRUE(ex.model.fibers);
+
+  OutputWriter writer(ex, dir.path() / "out");
+  writer.begin();
+  const ExperimentResult result = run_experiment(ex);
+  writer.finish(result);
+  EXPECT_TRUE(result.runs_succeeded());
+  EXPECT_EQ(result.figures.at("fibers.pruned"), 3.0);
+  std::ifstream vtu(dir.path() / "out" / "fibers.vtu");
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("NumberOfCells=\"3\""), std::string::npos) << text.substr(0, 300);
+  std::ifstream summary_file(dir.path() / "out" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["fibers"]["pruned"], 3);
+  EXPECT_EQ(summary["fibers"]["connection_count"], "global");
+
+  c["fibers"] = {{"pruning", "off"}};
+  const Experiment unpruned = load_experiment(write_config(dir, c));
+  EXPECT_FALSE(unpruned.model.fibers);
+  EXPECT_EQ(unpruned.fibers.kept, 15);
+
+  c["fibers"] = {{"pruning", "sometimes"}};
+  expect_config_error(dir, c, "fibers.pruning: expected one of auto, off");
+  c["fibers"] = {{"colour", "green"}};
+  expect_config_error(dir, c, "fibers.colour: unknown field");
 }
 
 TEST(ExperimentConfig, InvertedMeshNeedsFlip) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "geom/fiber_pruning.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/assembly.hpp"
 #include "model/model_fixtures.hpp"
@@ -48,6 +49,64 @@ TEST(FiberSystem, MatchesTheFullAssemblyWithBothBoundaryMethods) {
     expect_same_as_full_assembly(testing::paper_rectangle_model(), method);
     expect_same_as_full_assembly(testing::paper_sphere_model(), method);
     expect_same_as_full_assembly(sphere, method);
+  }
+}
+
+Model pruned_liver(ConnectionCount count) {
+  Model m;
+  m.surface = geom::remove_unused_vertices(
+                  geom::read_surface(testing::shared_mesh("liver.obj")).surface)
+                  .surface;
+  m.material.young_modulus.setConstant(2000.0);
+  m.material.surface_tension = 3.0;
+  for (int v : select_half_space(m.surface.V, parse_half_space("y >= 4.75", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  m.fibers = std::make_shared<const geom::FiberMask>(geom::prune_fibers(m.surface).mask);
+  m.connection_count = count;
+  return m;
+}
+
+TEST(FiberSystem, PrunedFibersMatchTheFullAssemblyForBothConnectionCounts) {
+  for (ConnectionCount count : {ConnectionCount::Symmetric, ConnectionCount::Global})
+    for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty})
+      expect_same_as_full_assembly(pruned_liver(count), method);
+}
+
+TEST(FiberSystem, PrunedBlocksIgnoreTranslationAndDropThePrunedPairs) {
+  const Model m = pruned_liver(ConnectionCount::Symmetric);
+  const Eigen::MatrixXd A = system_matrix(m, m.surface.V);
+  const int n = m.num_vertices();
+  const Eigen::MatrixXd K = A.topLeftCorner(n, n);
+  EXPECT_LT((K * Eigen::VectorXd::Ones(n)).cwiseAbs().maxCoeff(), 1e-12 * K.diagonal().maxCoeff());
+  EXPECT_LT((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-14 * K.diagonal().maxCoeff());
+  // A pruned pair is joined only where a mesh edge adds surface tension.
+  Model bulk_only = m;
+  bulk_only.material.surface_tension = 0.0;
+  const Eigen::MatrixXd B = system_matrix(bulk_only, m.surface.V);
+  int pruned = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (!m.fibers->kept(i, j)) {
+        ++pruned;
+        EXPECT_EQ(B(i, j), 0.0);
+      } else {
+        EXPECT_LT(B(i, j), 0.0);
+      }
+  EXPECT_EQ(pruned, 9591 - 5536);
+}
+
+TEST(FiberSystem, AFullMaskWithEitherCountIsTheUnprunedModel) {
+  Model m = testing::paper_sphere_model();
+  const Eigen::MatrixXd unpruned = system_matrix(m, m.surface.V);
+  m.fibers = std::make_shared<const geom::FiberMask>(m.num_vertices());  // every pair kept
+  for (ConnectionCount count : {ConnectionCount::Symmetric, ConnectionCount::Global}) {
+    m.connection_count = count;
+    // (n_i + n_j) / 2 = N - 1 for a convex body: the paper's normalisation.
+    EXPECT_LT((system_matrix(m, m.surface.V) - unpruned).cwiseAbs().maxCoeff(), 1e-12);
+    const FiberSystem system(m, m.surface.V, BoundaryMethod::Elimination, 1e9);
+    const FiberSystem plain(testing::paper_sphere_model(), m.surface.V,
+                            BoundaryMethod::Elimination, 1e9);
+    EXPECT_LT((system.dense_block(0) - plain.dense_block(0)).cwiseAbs().maxCoeff(), 1e-12);
   }
 }
 

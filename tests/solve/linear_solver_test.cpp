@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "geom/fiber_pruning.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/boundary_conditions.hpp"
 #include "model/model_fixtures.hpp"
@@ -50,11 +51,18 @@ struct Case {
   model::Model (*make)();
 };
 
+model::Model pruned_liver() {
+  model::Model m = mesh_model("liver.obj", "y >= 4.75");
+  m.fibers = std::make_shared<const geom::FiberMask>(geom::prune_fibers(m.surface).mask);
+  return m;
+}
+
 const Case kCases[] = {
     {"rectangle", [] { return testing::paper_rectangle_model(); }},
     {"sphere", [] { return testing::paper_sphere_model(); }},
     {"liver", [] { return mesh_model("liver.obj", "y >= 4.75"); }},
     {"cube", [] { return cube_with_prescribed_corner(); }},
+    {"liver_pruned", [] { return pruned_liver(); }},
 };
 
 using Param = std::tuple<size_t, SolverKind, BoundaryMethod>;
@@ -95,7 +103,7 @@ std::string param_name(const ::testing::TestParamInfo<Param>& info) {
 
 INSTANTIATE_TEST_SUITE_P(
     Backends, EveryBackend,
-    ::testing::Combine(::testing::Values(0u, 1u, 2u, 3u),
+    ::testing::Combine(::testing::Values(0u, 1u, 2u, 3u, 4u),
                        ::testing::Values(SolverKind::DenseLU, SolverKind::BlockCholesky,
                                          SolverKind::Cholmod, SolverKind::PCG),
                        ::testing::Values(BoundaryMethod::Elimination, BoundaryMethod::Penalty)),
