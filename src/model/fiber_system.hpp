@@ -32,6 +32,8 @@ class FiberSystem {
   int num_vertices() const { return n_; }
   int num_unknowns() const { return offsets_.back() + 1; }  // reduced, with P
   int offset(int axis) const { return offsets_[static_cast<size_t>(axis)]; }
+  // Start of each axis block in the reduced unknowns, then the end of the last.
+  const std::vector<int>& block_offsets() const { return offsets_; }
   const std::vector<int>& active(int axis) const { return active_[static_cast<size_t>(axis)]; }
   // Positions within active(axis) whose diagonal is the penalty (penalty method only).
   const std::vector<int>& penalised(int axis) const {

@@ -32,9 +32,7 @@ class BlockCholeskySolver final : public SchurSolver {
   Status factorize_K(const model::FiberSystem& system) override {
     const int count = system.blocks_equal() ? 1 : system.dim();
     factors_.clear();
-    offsets_.clear();
-    for (int a = 0; a < system.dim(); ++a) offsets_.push_back(system.offset(a));
-    offsets_.push_back(system.num_unknowns() - 1);
+    offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
       Eigen::MatrixXd K = system.dense_block(a);
       const int n = static_cast<int>(K.rows());

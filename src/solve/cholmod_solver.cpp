@@ -30,9 +30,7 @@ class CholmodSolver final : public SchurSolver {
   Status factorize_K(const model::FiberSystem& system) override {
     const int count = system.blocks_equal() ? 1 : system.dim();
     factors_.resize(static_cast<size_t>(count));
-    offsets_.clear();
-    for (int a = 0; a < system.dim(); ++a) offsets_.push_back(system.offset(a));
-    offsets_.push_back(system.num_unknowns() - 1);
+    offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
       const Status status = factors_[static_cast<size_t>(a)].factorize(system.sparse_block(a, true));
       if (!status.ok)

@@ -30,9 +30,7 @@ class PcgSolver final : public SchurSolver {
     system_ = &system;
     const int count = system.blocks_equal() ? 1 : system.dim();
     preconditioners_.resize(static_cast<size_t>(count));
-    offsets_.clear();
-    for (int a = 0; a < system.dim(); ++a) offsets_.push_back(system.offset(a));
-    offsets_.push_back(system.num_unknowns() - 1);
+    offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
       Eigen::SparseMatrix<double> M = system.sparse_block(a, false);
       std::vector<char> penalised(system.active(a).size(), 0);
