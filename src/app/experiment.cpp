@@ -309,7 +309,8 @@ void read_fibers(Fields& root, Experiment& ex) {
   if (!report.pruning) return;
   report.convex = geom::is_convex(m.surface);
   if (report.convex) return;
-  constexpr int kLargestPruned = 20000;  // N^2 pair tests and an N^2 byte table
+  // N^2 pair tests (5,000 vertices: about 2 minutes here) and an N^2 byte table.
+  constexpr int kLargestPruned = 10000;
   if (n > kLargestPruned)
     root.fail("fibers.pruning", "a concave body of " + std::to_string(n) +
                                     " vertices is beyond exact pruning (at most " +
