@@ -99,16 +99,6 @@ DofPartition partition_dofs(const Model& model) {
   return p;
 }
 
-Eigen::VectorXd constrained_values(const Model& model, const DofPartition& partition, int step,
-                                   int steps) {
-  Eigen::VectorXd values(static_cast<Eigen::Index>(partition.constrained.size()));
-  for (size_t k = 0; k < partition.constrained.size(); ++k) {
-    const Constraint& c = model.constraints[static_cast<size_t>(partition.constraint_of[k])];
-    values[static_cast<Eigen::Index>(k)] = c.value * c.schedule.factor(step, steps);
-  }
-  return values;
-}
-
 void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
                    Eigen::MatrixXd& A, Eigen::VectorXd& B) {
   for (size_t k = 0; k < partition.constrained.size(); ++k) {
@@ -141,16 +131,6 @@ void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
     for (Eigen::Index r = 0; r < nf; ++r)
       A_free(r, c) = A(partition.free[static_cast<size_t>(r)], partition.free[static_cast<size_t>(c)]);
   B_free = reduce_rhs(partition, values, A, B);
-}
-
-Eigen::VectorXd expand_solution(const DofPartition& partition, const Eigen::VectorXd& free,
-                                const Eigen::VectorXd& values, int num_unknowns) {
-  Eigen::VectorXd x(num_unknowns);
-  for (size_t k = 0; k < partition.free.size(); ++k)
-    x[partition.free[k]] = free[static_cast<Eigen::Index>(k)];
-  for (size_t k = 0; k < partition.constrained.size(); ++k)
-    x[partition.constrained[k]] = values[static_cast<Eigen::Index>(k)];
-  return x;
 }
 
 }  // namespace fiberfluid::model

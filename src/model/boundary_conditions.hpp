@@ -46,10 +46,6 @@ struct DofPartition {
 };
 DofPartition partition_dofs(const Model& model);
 
-// Values of the constrained unknowns after step k of n (in partition order).
-Eigen::VectorXd constrained_values(const Model& model, const DofPartition& partition, int step,
-                                   int steps);
-
 // The paper's penalty: A(d, d) = penalty and B(d) = penalty * value for each
 // constrained unknown d; the rest of the row is kept.
 void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
@@ -61,9 +57,5 @@ void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
                    Eigen::VectorXd& B_free);
 Eigen::VectorXd reduce_rhs(const DofPartition& partition, const Eigen::VectorXd& values,
                            const Eigen::MatrixXd& A, const Eigen::VectorXd& B);
-
-// The full unknown vector from the free part and the constrained values.
-Eigen::VectorXd expand_solution(const DofPartition& partition, const Eigen::VectorXd& free,
-                                const Eigen::VectorXd& values, int num_unknowns);
 
 }  // namespace fiberfluid::model

@@ -5,14 +5,9 @@
 #include <string>
 #include <vector>
 
-namespace fiberfluid::solve {
+#include "solve/status.hpp"
 
-// The outcome of a numerical step that can fail on valid input.
-struct Status {
-  bool ok = true;
-  std::string message;
-  static Status failure(std::string why) { return {false, std::move(why)}; }
-};
+namespace fiberfluid::solve {
 
 // LU with partial pivoting of a dense square matrix through LAPACK (dgetrf),
 // the paper's method. Factor once, then solve for as many right-hand sides as

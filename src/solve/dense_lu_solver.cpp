@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "solve/backends.hpp"
+#include "solve/dense_lu.hpp"
 
 namespace fiberfluid::solve {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "model/fiber_system.hpp"
-#include "solve/dense_lu.hpp"
+#include "solve/status.hpp"
 
 namespace fiberfluid::solve {
 

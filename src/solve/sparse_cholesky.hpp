@@ -4,7 +4,7 @@
 #include <Eigen/SparseCore>
 #include <memory>
 
-#include "solve/dense_lu.hpp"
+#include "solve/status.hpp"
 
 namespace fiberfluid::solve {
 

@@ -56,7 +56,7 @@ TEST(BoundaryConditions, PartitionMergesRepeatsAndRejectsConflicts) {
   EXPECT_THROW(partition_dofs(m), InputError);
 }
 
-TEST(BoundaryConditions, ReductionAndExpansionRoundTrip) {
+TEST(BoundaryConditions, ReductionMovesConstrainedValuesToTheRightHandSide) {
   Eigen::MatrixXd A(3, 3);
   A << 4, 1, 0, 1, 3, 1, 0, 1, 2;
   DofPartition p;
@@ -68,7 +68,6 @@ TEST(BoundaryConditions, ReductionAndExpansionRoundTrip) {
   reduce_system(p, values, A, Eigen::Vector3d(1, 0, 1), A_free, B_free);
   EXPECT_EQ(A_free, (Eigen::Matrix2d() << 4, 0, 0, 2).finished());
   EXPECT_EQ(B_free, Eigen::Vector2d(-1, -1));
-  EXPECT_EQ(expand_solution(p, Eigen::Vector2d(7, 8), values, 3), Eigen::Vector3d(7, 2, 8));
 }
 
 }  // namespace
