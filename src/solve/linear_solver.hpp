@@ -29,7 +29,6 @@ struct PcgOptions {
 
 // What a backend did, for the summaries.
 struct SolverStatistics {
-  int factorizations = 0;
   double factorization_flops = 0.0;  // dense paths: the LAPACK factorisation's flop count
   double factorization_kernel_seconds = 0.0;  // time inside that LAPACK routine
   int iterations = 0;                // pcg: iterations over all solves

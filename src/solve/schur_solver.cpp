@@ -8,7 +8,6 @@ namespace fiberfluid::solve {
 Status SchurSolver::factorize(const model::FiberSystem& system) {
   Status status = factorize_K(system);
   if (!status.ok) return status;
-  ++statistics_.factorizations;
   border_ = system.border();
   status = solve_K(border_, &z_);
   if (!status.ok) return status;
