@@ -59,8 +59,10 @@ struct MeshBuilder {
   }
 };
 
+// "file:line: ", or "file: " where the line is unknown (line 0: binary or
+// whitespace-separated data such as a PLY body).
 std::string where(const std::filesystem::path& path, int line) {
-  return path.string() + ":" + std::to_string(line) + ": ";
+  return path.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
 }
 
 double parse_number(const std::string& token, const std::filesystem::path& path, int line,

@@ -285,6 +285,10 @@ TEST(MeshIO, BadFilesAreRejectedWithTheirOwnMessage) {
                                          "element face 1\nproperty list uchar int vertex_index\n"
                                          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"),
                     "refers to vertex 9");
+  expect_read_error(dir.write("word.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"
+                                          "property float x\nproperty float y\nproperty float z\n"
+                                          "end_header\n0 zero 0\n"),
+                    "word.ply: expected a number for a PLY value, got 'zero'");
 }
 
 }  // namespace
