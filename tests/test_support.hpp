@@ -10,8 +10,8 @@
 
 namespace fiberfluid::testing {
 
-inline std::filesystem::path shared_mesh(const std::string& name) {
-  return std::filesystem::path(FIBERFLUID_SHARED_MESHES) / name;
+inline std::filesystem::path data_mesh(const std::string& name) {
+  return std::filesystem::path(FIBERFLUID_MESHES) / name;
 }
 
 inline std::filesystem::path experiment_file(const std::string& name) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Pruning benchmark (issue 4): the time to decide every fiber of concave
-// meshes exactly: the shared liver, torus and Bunny, and a generated torus
+// meshes exactly: the liver, torus and Bunny, and a generated torus
 // of 5,000 vertices. Prints a Markdown table.
 //   fiberfluid_pruning [--skip-large]
 #include <cstring>
@@ -26,11 +26,11 @@ void report(const std::string& name, const fiberfluid::geom::Surface& s) {
 int main(int argc, char** argv) {
   namespace geom = fiberfluid::geom;
   const bool skip_large = argc > 1 && std::strcmp(argv[1], "--skip-large") == 0;
-  const std::string shared = FIBERFLUID_SHARED_MESHES;
+  const std::string meshes = FIBERFLUID_MESHES;
   std::cout << "| mesh | vertices | fibers in all | kept | pruned | exact fallbacks | seconds |\n"
             << "|---|---|---|---|---|---|---|" << std::endl;
   for (const char* name : {"liver.obj", "torus.obj", "Bunny.stl"})
-    report(name, geom::remove_unused_vertices(geom::read_surface(shared + "/" + name).surface)
+    report(name, geom::remove_unused_vertices(geom::read_surface(meshes + "/" + name).surface)
                      .surface);
   if (!skip_large) report("torus R=2 r=0.7, 100 x 50", geom::torus(2.0, 0.7, 100, 50));
   return 0;

@@ -70,10 +70,8 @@ int main(int argc, char** argv) {
   config["surface"]["subdivisions"] = subdivisions;
   config["stepping"]["solver"] = solver;
   config["expected"] = nlohmann::json::array();
-  const std::string path = "/tmp/fiberfluid_scaling_" + std::to_string(getpid()) + ".json";
-  std::ofstream(path) << config.dump();
-  const fiberfluid::app::Experiment ex = fiberfluid::app::load_experiment(path);
-  std::remove(path.c_str());
+  const fiberfluid::app::Experiment ex =
+      fiberfluid::app::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
 
   const fiberfluid::app::ExperimentResult result = fiberfluid::app::run_experiment(ex);
   const fiberfluid::app::RunResult& run = result.runs.front();
@@ -81,7 +79,7 @@ int main(int argc, char** argv) {
   double slowest_step = 0.0;
   for (const auto& step : s.steps) slowest_step = std::max(slowest_step, step.seconds);
   nlohmann::json line = {
-      {"vertices", ex.model.num_vertices()},
+      {"vertices", ex.cases.front().model.num_vertices()},
       {"solver", solver},
       {"success", s.success},
       {"message", s.message},

@@ -4,6 +4,7 @@
 #include "app/json_fields.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -199,26 +200,37 @@ std::vector<model::Load> read_loads(Fields& root, const geom::Surface& surface,
   return loads;
 }
 
-std::vector<model::Constraint> read_constraints(Fields& root, const geom::Surface& surface,
-                                                const std::vector<int>& input_to_model) {
-  std::vector<model::Constraint> constraints;
+// Each entry of "supports" and "prescribed" is a group with its own reaction
+// force, named by "label" (default support_K / prescribed_K).
+void read_constraints(Fields& root, const geom::Surface& surface,
+                      const std::vector<int>& input_to_model, model::Model& model) {
+  auto add_group = [&](Fields& f, const std::string& fallback) {
+    const std::string label = f.string("label", fallback);
+    for (const std::string& other : model.constraint_groups)
+      if (other == label) f.fail("label", "\"" + label + "\" names another group already");
+    model.constraint_groups.push_back(label);
+    return static_cast<int>(model.constraint_groups.size()) - 1;
+  };
+  int k = 0;
   for (Fields f : root.objects("supports")) {
+    const int group = add_group(f, "support_" + std::to_string(k++));
     const std::vector<int> vertices = read_selection(f, surface, input_to_model);
     const std::vector<int> axes = read_axes(f, surface.dim);
     f.finish();
     for (int v : vertices)
-      for (int a : axes) constraints.push_back({v, a, 0.0, {}});
+      for (int a : axes) model.constraints.push_back({v, a, 0.0, {}, group});
   }
+  k = 0;
   for (Fields f : root.objects("prescribed")) {
+    const int group = add_group(f, "prescribed_" + std::to_string(k++));
     const std::vector<int> vertices = read_selection(f, surface, input_to_model);
     const Eigen::VectorXd displacement = f.vector("displacement", surface.dim);
     const model::Schedule schedule = read_schedule(f, "ramp");
     f.finish();
     for (int v : vertices)
       for (int a = 0; a < surface.dim; ++a)
-        constraints.push_back({v, a, displacement[a], schedule});
+        model.constraints.push_back({v, a, displacement[a], schedule, group});
   }
-  return constraints;
 }
 
 solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
@@ -236,21 +248,23 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   options.solver = *solve::solver_kind_from_string(solver);
   options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
   options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
+  options.max_volume_change = f.positive("max_volume_change", options.max_volume_change);
+  options.stop_on_inverted_faces =
+      f.boolean("stop_on_inverted_faces", options.stop_on_inverted_faces);
   f.finish();
   return options;
 }
 
-void check_tables(const Fields& root, const model::Model& model, const Variant& variant) {
+void check_tables(const Fields& root, const Case& c) {
   auto check = [&](const model::Schedule& s, const std::string& what) {
     if (s.kind == model::Schedule::Kind::Table &&
-        static_cast<int>(s.values.size()) != variant.stepping.steps)
+        static_cast<int>(s.values.size()) != c.stepping.steps)
       root.fail(what, "the schedule lists " + std::to_string(s.values.size()) +
-                          " factors but run \"" + variant.name + "\" has " +
-                          std::to_string(variant.stepping.steps) + " steps");
+                          " factors but stepping.steps is " + std::to_string(c.stepping.steps));
   };
-  for (size_t l = 0; l < model.loads.size(); ++l)
-    check(model.loads[l].schedule, "loads[" + std::to_string(l) + "].schedule");
-  for (const model::Constraint& c : model.constraints) check(c.schedule, "prescribed.schedule");
+  for (size_t l = 0; l < c.model.loads.size(); ++l)
+    check(c.model.loads[l].schedule, "loads[" + std::to_string(l) + "].schedule");
+  for (const model::Constraint& k : c.model.constraints) check(k.schedule, "prescribed.schedule");
 }
 
 std::vector<ExpectedFigure> read_expected(Fields& root) {
@@ -287,7 +301,7 @@ std::vector<ExpectedFigure> read_expected(Fields& root) {
 }
 
 // Reads "fibers" and prunes the fibers that leave a concave body.
-void read_fibers(Fields& root, Experiment& ex) {
+void read_fibers(Fields& root, Case& ex) {
   std::string mode = "auto", count = "symmetric";
   if (root.has("fibers")) {
     Fields f = root.object("fibers");
@@ -331,31 +345,101 @@ void read_fibers(Fields& root, Experiment& ex) {
   m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
 }
 
-void read_simulation(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
-  Fields surface = root.object("surface");
-  ex.input_surface = read_surface_spec(surface, folder, &ex.warnings);
-  surface.finish();
-  const geom::CompactSurface compact = geom::remove_unused_vertices(ex.input_surface);
-  ex.model_to_input = compact.to_input;
-  ex.model.surface = compact.surface;
-  const int dim = ex.model.dim();
-  ex.model.material = read_material(root.object("material"), dim);
-  ex.model.loads = read_loads(root, ex.model.surface, compact.from_input);
-  ex.model.constraints = read_constraints(root, ex.model.surface, compact.from_input);
-  read_fibers(root, ex);
+// The surface, its compaction and its fibers: what several variants that
+// share "surface" and "fibers" build once (pruning a large mesh takes seconds).
+struct SurfaceKey {
+  std::string surface, fibers;
+  bool operator==(const SurfaceKey& o) const { return surface == o.surface && fibers == o.fibers; }
+};
 
-  solve::SteppingOptions base;
-  if (root.has("stepping")) base = read_stepping(root.object("stepping"), base);
-  for (Fields f : root.objects("variants")) {
-    Variant v;
-    v.name = f.string("name");
-    v.stepping = f.has("stepping") ? read_stepping(f.object("stepping"), base) : base;
-    f.finish();
-    ex.variants.push_back(v);
+// Builds one case from a complete simulation document, reusing the surface
+// and fibers of an earlier case with the same "surface" and "fibers".
+void build_case(Fields& root, const std::filesystem::path& folder, std::vector<Case>& built,
+                std::vector<SurfaceKey>& keys, std::vector<std::string>* warnings, Case& c) {
+  const SurfaceKey key{root.raw("surface").dump(),
+                       root.has("fibers") ? root.raw("fibers").dump() : std::string()};
+  const auto same = std::find(keys.begin(), keys.end(), key);
+  if (same != keys.end()) {
+    const Case& earlier = built[static_cast<size_t>(same - keys.begin())];
+    c.input_surface = earlier.input_surface;
+    c.model_to_input = earlier.model_to_input;
+    c.model.surface = earlier.model.surface;
+    c.model.fibers = earlier.model.fibers;
+    c.model.connection_count = earlier.model.connection_count;
+    c.fibers = earlier.fibers;
+  } else {
+    Fields surface = root.object("surface");
+    c.input_surface = read_surface_spec(surface, folder, warnings);
+    surface.finish();
+    const geom::CompactSurface compact = geom::remove_unused_vertices(c.input_surface);
+    c.model_to_input = compact.to_input;
+    c.model.surface = compact.surface;
+    read_fibers(root, c);
   }
-  if (ex.variants.empty()) ex.variants.push_back({"", base});
-  for (const Variant& v : ex.variants) check_tables(root, ex.model, v);
+  std::vector<int> from_input(static_cast<size_t>(c.input_surface.num_vertices()), -1);
+  for (size_t m = 0; m < c.model_to_input.size(); ++m)
+    from_input[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
+  const int dim = c.model.dim();
+  c.model.material = read_material(root.object("material"), dim);
+  c.model.loads = read_loads(root, c.model.surface, from_input);
+  read_constraints(root, c.model.surface, from_input, c.model);
+  c.stepping = root.has("stepping") ? read_stepping(root.object("stepping"), {})
+                                    : solve::SteppingOptions{};
+  check_tables(root, c);
+  root.finish();
+  keys.push_back(key);
+}
 
+// Fields of the experiment that a variant may not patch.
+const char* const kExperimentFields[] = {"name", "description", "kind", "variants", "expected",
+                                         "output"};
+
+void check_variant_name(const Fields& f, const std::string& name,
+                        const std::vector<Case>& earlier) {
+  const bool safe = !name.empty() && name != "." && name != ".." &&
+                    std::all_of(name.begin(), name.end(), [](unsigned char ch) {
+                      return std::isalnum(ch) || ch == '_' || ch == '-' || ch == '.';
+                    });
+  if (!safe)
+    f.fail("name", "expected a non-empty name of letters, digits, '_', '-' or '.' (it names "
+                   "the variant's output folder), got \"" + name + "\"");
+  for (const Case& c : earlier)
+    if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
+}
+
+// A simulation: the base document, or one case per variant, each the base
+// with the variant's JSON merge patch (RFC 7386) applied.
+void read_simulation(Fields& root, const nlohmann::json& document,
+                     const std::filesystem::path& folder, Experiment& ex) {
+  json base = document;
+  for (const char* field : kExperimentFields) base.erase(field);
+  std::vector<SurfaceKey> keys;
+  if (!root.has("variants")) {
+    Fields f(base, "", root.file());
+    Case c;
+    build_case(f, folder, ex.cases, keys, &ex.warnings, c);
+    ex.cases.push_back(std::move(c));
+  } else {
+    const json& variants = root.raw("variants");
+    if (!variants.is_array() || variants.empty())
+      root.fail("variants", "expected a non-empty list of objects");
+    for (size_t k = 0; k < variants.size(); ++k) {
+      Fields v(variants[k], "variants[" + std::to_string(k) + "]", root.file());
+      Case c;
+      c.variant = v.string("name");
+      check_variant_name(v, c.variant, ex.cases);
+      c.patch = variants[k];
+      c.patch.erase("name");
+      for (const char* field : kExperimentFields)
+        if (c.patch.contains(field))
+          v.fail(field, "belongs to the whole experiment; a variant cannot change it");
+      json patched = base;
+      patched.merge_patch(c.patch);
+      Fields f(patched, "", root.file() + " [variant " + c.variant + "]");
+      build_case(f, folder, ex.cases, keys, &ex.warnings, c);
+      ex.cases.push_back(std::move(c));
+    }
+  }
   if (root.has("output")) {
     Fields f = root.object("output");
     ex.output.vtk = f.boolean("vtk", true);
@@ -391,6 +475,25 @@ geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
   return read.surface;
 }
 
+Experiment parse_experiment(const json& document, const std::filesystem::path& folder,
+                            const std::string& label) {
+  Fields root(document, "", label);
+  Experiment ex;
+  ex.name = root.string("name", "experiment");
+  ex.description = root.string("description", "");
+  ex.kind = root.choice("kind", "simulate", {"simulate", "areas"}) == "areas"
+                ? Experiment::Kind::Areas
+                : Experiment::Kind::Simulate;
+  ex.expected = read_expected(root);
+  if (ex.kind == Experiment::Kind::Simulate) {
+    read_simulation(root, document, folder, ex);  // each case checks its own fields
+  } else {
+    read_areas(root, folder, ex);
+    root.finish();
+  }
+  return ex;
+}
+
 Experiment load_experiment(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open the experiment file");
@@ -400,19 +503,9 @@ Experiment load_experiment(const std::filesystem::path& path) {
   } catch (const json::parse_error& e) {
     throw InputError(path.string() + ": not valid JSON: " + e.what());
   }
-  Fields root(document, "", path.string());
-  Experiment ex;
+  if (document.is_object() && !document.contains("name")) document["name"] = path.stem().string();
+  Experiment ex = parse_experiment(document, path.parent_path(), path.string());
   ex.source = path;
-  ex.name = root.string("name", path.stem().string());
-  ex.description = root.string("description", "");
-  ex.kind = root.choice("kind", "simulate", {"simulate", "areas"}) == "areas"
-                ? Experiment::Kind::Areas
-                : Experiment::Kind::Simulate;
-  const std::filesystem::path folder = path.parent_path();
-  if (ex.kind == Experiment::Kind::Simulate) read_simulation(root, folder, ex);
-  else read_areas(root, folder, ex);
-  ex.expected = read_expected(root);
-  root.finish();
   return ex;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,12 +22,6 @@ struct ExpectedFigure {
   std::optional<double> at_most, at_least;
   Eigen::MatrixXd matrix;                 // for matrix figures ("system_matrix")
   std::string note;                       // where the number comes from
-};
-
-// One run of a sweep: a label and the stepping options it uses.
-struct Variant {
-  std::string name;
-  solve::SteppingOptions stepping;
 };
 
 struct OutputOptions {
@@ -54,28 +49,39 @@ struct NamedSurface {
   geom::Surface surface;
 };
 
+// One simulation, fully resolved: the whole experiment when it does not
+// sweep, or one variant of a sweep (the base document with the variant's
+// JSON merge patch applied).
+struct Case {
+  std::string variant;        // "" unless the experiment sweeps
+  nlohmann::json patch;       // the variant's merge patch (null without a sweep)
+  // The surface as given (input vertex order), the model on its used
+  // vertices, and the map between the two.
+  geom::Surface input_surface;
+  std::vector<int> model_to_input;
+  model::Model model;
+  solve::SteppingOptions stepping;
+  FiberReport fibers;
+};
+
 // A parsed and validated experiment file.
 struct Experiment {
   enum class Kind { Simulate, Areas };
   Kind kind = Kind::Simulate;
   std::string name;
   std::string description;
-  std::filesystem::path source;  // the JSON file
+  std::filesystem::path source;  // the JSON file ("" for a document built in a program)
 
-  // Simulate: the surface as given (input vertex order), the model on its
-  // used vertices, and the map between the two.
-  geom::Surface input_surface;
-  std::vector<int> model_to_input;
-  model::Model model;
-  std::vector<Variant> variants;  // one unless the file sweeps
+  std::vector<Case> cases;       // Simulate: one, or one per variant
   OutputOptions output;
-  FiberReport fibers;
 
   // Areas:
   std::vector<NamedSurface> area_surfaces;
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader
+
+  bool sweeps() const { return !cases.empty() && !cases.front().variant.empty(); }
 };
 
 // Reads and validates an experiment file. Throws InputError naming the file
@@ -83,6 +89,11 @@ struct Experiment {
 // for an unknown field, a wrong type, a missing or bad mesh, a selection that
 // selects nothing; nothing is written.
 Experiment load_experiment(const std::filesystem::path& path);
+
+// The same from a JSON document built in a program (e.g. a Python dict):
+// relative mesh paths are taken from `folder`, and errors name `label`.
+Experiment parse_experiment(const nlohmann::json& document, const std::filesystem::path& folder,
+                            const std::string& label);
 
 // Reads a mesh file and checks it (closed, manifold, outward, ...), optionally
 // flipping an inward mesh first. Throws InputError naming the file.

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // fiberfluid: command-line tool. It only parses, loads and dispatches.
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <mutex>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -11,6 +13,7 @@
 #include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
+#include "geom/progress.hpp"
 
 namespace {
 
@@ -18,44 +21,107 @@ namespace app = fiberfluid::app;
 
 enum ExitCode { kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3 };
 
-// Prints a progress line per step on a terminal, or about ten lines otherwise.
-class Progress {
+// Draws the library's progress reports on stderr: one line redrawn in place
+// on a terminal, plain lines (a new phase, every tenth, or every 10 s) when
+// stderr is a file or a pipe. Each line has the elapsed time of the phase and,
+// when its total is known, an estimate of what remains.
+class ProgressPrinter {
  public:
-  explicit Progress(const app::Experiment& ex) : ex_(ex), tty_(isatty(STDERR_FILENO) != 0) {}
-  void operator()(size_t run, const fiberfluid::solve::StepRecord& r) const {
-    const int steps = ex_.variants[run].stepping.steps;
-    if (steps < 10) return;
-    const bool last = r.step == steps;
-    if (!tty_ && r.step % std::max(1, steps / 10) != 0 && !last) return;
-    const std::string& variant = ex_.variants[run].name;
-    std::fprintf(stderr, "%s[%s%s%s] step %d/%d  P = %.6g  max|u| = %.6g%s", tty_ ? "\r" : "",
-                 ex_.name.c_str(), variant.empty() ? "" : " ", variant.c_str(), r.step, steps,
-                 r.pressure, r.max_displacement, tty_ && !last ? "" : "\n");
+  ProgressPrinter() : tty_(isatty(STDERR_FILENO) != 0) {}
+
+  void operator()(const std::string& label, const char* phase, double done, double total) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const Clock::time_point now = Clock::now();
+    const std::string key = label + "|" + phase;
+    const bool fresh = key != key_ || done < done_;
+    if (fresh) {
+      key_ = key;
+      start_ = now;
+      tenth_ = -1;
+    }
+    done_ = done;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const bool finished = total > 0.0 && done >= total;
+    const int tenth = total > 0.0 ? static_cast<int>(10.0 * done / total) : -1;
+    if (tty_) {
+      if (!finished && !fresh && now - drawn_ < std::chrono::milliseconds(100)) return;
+    } else if (!fresh && !finished && tenth == tenth_ &&
+               now - drawn_ < std::chrono::seconds(10)) {
+      return;
+    }
+    tenth_ = tenth;
+    drawn_ = now;
+    std::string line = (label.empty() ? "" : "[" + label + "] ") + phase;
+    char buffer[160];
+    if (total > 0.0) {
+      std::snprintf(buffer, sizeof buffer, " %g/%g (%.0f%%)  %.1f s", done, total,
+                    100.0 * done / total, elapsed);
+      line += buffer;
+      if (done > 0.0 && !finished) {
+        std::snprintf(buffer, sizeof buffer, ", about %.0f s left",
+                      elapsed * (total - done) / done);
+        line += buffer;
+      }
+    } else {
+      std::snprintf(buffer, sizeof buffer, " %g  %.1f s", done, elapsed);
+      line += buffer;
+    }
+    if (tty_) std::fprintf(stderr, "\r\033[K%s", line.c_str());
+    else std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+  }
+
+  // Ends the redrawn line, so that what follows starts on its own.
+  void close() {
+    if (tty_) std::fprintf(stderr, "\r\033[K");
   }
 
  private:
-  const app::Experiment& ex_;
+  using Clock = std::chrono::steady_clock;
+  std::mutex mutex_;
   bool tty_;
+  std::string key_;
+  Clock::time_point start_, drawn_;
+  double done_ = 0.0;
+  int tenth_ = -1;
 };
 
-int run_command(const std::string& path, std::string output, bool check_expected) {
+struct RunFlags {
+  std::string output;
+  bool check_expected = false;
+  bool quiet = false;
+  int jobs = 0;
+};
+
+int run_command(const std::string& path, const RunFlags& flags) {
+  ProgressPrinter printer;
+  if (!flags.quiet)
+    fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
+                                             double done, double total) {
+      printer(label, phase, done, total);
+    });
   const app::Experiment ex = app::load_experiment(path);  // throws before anything is written
+  printer.close();
   for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
-  if (output.empty()) output = "out/" + ex.name;
+  const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
 
   app::OutputWriter writer(ex, output);
   writer.begin();
-  const Progress progress(ex);
+  app::RunOptions options;
+  options.jobs = flags.jobs;
   const app::ExperimentResult result = app::run_experiment(
-      ex, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
-        progress(run, r);
+      ex,
+      [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
         writer.on_step(run, r, x);
-      });
+      },
+      options);
+  printer.close();
+  fiberfluid::set_progress_sink({});
   writer.finish(result);
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
   if (ex.kind == app::Experiment::Kind::Simulate) {
-    const app::FiberReport& f = ex.fibers;
+    const app::FiberReport& f = ex.cases.front().fibers;
     std::cout << "  fibers: " << f.kept << " kept of " << f.pairs << " ("
               << (!f.pruning ? "pruning off" : f.convex ? "convex" : "pruned exactly")
               << "; per vertex " << f.min_per_vertex << " / " << f.mean_per_vertex << " / "
@@ -73,7 +139,7 @@ int run_command(const std::string& path, std::string output, bool check_expected
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
-  if (check_expected && !result.checks_passed()) {
+  if (flags.check_expected && !result.checks_passed()) {
     std::cerr << "error: some expected figures were not met (see above)\n";
     return kChecksFailed;
   }
@@ -99,13 +165,19 @@ int main(int argc, char** argv) {
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);
 
-  std::string experiment, output, mesh;
-  bool check_expected = false, flip = false;
+  std::string experiment, mesh;
+  RunFlags flags;
+  bool flip = false;
   CLI::App* run = cli.add_subcommand("run", "Run an experiment file");
   run->add_option("experiment", experiment, "Experiment file (JSON)")->required();
-  run->add_option("-o,--output", output, "Output folder (default: out/<experiment name>)");
-  run->add_flag("--check", check_expected,
+  run->add_option("-o,--output", flags.output, "Output folder (default: out/<experiment name>)");
+  run->add_flag("--check", flags.check_expected,
                 "Exit with status 3 when an expected figure of the file is not met");
+  run->add_flag("-q,--quiet", flags.quiet, "No progress lines");
+  run->add_option("-j,--jobs", flags.jobs,
+                  "Variants of a sweep run at once (default: one per core); each gets "
+                  "cores / jobs threads")
+      ->check(CLI::Range(0, 256));
 
   CLI::App* check = cli.add_subcommand("check", "Check a mesh file and print its report");
   check->add_option("mesh", mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
@@ -113,7 +185,7 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(cli, argc, argv);
   try {
-    if (run->parsed()) return run_command(experiment, output, check_expected);
+    if (run->parsed()) return run_command(experiment, flags);
     return check_command(mesh, flip);
   } catch (const fiberfluid::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";

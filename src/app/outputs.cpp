@@ -1,9 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/outputs.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <iomanip>
+#include <sstream>
 
 #include "geom/area_vectors.hpp"
+#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/vtk_writer.hpp"
 #include "model/assembly.hpp"
@@ -12,6 +22,9 @@ namespace fiberfluid::app {
 namespace {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
+
+const char kAxes[] = "xyz";
 
 json stepping_json(const solve::SteppingOptions& s) {
   return {{"steps", s.steps},
@@ -21,31 +34,54 @@ json stepping_json(const solve::SteppingOptions& s) {
           {"penalty", s.penalty},
           {"solver", solve::to_string(s.solver)},
           {"tolerance", s.pcg.tolerance},
-          {"max_iterations", s.pcg.max_iterations}};
+          {"max_iterations", s.pcg.max_iterations},
+          {"max_volume_change", s.max_volume_change},
+          {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
 }
 
-json run_json(const Experiment& ex, const ExperimentResult& result, const RunResult& run) {
+std::string group_name(const model::Model& m, size_t g) {
+  return g < m.constraint_groups.size() ? m.constraint_groups[g] : "supports";
+}
+
+json vector_json(const Eigen::Vector3d& v, int dim) {
+  json out = json::array();
+  for (int a = 0; a < dim; ++a) out.push_back(v[a]);
+  return out;
+}
+
+json reactions_json(const model::Model& m, const solve::StepRecord& r) {
+  json out = json::object();
+  for (size_t g = 0; g < r.reactions.size(); ++g)
+    out[group_name(m, g)] = vector_json(r.reactions[g], m.dim());
+  return out;
+}
+
+json run_json(const Case& c, const ExperimentResult& result, const RunResult& run) {
+  const model::Model& m = c.model;
   json steps = json::array();
   for (const solve::StepRecord& r : run.summary.steps) {
     json factors = json::object();
-    for (size_t l = 0; l < ex.model.loads.size(); ++l)
-      factors[ex.model.loads[l].label] = r.load_factors[l];
+    for (size_t l = 0; l < m.loads.size(); ++l) factors[m.loads[l].label] = r.load_factors[l];
     steps.push_back({{"step", r.step},
                      {"load_factors", factors},
                      {"pressure", r.pressure},
                      {"volume", r.volume},
                      {"max_displacement", r.max_displacement},
+                     {"applied_force", vector_json(r.applied_force, m.dim())},
+                     {"reactions", reactions_json(m, r)},
                      {"seconds", r.seconds}});
   }
   json final_figures = json::object();
   const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
   for (const auto& [name, value] : result.figures)
-    if (name.rfind(prefix, 0) == 0) final_figures[name.substr(prefix.size())] = value;
+    if (name.rfind(prefix, 0) == 0 && (!run.variant.empty() || name.rfind("fibers.", 0) != 0))
+      final_figures[name.substr(prefix.size())] = value;
   return {{"variant", run.variant},
+          {"patch", c.patch},
           {"solver", solve::to_string(run.summary.solver)},
           {"pcg_iterations", run.summary.solver_statistics.iterations},
           {"factorization_flops", run.summary.solver_statistics.factorization_flops},
-          {"stepping", stepping_json(run.stepping)},
+          {"stepping", stepping_json(c.stepping)},
           {"success", run.summary.success},
           {"message", run.summary.message},
           {"factorizations", run.summary.factorizations},
@@ -57,6 +93,78 @@ json run_json(const Experiment& ex, const ExperimentResult& result, const RunRes
           {"final", final_figures}};
 }
 
+json fibers_json(const Case& c) {
+  const FiberReport& f = c.fibers;
+  return {{"pruning", f.pruning ? "auto" : "off"},
+          {"convex", f.convex},
+          {"connection_count", model::to_string(c.model.connection_count)},
+          {"in_all", f.pairs},
+          {"kept", f.kept},
+          {"pruned", f.pairs - f.kept},
+          {"kept_per_vertex", {{"min", f.min_per_vertex},
+                               {"mean", f.mean_per_vertex},
+                               {"max", f.max_per_vertex}}},
+          {"pruning_seconds", f.seconds},
+          {"exact_fallbacks", f.exact_fallbacks}};
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char ch : text) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
+// Rows of cells joined by commas, numbers with 17 significant digits.
+class CsvTable {
+ public:
+  void header(const std::string& name) { cells_.push_back(csv_field(name)); }
+  void text(const std::string& value) { cells_.push_back(csv_field(value)); }
+  void number(double value) {
+    std::ostringstream out;
+    out << std::setprecision(17) << value;
+    cells_.push_back(out.str());
+  }
+  void end_row() {
+    for (size_t k = 0; k < cells_.size(); ++k) out_ << (k ? "," : "") << cells_[k];
+    out_ << "\n";
+    cells_.clear();
+  }
+  std::string str() const { return out_.str(); }
+
+ private:
+  std::vector<std::string> cells_;
+  std::ostringstream out_;
+};
+
+bool process_alive(long pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+
+// Removes "DIR.running-PID" folders whose process has gone (killed runs).
+void remove_abandoned_staging(const fs::path& target) {
+  const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  if (!fs::is_directory(parent)) return;
+  const std::string prefix = target.filename().string() + ".running-";
+  for (const fs::directory_entry& entry : fs::directory_iterator(parent)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    char* end = nullptr;
+    const long pid = std::strtol(name.c_str() + prefix.size(), &end, 10);
+    if (end && *end == '\0' && !process_alive(pid)) fs::remove_all(entry.path());
+  }
+}
+
+// Puts `from` at `to` in one step, replacing what `to` held (then removed).
+void move_into_place(const fs::path& from, const fs::path& to) {
+  if (!fs::exists(to)) {
+    fs::rename(from, to);
+    return;
+  }
+  if (renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_EXCHANGE) != 0)
+    throw InputError(to.string() + ": cannot replace the folder: " + std::strerror(errno));
+  fs::remove_all(from);  // now the previous result
+}
+
 }  // namespace
 
 json summary_json(const Experiment& ex, const ExperimentResult& result) {
@@ -66,25 +174,20 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   doc["source"] = ex.source.string();
   doc["fiberfluid_version"] = FIBERFLUID_VERSION;
   doc["kind"] = ex.kind == Experiment::Kind::Areas ? "areas" : "simulate";
+  doc["units"] = {{"length", "m"},        {"displacement", "m"}, {"force", "N"},
+                  {"pressure", "Pa"},     {"volume", "m^3 (m^2 in 2D)"},
+                  {"Y", "Pa"},            {"gamma", "N/m"},      {"time", "s"}};
+  doc["success"] = result.runs_succeeded();
   if (ex.kind == Experiment::Kind::Simulate) {
-    doc["surface"] = {{"dimension", ex.input_surface.dim},
-                      {"vertices", ex.input_surface.num_vertices()},
-                      {"used_vertices", ex.model.num_vertices()},
-                      {"faces", ex.input_surface.num_faces()}};
-    const FiberReport& f = ex.fibers;
-    doc["fibers"] = {{"pruning", f.pruning ? "auto" : "off"},
-                     {"convex", f.convex},
-                     {"connection_count", model::to_string(ex.model.connection_count)},
-                     {"in_all", f.pairs},
-                     {"kept", f.kept},
-                     {"pruned", f.pairs - f.kept},
-                     {"kept_per_vertex", {{"min", f.min_per_vertex},
-                                          {"mean", f.mean_per_vertex},
-                                          {"max", f.max_per_vertex}}},
-                     {"pruning_seconds", f.seconds},
-                     {"exact_fallbacks", f.exact_fallbacks}};
+    const Case& first = ex.cases.front();
+    doc["surface"] = {{"dimension", first.input_surface.dim},
+                      {"vertices", first.input_surface.num_vertices()},
+                      {"used_vertices", first.model.num_vertices()},
+                      {"faces", first.input_surface.num_faces()}};
+    doc["fibers"] = fibers_json(first);
     json runs = json::array();
-    for (const RunResult& run : result.runs) runs.push_back(run_json(ex, result, run));
+    for (size_t r = 0; r < result.runs.size(); ++r)
+      runs.push_back(run_json(ex.cases[r], result, result.runs[r]));
     doc["runs"] = runs;
   }
   doc["figures"] = result.figures;
@@ -100,51 +203,174 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   return doc;
 }
 
-OutputWriter::OutputWriter(const Experiment& experiment, std::filesystem::path folder)
-    : experiment_(experiment), folder_(std::move(folder)) {}
+std::string steps_csv(const Case& c, const RunResult& run) {
+  const model::Model& m = c.model;
+  const int dim = m.dim();
+  const size_t groups = std::max<size_t>(1, m.constraint_groups.size());
+  CsvTable t;
+  t.header("step");
+  for (const model::Load& load : m.loads) t.header("load_factor_" + load.label);
+  t.header("pressure_Pa");
+  t.header(dim == 3 ? "volume_m3" : "area_m2");
+  t.header("max_displacement_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("applied_force_") + kAxes[a] + "_N");
+  for (size_t g = 0; g < groups; ++g)
+    for (int a = 0; a < dim; ++a)
+      t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
+  t.header("seconds");
+  t.end_row();
+  for (const solve::StepRecord& r : run.summary.steps) {
+    t.number(r.step);
+    for (double f : r.load_factors) t.number(f);
+    t.number(r.pressure);
+    t.number(r.volume);
+    t.number(r.max_displacement);
+    for (int a = 0; a < dim; ++a) t.number(r.applied_force[a]);
+    for (size_t g = 0; g < groups; ++g)
+      for (int a = 0; a < dim; ++a) t.number(g < r.reactions.size() ? r.reactions[g][a] : 0.0);
+    t.number(r.seconds);
+    t.end_row();
+  }
+  return t.str();
+}
 
-std::filesystem::path OutputWriter::run_folder(size_t run) const {
-  const std::string& variant = experiment_.variants[run].name;
-  return variant.empty() ? folder_ : folder_ / variant;
+std::string vertices_csv(const Case& c, const RunResult& run) {
+  const int dim = c.input_surface.dim;
+  const Eigen::MatrixXd& S = c.input_surface.V;
+  const Eigen::MatrixXd U = input_positions(c, run.summary.unknowns) - S;
+  Eigen::MatrixXd reactions = Eigen::MatrixXd::Zero(S.rows(), dim);
+  if (run.summary.reaction_forces.rows() == c.model.num_vertices())
+    for (size_t m = 0; m < c.model_to_input.size(); ++m)
+      reactions.row(c.model_to_input[m]) =
+          run.summary.reaction_forces.row(static_cast<Eigen::Index>(m));
+  CsvTable t;
+  t.header("vertex");
+  for (int a = 0; a < dim; ++a) t.header(std::string(1, kAxes[a]) + "_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("u") + kAxes[a] + "_m");
+  t.header("u_magnitude_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("reaction_") + kAxes[a] + "_N");
+  t.end_row();
+  for (Eigen::Index i = 0; i < S.rows(); ++i) {
+    t.number(static_cast<double>(i));
+    for (int a = 0; a < dim; ++a) t.number(S(i, a));
+    for (int a = 0; a < dim; ++a) t.number(U(i, a));
+    t.number(U.row(i).norm());
+    for (int a = 0; a < dim; ++a) t.number(reactions(i, a));
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::string comparison_csv(const Experiment& ex, const ExperimentResult& result) {
+  const char* figures[] = {"max_displacement", "final_pressure", "final_volume",
+                           "volume_change_relative"};
+  const char* headers[] = {"max_displacement_m", "final_pressure_Pa", "final_volume_m3",
+                           "volume_change_relative"};
+  CsvTable t;
+  t.header("variant");
+  t.header("success");
+  t.header("steps");
+  for (const char* h : headers) t.header(h);
+  // Reactions at the end, per group of the first case (variants may differ).
+  const model::Model& first = ex.cases.front().model;
+  const size_t groups = first.constraint_groups.size();
+  for (size_t g = 0; g < groups; ++g)
+    for (int a = 0; a < first.dim(); ++a)
+      t.header("reaction_" + group_name(first, g) + "_" + kAxes[a] + "_N");
+  t.header("seconds");
+  t.header("message");
+  t.header("patch");
+  t.end_row();
+  for (size_t r = 0; r < result.runs.size(); ++r) {
+    const RunResult& run = result.runs[r];
+    const solve::SteppingSummary& s = run.summary;
+    t.text(run.variant);
+    t.text(s.success ? "true" : "false");
+    t.number(static_cast<double>(s.steps.size()));
+    for (const char* f : figures) {
+      const auto value = s.success ? run_figure(ex.cases[r], run, f) : std::nullopt;
+      if (value) t.number(*value);
+      else t.text("");
+    }
+    const bool same_groups = ex.cases[r].model.constraint_groups == first.constraint_groups;
+    for (size_t g = 0; g < groups; ++g)
+      for (int a = 0; a < first.dim(); ++a) {
+        if (s.success && same_groups && !s.steps.empty()) t.number(s.steps.back().reactions[g][a]);
+        else t.text("");
+      }
+    t.number(s.total_seconds);
+    t.text(s.message);
+    t.text(ex.cases[r].patch.is_null() ? "" : ex.cases[r].patch.dump());
+    t.end_row();
+  }
+  return t.str();
+}
+
+OutputWriter::OutputWriter(const Experiment& experiment, fs::path folder)
+    : experiment_(experiment), target_(std::move(folder)) {
+  const bool replaceable = !fs::exists(target_) ||
+                           (fs::is_directory(target_) &&
+                            (fs::is_empty(target_) || fs::exists(target_ / "summary.json")));
+  if (!replaceable)
+    throw InputError(target_.string() +
+                     ": exists and is not a fiberfluid output folder (no summary.json); "
+                     "choose another output folder with -o");
+  staging_ = target_;
+  staging_ += ".running-" + std::to_string(getpid());
+  result_folder_ = target_;
+}
+
+fs::path OutputWriter::run_folder(size_t run) const {
+  const std::string& variant = experiment_.cases[run].variant;
+  return variant.empty() ? staging_ : staging_ / variant;
 }
 
 void OutputWriter::begin() {
-  std::filesystem::create_directories(folder_);
+  if (!target_.parent_path().empty()) fs::create_directories(target_.parent_path());
+  remove_abandoned_staging(target_);
+  fs::remove_all(staging_);
+  fs::create_directories(staging_);
+  geom::write_text_file(staging_ / "INCOMPLETE",
+                        "fiberfluid is writing this folder, or was stopped while it did: "
+                        "these are not the results of a complete run.\n");
   if (experiment_.kind != Experiment::Kind::Simulate) return;
-  series_.assign(experiment_.variants.size(), {});
+  series_.assign(experiment_.cases.size(), {});
   write_fibers();
-  for (size_t r = 0; r < experiment_.variants.size(); ++r) {
+  for (size_t r = 0; r < experiment_.cases.size(); ++r) {
+    fs::create_directories(run_folder(r));
     if (!experiment_.output.vtk) continue;
-    std::filesystem::create_directories(run_folder(r) / "vtk");
-    write_state(r, 0, Eigen::VectorXd::Zero(experiment_.model.num_unknowns()));
+    fs::create_directories(run_folder(r) / "vtk");
+    write_state(r, 0, Eigen::VectorXd::Zero(experiment_.cases[r].model.num_unknowns()));
   }
 }
 
 void OutputWriter::write_fibers() const {
-  const std::string& which = experiment_.fibers.write;
+  const Case& c = experiment_.cases.front();
+  const std::string& which = c.fibers.write;
   if (which == "none") return;
-  const model::Model& m = experiment_.model;
+  const model::Model& m = c.model;
   std::vector<std::pair<int, int>> lines;
   for (int i = 0; i < m.num_vertices(); ++i)
     for (int j = i + 1; j < m.num_vertices(); ++j) {
       const bool kept = !m.fibers || m.fibers->kept(i, j);
       if (kept == (which == "kept")) lines.emplace_back(i, j);
     }
-  geom::write_lines_vtu(folder_ / "fibers.vtu", m.surface.V, lines);
+  geom::write_lines_vtu(staging_ / "fibers.vtu", m.surface.V, lines);
 }
 
 void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns) {
-  const model::Model& m = experiment_.model;
-  geom::Surface deformed = experiment_.input_surface;
-  deformed.V = input_positions(experiment_, unknowns);
+  const Case& c = experiment_.cases[run];
+  const model::Model& m = c.model;
+  geom::Surface deformed = c.input_surface;
+  deformed.V = input_positions(c, unknowns);
   const int n = deformed.num_vertices(), dim = deformed.dim;
-  const Eigen::MatrixXd U = deformed.V - experiment_.input_surface.V;
+  const Eigen::MatrixXd U = deformed.V - c.input_surface.V;
   // Area vectors of the current geometry, zero on vertices in no face.
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, dim);
   const Eigen::MatrixXd model_S =
       geom::vertex_area_vectors(m.surface.V + model::displacements(m, unknowns), m.surface.F).S;
-  for (size_t k = 0; k < experiment_.model_to_input.size(); ++k)
-    S.row(experiment_.model_to_input[k]) = model_S.row(static_cast<Eigen::Index>(k));
+  for (size_t k = 0; k < c.model_to_input.size(); ++k)
+    S.row(c.model_to_input[k]) = model_S.row(static_cast<Eigen::Index>(k));
   char name[32];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
   geom::write_vtu(run_folder(run) / "vtk" / name, deformed,
@@ -156,21 +382,49 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
 
 void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
                            const Eigen::VectorXd& unknowns) {
-  const bool last = record.step == experiment_.variants[run].stepping.steps;
+  const bool last = record.step == experiment_.cases[run].stepping.steps;
   if (experiment_.output.vtk && (last || record.step % experiment_.output.every == 0))
     write_state(run, record.step, unknowns);
 }
 
 void OutputWriter::finish(const ExperimentResult& result) {
   for (size_t r = 0; r < result.runs.size(); ++r) {
+    const Case& c = experiment_.cases[r];
+    const RunResult& run = result.runs[r];
     if (experiment_.output.vtk) geom::write_pvd(run_folder(r) / "series.pvd", series_[r]);
-    if (experiment_.output.obj && result.runs[r].summary.success) {
-      geom::Surface deformed = experiment_.input_surface;
-      deformed.V = input_positions(experiment_, result.runs[r].summary.unknowns);
+    geom::write_text_file(run_folder(r) / "steps.csv", steps_csv(c, run));
+    if (!run.summary.success) continue;
+    geom::write_text_file(run_folder(r) / "vertices.csv", vertices_csv(c, run));
+    if (experiment_.output.obj) {
+      geom::Surface deformed = c.input_surface;
+      deformed.V = input_positions(c, run.summary.unknowns);
       geom::write_obj(run_folder(r) / "final.obj", deformed);
     }
   }
-  geom::write_text_file(folder_ / "summary.json", summary_json(experiment_, result).dump(2) + "\n");
+  if (experiment_.sweeps())
+    geom::write_text_file(staging_ / "comparison.csv", comparison_csv(experiment_, result));
+  geom::write_text_file(staging_ / "summary.json",
+                        summary_json(experiment_, result).dump(2) + "\n");
+
+  if (result.runs_succeeded()) {
+    fs::remove(staging_ / "INCOMPLETE");
+    move_into_place(staging_, target_);
+    result_folder_ = target_;
+    return;
+  }
+  std::string why;
+  for (const RunResult& run : result.runs)
+    if (!run.summary.success)
+      why += (run.variant.empty() ? "" : run.variant + ": ") + run.summary.message + "\n";
+  geom::write_text_file(staging_ / "FAILED",
+                        "this run failed; the last complete result (if any) is in " +
+                            target_.filename().string() + "\n" + why);
+  fs::remove(staging_ / "INCOMPLETE");
+  fs::path failed = target_;
+  failed += ".failed";
+  fs::remove_all(failed);
+  fs::rename(staging_, failed);
+  result_folder_ = failed;
 }
 
 }  // namespace fiberfluid::app

@@ -12,26 +12,47 @@
 
 namespace fiberfluid::app {
 
-// The summary.json document: the experiment, per run its stepping options
-// and per step load factors, pressure, volume, largest displacement and wall
-// time, then the final figures and the checks of the expected ones.
+// The summary.json document: the experiment, its units, per run the stepping
+// options and per step load factors, pressure, volume, largest displacement,
+// reactions and wall time, then the final figures and the checks of the
+// expected ones.
 nlohmann::json summary_json(const Experiment& experiment, const ExperimentResult& result);
 
-// Writes an experiment's files into a folder as the run goes:
-//   summary.json, fibers.vtu when asked, and per run (in a subfolder named after the variant when
-//   the experiment sweeps): final.obj, series.pvd and vtk/step_NNNN.vtu with
-//   point data displacement, displacement_magnitude and area_vector.
-// Every file is written whole or not at all (temporary file and rename).
+// CSV tables (comma-separated, one header line, SI units in the column names):
+// per load step of a run; per input vertex at the end of a run; one row per
+// variant of a sweep.
+std::string steps_csv(const Case& c, const RunResult& run);
+std::string vertices_csv(const Case& c, const RunResult& run);
+std::string comparison_csv(const Experiment& experiment, const ExperimentResult& result);
+
+// Writes an experiment's files as the run goes, so that a folder never mixes
+// two runs: everything goes to a staging folder beside the target
+// ("DIR.running-PID", marked by a file INCOMPLETE), which replaces DIR in one
+// atomic exchange when every run succeeded. When a run fails, DIR keeps the
+// last complete result and the staging folder becomes "DIR.failed" with a
+// FAILED file saying why. A run that is killed leaves its staging folder
+// apart (a later run removes it once its process has gone).
+//
+// Files, per run (in a subfolder named after the variant when the experiment
+// sweeps): final.obj, steps.csv, vertices.csv, series.pvd and
+// vtk/step_NNNN.vtu (point data displacement, displacement_magnitude,
+// area_vector); at the top: summary.json, comparison.csv for a sweep,
+// fibers.vtu when asked.
 class OutputWriter {
  public:
+  // Throws InputError when DIR exists and is not a fiberfluid output folder
+  // (it holds files but no summary.json): it is never replaced.
   OutputWriter(const Experiment& experiment, std::filesystem::path folder);
 
-  // Creates the folders and writes step 0 (the reference) of each run.
+  // Creates the staging folder and writes step 0 (the reference) of each run.
   void begin();
+  // Runs of a sweep may report steps from several threads: each run's files are its own.
   void on_step(size_t run, const solve::StepRecord& record, const Eigen::VectorXd& unknowns);
+  // Writes the summaries and moves the staging folder into place.
   void finish(const ExperimentResult& result);
 
-  const std::filesystem::path& folder() const { return folder_; }
+  // Where the results are: DIR after a success, DIR.failed after a failure.
+  const std::filesystem::path& folder() const { return result_folder_; }
 
  private:
   std::filesystem::path run_folder(size_t run) const;
@@ -39,7 +60,7 @@ class OutputWriter {
   void write_fibers() const;  // fibers.vtu: the kept or pruned fibers, if asked
 
   const Experiment& experiment_;
-  std::filesystem::path folder_;
+  std::filesystem::path target_, staging_, result_folder_;
   std::vector<std::vector<std::pair<double, std::string>>> series_;  // per run
 };
 

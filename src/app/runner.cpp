@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/runner.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <omp.h>
+#include <thread>
 #include <sstream>
 
 #include "geom/area_vectors.hpp"
+#include "geom/progress.hpp"
 #include "model/assembly.hpp"
 #include "model/boundary_conditions.hpp"
 
@@ -46,16 +51,17 @@ void add_area_figures(const Experiment& ex, ExperimentResult& result) {
 
 // Splits "variant.figure" when the prefix names a run; a single run also
 // answers unprefixed names.
-const RunResult* run_for(const ExperimentResult& result, const std::string& name,
-                         std::string* figure) {
-  for (const RunResult& run : result.runs) {
-    if (!run.variant.empty() && name.rfind(run.variant + ".", 0) == 0) {
-      *figure = name.substr(run.variant.size() + 1);
-      return &run;
+// The index of that run, or -1.
+int run_for(const ExperimentResult& result, const std::string& name, std::string* figure) {
+  for (size_t r = 0; r < result.runs.size(); ++r) {
+    const std::string& variant = result.runs[r].variant;
+    if (!variant.empty() && name.rfind(variant + ".", 0) == 0) {
+      *figure = name.substr(variant.size() + 1);
+      return static_cast<int>(r);
     }
   }
   *figure = name;
-  return result.runs.size() == 1 ? &result.runs.front() : nullptr;
+  return result.runs.size() == 1 ? 0 : -1;
 }
 
 FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
@@ -63,10 +69,10 @@ FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
   FigureCheck check;
   check.expected = expected;
   std::string figure;
-  const RunResult* run = run_for(result, expected.figure, &figure);
+  const int r = run_for(result, expected.figure, &figure);
   if (expected.matrix.size() > 0) {
-    if (run == nullptr || figure != "system_matrix") return check;
-    const Eigen::MatrixXd A = constrained_system_matrix(ex, *run);
+    if (r < 0 || figure != "system_matrix") return check;
+    const Eigen::MatrixXd A = constrained_system_matrix(ex.cases[static_cast<size_t>(r)]);
     check.found = A.rows() == expected.matrix.rows() && A.cols() == expected.matrix.cols();
     if (!check.found) return check;
     check.actual = (A - expected.matrix).cwiseAbs().maxCoeff();
@@ -76,7 +82,8 @@ FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
   std::optional<double> value;
   auto it = result.figures.find(expected.figure);
   if (it != result.figures.end()) value = it->second;
-  else if (run != nullptr) value = run_figure(ex, *run, figure);
+  else if (r >= 0)
+    value = run_figure(ex.cases[static_cast<size_t>(r)], result.runs[static_cast<size_t>(r)], figure);
   if (!value) return check;
   check.found = true;
   check.actual = *value;
@@ -120,7 +127,7 @@ bool ExperimentResult::checks_passed() const {
   return true;
 }
 
-Eigen::MatrixXd input_positions(const Experiment& ex, const Eigen::VectorXd& unknowns) {
+Eigen::MatrixXd input_positions(const Case& ex, const Eigen::VectorXd& unknowns) {
   Eigen::MatrixXd X = ex.input_surface.V;
   const Eigen::MatrixXd model_X = model::positions(ex.model, unknowns);
   for (size_t m = 0; m < ex.model_to_input.size(); ++m)
@@ -128,8 +135,7 @@ Eigen::MatrixXd input_positions(const Experiment& ex, const Eigen::VectorXd& unk
   return X;
 }
 
-std::optional<double> run_figure(const Experiment& ex, const RunResult& run,
-                                 const std::string& name) {
+std::optional<double> run_figure(const Case& ex, const RunResult& run, const std::string& name) {
   const model::Model& m = ex.model;
   const Eigen::VectorXd& x = run.summary.unknowns;
   const Eigen::MatrixXd U = model::displacements(m, x);
@@ -159,13 +165,13 @@ std::optional<double> run_figure(const Experiment& ex, const RunResult& run,
   return std::nullopt;
 }
 
-Eigen::MatrixXd constrained_system_matrix(const Experiment& ex, const RunResult& run) {
+Eigen::MatrixXd constrained_system_matrix(const Case& ex) {
   Eigen::MatrixXd A = model::system_matrix(ex.model, ex.model.surface.V);
   const model::DofPartition partition = model::partition_dofs(ex.model);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(partition.constrained.size());
-  if (run.stepping.boundary_method == model::BoundaryMethod::Penalty) {
+  if (ex.stepping.boundary_method == model::BoundaryMethod::Penalty) {
     Eigen::VectorXd B = Eigen::VectorXd::Zero(A.rows());
-    model::apply_penalty(partition, zero, run.stepping.penalty, A, B);
+    model::apply_penalty(partition, zero, ex.stepping.penalty, A, B);
     return A;
   }
   Eigen::MatrixXd A_free;
@@ -174,29 +180,59 @@ Eigen::MatrixXd constrained_system_matrix(const Experiment& ex, const RunResult&
   return A_free;
 }
 
-ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer) {
+static int effective_jobs(const RunOptions& options, size_t cases) {
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int wanted = options.jobs > 0 ? options.jobs : cores;
+  return std::max(1, std::min(wanted, static_cast<int>(cases)));
+}
+
+ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
+                                const RunOptions& options) {
   ExperimentResult result;
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
   } else {
-    result.figures["fibers.in_all"] = static_cast<double>(ex.fibers.pairs);
-    result.figures["fibers.kept"] = static_cast<double>(ex.fibers.kept);
-    result.figures["fibers.pruned"] = static_cast<double>(ex.fibers.pairs - ex.fibers.kept);
-    for (size_t r = 0; r < ex.variants.size(); ++r) {
-      RunResult run;
-      run.variant = ex.variants[r].name;
-      run.stepping = ex.variants[r].stepping;
+    result.runs.resize(ex.cases.size());
+    std::atomic<size_t> finished{0};
+    const auto run_case = [&](size_t r) {
+      const ProgressLabel label(ex.cases[r].variant);
+      RunResult& run = result.runs[r];
+      run.variant = ex.cases[r].variant;
       solve::StepObserver step_observer;
       if (observer)
-        step_observer = [&](const solve::StepRecord& record, const Eigen::VectorXd& x) {
-          observer(r, record, x);
-        };
-      run.summary = solve::solve_load_steps(ex.model, run.stepping, step_observer);
+        step_observer = [&observer, r](const solve::StepRecord& record,
+                                       const Eigen::VectorXd& x) { observer(r, record, x); };
+      run.summary = solve::solve_load_steps(ex.cases[r].model, ex.cases[r].stepping, step_observer);
+      if (ex.cases.size() > 1)
+        report_progress("variants", static_cast<double>(++finished),
+                        static_cast<double>(ex.cases.size()));
+    };
+    const int jobs = effective_jobs(options, ex.cases.size());
+    if (jobs == 1) {
+      for (size_t r = 0; r < ex.cases.size(); ++r) run_case(r);
+    } else {
+      // A small pool: each worker takes the next case; OpenMP threads are
+      // shared out so that jobs x threads stays at the core count.
+      const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+      std::atomic<size_t> next{0};
+      std::vector<std::thread> workers;
+      for (int w = 0; w < jobs; ++w)
+        workers.emplace_back([&] {
+          omp_set_num_threads(std::max(1, cores / jobs));
+          for (size_t r = next++; r < ex.cases.size(); r = next++) run_case(r);
+        });
+      for (std::thread& worker : workers) worker.join();
+    }
+    const FiberReport& fibers = ex.cases.front().fibers;
+    result.figures["fibers.in_all"] = static_cast<double>(fibers.pairs);
+    result.figures["fibers.kept"] = static_cast<double>(fibers.kept);
+    result.figures["fibers.pruned"] = static_cast<double>(fibers.pairs - fibers.kept);
+    for (size_t r = 0; r < ex.cases.size(); ++r) {
+      const RunResult& run = result.runs[r];
       const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
       if (run.summary.success)
         for (const char* name : kRunFigures)
-          result.figures[prefix + name] = *run_figure(ex, run, name);
-      result.runs.push_back(std::move(run));
+          result.figures[prefix + name] = *run_figure(ex.cases[r], run, name);
     }
   }
   for (const ExpectedFigure& expected : ex.expected)

@@ -12,9 +12,9 @@
 
 namespace fiberfluid::app {
 
+// The outcome of one case (Experiment::cases, same index).
 struct RunResult {
   std::string variant;
-  solve::SteppingOptions stepping;
   solve::SteppingSummary summary;
 };
 
@@ -35,28 +35,37 @@ struct ExperimentResult {
   bool checks_passed() const;
 };
 
-// Observes each load step of a run: (run index, record, unknowns).
+// Observes each load step of a run: (case index, record, unknowns). With
+// several jobs it is called from several threads at once.
 using RunObserver =
     std::function<void(size_t run, const solve::StepRecord&, const Eigen::VectorXd&)>;
 
-// Runs every variant of a simulation (or measures the surfaces of an areas
+struct RunOptions {
+  // Cases run at once. Each job's OpenMP loops get cores / jobs threads, so a
+  // sweep of small models runs its variants side by side and a single large
+  // model keeps every core for its pair loops. 0: as many as there are cores
+  // (at most one per case).
+  int jobs = 0;
+};
+
+// Runs every case of a simulation (or measures the surfaces of an areas
 // experiment), then computes the figures and checks the expected ones.
-ExperimentResult run_experiment(const Experiment& experiment, const RunObserver& observer = {});
+ExperimentResult run_experiment(const Experiment& experiment, const RunObserver& observer = {},
+                                const RunOptions& options = {});
 
 // Positions of every input vertex (input order and count; vertices that are
 // in no face stay where they are) for a model unknown vector.
-Eigen::MatrixXd input_positions(const Experiment& experiment, const Eigen::VectorXd& unknowns);
+Eigen::MatrixXd input_positions(const Case& c, const Eigen::VectorXd& unknowns);
 
 // A named figure of one run, or nothing when the name is unknown:
 //   max_displacement, final_pressure, final_volume, initial_volume,
 //   volume_change_relative, mean_displacement_over_diagonal (the paper's
 //   Eq. 9), surface_area, steps, factorizations,
 //   position.I.x / displacement.I.y (I an input vertex index).
-std::optional<double> run_figure(const Experiment& experiment, const RunResult& run,
-                                 const std::string& name);
+std::optional<double> run_figure(const Case& c, const RunResult& run, const std::string& name);
 
 // The paper's A for a run with its boundary conditions applied by penalty
 // (the rows and columns of every unknown) or by elimination (free unknowns).
-Eigen::MatrixXd constrained_system_matrix(const Experiment& experiment, const RunResult& run);
+Eigen::MatrixXd constrained_system_matrix(const Case& c);
 
 }  // namespace fiberfluid::app

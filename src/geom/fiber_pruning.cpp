@@ -3,6 +3,12 @@
 // the method paper's "Concave objects"). CGAL stays in this file.
 #include "geom/fiber_pruning.hpp"
 
+#include <omp.h>
+
+#include <atomic>
+
+#include "geom/progress.hpp"
+
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
@@ -226,16 +232,23 @@ PruningResult prune_3d(const Surface& s) {
   const VertexStars stars(s);
   const int n = s.num_vertices();
   long long fallbacks = 0;
+  const double pairs = 0.5 * n * (n - 1.0);
+  std::atomic<long long> pairs_done{0};
+  report_progress("pruning", 0.0, pairs);
 #pragma omp parallel reduction(+ : fallbacks)
   {
     const ExactSolid exact(s);
     std::vector<int> faces;
 #pragma omp for schedule(dynamic, 4)
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n; ++i) {
       for (int j = i + 1; j < n; ++j)
         if (!keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks))
           result.mask.prune(i, j);
+      const long long done = pairs_done += n - 1 - i;
+      if (omp_get_thread_num() == 0) report_progress("pruning", static_cast<double>(done), pairs);
+    }
   }
+  report_progress("pruning", pairs, pairs);
   result.exact_fallbacks = fallbacks;
   return result;
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <regex>
 
 #include "geom/error.hpp"
@@ -57,6 +58,11 @@ std::string singular_setup_reason(const Model& model) {
   if (model.constraints.empty())
     return "no supports: nothing holds the body, so rigid motion makes the system singular; "
            "fix some vertices";
+  std::set<int> held;
+  for (const Constraint& c : model.constraints) held.insert(model.dof(c.vertex, c.axis));
+  if (static_cast<int>(held.size()) == model.dim() * model.num_vertices())
+    return "the supports fix every vertex on every axis: nothing is left free to deform "
+           "(select fewer vertices)";
   const char* names = "xyz";
   for (int a = 0; a < model.dim(); ++a) {
     const bool held = std::any_of(model.constraints.begin(), model.constraints.end(),

@@ -222,6 +222,37 @@ Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
   return out;
 }
 
+Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,
+                                            const Eigen::MatrixXd& U, double P) const {
+  const Coordinates x(X_);
+  const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data(), *a = area_.data();
+  const size_t n = static_cast<size_t>(n_);
+  const Eigen::MatrixXd surface = surface_ * U;  // sparse: cheap at every row
+  const auto rows = static_cast<Eigen::Index>(vertices.size());
+  Eigen::MatrixXd out(rows, dim_);
+#pragma omp parallel
+  {
+    std::vector<double> h(n);
+#pragma omp for schedule(dynamic, 8)
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const int i = vertices[static_cast<size_t>(r)];
+      const size_t u = static_cast<size_t>(i);
+      factors_.row(i, h.data());
+      for (int axis = 0; axis < dim_; ++axis) {
+        const double* v = U.col(axis).data();
+        double sum = 0.0;
+        for (size_t j = 0; j < n; ++j) {
+          if (j == u) continue;
+          const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+          sum += h[j] * (a[u] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz) * (v[u] - v[j]);
+        }
+        out(r, axis) = young(axis) * sum + gamma_ * surface(i, axis) + S_(i, axis) * P;
+      }
+    }
+  }
+  return out;
+}
+
 Eigen::SparseMatrix<double> FiberSystem::sparse_block(int axis, bool include_bulk) const {
   const std::vector<int>& act = active(axis);
   std::vector<int> position(static_cast<size_t>(n_), -1);

@@ -67,6 +67,13 @@ class FiberSystem {
   // K u over the reduced unknowns except P, matrix-free.
   Eigen::VectorXd apply_K(const Eigen::VectorXd& u) const;
 
+  // Rows of the unreduced A(X) [U; P] at the listed vertices: per vertex i and
+  // axis a, Y_a (L_bulk U)_ia + gamma (L_surf U)_ia + S_ia P, the force that the
+  // fibers and the fluid need at i (boundary conditions not applied). The
+  // reactions of the supports are these rows minus the loads. U: #V by dim.
+  Eigen::MatrixXd unreduced_rows(const std::vector<int>& vertices, const Eigen::MatrixXd& U,
+                                 double P) const;
+
   // The border s over the reduced unknowns except P.
   Eigen::VectorXd border() const;
 

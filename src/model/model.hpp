@@ -53,6 +53,7 @@ struct Constraint {
   int axis = 0;       // 0, 1, 2 = x, y, z
   double value = 0.0; // displacement at full load
   Schedule schedule;  // how the displacement is reached
+  int group = 0;      // index into Model::constraint_groups: whose reaction this adds to
 };
 
 // How the bulk fibers are normalised once some are pruned: the paper divides
@@ -70,6 +71,9 @@ struct Model {
   Material material;
   std::vector<Load> loads;
   std::vector<Constraint> constraints;
+  // Names of the support and prescribed groups (one per experiment entry), for
+  // reporting the reaction force of each; constraints refer to them by index.
+  std::vector<std::string> constraint_groups;
   // The bulk fibers that exist: null means every pair (a convex body).
   std::shared_ptr<const geom::FiberMask> fibers;
   ConnectionCount connection_count = ConnectionCount::Symmetric;

@@ -23,6 +23,10 @@ struct SteppingOptions {
   double penalty = 1e9;           // the paper's diagonal value, for BoundaryMethod::Penalty
   SolverKind solver = SolverKind::Auto;  // the linear backend; Auto chooses by size
   PcgOptions pcg;                 // for SolverKind::PCG
+  // Runaway guards: a step that changes the enclosed volume by more than this
+  // fraction of the reference volume, or turns a face over, ends the run.
+  double max_volume_change = 0.5;
+  bool stop_on_inverted_faces = true;
 
   bool IsValid(std::string* why) const;
 };
@@ -34,6 +38,10 @@ struct StepRecord {
   double volume = 0.0;                // enclosed volume (area in 2D) after this step
   double max_displacement = 0.0;      // max_i |u_i|
   double seconds = 0.0;               // wall time of this step
+  // Force that each constraint group (Model::constraint_groups) exerts on the
+  // body, and the sum of the external loads; they sum to zero at equilibrium.
+  std::vector<Eigen::Vector3d> reactions;
+  Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();
 };
 
 struct SteppingSummary {
@@ -41,6 +49,7 @@ struct SteppingSummary {
   std::string message;                // why it failed, or "" on success
   std::vector<StepRecord> steps;
   Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
+  Eigen::MatrixXd reaction_forces;    // #V by dim: the support force on each vertex at the end
   SolverKind solver = SolverKind::Auto;  // the backend that ran
   SolverStatistics solver_statistics;
   int factorizations = 0;
@@ -56,7 +65,9 @@ struct SteppingSummary {
 using StepObserver = std::function<void(const StepRecord&, const Eigen::VectorXd&)>;
 
 // Runs the load steps. Expected numerical failures (a singular setup, a
-// singular matrix) come back as success = false with a message.
+// singular matrix, a runaway: non-finite values, a face turned over, a volume
+// change beyond max_volume_change) come back as success = false with a
+// message naming the step and the cause.
 SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
                                  const StepObserver& observer = {});
 

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "geom/progress.hpp"
 #include "solve/backends.hpp"
 #include "solve/schur_solver.hpp"
 #include "solve/sparse_cholesky.hpp"
@@ -63,6 +64,7 @@ class PcgSolver final : public SchurSolver {
       *w += alpha * p;
       r -= alpha * q;
       ++statistics_.iterations;
+      report_progress("pcg", it, 0.0);
       if (r.norm() <= options_.tolerance * norm_f) return {};
       z = precondition(r);
       const double rz_next = r.dot(z);

@@ -32,7 +32,7 @@ Outcome run_cli(const std::string& arguments) {
 }
 
 TEST(Cli, CheckReportsAGoodMesh) {
-  const Outcome o = run_cli("check " + testing::shared_mesh("torus.obj").string());
+  const Outcome o = run_cli("check " + testing::data_mesh("torus.obj").string());
   EXPECT_EQ(o.status, 0) << o.output;
   for (const char* part : {"vertices:      800", "closed:        yes", "genus:         1",
                            "consistent, outward"})

@@ -38,7 +38,7 @@ nlohmann::json base_config() {
   return nlohmann::json::parse(R"({
     "name": "tiny",
     "surface": {"generator": "icosphere", "subdivisions": 1, "radius": 1.0},
-    "material": {"Y": 1000, "gamma": 10},
+    "material": {"Y": 100000, "gamma": 10},
     "supports": [{"where": "z >= 0.5"}],
     "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
     "stepping": {"steps": 2}
@@ -65,11 +65,14 @@ void expect_config_error(const ScratchDir& dir, const nlohmann::json& config,
 TEST(ExperimentConfig, BaseConfigIsValid) {
   ScratchDir dir;
   const Experiment ex = load_experiment(write_config(dir, base_config()));
-  EXPECT_EQ(ex.model.num_vertices(), 42);
-  EXPECT_EQ(ex.variants.size(), 1u);
-  EXPECT_EQ(ex.variants[0].stepping.steps, 2);
-  EXPECT_EQ(ex.model.loads[0].density, 1000.0);  // the default
-  EXPECT_FALSE(ex.model.constraints.empty());
+  ASSERT_EQ(ex.cases.size(), 1u);
+  const Case& c = ex.cases[0];
+  EXPECT_EQ(c.model.num_vertices(), 42);
+  EXPECT_FALSE(ex.sweeps());
+  EXPECT_EQ(c.stepping.steps, 2);
+  EXPECT_EQ(c.model.loads[0].density, 1000.0);  // the default
+  EXPECT_FALSE(c.model.constraints.empty());
+  EXPECT_EQ(c.model.constraint_groups, std::vector<std::string>{"support_0"});
 }
 
 TEST(ExperimentConfig, BadFieldsAreNamed) {
@@ -116,7 +119,7 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
 
   c = base_config();
   c["loads"][0]["schedule"] = {0.5, 1.0, 1.5};
-  expect_config_error(dir, c, "the schedule lists 3 factors but run \"\" has 2 steps");
+  expect_config_error(dir, c, "the schedule lists 3 factors but stepping.steps is 2");
 
   c = base_config();
   c["loads"][0]["type"] = "wind";
@@ -134,7 +137,7 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  EXPECT_TRUE(load_experiment(write_config(dir, c)).fibers.convex);  // an icosphere
+  EXPECT_TRUE(load_experiment(write_config(dir, c)).cases[0].fibers.convex);  // an icosphere
 
   // The paper's 2D L: three pairs see each other across the re-entrant corner.
   c["surface"] = {{"generator", "polygon"},
@@ -143,11 +146,12 @@ TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   c["loads"][0]["acceleration"] = {0, -9.81};
   c["fibers"] = {{"write", "pruned"}, {"connection_count", "global"}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  EXPECT_FALSE(ex.fibers.convex);
-  EXPECT_EQ(ex.fibers.pairs, 15);
-  EXPECT_EQ(ex.fibers.kept, 12);
-  EXPECT_EQ(ex.model.connection_count, model::ConnectionCount::Global);
-  ASSERT_TRUE(ex.model.fibers);
+  const Case& l_case = ex.cases[0];
+  EXPECT_FALSE(l_case.fibers.convex);
+  EXPECT_EQ(l_case.fibers.pairs, 15);
+  EXPECT_EQ(l_case.fibers.kept, 12);
+  EXPECT_EQ(l_case.model.connection_count, model::ConnectionCount::Global);
+  ASSERT_TRUE(l_case.model.fibers);
 
   OutputWriter writer(ex, dir.path() / "out");
   writer.begin();
@@ -165,8 +169,8 @@ TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
 
   c["fibers"] = {{"pruning", "off"}};
   const Experiment unpruned = load_experiment(write_config(dir, c));
-  EXPECT_FALSE(unpruned.model.fibers);
-  EXPECT_EQ(unpruned.fibers.kept, 15);
+  EXPECT_FALSE(unpruned.cases[0].model.fibers);
+  EXPECT_EQ(unpruned.cases[0].fibers.kept, 15);
 
   c["fibers"] = {{"pruning", "sometimes"}};
   expect_config_error(dir, c, "fibers.pruning: expected one of auto, off");
@@ -176,7 +180,7 @@ TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
 
 TEST(ExperimentConfig, InvertedMeshNeedsFlip) {
   ScratchDir dir;
-  geom::Surface inward = geom::read_surface(testing::shared_mesh("icosahedron.obj")).surface;
+  geom::Surface inward = geom::read_surface(testing::data_mesh("icosahedron.obj")).surface;
   geom::flip_orientation(inward);
   geom::write_obj(dir.path() / "inward.obj", inward);
   nlohmann::json c = base_config();
@@ -190,13 +194,14 @@ TEST(ExperimentConfig, InvertedMeshNeedsFlip) {
 TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  c["surface"] = {{"file", testing::shared_mesh("liver.obj").string()}};
+  c["surface"] = {{"file", testing::data_mesh("liver.obj").string()}, {"scale", 0.04}};
   c["supports"][0] = {{"vertices", {0, 1, 2, 3, 4, 5}}};  // liver's vertices 0..5 are used
   c["loads"][0]["acceleration"] = {0, -9.81, 0};
   c["output"] = {{"vtk", true}, {"every", 1}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  EXPECT_EQ(ex.input_surface.num_vertices(), 181);
-  EXPECT_EQ(ex.model.num_vertices(), 139);
+  const Case& liver = ex.cases[0];
+  EXPECT_EQ(liver.input_surface.num_vertices(), 181);
+  EXPECT_EQ(liver.model.num_vertices(), 139);
 
   OutputWriter writer(ex, dir.path() / "out");
   writer.begin();
@@ -209,10 +214,10 @@ TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) 
 
   const geom::Surface final_surface = geom::read_surface(dir.path() / "out" / "final.obj").surface;
   EXPECT_EQ(final_surface.num_vertices(), 181);
-  EXPECT_EQ(final_surface.F, ex.input_surface.F);
+  EXPECT_EQ(final_surface.F, liver.input_surface.F);
   for (int i = 0; i < 181; ++i) {
-    if (ex.input_surface.F.cwiseEqual(i).any()) continue;  // unused vertices stay in place
-    EXPECT_NEAR((final_surface.V.row(i) - ex.input_surface.V.row(i)).norm(), 0.0, 1e-12);
+    if (liver.input_surface.F.cwiseEqual(i).any()) continue;  // unused vertices stay in place
+    EXPECT_NEAR((final_surface.V.row(i) - liver.input_surface.V.row(i)).norm(), 0.0, 1e-12);
   }
   for (const char* file : {"summary.json", "series.pvd", "vtk/step_0000.vtu", "vtk/step_0002.vtu"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / file)) << file;

@@ -59,7 +59,7 @@ TEST(AreaVectors, VertexAreasSumToTheSurfaceAreaOnEverySharedMesh) {
   for (const char* name :
        {"cube.obj", "icosahedron.obj", "liver.obj", "sphere_02b.obj", "torus.obj", "Bunny.stl"}) {
     SCOPED_TRACE(name);
-    const Surface s = read_surface(testing::shared_mesh(name)).surface;
+    const Surface s = read_surface(testing::data_mesh(name)).surface;
     const VertexAreaVectors areas = vertex_area_vectors(s.V, s.F);
     EXPECT_NEAR(areas.magnitude.sum(), surface_area(s.V, s.F), 1e-10 * areas.surface_area);
     // A closed surface's area vectors cancel.
@@ -102,7 +102,7 @@ void expect_volume_gradient(const Surface& s, double perturbation) {
 
 TEST(AreaVectors, SummedAreaVectorsAreDimTimesTheVolumeGradient) {
   expect_volume_gradient(icosphere(2, 1.0), 0.05);
-  expect_volume_gradient(read_surface(testing::shared_mesh("liver.obj")).surface, 0.01);
+  expect_volume_gradient(read_surface(testing::data_mesh("liver.obj")).surface, 0.01);
   expect_volume_gradient(rectangle({0, 0}, {3, 2}, 3, 2), 0.05);
 }
 

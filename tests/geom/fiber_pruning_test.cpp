@@ -244,13 +244,13 @@ TEST(FiberPruning, TorusPrunesTheFibersAcrossItsHole) {
 
 TEST(FiberPruning, AgreesWithTheBruteForceOnSharedMeshes) {
   const Surface liver =
-      remove_unused_vertices(read_surface(testing::shared_mesh("liver.obj")).surface).surface;
+      remove_unused_vertices(read_surface(testing::data_mesh("liver.obj")).surface).surface;
   const PruningResult r = prune_fibers(liver);
   EXPECT_FALSE(r.convex);
   EXPECT_GT(r.mask.num_pairs() - r.mask.num_kept(), 0);
   expect_agreement(liver, r);
 
-  const Surface torus_mesh = read_surface(testing::shared_mesh("torus.obj")).surface;
+  const Surface torus_mesh = read_surface(testing::data_mesh("torus.obj")).surface;
   const PruningResult t = prune_fibers(torus_mesh);
   expect_agreement(torus_mesh, t, /*row_step=*/25);  // every pair of 32 of its 800 vertices
 }
@@ -259,7 +259,7 @@ TEST(FiberPruning, SharedCubeIsDecidedOnItsStoredCoordinates) {
   // One vertex of cube.obj is off by 1e-6 (SOURCES.md): its faces are not
   // exactly flat, and the exact decision prunes what leaves the body by
   // that much. The brute force (tolerance 1e-10) sees the same.
-  const Surface s = read_surface(testing::shared_mesh("cube.obj")).surface;
+  const Surface s = read_surface(testing::data_mesh("cube.obj")).surface;
   const PruningResult r = prune_fibers(s);
   expect_agreement(s, r);
 }

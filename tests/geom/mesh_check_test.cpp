@@ -31,7 +31,7 @@ Surface drop_last_face(Surface s) {
 }
 
 TEST(MeshCheck, GoodMeshes) {
-  const MeshReport r = inspect(read_surface(testing::shared_mesh("torus.obj")).surface);
+  const MeshReport r = inspect(read_surface(testing::data_mesh("torus.obj")).surface);
   EXPECT_TRUE(r.ok());
   EXPECT_EQ(r.genus, 1);
   EXPECT_EQ(r.euler_characteristic, 0);
@@ -108,7 +108,7 @@ TEST(MeshCheck, PolygonProblems) {
 }
 
 TEST(MeshCheck, UnusedVerticesAreAWarningNotAnError) {
-  const MeshReport r = inspect(read_surface(testing::shared_mesh("liver.obj")).surface);
+  const MeshReport r = inspect(read_surface(testing::data_mesh("liver.obj")).surface);
   EXPECT_TRUE(r.ok());
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_NE(r.warnings[0].find("42 vertices"), std::string::npos);

@@ -36,7 +36,7 @@ struct SharedMesh {
   bool convex;
 };
 
-// Counts from ../shared/meshes/SOURCES.md.
+// Counts from data/meshes/SOURCES.md.
 TEST(MeshIO, ReadsEverySharedMesh) {
   const SharedMesh meshes[] = {
       {"icosahedron.obj", 12, 12, 20, 0, true}, {"sphere_02b.obj", 42, 42, 80, 0, true},
@@ -44,7 +44,7 @@ TEST(MeshIO, ReadsEverySharedMesh) {
       {"torus.obj", 800, 800, 1600, 1, false},  {"Bunny.stl", 1366, 1366, 2728, 0, false}};
   for (const SharedMesh& m : meshes) {
     SCOPED_TRACE(m.file);
-    const ReadResult read = read_surface(testing::shared_mesh(m.file));
+    const ReadResult read = read_surface(testing::data_mesh(m.file));
     const MeshReport r = inspect(read.surface);
     EXPECT_TRUE(r.ok()) << (r.problems.empty() ? "" : r.problems.front());
     EXPECT_EQ(r.vertices, m.vertices);
@@ -229,7 +229,7 @@ TEST(MeshIO, EveryReaderReadsEverySharedMesh) {
        {"cube.obj", "icosahedron.obj", "liver.obj", "sphere_02b.obj", "torus.obj", "Bunny.stl"}) {
     SCOPED_TRACE(name);
     const Surface original =
-        remove_unused_vertices(read_surface(testing::shared_mesh(name)).surface).surface;
+        remove_unused_vertices(read_surface(testing::data_mesh(name)).surface).surface;
     const double area = surface_area(original.V, original.F);
     const double volume = enclosed_volume(original.V, original.F);
     write_obj(dir.path() / "mesh.obj", original);

@@ -43,7 +43,7 @@ class AssemblyOnMeshes : public ::testing::TestWithParam<const char*> {
   Model model() const {
     Model m;
     m.surface = geom::remove_unused_vertices(
-                    geom::read_surface(testing::shared_mesh(GetParam())).surface)
+                    geom::read_surface(testing::data_mesh(GetParam())).surface)
                     .surface;
     m.material.young_modulus = {2.0, 3.0, 5.0};  // anisotropic on purpose
     m.material.surface_tension = 0.7;

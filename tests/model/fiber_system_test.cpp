@@ -55,7 +55,7 @@ TEST(FiberSystem, MatchesTheFullAssemblyWithBothBoundaryMethods) {
 Model pruned_liver(ConnectionCount count) {
   Model m;
   m.surface = geom::remove_unused_vertices(
-                  geom::read_surface(testing::shared_mesh("liver.obj")).surface)
+                  geom::read_surface(testing::data_mesh("liver.obj")).surface)
                   .surface;
   m.material.young_modulus.setConstant(2000.0);
   m.material.surface_tension = 3.0;

@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "geom/progress.hpp"
+
+#include <utility>
+
+namespace fiberfluid {
+namespace {
+
+ProgressSink& sink() {
+  static ProgressSink installed;
+  return installed;
+}
+
+thread_local std::string current_label;
+
+}  // namespace
+
+void set_progress_sink(ProgressSink s) { sink() = std::move(s); }
+
+void report_progress(const char* phase, double done, double total) {
+  if (sink()) sink()(current_label, phase, done, total);
+}
+
+ProgressLabel::ProgressLabel(std::string label) : previous_(std::move(current_label)) {
+  current_label = std::move(label);
+}
+
+ProgressLabel::~ProgressLabel() { current_label = std::move(previous_); }
+
+}  // namespace fiberfluid

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// How long phases say how far they are. The library never prints: it reports
+// to one process-wide sink that the application installs (the command line
+// draws a progress line). Without a sink a report costs a branch.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace fiberfluid {
+
+// label: the run it belongs to ("" or a sweep's variant: set per thread by
+// ProgressLabel); phase: "pruning", "factorize", "pcg", "step", "variants";
+// done of total in the phase's own unit (total 0 when it is not known).
+using ProgressSink = std::function<void(const std::string& label, const char* phase,
+                                        double done, double total)>;
+
+// Install before starting work; the sink must be safe to call from several
+// threads at once (a sweep runs variants side by side). An empty sink stops it.
+void set_progress_sink(ProgressSink sink);
+void report_progress(const char* phase, double done, double total);
+
+// Names the run that this thread's reports belong to, for its lifetime.
+class ProgressLabel {
+ public:
+  explicit ProgressLabel(std::string label);
+  ~ProgressLabel();
+  ProgressLabel(const ProgressLabel&) = delete;
+  ProgressLabel& operator=(const ProgressLabel&) = delete;
+
+ private:
+  std::string previous_;
+};
+
+}  // namespace fiberfluid
