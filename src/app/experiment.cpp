@@ -179,7 +179,7 @@ std::vector<model::Load> read_loads(Fields& root, const geom::Surface& surface,
   for (Fields f : root.objects("loads")) {
     model::Load load;
     const std::string type = f.choice("type", "", {"gravity", "point"});
-    load.label = f.string("label", type + " " + std::to_string(loads.size()));
+    load.label = f.string("label", type + "_" + std::to_string(loads.size()));
     if (type == "gravity") {
       load.kind = model::Load::Kind::Hydrostatic;
       load.acceleration.head(surface.dim) = f.vector("acceleration", surface.dim);

@@ -2,6 +2,7 @@
 // fiberfluid: command-line tool. It only parses, loads and dispatches.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <cstdio>
 #include <iostream>
@@ -21,40 +22,37 @@ namespace app = fiberfluid::app;
 
 enum ExitCode { kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3 };
 
-// Draws the library's progress reports on stderr: one line redrawn in place
-// on a terminal, plain lines (a new phase, every tenth, or every 10 s) when
-// stderr is a file or a pipe. Each line has the elapsed time of the phase and,
-// when its total is known, an estimate of what remains.
+// Draws the library's progress reports on stderr, for phases that run longer
+// than a moment: one line redrawn in place on a terminal; plain lines (every
+// tenth, or every 10 s, and the end) when stderr is a file or a pipe. Each
+// line has the elapsed time of the phase and, when its total is known, an
+// estimate of what remains.
 class ProgressPrinter {
  public:
   ProgressPrinter() : tty_(isatty(STDERR_FILENO) != 0) {}
 
   void operator()(const std::string& label, const char* phase, double done, double total) {
+    using std::chrono::duration;
     const std::lock_guard<std::mutex> lock(mutex_);
     const Clock::time_point now = Clock::now();
-    const std::string key = label + "|" + phase;
-    const bool fresh = key != key_ || done < done_;
-    if (fresh) {
-      key_ = key;
-      start_ = now;
-      tenth_ = -1;
-    }
-    done_ = done;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    Phase& p = phases_[label + "|" + phase];
+    if (p.start == Clock::time_point{} || done < p.done) p = Phase{now};  // a new phase
+    const bool repeat = done == p.done && p.printed;
+    p.done = done;
+    const double elapsed = duration<double>(now - p.start).count();
     const bool finished = total > 0.0 && done >= total;
     const int tenth = total > 0.0 ? static_cast<int>(10.0 * done / total) : -1;
-    if (tty_) {
-      if (!finished && !fresh && now - drawn_ < std::chrono::milliseconds(100)) return;
-    } else if (!fresh && !finished && tenth == tenth_ &&
-               now - drawn_ < std::chrono::seconds(10)) {
-      return;
-    }
-    tenth_ = tenth;
-    drawn_ = now;
+    if (repeat || (elapsed < kQuietSeconds && !(finished && p.printed))) return;
+    const double since_last = duration<double>(now - p.drawn).count();
+    if (!finished && (tty_ ? since_last < 0.1 : tenth == p.tenth && since_last < 10.0)) return;
+    p.tenth = tenth;
+    p.drawn = now;
+    p.printed = true;
+
     std::string line = (label.empty() ? "" : "[" + label + "] ") + phase;
     char buffer[160];
     if (total > 0.0) {
-      std::snprintf(buffer, sizeof buffer, " %g/%g (%.0f%%)  %.1f s", done, total,
+      std::snprintf(buffer, sizeof buffer, " %g/%g (%.0f%%), %.1f s", done, total,
                     100.0 * done / total, elapsed);
       line += buffer;
       if (done > 0.0 && !finished) {
@@ -63,27 +61,35 @@ class ProgressPrinter {
         line += buffer;
       }
     } else {
-      std::snprintf(buffer, sizeof buffer, " %g  %.1f s", done, elapsed);
+      std::snprintf(buffer, sizeof buffer, " %g, %.1f s", done, elapsed);
       line += buffer;
     }
     if (tty_) std::fprintf(stderr, "\r\033[K%s", line.c_str());
     else std::fprintf(stderr, "%s\n", line.c_str());
     std::fflush(stderr);
+    line_open_ = tty_;
   }
 
-  // Ends the redrawn line, so that what follows starts on its own.
+  // Clears a redrawn line, so that what follows starts on its own.
   void close() {
-    if (tty_) std::fprintf(stderr, "\r\033[K");
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (line_open_) std::fprintf(stderr, "\r\033[K");
+    line_open_ = false;
   }
 
  private:
   using Clock = std::chrono::steady_clock;
+  static constexpr double kQuietSeconds = 2.0;  // shorter phases print nothing
+  struct Phase {
+    Clock::time_point start, drawn;
+    double done = 0.0;
+    int tenth = -1;
+    bool printed = false;
+  };
   std::mutex mutex_;
   bool tty_;
-  std::string key_;
-  Clock::time_point start_, drawn_;
-  double done_ = 0.0;
-  int tenth_ = -1;
+  bool line_open_ = false;
+  std::map<std::string, Phase> phases_;
 };
 
 struct RunFlags {

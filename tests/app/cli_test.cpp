@@ -1,10 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The command-line tool, run as a user would.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <chrono>
 #include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "test_support.hpp"
 
@@ -77,6 +83,109 @@ TEST(Cli, SingularSetupIsAFailureStatusNotACrash) {
   const Outcome o = run_cli("run " + config.string() + " -o " + (dir.path() / "out").string());
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.output.find("no supports"), std::string::npos) << o.output;
+}
+
+TEST(Cli, ARunawayStopsWithStatus2NamingTheStep) {
+  ScratchDir dir;
+  // The sphere experiment with a fluid 1e9 times too heavy.
+  std::ifstream in(testing::experiment_file("sphere.json"));
+  nlohmann::json config = nlohmann::json::parse(in);
+  config["loads"][0]["density"] = 1e12;
+  config["expected"] = nlohmann::json::array();
+  const auto file = dir.write("runaway.json", config.dump());
+  const Outcome o = run_cli("run " + file.string() + " -o " + (dir.path() / "out").string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("error: step 1: runaway: face"), std::string::npos) << o.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "out.failed" / "FAILED"));
+}
+
+TEST(Cli, SupportsOnEveryVertexAreNamed) {
+  ScratchDir dir;
+  const auto config = dir.write("fixed.json", R"({"name": "fixed",
+    "surface": {"generator": "icosphere", "subdivisions": 1},
+    "material": {"Y": 1000},
+    "supports": [{"where": "z >= -2"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}]})");
+  const Outcome o = run_cli("run " + config.string() + " -o " + (dir.path() / "out").string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("the supports fix every vertex on every axis"), std::string::npos)
+      << o.output;
+}
+
+// Starts the tool in the background; its standard output and error go to a file.
+pid_t start_cli(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::FILE* out = std::freopen(log.c_str(), "w", stdout);
+    if (out != nullptr) dup2(fileno(stdout), STDERR_FILENO);
+    std::vector<char*> argv{const_cast<char*>(FIBERFLUID_CLI)};
+    for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(FIBERFLUID_CLI, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+int count_files(const std::filesystem::path& folder) {
+  if (!std::filesystem::exists(folder)) return 0;
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) n += entry.is_regular_file();
+  return n;
+}
+
+TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
+  ScratchDir dir;
+  const std::filesystem::path out = dir.path() / "out";
+  // Long enough to be killed part way: 642 vertices, 400 steps, a .vtu per step.
+  nlohmann::json config = nlohmann::json::parse(R"({"name": "long",
+    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
+    "material": {"Y": 20000, "gamma": 1},
+    "supports": [{"where": "z >= 0.04"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 400, "rebuild_matrix": true, "solver": "block-cholesky"}})");
+  const auto long_run = dir.write("long.json", config.dump());
+  config["stepping"]["steps"] = 3;
+  const auto short_run = dir.write("short.json", config.dump());
+
+  auto kill_part_way = [&](const std::string& name) {
+    const pid_t pid = start_cli({"run", long_run.string(), "-o", out.string()},
+                                dir.path() / (name + ".log"));
+    std::filesystem::path staging = out;
+    staging += ".running-" + std::to_string(pid);
+    for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+    EXPECT_GE(count_files(staging / "vtk"), 5);
+    EXPECT_TRUE(std::filesystem::exists(staging / "INCOMPLETE"));
+    return staging;
+  };
+
+  // Killed with no earlier result: nothing appears at out.
+  const std::filesystem::path first_staging = kill_part_way("first");
+  EXPECT_FALSE(std::filesystem::exists(out));
+
+  // A short rerun: out holds exactly its 4 states; the killed run's folder is gone.
+  Outcome o = run_cli("run " + short_run.string() + " -q -o " + out.string());
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_FALSE(std::filesystem::exists(first_staging));
+  EXPECT_EQ(count_files(out / "vtk"), 4);
+  EXPECT_FALSE(std::filesystem::exists(out / "INCOMPLETE"));
+  std::ifstream summary_in(out / "summary.json");
+  const std::string summary((std::istreambuf_iterator<char>(summary_in)),
+                            std::istreambuf_iterator<char>());
+
+  // Killed again: the complete short result stays untouched.
+  kill_part_way("second");
+  EXPECT_EQ(count_files(out / "vtk"), 4);
+  std::ifstream again_in(out / "summary.json");
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again_in)),
+                        std::istreambuf_iterator<char>()),
+            summary);
 }
 
 TEST(Cli, UsageErrors) {

@@ -31,7 +31,7 @@ TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
 INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                          ::testing::Values("rectangle.json", "areas.json", "sphere.json",
                                            "round_trip.json", "liver_gravity.json",
-                                           "bunny_gravity.json"));
+                                           "bunny_gravity.json", "liver_sweep.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {

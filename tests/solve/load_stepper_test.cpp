@@ -216,3 +216,106 @@ TEST(LoadStepper, RefusesADenseSystemLargerThanMemory) {
 
 }  // namespace
 }  // namespace fiberfluid::solve
+
+// ------------------------------------------------------------ reactions
+namespace fiberfluid::solve {
+namespace {
+
+// Sum of the group reactions and the applied loads of the last step, and the
+// size of the applied load, for the equilibrium check.
+std::pair<double, double> equilibrium_error(const SteppingSummary& s) {
+  const StepRecord& last = s.steps.back();
+  Eigen::Vector3d total = last.applied_force;
+  for (const Eigen::Vector3d& r : last.reactions) total += r;
+  return {total.norm(), last.applied_force.norm()};
+}
+
+TEST(Reactions, PaperRectangleSupportsCarryTheAppliedForce) {
+  // model.md section 8 by hand: the rows of v3 and v2 in y give
+  // -84 (16/3) - 105 (16/3) - 21 (32) = -1680 each; v3's x row gives 0.
+  for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
+    const SteppingSummary s = solve_load_steps(testing::paper_rectangle_model(), options(1, method));
+    ASSERT_TRUE(s.success) << s.message;
+    EXPECT_NEAR(s.reaction_forces(2, 1), -1680.0, 1e-9);
+    EXPECT_NEAR(s.reaction_forces(1, 1), -1680.0, 1e-9);
+    EXPECT_NEAR(s.reaction_forces(2, 0), 0.0, 1e-9);
+    EXPECT_EQ(s.reaction_forces(0, 1), 0.0);  // free vertices carry none
+    ASSERT_EQ(s.steps.back().reactions.size(), 1u);
+    EXPECT_NEAR(s.steps.back().reactions[0].y(), -3360.0, 1e-9);
+    EXPECT_NEAR(s.steps.back().applied_force.y(), 3360.0, 1e-9);
+  }
+}
+
+TEST(Reactions, AgreeWithTheDenseAssemblyRows) {
+  // An independent path: (A(s) x - B) at the constrained unknowns of the
+  // plain dense assembly, for the sphere in one step (A and the loads at s).
+  const model::Model m = testing::paper_sphere_model();
+  SteppingOptions o = options(1);
+  o.update_load_geometry = false;
+  const SteppingSummary s = solve_load_steps(m, o);
+  ASSERT_TRUE(s.success) << s.message;
+  const Eigen::VectorXd residual = model::linear_residual(m, s.unknowns, {1.0, 1.0});
+  double largest = 0.0;
+  for (const model::Constraint& c : m.constraints)
+    largest = std::max(largest, std::abs(s.reaction_forces(c.vertex, c.axis) -
+                                         residual[m.dof(c.vertex, c.axis)]));
+  EXPECT_LT(largest, 1e-9 * s.reaction_forces.cwiseAbs().maxCoeff());
+}
+
+TEST(Reactions, BalanceTheLoadsAtEveryStep) {
+  // Global equilibrium: the Laplacian rows and the closed surface's area
+  // vectors each sum to zero, so the reactions balance the loads, with A
+  // constant or rebuilt, by elimination or penalty.
+  for (bool rebuild : {false, true})
+    for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
+      SteppingOptions o = options(10, method);
+      o.rebuild_matrix = rebuild;
+      const SteppingSummary s = solve_load_steps(testing::paper_sphere_model(), o);
+      ASSERT_TRUE(s.success) << s.message;
+      for (const StepRecord& r : s.steps) {
+        Eigen::Vector3d total = r.applied_force;
+        for (const Eigen::Vector3d& reaction : r.reactions) total += reaction;
+        EXPECT_LT(total.norm(), 1e-10 * r.applied_force.norm()) << "step " << r.step;
+      }
+      const auto [error, size] = equilibrium_error(s);
+      EXPECT_GT(size, 1e4);  // the fluid's weight, about rho g V = 4e4 N
+      EXPECT_LT(error, 1e-10 * size);
+    }
+}
+
+// ------------------------------------------------------------ guards
+TEST(Guards, ALoadFarTooLargeIsARunawayNamingTheStep) {
+  model::Model m = testing::paper_sphere_model();
+  m.loads[0].density *= 1e9;
+  const SteppingSummary s = solve_load_steps(m, options(10));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("step 1: runaway"), std::string::npos) << s.message;
+  EXPECT_TRUE(s.steps.empty());
+}
+
+TEST(Guards, VolumeDriftBeyondTheBoundStops) {
+  // The sphere drifts +2.9% over its 10 steps with A constant: a bound of 1%
+  // stops it part way, naming the option.
+  SteppingOptions o = options(10);
+  o.max_volume_change = 0.01;
+  const SteppingSummary s = solve_load_steps(testing::paper_sphere_model(), o);
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("runaway: the enclosed volume changed by"), std::string::npos)
+      << s.message;
+  EXPECT_NE(s.message.find("stepping.max_volume_change"), std::string::npos) << s.message;
+  EXPECT_GT(s.steps.size(), 0u);
+  EXPECT_LT(s.steps.size(), 10u);
+}
+
+TEST(Guards, ASupportOnEveryVertexIsNamed) {
+  model::Model m = testing::paper_sphere_model();
+  m.constraints.clear();
+  for (int v = 0; v < m.num_vertices(); ++v)
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  const SteppingSummary s = solve_load_steps(m, options(1));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("fix every vertex on every axis"), std::string::npos) << s.message;
+}
+
+}  // namespace
+}  // namespace fiberfluid::solve
