@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Plots a fiberfluid summary.json: the deformed surface beside its reference
-(when final.obj is there), and per load step the largest displacement and the
-pressure of every run. For a sweep with a round trip, also Eq. 9 against n.
+"""Plots a fiberfluid result folder (SI units throughout).
 
     /usr/bin/python3 experiments/plot.py out/sphere/summary.json out/sphere/plot.png
+
+Panels: the deformed surface coloured by |u| with the undeformed outline drawn
+over it (for a sweep, the variant that moved most); per load step the largest
+displacement and the pressure of every run, one curve per variant; the
+reactions of the supports; and for a round-trip sweep, Eq. 9 against n.
 """
+import csv
 import json
 import os
 import sys
@@ -14,66 +18,125 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import cm, colors  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
 
-def read_obj(path):
-    vertices, faces = [], []
+def read_obj_faces(path):
+    faces = []
     with open(path) as f:
         for line in f:
             words = line.split()
-            if not words:
-                continue
-            if words[0] == "v":
-                vertices.append([float(w) for w in words[1:4]])
-            elif words[0] in ("f", "l"):
+            if words and words[0] in ("f", "l"):
                 faces.append([int(w.split("/")[0]) - 1 for w in words[1:]])
-    return vertices, faces
+    return faces
 
 
-def draw_surface(ax, vertices, faces, colour, label):
-    xs = [v[0] for v in vertices]
-    ys = [v[1] for v in vertices]
-    zs = [v[2] for v in vertices]
-    if faces and len(faces[0]) == 3:
-        ax.plot_trisurf(xs, ys, zs, triangles=faces, color=colour, alpha=0.35,
-                        edgecolor="k", linewidth=0.1, label=label)
+def read_vertices_csv(path):
+    """Reference positions and displacements per vertex, from vertices.csv."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    axes = [a for a in "xyz" if f"{a}_m" in rows[0]]
+    reference = [[float(r[f"{a}_m"]) for a in axes] for r in rows]
+    displacement = [[float(r[f"u{a}_m"]) for a in axes] for r in rows]
+    magnitude = [float(r["u_magnitude_m"]) for r in rows]
+    return reference, displacement, magnitude
+
+
+def draw_deformed(fig, position, run_folder, title):
+    reference, displacement, magnitude = read_vertices_csv(os.path.join(run_folder, "vertices.csv"))
+    faces = read_obj_faces(os.path.join(run_folder, "final.obj"))
+    deformed = [[s + u for s, u in zip(p, d)] for p, d in zip(reference, displacement)]
+    norm = colors.Normalize(vmin=0.0, vmax=max(max(magnitude), 1e-300))
+    colour_map = cm.viridis
+    three_d = len(reference[0]) == 3
+    if three_d:
+        ax = fig.add_subplot(*position, projection="3d")
+        face_u = [sum(magnitude[i] for i in f) / len(f) for f in faces]
+        ax.add_collection3d(Poly3DCollection([[deformed[i] for i in f] for f in faces],
+                                             facecolors=colour_map(norm(face_u)),
+                                             edgecolor="none", alpha=0.9))
+        ax.add_collection3d(Line3DCollection([[reference[i] for i in f] + [reference[f[0]]]
+                                              for f in faces],
+                                             colors="0.35", linewidths=0.25))
+        everything = reference + deformed
+        low = [min(p[a] for p in everything) for a in range(3)]
+        high = [max(p[a] for p in everything) for a in range(3)]
+        ax.set_xlim(low[0], high[0])
+        ax.set_ylim(low[1], high[1])
+        ax.set_zlim(low[2], high[2])
+        ax.set_box_aspect([max(h - l, 1e-12) for l, h in zip(low, high)])
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
     else:
+        ax = fig.add_subplot(*position)
         for a, b in faces:
-            ax.plot([xs[a], xs[b]], [ys[a], ys[b]], [zs[a], zs[b]], color=colour)
+            ax.plot([reference[a][0], reference[b][0]], [reference[a][1], reference[b][1]],
+                    color="0.5", linestyle="--", linewidth=1)
+            mean_u = 0.5 * (magnitude[a] + magnitude[b])
+            ax.plot([deformed[a][0], deformed[b][0]], [deformed[a][1], deformed[b][1]],
+                    color=colour_map(norm(mean_u)), linewidth=2.5)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+    fig.colorbar(cm.ScalarMappable(norm=norm, cmap=colour_map), ax=ax, shrink=0.7,
+                 pad=0.15 if three_d else 0.05,
+                 label="|u| [m]")
+    ax.set_title(title + "\n(grey: undeformed outline)", fontsize=9)
+
+
+def run_folder(folder, run):
+    return os.path.join(folder, run["variant"]) if run["variant"] else folder
 
 
 def main(summary_path, png_path):
     with open(summary_path) as f:
         summary = json.load(f)
-    runs = summary.get("runs", [])
-    folder = os.path.dirname(summary_path)
-    final_obj = os.path.join(folder, "final.obj")
-    sweep = len(runs) > 1
-    panels = 2 + (1 if os.path.exists(final_obj) else 0) + (1 if sweep else 0)
-    fig = plt.figure(figsize=(5 * panels, 4.5))
+    folder = os.path.dirname(summary_path) or "."
+    runs = [r for r in summary.get("runs", []) if r["steps"]]
+    if not runs:
+        sys.exit(f"{summary_path}: no load steps to plot")
+    sweep = len(summary.get("runs", [])) > 1
+    # A round trip: every load back to zero at the end of every run.
+    round_trip = sweep and all(
+        r["success"] and not any(r["steps"][-1]["load_factors"].values()) for r in runs)
+    drawable = [r for r in runs if r["success"] and
+                os.path.exists(os.path.join(run_folder(folder, r), "vertices.csv")) and
+                os.path.exists(os.path.join(run_folder(folder, r), "final.obj"))]
+    panels = (1 if drawable else 0) + 3 + (1 if round_trip else 0)
+    fig = plt.figure(figsize=(4.8 * panels, 4.5))
     k = 1
-    if os.path.exists(final_obj):
-        ax = fig.add_subplot(1, panels, k, projection="3d")
+    if drawable:
+        shown = max(drawable, key=lambda r: r["steps"][-1]["max_displacement"])
+        title = "deformed surface" + (f", variant {shown['variant']}" if shown["variant"] else "")
+        draw_deformed(fig, (1, panels, k), run_folder(folder, shown), title)
         k += 1
-        v_final, faces = read_obj(final_obj)
-        draw_surface(ax, v_final, faces, "tab:red", "deformed")
-        ax.set_title("deformed surface (final.obj)")
-        ax.set_box_aspect([max(v[a] for v in v_final) - min(v[a] for v in v_final)
-                           for a in range(3)])
-    for key, label in (("max_displacement", "largest |u|"), ("pressure", "pressure P")):
+    for key, label in (("max_displacement", "largest displacement |u| [m]"),
+                       ("pressure", "pressure P [Pa]")):
         ax = fig.add_subplot(1, panels, k)
         k += 1
         for run in runs:
             steps = [s["step"] for s in run["steps"]]
-            values = [s[key] for s in run["steps"]]
-            ax.plot(steps, values, marker="." if len(steps) < 50 else None,
+            ax.plot(steps, [s[key] for s in run["steps"]], marker="." if len(steps) < 50 else None,
                     label=run["variant"] or summary["experiment"])
         ax.set_xlabel("load step")
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
         if sweep:
             ax.legend(fontsize=7)
-    if sweep:
+    ax = fig.add_subplot(1, panels, k)
+    k += 1
+    for run in runs:
+        for group in run["steps"][-1].get("reactions", {}):
+            magnitudes = [sum(c * c for c in s["reactions"][group]) ** 0.5 for s in run["steps"]]
+            name = (run["variant"] + ": " if run["variant"] else "") + group
+            ax.plot([s["step"] for s in run["steps"]], magnitudes, label=name)
+    ax.set_xlabel("load step")
+    ax.set_ylabel("support reaction |R| [N]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    if round_trip:
         ax = fig.add_subplot(1, panels, k)
         by_kind = {}
         for run in runs:
@@ -85,10 +148,10 @@ def main(summary_path, png_path):
             ax.loglog([p[0] for p in points], [p[1] for p in points], marker="o", label=kind)
         ax.loglog([1, 10, 100], [0.03, 0.003, 0.0003], "k--", marker="s", label="paper (breasts)")
         ax.set_xlabel("steps each way n")
-        ax.set_ylabel("Eq. 9 after the round trip")
+        ax.set_ylabel("Eq. 9 after the round trip [-]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle(summary["experiment"])
+    fig.suptitle(summary["experiment"] + ("" if summary.get("success", True) else " (FAILED)"))
     fig.tight_layout()
     fig.savefig(png_path, dpi=110)
 

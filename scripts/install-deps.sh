@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
+  python3-dev pybind11-dev python3-pytest    # the Python module and its tests
 )
 
 missing=()

@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The Python module `fiberfluid`: read and check meshes, build experiments
+// from files or dicts, run them (sweeps too) and get the results as numpy
+// arrays. A thin layer over fiberfluid::app; bad input raises ValueError with
+// the library's message.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/experiment.hpp"
+#include "app/outputs.hpp"
+#include "app/runner.hpp"
+#include "geom/error.hpp"
+#include "geom/mesh_check.hpp"
+#include "geom/mesh_io.hpp"
+
+namespace py = pybind11;
+namespace ff = fiberfluid;
+
+namespace {
+
+// A plain dict (or list) to JSON, through Python's own json module.
+nlohmann::json to_json(const py::object& document) {
+  const std::string text = py::module_::import("json").attr("dumps")(document).cast<std::string>();
+  return nlohmann::json::parse(text);
+}
+
+py::object to_python(const nlohmann::json& document) {
+  return py::module_::import("json").attr("loads")(document.dump());
+}
+
+// Per-step records of one run as numpy arrays (SI units).
+py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s) {
+  const auto n = static_cast<Eigen::Index>(s.steps.size());
+  const int dim = c.model.dim();
+  Eigen::VectorXi step(n);
+  Eigen::VectorXd pressure(n), volume(n), max_displacement(n), seconds(n);
+  Eigen::MatrixXd applied(n, dim), factors(n, static_cast<Eigen::Index>(c.model.loads.size()));
+  const size_t groups = std::max<size_t>(1, c.model.constraint_groups.size());
+  std::vector<Eigen::MatrixXd> reactions(groups, Eigen::MatrixXd::Zero(n, dim));
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const ff::solve::StepRecord& r = s.steps[static_cast<size_t>(k)];
+    step[k] = r.step;
+    pressure[k] = r.pressure;
+    volume[k] = r.volume;
+    max_displacement[k] = r.max_displacement;
+    seconds[k] = r.seconds;
+    applied.row(k) = r.applied_force.head(dim).transpose();
+    for (size_t l = 0; l < r.load_factors.size(); ++l)
+      factors(k, static_cast<Eigen::Index>(l)) = r.load_factors[l];
+    for (size_t g = 0; g < r.reactions.size() && g < groups; ++g)
+      reactions[g].row(k) = r.reactions[g].head(dim).transpose();
+  }
+  py::dict out;
+  out["step"] = step;
+  out["pressure"] = pressure;
+  out["volume"] = volume;
+  out["max_displacement"] = max_displacement;
+  out["seconds"] = seconds;
+  out["applied_force"] = applied;
+  py::dict load_factors;
+  for (size_t l = 0; l < c.model.loads.size(); ++l)
+    load_factors[py::str(c.model.loads[l].label)] = Eigen::VectorXd(factors.col(static_cast<Eigen::Index>(l)));
+  out["load_factors"] = load_factors;
+  py::dict reaction_dict;
+  for (size_t g = 0; g < groups; ++g)
+    reaction_dict[py::str(g < c.model.constraint_groups.size() ? c.model.constraint_groups[g]
+                                                               : std::string("supports"))] =
+        reactions[g];
+  out["reactions"] = reaction_dict;
+  return out;
+}
+
+// One run's results: the deformed surface in input order, the steps, the figures.
+py::dict run_dict(const ff::app::Experiment& ex, const ff::app::ExperimentResult& result,
+                  size_t r) {
+  const ff::app::Case& c = ex.cases[r];
+  const ff::app::RunResult& run = result.runs[r];
+  py::dict out;
+  out["variant"] = run.variant;
+  out["success"] = run.summary.success;
+  out["message"] = run.summary.message;
+  out["solver"] = std::string(ff::solve::to_string(run.summary.solver));
+  out["reference_positions"] = c.input_surface.V;
+  out["faces"] = c.input_surface.F;
+  if (run.summary.success) {
+    const Eigen::MatrixXd X = ff::app::input_positions(c, run.summary.unknowns);
+    out["positions"] = X;
+    out["displacements"] = Eigen::MatrixXd(X - c.input_surface.V);
+    out["pressure"] = run.summary.unknowns[c.model.pressure_dof()];
+  }
+  out["steps"] = steps_dict(c, run.summary);
+  py::dict figures;
+  const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
+  for (const auto& [name, value] : result.figures)
+    if (name.rfind(prefix, 0) == 0) figures[py::str(name.substr(prefix.size()))] = value;
+  out["figures"] = figures;
+  return out;
+}
+
+// Runs an experiment; with `output`, also writes its result folder as the
+// command line does. Returns {"success", "runs": [...], "figures", "checks"}.
+py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output) {
+  ff::app::ExperimentResult result;
+  {
+    py::gil_scoped_release release;  // a long solve lets other Python threads run
+    ff::app::RunOptions options;
+    options.jobs = jobs;
+    if (output.empty()) {
+      result = ff::app::run_experiment(ex, {}, options);
+    } else {
+      ff::app::OutputWriter writer(ex, output);
+      writer.begin();
+      result = ff::app::run_experiment(
+          ex,
+          [&](size_t run, const ff::solve::StepRecord& record, const Eigen::VectorXd& x) {
+            writer.on_step(run, record, x);
+          },
+          options);
+      writer.finish(result);
+    }
+  }
+  py::dict out;
+  out["success"] = result.runs_succeeded();
+  py::list runs;
+  for (size_t r = 0; r < result.runs.size(); ++r) runs.append(run_dict(ex, result, r));
+  out["runs"] = runs;
+  out["figures"] = result.figures;
+  py::list checks;
+  for (const ff::app::FigureCheck& c : result.checks) {
+    py::dict check;
+    check["figure"] = c.expected.figure;
+    check["actual"] = c.actual;
+    check["passed"] = c.passed;
+    check["report"] = c.Describe();
+    checks.append(check);
+  }
+  out["checks"] = checks;
+  return out;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(fiberfluid, m) {
+  m.doc() = "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
+            "SI units throughout: m, N, Pa.";
+  py::register_exception<ff::InputError>(m, "InputError", PyExc_ValueError);
+
+  m.def(
+      "read_mesh",
+      [](const std::filesystem::path& path, bool flip) {
+        ff::geom::ReadResult read = ff::geom::read_surface(path);
+        if (flip) ff::geom::flip_orientation(read.surface);
+        const ff::geom::MeshReport report = ff::geom::inspect(read.surface);
+        py::dict out;
+        out["vertices"] = read.surface.V;
+        out["faces"] = read.surface.F;
+        out["dimension"] = read.surface.dim;
+        out["ok"] = report.ok();
+        out["problems"] = report.problems;
+        std::vector<std::string> warnings = read.warnings;
+        warnings.insert(warnings.end(), report.warnings.begin(), report.warnings.end());
+        out["warnings"] = warnings;
+        out["report"] = ff::geom::format_report(report, path.string());
+        return out;
+      },
+      py::arg("path"), py::arg("flip") = false,
+      "Reads an OBJ, OFF, STL or PLY surface and checks it. Returns a dict: vertices (#V x 3), "
+      "faces, ok, problems, warnings, report (the text of `fiberfluid check`).");
+
+  py::class_<ff::app::Experiment>(m, "Experiment",
+                                  "A parsed, validated experiment: one run or a sweep of variants.")
+      .def_static("from_file", &ff::app::load_experiment, py::arg("path"),
+                  "Reads an experiment file (JSON). Raises InputError (a ValueError) naming the "
+                  "file and field on bad input.")
+      .def_static(
+          "from_dict",
+          [](const py::object& document, const std::filesystem::path& folder) {
+            return ff::app::parse_experiment(to_json(document), folder, "<dict>");
+          },
+          py::arg("document"), py::arg("folder") = std::filesystem::path("."),
+          "Builds an experiment from a dict with the fields of an experiment file; relative "
+          "mesh paths are taken from `folder`.")
+      .def_property_readonly("name", [](const ff::app::Experiment& ex) { return ex.name; })
+      .def_property_readonly("variants",
+                             [](const ff::app::Experiment& ex) {
+                               std::vector<std::string> names;
+                               for (const ff::app::Case& c : ex.cases) names.push_back(c.variant);
+                               return names;
+                             })
+      .def_property_readonly("warnings", [](const ff::app::Experiment& ex) { return ex.warnings; })
+      .def_property_readonly("num_vertices",
+                             [](const ff::app::Experiment& ex) {
+                               return ex.cases.empty() ? 0 : ex.cases.front().model.num_vertices();
+                             })
+      .def("run", &run, py::arg("jobs") = 0, py::arg("output") = std::string(),
+           "Runs every variant (`jobs` at once; 0: one per core). With `output`, writes the "
+           "result folder as `fiberfluid run -o` does. Returns a dict with success, runs (each "
+           "with positions, displacements, pressure, steps as numpy arrays, figures), figures "
+           "and checks.");
+
+  m.def(
+      "summary",
+      [](const std::filesystem::path& folder) {
+        std::ifstream in(folder / "summary.json");
+        if (!in) throw ff::InputError((folder / "summary.json").string() + ": cannot open");
+        return to_python(nlohmann::json::parse(in));
+      },
+      py::arg("folder"), "Reads the summary.json of a result folder as a dict.");
+  m.attr("__version__") = FIBERFLUID_VERSION;
+}

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs the built fiberfluid into a scratch prefix, builds examples/cpp
+# against that prefix as a separate project, and runs it.
+#   tests/install/build_example.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build="$1" source="$2"
+scratch="$(mktemp -d)"
+trap 'rm -rf "$scratch"' EXIT
+cmake --install "$build" --prefix "$scratch/prefix" >/dev/null
+cmake -S "$source/examples/cpp" -B "$scratch/build" -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_PREFIX_PATH="$scratch/prefix" >/dev/null
+cmake --build "$scratch/build" -j2 >/dev/null
+output="$("$scratch/build/sag_sphere")"
+echo "$output"
+# Four times the modulus sags about a quarter as far; the cap carries the
+# fluid's load (rho g V is about 5 N) upward in both.
+awk '/^soft:/ {soft = $4; soft_r = $9} /^stiff:/ {stiff = $4; stiff_r = $9}
+     END {ratio = stiff / soft
+          if (!(ratio > 0.2 && ratio < 0.3 && soft_r > 4 && stiff_r > 4)) {
+            print "unexpected figures: ratio " ratio ", reactions " soft_r " " stiff_r; exit 1 } }' \
+    <<<"$output"

@@ -1,0 +1,111 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The Python module: meshes, experiments from files and dicts, sweeps, numpy results."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+import fiberfluid
+
+SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+MESHES = os.path.join(SOURCE, "data", "meshes")
+EXPERIMENTS = os.path.join(SOURCE, "experiments")
+
+
+def rectangle_dict():
+    """The paper's worked example (model.md section 8), exact by elimination."""
+    with open(os.path.join(EXPERIMENTS, "rectangle.json")) as f:
+        document = json.load(f)
+    document["stepping"]["boundary_method"] = "elimination"
+    document["expected"] = []
+    return document
+
+
+def test_read_mesh_reports_counts_and_problems(tmp_path):
+    liver = fiberfluid.read_mesh(os.path.join(MESHES, "liver.obj"))
+    assert liver["vertices"].shape == (181, 3)
+    assert liver["faces"].shape == (274, 3)
+    assert liver["ok"]
+    assert any("referenced by no face" in w for w in liver["warnings"])
+    open_mesh = tmp_path / "open.obj"
+    open_mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n")
+    report = fiberfluid.read_mesh(str(open_mesh))
+    assert not report["ok"]
+    assert "not closed" in report["problems"][0]
+    with pytest.raises(ValueError, match="cannot open"):
+        fiberfluid.read_mesh(str(tmp_path / "missing.obj"))
+
+
+def test_paper_rectangle_from_a_dict():
+    result = fiberfluid.Experiment.from_dict(rectangle_dict()).run()
+    assert result["success"]
+    run = result["runs"][0]
+    # u1x = u2x = -4, u1y = u4y = 16/3, P = 32 (the paper's solution)
+    np.testing.assert_allclose(run["displacements"][:, 0], [-4, -4, 0, 0], atol=1e-10)
+    np.testing.assert_allclose(run["displacements"][:, 1], [16 / 3, 0, 0, 16 / 3], atol=1e-10)
+    assert run["pressure"] == pytest.approx(32.0, abs=1e-10)
+    # The two supports carry the applied 2 x 1680 N.
+    reactions = sum(r[-1] for r in run["steps"]["reactions"].values())
+    np.testing.assert_allclose(reactions, [0.0, -3360.0], atol=1e-9)
+    np.testing.assert_allclose(run["steps"]["applied_force"][-1], [0.0, 3360.0], atol=1e-9)
+
+
+def test_a_sweep_gives_one_run_per_variant_with_step_arrays():
+    experiment = fiberfluid.Experiment.from_file(os.path.join(EXPERIMENTS, "liver_sweep.json"))
+    assert experiment.variants == ["Y10kPa", "Y20kPa", "Y40kPa", "Y80kPa"]
+    result = experiment.run(jobs=2)
+    assert result["success"]
+    largest = [run["figures"]["max_displacement"] for run in result["runs"]]
+    assert largest == sorted(largest, reverse=True)  # stiffer, smaller
+    assert largest[1] == pytest.approx(0.0112338, abs=1e-7)  # liver_gravity.json
+    steps = result["runs"][0]["steps"]
+    assert steps["step"].tolist() == list(range(1, 11))
+    assert steps["reactions"]["top"].shape == (10, 3)
+    # Equilibrium at every step.
+    total = steps["reactions"]["top"] + steps["applied_force"]
+    assert np.abs(total).max() < 1e-10 * np.abs(steps["applied_force"]).max()
+
+
+def test_bad_input_raises_value_error_naming_the_field():
+    document = rectangle_dict()
+    document["material"]["Y"] = "stiff"
+    with pytest.raises(ValueError, match=r"<dict>: material.Y: expected a number"):
+        fiberfluid.Experiment.from_dict(document)
+    with pytest.raises(ValueError, match="cannot open the experiment file"):
+        fiberfluid.Experiment.from_file("no_such_experiment.json")
+
+
+def test_a_runaway_is_reported_not_returned(tmp_path):
+    with open(os.path.join(EXPERIMENTS, "sphere.json")) as f:
+        document = json.load(f)
+    document["loads"][0]["density"] = 1e12
+    result = fiberfluid.Experiment.from_dict(document).run(output=str(tmp_path / "out"))
+    assert not result["success"]
+    assert "step 1: runaway" in result["runs"][0]["message"]
+    assert "positions" not in result["runs"][0]
+    assert (tmp_path / "out.failed" / "FAILED").exists()
+
+
+def test_writes_a_result_folder_like_the_command_line(tmp_path):
+    out = tmp_path / "rect"
+    fiberfluid.Experiment.from_dict(rectangle_dict()).run(output=str(out))
+    summary = fiberfluid.summary(str(out))
+    assert summary["units"]["force"] == "N"
+    assert summary["runs"][0]["final"]["final_pressure"] == pytest.approx(32.0)
+    for name in ("steps.csv", "vertices.csv", "final.obj", "series.pvd"):
+        assert (out / name).exists(), name
+
+
+def test_the_python_example_runs(tmp_path):
+    import subprocess
+    import sys
+    png = tmp_path / "sweep.png"
+    done = subprocess.run([sys.executable, os.path.join(EXPERIMENTS, "python_sweep.py"), str(png)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split() for line in done.stdout.splitlines()[1:7]]
+    largest = [float(row[1]) for row in rows]
+    assert largest == sorted(largest, reverse=True)
+    assert png.stat().st_size > 10000
