@@ -70,6 +70,10 @@ int main(int argc, char** argv) {
   config["surface"]["subdivisions"] = subdivisions;
   config["stepping"]["solver"] = solver;
   config["expected"] = nlohmann::json::array();
+  // Gravity only: the sphere's 300 N point force on one vertex turns faces
+  // over on meshes of 10,242 vertices and more (a point load on ever smaller
+  // areas), which the runaway guard rightly stops.
+  config["loads"] = nlohmann::json::array({config["loads"][0]});
   const fiberfluid::app::Experiment ex =
       fiberfluid::app::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
 

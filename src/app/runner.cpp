@@ -207,6 +207,7 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
         report_progress("variants", static_cast<double>(++finished),
                         static_cast<double>(ex.cases.size()));
     };
+    if (ex.cases.size() > 1) report_progress("variants", 0.0, static_cast<double>(ex.cases.size()));
     const int jobs = effective_jobs(options, ex.cases.size());
     if (jobs == 1) {
       for (size_t r = 0; r < ex.cases.size(); ++r) run_case(r);

@@ -24,15 +24,60 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The vertices with at least one constrained axis, ascending.
-std::vector<int> constrained_vertices(const model::Model& model) {
-  std::vector<char> held(static_cast<size_t>(model.num_vertices()), 0);
-  for (const model::Constraint& c : model.constraints) held[static_cast<size_t>(c.vertex)] = 1;
-  std::vector<int> vertices;
-  for (int i = 0; i < model.num_vertices(); ++i)
-    if (held[static_cast<size_t>(i)]) vertices.push_back(i);
-  return vertices;
-}
+// The force each support exerts on the body: at every held unknown, the
+// unreduced row of the step's A times the step's increment, less the load
+// increment there, summed over the steps (the incremental scheme's own
+// equilibrium, whatever A and the loads were built from).
+class Reactions {
+ public:
+  // Throws InputError when one unknown is held at two different values.
+  explicit Reactions(const model::Model& model)
+      : model_(model),
+        partition_(model::partition_dofs(model)),
+        per_vertex_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
+    const int n = model.num_vertices();
+    for (int d : partition_.constrained) held_vertices_.push_back(d % n);
+    std::sort(held_vertices_.begin(), held_vertices_.end());
+    held_vertices_.erase(std::unique(held_vertices_.begin(), held_vertices_.end()),
+                         held_vertices_.end());
+  }
+
+  void add_step(const model::FiberSystem& system, const Eigen::VectorXd& dx,
+                const Eigen::VectorXd& dB) {
+    const Eigen::MatrixXd rows = system.unreduced_rows(
+        held_vertices_, model::displacements(model_, dx), dx[model_.pressure_dof()]);
+    const int n = model_.num_vertices();
+    for (int d : partition_.constrained) {
+      const int vertex = d % n, axis = d / n;
+      const auto row = std::lower_bound(held_vertices_.begin(), held_vertices_.end(), vertex) -
+                       held_vertices_.begin();
+      per_vertex_(vertex, axis) += rows(row, axis) - dB[d];
+    }
+  }
+
+  // #V by dim: zero where nothing is held.
+  const Eigen::MatrixXd& per_vertex() const { return per_vertex_; }
+
+  // The sum over each group of Model::constraint_groups (one group when none is named).
+  std::vector<Eigen::Vector3d> per_group() const {
+    std::vector<Eigen::Vector3d> sums(std::max<size_t>(1, model_.constraint_groups.size()),
+                                      Eigen::Vector3d::Zero());
+    const int n = model_.num_vertices();
+    for (size_t k = 0; k < partition_.constrained.size(); ++k) {
+      const int d = partition_.constrained[k];
+      const model::Constraint& c =
+          model_.constraints[static_cast<size_t>(partition_.constraint_of[k])];
+      sums[static_cast<size_t>(c.group) % sums.size()][d / n] += per_vertex_(d % n, d / n);
+    }
+    return sums;
+  }
+
+ private:
+  const model::Model& model_;
+  model::DofPartition partition_;    // each held unknown once, with its constraint
+  std::vector<int> held_vertices_;   // ascending
+  Eigen::MatrixXd per_vertex_;
+};
 
 // Why the state reached after a step is a runaway rather than a result, or "".
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
@@ -98,15 +143,18 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   const Eigen::MatrixXd& reference = model.surface.V;
   const double reference_volume = geom::enclosed_volume(reference, model.surface.F);
   const Eigen::MatrixXd reference_face_areas = geom::face_area_vectors(reference, model.surface.F);
-  const std::vector<int> held = constrained_vertices(model);
-  const size_t groups = std::max<size_t>(1, model.constraint_groups.size());
-  const int dim = model.dim(), nv = model.num_vertices();
-  summary.reaction_forces = Eigen::MatrixXd::Zero(nv, dim);
-  Eigen::Vector3d applied = Eigen::Vector3d::Zero();
-  Eigen::MatrixXd reaction_before = summary.reaction_forces;
+  std::optional<Reactions> reactions;
+  try {
+    reactions.emplace(model);
+  } catch (const InputError& e) {  // one unknown held at two values
+    return fail(e.what());
+  }
+  const int nv = model.num_vertices();
+  Eigen::Vector3d applied = Eigen::Vector3d::Zero();  // the loads so far, summed over vertices
   std::optional<model::FiberSystem> system;  // outlives its factorisation
   std::unique_ptr<LinearSolver> solver;
 
+  report_progress("step", 0, n);
   for (int k = 1; k <= n; ++k) {
     const Clock::time_point step_start = Clock::now();
     const Eigen::MatrixXd X = model::positions(model, summary.unknowns);
@@ -162,17 +210,8 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     why = runaway_reason(model, options, X_now, volume, reference_volume, reference_face_areas);
     if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
 
-    // Reactions: the unreduced rows of this step's A times the increment,
-    // less the load increment, accumulated at the constrained unknowns.
-    const Eigen::MatrixXd forces = system->unreduced_rows(
-        held, model::displacements(model, dx), dx[model.pressure_dof()]);
-    for (const model::Constraint& c : model.constraints) {
-      const auto r = std::lower_bound(held.begin(), held.end(), c.vertex) - held.begin();
-      summary.reaction_forces(c.vertex, c.axis) =
-          reaction_before(c.vertex, c.axis) + forces(r, c.axis) - dB[model.dof(c.vertex, c.axis)];
-    }
-    reaction_before = summary.reaction_forces;
-    for (int a = 0; a < dim; ++a) applied[a] += dB.segment(a * nv, nv).sum();
+    reactions->add_step(*system, dx, dB);
+    for (int a = 0; a < model.dim(); ++a) applied[a] += dB.segment(a * nv, nv).sum();
 
     StepRecord record;
     record.step = k;
@@ -180,15 +219,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     record.pressure = summary.unknowns[model.pressure_dof()];
     record.volume = volume;
     record.applied_force = applied;
-    record.reactions.assign(groups, Eigen::Vector3d::Zero());
-    std::vector<char> counted(static_cast<size_t>(dim * nv), 0);  // a unknown held twice counts once
-    for (const model::Constraint& c : model.constraints) {
-      char& seen = counted[static_cast<size_t>(model.dof(c.vertex, c.axis))];
-      if (seen) continue;
-      seen = 1;
-      record.reactions[static_cast<size_t>(c.group) % groups][c.axis] +=
-          summary.reaction_forces(c.vertex, c.axis);
-    }
+    record.reactions = reactions->per_group();
     record.max_displacement =
         model::displacements(model, summary.unknowns).rowwise().norm().maxCoeff();
     record.seconds = seconds_since(step_start);
@@ -196,6 +227,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     report_progress("step", k, n);
     if (observer) observer(record, summary.unknowns);
   }
+  summary.reaction_forces = reactions->per_vertex();
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;
