@@ -301,19 +301,19 @@ std::vector<ExpectedFigure> read_expected(Fields& root) {
 }
 
 // Reads "fibers" and prunes the fibers that leave a concave body.
-void read_fibers(Fields& root, Case& ex) {
+void read_fibers(Fields& root, Case& c) {
   std::string mode = "auto", count = "symmetric";
   if (root.has("fibers")) {
     Fields f = root.object("fibers");
     mode = f.choice("pruning", "auto", {"auto", "off"});
     count = f.choice("connection_count", "symmetric", {"symmetric", "global"});
-    ex.fibers.write = f.choice("write", "none", {"none", "kept", "pruned"});
+    c.fibers.write = f.choice("write", "none", {"none", "kept", "pruned"});
     f.finish();
   }
-  model::Model& m = ex.model;
+  model::Model& m = c.model;
   m.connection_count =
       count == "global" ? model::ConnectionCount::Global : model::ConnectionCount::Symmetric;
-  FiberReport& report = ex.fibers;
+  FiberReport& report = c.fibers;
   report.pruning = mode == "auto";
   const int n = m.num_vertices();
   report.pairs = static_cast<long long>(n) * (n - 1) / 2;

@@ -188,6 +188,26 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
             summary);
 }
 
+TEST(Cli, LongPhasesShowProgressUnlessQuiet) {
+  ScratchDir dir;
+  // About 4 s of load steps (642 vertices, A rebuilt every step, 10 ms each).
+  const auto config = dir.write("steps.json", R"({"name": "steps",
+    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
+    "material": {"Y": 20000, "gamma": 1},
+    "supports": [{"where": "z >= 0.04"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 400, "rebuild_matrix": true, "solver": "block-cholesky"},
+    "output": {"vtk": false}})");
+  Outcome o = run_cli("run " + config.string() + " -o " + (dir.path() / "a").string());
+  ASSERT_EQ(o.status, 0) << o.output;
+  // Not a terminal: plain lines with the elapsed time and an estimate of what is left.
+  EXPECT_NE(o.output.find("step 400/400 (100%), "), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find(" s left"), std::string::npos) << o.output;
+  o = run_cli("run " + config.string() + " -q -o " + (dir.path() / "b").string());
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_EQ(o.output.find("step "), std::string::npos) << o.output;
+}
+
 TEST(Cli, UsageErrors) {
   EXPECT_NE(run_cli("").status, 0);
   EXPECT_NE(run_cli("run").status, 0);
