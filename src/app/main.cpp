@@ -99,8 +99,9 @@ class ProgressPrinter {
                       elapsed * (p.total - p.done) / p.done);
         line += buffer;
       }
-    } else {
-      std::snprintf(buffer, sizeof buffer, " %g, %.1f s", p.done, elapsed);
+    } else {  // a count with no known end, or only a start
+      if (p.done > 0.0) line += " " + std::to_string(static_cast<long long>(p.done));
+      std::snprintf(buffer, sizeof buffer, ", %.1f s", elapsed);
       line += buffer;
     }
     if (tty_) std::fprintf(stderr, "\r\033[K%s", line.c_str());

@@ -10,8 +10,9 @@
 namespace fiberfluid {
 
 // label: the run it belongs to ("" or a sweep's variant: set per thread by
-// ProgressLabel); phase: "pruning", "factorize", "pcg", "step", "variants";
-// done of total in the phase's own unit (total 0 when it is not known).
+// ProgressLabel); phase: "pruning", "factorize", "pcg iteration", "step",
+// "variants"; done of total in the phase's own unit (total 0 when it is not
+// known; done 0 and total 0: the phase has begun).
 using ProgressSink = std::function<void(const std::string& label, const char* phase,
                                         double done, double total)>;
 

@@ -176,7 +176,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
         if (!status.ok) return fail(status.message);
       }
       t = Clock::now();
-      report_progress("factorize", 0.0, 1.0);
+      report_progress("factorize", 0.0, 0.0);  // one call: elapsed time only
       const Status status = solver->factorize(*system);
       report_progress("factorize", 1.0, 1.0);
       summary.factorize_seconds += seconds_since(t);

@@ -64,7 +64,7 @@ class PcgSolver final : public SchurSolver {
       *w += alpha * p;
       r -= alpha * q;
       ++statistics_.iterations;
-      report_progress("pcg", it, 0.0);
+      report_progress("pcg iteration", it, 0.0);
       if (r.norm() <= options_.tolerance * norm_f) return {};
       z = precondition(r);
       const double rz_next = r.dot(z);
