@@ -81,9 +81,10 @@ class Reactions {
 
 // Why the state reached after a step is a runaway rather than a result, or "".
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
-                           const Eigen::MatrixXd& X, double volume, double reference_volume,
+                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X,
+                           double volume, double reference_volume,
                            const Eigen::MatrixXd& reference_face_areas) {
-  if (!X.allFinite()) return "the displacements are not finite";
+  if (!unknowns.allFinite()) return "the solution (displacements or pressure) is not finite";
   if (options.stop_on_inverted_faces) {
     const Eigen::MatrixXd now = geom::face_area_vectors(X, model.surface.F);
     for (Eigen::Index f = 0; f < now.rows(); ++f)
@@ -207,7 +208,8 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     summary.unknowns += dx;
     const Eigen::MatrixXd X_now = model::positions(model, summary.unknowns);
     const double volume = geom::enclosed_volume(X_now, model.surface.F);
-    why = runaway_reason(model, options, X_now, volume, reference_volume, reference_face_areas);
+    why = runaway_reason(model, options, summary.unknowns, X_now, volume, reference_volume,
+                         reference_face_areas);
     if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
 
     reactions->add_step(*system, dx, dB);
@@ -220,8 +222,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     record.volume = volume;
     record.applied_force = applied;
     record.reactions = reactions->per_group();
-    record.max_displacement =
-        model::displacements(model, summary.unknowns).rowwise().norm().maxCoeff();
+    record.max_displacement = (X_now - reference).rowwise().norm().maxCoeff();
     record.seconds = seconds_since(step_start);
     summary.steps.push_back(record);
     report_progress("step", k, n);
