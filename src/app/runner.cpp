@@ -180,9 +180,10 @@ Eigen::MatrixXd constrained_system_matrix(const Case& ex) {
   return A_free;
 }
 
+static int core_count() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+
 static int effective_jobs(const RunOptions& options, size_t cases) {
-  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  const int wanted = options.jobs > 0 ? options.jobs : cores;
+  const int wanted = options.jobs > 0 ? options.jobs : core_count();
   return std::max(1, std::min(wanted, static_cast<int>(cases)));
 }
 
@@ -214,12 +215,12 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
     } else {
       // A small pool: each worker takes the next case; OpenMP threads are
       // shared out so that jobs x threads stays at the core count.
-      const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+      const int threads_per_job = std::max(1, core_count() / jobs);
       std::atomic<size_t> next{0};
       std::vector<std::thread> workers;
       for (int w = 0; w < jobs; ++w)
         workers.emplace_back([&] {
-          omp_set_num_threads(std::max(1, cores / jobs));
+          omp_set_num_threads(threads_per_job);
           for (size_t r = next++; r < ex.cases.size(); r = next++) run_case(r);
         });
       for (std::thread& worker : workers) worker.join();
