@@ -287,9 +287,9 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
     t.text(run.variant);
     t.text(s.success ? "true" : "false");
     t.number(static_cast<double>(s.steps.size()));
-    for (const char* f : figures) {
-      const auto value = s.success ? run_figure(ex.cases[r], run, f) : std::nullopt;
-      if (value) t.number(*value);
+    for (const char* f : figures) {  // as the runner computed them; none for a failed run
+      const auto value = result.figures.find(run.variant + "." + f);
+      if (value != result.figures.end()) t.number(value->second);
       else t.text("");
     }
     const bool same_groups = ex.cases[r].model.constraint_groups == first.constraint_groups;
