@@ -23,7 +23,7 @@ namespace {
 
 namespace app = fiberfluid::app;
 
-enum ExitCode { kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3 };
+enum ExitCode { kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3, kUsage = 64 };
 
 // Draws the library's progress reports on stderr, for phases that run longer
 // than a moment: one line redrawn in place on a terminal; plain lines (every
@@ -229,7 +229,15 @@ int main(int argc, char** argv) {
   check->add_option("mesh", mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
   check->add_flag("--flip", flip, "Reverse the face orientation before checking");
 
-  CLI11_PARSE(cli, argc, argv);
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One status for every usage mistake (sysexits' EX_USAGE), distinct from bad input files.
+    cli.exit(e);
+    return kUsage;
+  }
   try {
     if (run->parsed()) return run_command(experiment, flags);
     return check_command(mesh, flip);

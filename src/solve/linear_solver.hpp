@@ -56,7 +56,9 @@ class LinearSolver {
 std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptions& pcg = {});
 
 // The default by size: the paper's dense LU for small systems, block
-// Cholesky while a dense N x N block fits easily in memory, pcg beyond.
+// Cholesky while its dense N x N blocks fit in 30% of `memory_bytes`, pcg beyond.
+SolverKind choose_solver(const model::FiberSystem& system, double memory_bytes);
+// The same for this machine's physical memory.
 SolverKind choose_solver(const model::FiberSystem& system);
 
 // Physical memory of this machine in bytes.

@@ -209,9 +209,20 @@ TEST(Cli, LongPhasesShowProgressUnlessQuiet) {
 }
 
 TEST(Cli, UsageErrors) {
-  EXPECT_NE(run_cli("").status, 0);
-  EXPECT_NE(run_cli("run").status, 0);
-  EXPECT_NE(run_cli("frobnicate").status, 0);
+  // Status 64 and CLI11's message, not just any failure (a missing binary exits 127).
+  const struct {
+    const char* arguments;
+    const char* message;
+  } cases[] = {{"", "A subcommand is required"},
+               {"run", "experiment is required"},
+               {"frobnicate", "A subcommand is required"},
+               {"run x.json -j -3", "--jobs"}};
+  for (const auto& c : cases) {
+    const Outcome o = run_cli(c.arguments);
+    EXPECT_EQ(o.status, 64) << c.arguments << "\n" << o.output;
+    EXPECT_NE(o.output.find(c.message), std::string::npos) << c.arguments << "\n" << o.output;
+  }
+  EXPECT_EQ(run_cli("--help").status, 0);
 }
 
 }  // namespace
