@@ -64,8 +64,4 @@ Eigen::MatrixXd input_positions(const Case& c, const Eigen::VectorXd& unknowns);
 //   position.I.x / displacement.I.y (I an input vertex index).
 std::optional<double> run_figure(const Case& c, const RunResult& run, const std::string& name);
 
-// The paper's A for a run with its boundary conditions applied by penalty
-// (the rows and columns of every unknown) or by elimination (free unknowns).
-Eigen::MatrixXd constrained_system_matrix(const Case& c);
-
 }  // namespace fiberfluid::app

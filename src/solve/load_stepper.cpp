@@ -152,7 +152,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   }
   const int nv = model.num_vertices();
   Eigen::Vector3d applied = Eigen::Vector3d::Zero();  // the loads so far, summed over vertices
-  std::optional<model::FiberSystem> system;  // outlives its factorisation
+  std::shared_ptr<const model::FiberSystem> system;  // outlives its factorisation
   std::unique_ptr<LinearSolver> solver;
 
   report_progress("step", 0, n);
@@ -163,8 +163,9 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     if (k == 1 || options.rebuild_matrix) {
       Clock::time_point t = Clock::now();
       try {
-        system.emplace(model, options.rebuild_matrix ? X : reference, options.boundary_method,
-                       options.penalty);
+        system = std::make_shared<const model::FiberSystem>(
+            model, options.rebuild_matrix ? X : reference, options.boundary_method,
+            options.penalty);
       } catch (const InputError& e) {  // e.g. two vertices pressed onto each other
         return fail("step " + std::to_string(k) + ": " + e.what());
       }
@@ -229,6 +230,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     if (observer) observer(record, summary.unknowns);
   }
   summary.reaction_forces = reactions->per_vertex();
+  summary.system = system;
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;

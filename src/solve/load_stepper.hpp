@@ -3,10 +3,12 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "model/boundary_conditions.hpp"
+#include "model/fiber_system.hpp"
 #include "model/model.hpp"
 #include "solve/linear_solver.hpp"
 
@@ -51,6 +53,9 @@ struct SteppingSummary {
   Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
   Eigen::MatrixXd reaction_forces;    // #V by dim: the support force on each vertex at the end
   SolverKind solver = SolverKind::Auto;  // the backend that ran
+  // The bordered system the backend factored last (reduced, boundary
+  // conditions applied): what was actually solved.
+  std::shared_ptr<const model::FiberSystem> system;
   SolverStatistics solver_statistics;
   int factorizations = 0;
   double assemble_seconds = 0.0;
