@@ -157,16 +157,51 @@ std::vector<int> read_axes(Fields& f, int dim) {
 }
 
 // ------------------------------------------------------------ model parts
+model::FiberLaw read_law(Fields f) {
+  const std::string type =
+      f.choice("type", "constant", {"constant", "exponential", "bilinear", "tabulated"});
+  model::FiberLaw law;
+  if (type == "constant") {
+    law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
+  } else if (type == "exponential") {
+    law = model::FiberLaw::exponential(f.positive("Y0", 1.0), f.number("beta"));
+  } else if (type == "bilinear") {
+    law = model::FiberLaw::bilinear(f.positive("Y_t", 1.0), f.positive("Y_c", 1.0));
+  } else {
+    const Eigen::VectorXd strain = f.vector("strain", -1), stress = f.vector("stress", -1);
+    if (stress.size() != strain.size())
+      f.fail("stress", "expected as many stresses as strains (" + std::to_string(strain.size()) +
+                           "), got " + std::to_string(stress.size()));
+    law = model::FiberLaw::tabulated({strain.data(), strain.data() + strain.size()},
+                                     {stress.data(), stress.data() + stress.size()});
+    law.set_parameter("scale", f.positive("scale", 1.0));
+  }
+  f.finish();
+  const std::string why = law.check();
+  if (!why.empty()) f.fail(type == "tabulated" ? "stress" : "", why);
+  return law;
+}
+
 model::Material read_material(Fields f, int dim) {
   model::Material m;
-  const json& y = f.raw("Y");
-  if (y.is_array()) {
+  if (f.has("law") && f.has("Y"))
+    f.fail("Y", "give either Y (the linear model) or a law with its parameters, not both");
+  if (f.has("law")) {
+    m.law = read_law(f.object("law"));
+    if (f.has("axis_factors")) {
+      const Eigen::VectorXd factors = f.vector("axis_factors", dim);
+      if (!(factors.array() > 0).all()) f.fail("axis_factors", "expected positive numbers");
+      m.axis_factors.head(dim) = factors;
+    }
+  } else if (f.raw("Y").is_array()) {
+    // The paper's per-axis moduli: the constant law 1 times exact factors.
     const Eigen::VectorXd values = f.vector("Y", dim);
-    m.young_modulus.setZero();
-    m.young_modulus.head(dim) = values;
     if ((values.array() < 0).any()) f.fail("Y", "expected numbers >= 0");
+    m.law = model::FiberLaw::constant(1.0);
+    m.axis_factors.setZero();
+    m.axis_factors.head(dim) = values;
   } else {
-    m.young_modulus.setConstant(f.non_negative("Y", 0.0));
+    m.law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
   }
   m.surface_tension = f.non_negative("gamma", 0.0);
   f.finish();

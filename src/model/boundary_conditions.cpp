@@ -72,7 +72,7 @@ std::string singular_setup_reason(const Model& model) {
              names[a] + ", so the system is singular";
     // Zero stiffness is singular; a negative one is left to the solvers,
     // which report a matrix that is not positive definite.
-    if (model.material.young_modulus[a] == 0.0 && model.material.surface_tension == 0.0)
+    if (model.material.young_modulus()[a] == 0.0 && model.material.surface_tension == 0.0)
       return std::string("no stiffness along ") + names[a] +
              ": Y and gamma are both zero, so the system is singular";
   }

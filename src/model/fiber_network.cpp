@@ -5,6 +5,7 @@
 #include <string>
 
 #include "geom/error.hpp"
+#include "model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -70,18 +71,18 @@ FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd
     factors.row(i, h.data());
     for (int j = i + 1; j < n; ++j)
       if (h[static_cast<size_t>(j)] != 0.0)
-        add_fiber(out.bulk, i, j, h[static_cast<size_t>(j)] * (area[i] + area[j]) / fiber_length(X, i, j));
+        add_fiber(out.bulk, i, j, bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
   }
   for (Eigen::Index e = 0; e < edges.rows(); ++e) {
     const int i = edges(e, 0), k = edges(e, 1);
     const double length = fiber_length(X, i, k);
-    add_fiber(out.surface, i, k, (area[i] + area[k]) / (2.0 * length * length));
+    add_fiber(out.surface, i, k, surface_weight(area[i], area[k], length * length));
   }
   return out;
 }
 
 Eigen::MatrixXd axis_block(const FiberLaplacians& laplacians, const Material& material, int axis) {
-  return material.young_modulus[axis] * laplacians.bulk +
+  return material.young_modulus()[axis] * laplacians.bulk +
          material.surface_tension * laplacians.surface;
 }
 

@@ -7,6 +7,7 @@
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
 #include "model/fiber_network.hpp"
+#include "model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -22,7 +23,7 @@ Eigen::SparseMatrix<double> build_surface_laplacian(const Eigen::MatrixXd& X,
     if (!(length2 > 0.0))
       throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(k) +
                        " coincide: the fiber between them has zero length");
-    const double w = (area[i] + area[k]) / (2.0 * length2);
+    const double w = surface_weight(area[i], area[k], length2);
     entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
   }
   Eigen::SparseMatrix<double> L(X.rows(), X.rows());
@@ -46,12 +47,16 @@ struct Coordinates {
 
 FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
                          double penalty)
+    : FiberSystem(model, X, DofMap::from_constraints(model), method, penalty) {}
+
+FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, const DofMap& dofs,
+                         BoundaryMethod method, double penalty, const Eigen::MatrixXd* strained)
     : dim_(model.dim()),
       n_(model.num_vertices()),
       X_(X),
       fibers_(model.fibers),
       factors_(model.fibers.get(), model.connection_count, model.num_vertices()),
-      young_(model.material.young_modulus),
+      young_(model.material.young_modulus()),
       gamma_(model.material.surface_tension),
       method_(method),
       penalty_(penalty) {
@@ -59,18 +64,21 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryM
   area_ = areas.magnitude;
   S_ = areas.S;
   surface_ = build_surface_laplacian(X, area_, geom::unique_edges(model.surface));
+  if (!model.material.law.is_constant()) {
+    // Y_a(e) = m_a Y(e): the factors here, Y(e) in every pair weight.
+    law_ = &model.material.law;
+    young_ = model.material.axis_factors;
+    reference_ = model.surface.V;
+    strained_ = strained != nullptr ? *strained : model.surface.V;
+  }
 
-  const DofPartition partition = partition_dofs(model);
-  std::vector<std::vector<char>> fixed(static_cast<size_t>(dim_),
-                                       std::vector<char>(static_cast<size_t>(n_), 0));
-  for (int d : partition.constrained) fixed[static_cast<size_t>(d / n_)][static_cast<size_t>(d % n_)] = 1;
   active_.resize(static_cast<size_t>(dim_));
   penalised_.resize(static_cast<size_t>(dim_));
   constrained_.resize(static_cast<size_t>(dim_));
   offsets_.assign(1, 0);
   for (int a = 0; a < dim_; ++a) {
     for (int i = 0; i < n_; ++i) {
-      const bool is_fixed = fixed[static_cast<size_t>(a)][static_cast<size_t>(i)];
+      const bool is_fixed = dofs.held(a * n_ + i);
       if (is_fixed) constrained_[static_cast<size_t>(a)].push_back(i);
       if (method == BoundaryMethod::Penalty) {
         if (is_fixed)
@@ -82,6 +90,18 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryM
       }
     }
     offsets_.push_back(offsets_.back() + static_cast<int>(active_[static_cast<size_t>(a)].size()));
+  }
+}
+
+void FiberSystem::pair_row(int i, double* row) const {
+  factors_.row(i, row);
+  if (law_ == nullptr) return;
+  // The secant modulus of each fiber at its strain e_ij = |y_i - y_j| / L_ij - 1.
+  for (int j = 0; j < n_; ++j) {
+    if (row[j] == 0.0) continue;
+    const double length = (reference_.row(i) - reference_.row(j)).norm();
+    const double strain = (strained_.row(i) - strained_.row(j)).norm() / length - 1.0;
+    row[j] *= law_->modulus(strain);
   }
 }
 
@@ -115,7 +135,7 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
       for (Eigen::Index c = 0; c < m; ++c) {
         double* column = K.col(c).data();
         const size_t j = static_cast<size_t>(c);
-        factors_.row(act[j], full.data());
+        pair_row(act[j], full.data());
         for (Eigen::Index r = c + 1; r < m; ++r)
           h[static_cast<size_t>(r)] = full[static_cast<size_t>(act[static_cast<size_t>(r)])];
         const double* hc = h.data();
@@ -123,7 +143,7 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
         for (Eigen::Index r = c + 1; r < m; ++r) {
           const size_t i = static_cast<size_t>(r);
           const double dx = x0[i] - x0[j], dy = x1[i] - x1[j], dz = x2[i] - x2[j];
-          column[r] = -y * hc[i] * (a[i] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz);
+          column[r] = -y * bulk_weight(hc[i], a[i], a[j], std::sqrt(dx * dx + dy * dy + dz * dz));
         }
       }
     }
@@ -162,7 +182,7 @@ Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
 #pragma omp for schedule(dynamic, 32)
     for (int i = 0; i < n_; ++i) {
       const size_t u = static_cast<size_t>(i);
-      factors_.row(i, row.data());
+      pair_row(i, row.data());
       const double* h = row.data();
       double sum = 0.0;
 #pragma omp simd reduction(+ : sum)
@@ -170,7 +190,7 @@ Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
         const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
         // h_ii = 0; r2 = 1 there only avoids 1/0.
         const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-        sum += h[j] * (a[u] + a[j]) / std::sqrt(r2);
+        sum += bulk_weight(h[j], a[u], a[j], std::sqrt(r2));
       }
       diagonal[i] = sum;
     }
@@ -200,7 +220,7 @@ Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
 #pragma omp for schedule(dynamic, 32)
       for (int i = 0; i < n_; ++i) {
         const size_t u = static_cast<size_t>(i);
-        factors_.row(i, row.data());
+        pair_row(i, row.data());
         const double* h = row.data();
         double s0 = 0.0, s1 = 0.0, s2 = 0.0;
 #pragma omp simd reduction(+ : s0, s1, s2)
@@ -208,7 +228,7 @@ Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
           const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
           // j == i contributes (v_i - v_i) = 0; r2 = 1 there only avoids 1/0.
           const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-          const double w = h[j] * (a[u] + a[j]) / std::sqrt(r2);
+          const double w = bulk_weight(h[j], a[u], a[j], std::sqrt(r2));
           s0 += w * (v0[u] - v0[j]);
           s1 += w * (v1[u] - v1[j]);
           s2 += w * (v2[u] - v2[j]);
@@ -237,14 +257,14 @@ Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,
     for (Eigen::Index r = 0; r < rows; ++r) {
       const int i = vertices[static_cast<size_t>(r)];
       const size_t u = static_cast<size_t>(i);
-      factors_.row(i, h.data());
+      pair_row(i, h.data());
       for (int axis = 0; axis < dim_; ++axis) {
         const double* v = U.col(axis).data();
         double sum = 0.0;
         for (size_t j = 0; j < n; ++j) {
           if (j == u) continue;
           const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-          sum += h[j] * (a[u] + a[j]) / std::sqrt(dx * dx + dy * dy + dz * dz) * (v[u] - v[j]);
+          sum += bulk_weight(h[j], a[u], a[j], std::sqrt(dx * dx + dy * dy + dz * dz)) * (v[u] - v[j]);
         }
         out(r, axis) = young(axis) * sum + gamma_ * surface(i, axis) + S_(i, axis) * P;
       }

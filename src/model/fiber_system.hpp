@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "model/boundary_conditions.hpp"
+#include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
 #include "model/model.hpp"
 
@@ -25,8 +26,15 @@ namespace fiberfluid::model {
 // one block on request and bulk_product() applies it on the fly.
 class FiberSystem {
  public:
+  // The supports and prescribed values of the model held.
   FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
               double penalty);
+  // The unknowns that `dofs` holds (e.g. with a contact active set). With a
+  // strain-dependent law, each bulk weight is multiplied by the secant modulus
+  // Y(e_ij) at the strains of `strained` (positions #V by dim, against the
+  // reference lengths); null means the small-strain modulus Y(0).
+  FiberSystem(const Model& model, const Eigen::MatrixXd& X, const DofMap& dofs,
+              BoundaryMethod method, double penalty, const Eigen::MatrixXd* strained = nullptr);
 
   int dim() const { return dim_; }
   int num_vertices() const { return n_; }
@@ -85,6 +93,8 @@ class FiberSystem {
 
  private:
   Eigen::VectorXd compute_bulk_diagonal() const;  // one pass over the pairs
+  // Fills row (length N) with h_ij, times Y(e_ij) / ... for a strain-dependent law.
+  void pair_row(int i, double* row) const;
 
   int dim_ = 3, n_ = 0;
   Eigen::MatrixXd X_;
@@ -94,7 +104,10 @@ class FiberSystem {
   Eigen::MatrixXd S_;
   Eigen::SparseMatrix<double> surface_;
   mutable Eigen::VectorXd bulk_diagonal_;  // empty until first asked for
-  Eigen::Vector3d young_;
+  Eigen::Vector3d young_;  // per axis: Y m_a, or m_a when the moduli are per pair
+  // Strain-dependent law: the law, the reference and strained positions.
+  const FiberLaw* law_ = nullptr;
+  Eigen::MatrixXd reference_, strained_;
   double gamma_ = 0.0;
   BoundaryMethod method_;
   double penalty_ = 0.0;

@@ -8,14 +8,29 @@
 
 #include "geom/fiber_pruning.hpp"
 #include "geom/surface.hpp"
+#include "model/fiber_law.hpp"
 
 namespace fiberfluid::model {
 
-// Linear material of the paper: one Young's modulus per axis (the x block of
-// the system uses Y.x(), and so on) and a surface tension on mesh edges.
+// The material: the bulk fibers' law Y(e) (force per area, Pa), the paper's
+// per-axis moduli as multipliers of the law (the x block uses
+// axis_factors.x() Y(e), and so on), and a constant surface tension on mesh
+// edges. The paper's linear model is the constant law.
 struct Material {
-  Eigen::Vector3d young_modulus = Eigen::Vector3d::Ones();  // Y per axis, force per area (Pa)
-  double surface_tension = 0.0;                             // gamma, force per length (N/m)
+  FiberLaw law = FiberLaw::constant(1.0);
+  Eigen::Vector3d axis_factors = Eigen::Vector3d::Ones();
+  double surface_tension = 0.0;  // gamma, force per length (N/m)
+
+  // The small-strain modulus per axis, axis_factors Y(0): what the linear model uses.
+  Eigen::Vector3d young_modulus() const { return law.modulus(0.0) * axis_factors; }
+  // The paper's linear material: one Y per axis (as the constant law 1 and
+  // the moduli as factors, so that Y_a is exact) or one Y for all.
+  static Material linear(const Eigen::Vector3d& Y, double gamma = 0.0) {
+    return {FiberLaw::constant(1.0), Y, gamma};
+  }
+  static Material linear(double Y, double gamma = 0.0) {
+    return {FiberLaw::constant(Y), Eigen::Vector3d::Ones(), gamma};
+  }
 };
 
 // How a load or a prescribed displacement grows over the load steps: the

@@ -150,6 +150,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   } catch (const InputError& e) {  // one unknown held at two values
     return fail(e.what());
   }
+  const model::DofMap dofs = model::DofMap::from_constraints(model);
   const int nv = model.num_vertices();
   Eigen::Vector3d applied = Eigen::Vector3d::Zero();  // the loads so far, summed over vertices
   std::shared_ptr<const model::FiberSystem> system;  // outlives its factorisation
@@ -163,9 +164,11 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     if (k == 1 || options.rebuild_matrix) {
       Clock::time_point t = Clock::now();
       try {
+        // Rebuilt: lengths, area vectors and (for a strain-dependent law) the
+        // secant moduli from x_{k-1}, the paper's words (model.md section 7).
         system = std::make_shared<const model::FiberSystem>(
-            model, options.rebuild_matrix ? X : reference, options.boundary_method,
-            options.penalty);
+            model, options.rebuild_matrix ? X : reference, dofs, options.boundary_method,
+            options.penalty, options.rebuild_matrix ? &X : nullptr);
       } catch (const InputError& e) {  // e.g. two vertices pressed onto each other
         return fail("step " + std::to_string(k) + ": " + e.what());
       }

@@ -45,7 +45,7 @@ class AssemblyOnMeshes : public ::testing::TestWithParam<const char*> {
     m.surface = geom::remove_unused_vertices(
                     geom::read_surface(testing::data_mesh(GetParam())).surface)
                     .surface;
-    m.material.young_modulus = {2.0, 3.0, 5.0};  // anisotropic on purpose
+    m.material = Material::linear(Eigen::Vector3d(2.0, 3.0, 5.0));  // anisotropic on purpose
     m.material.surface_tension = 0.7;
     return m;
   }

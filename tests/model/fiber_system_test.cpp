@@ -44,7 +44,7 @@ void expect_same_as_full_assembly(const Model& m, BoundaryMethod method) {
 
 TEST(FiberSystem, MatchesTheFullAssemblyWithBothBoundaryMethods) {
   Model sphere = testing::paper_sphere_model();
-  sphere.material.young_modulus = {3000, 2000, 1000};  // distinct blocks
+  sphere.material = Material::linear(Eigen::Vector3d(3000, 2000, 1000));  // distinct blocks
   for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
     expect_same_as_full_assembly(testing::paper_rectangle_model(), method);
     expect_same_as_full_assembly(testing::paper_sphere_model(), method);
@@ -57,7 +57,7 @@ Model pruned_liver(ConnectionCount count) {
   m.surface = geom::remove_unused_vertices(
                   geom::read_surface(testing::data_mesh("liver.obj")).surface)
                   .surface;
-  m.material.young_modulus.setConstant(2000.0);
+  m.material.law = FiberLaw::constant(2000.0);
   m.material.surface_tension = 3.0;
   for (int v : select_half_space(m.surface.V, parse_half_space("y >= 4.75", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
@@ -113,7 +113,7 @@ TEST(FiberSystem, AFullMaskWithEitherCountIsTheUnprunedModel) {
 TEST(FiberSystem, EqualBlocksAreRecognised) {
   Model m = testing::paper_sphere_model();
   EXPECT_TRUE(FiberSystem(m, m.surface.V, BoundaryMethod::Elimination, 1e9).blocks_equal());
-  m.material.young_modulus.z() = 1.0;
+  m.material.axis_factors.z() = 0.5;
   EXPECT_FALSE(FiberSystem(m, m.surface.V, BoundaryMethod::Elimination, 1e9).blocks_equal());
   Model partial = testing::paper_sphere_model();
   partial.constraints.push_back({100, 0, 0.0, {}});  // x only: the x block loses a vertex

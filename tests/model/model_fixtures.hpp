@@ -14,7 +14,7 @@ inline model::Model paper_rectangle_model() {
   Eigen::MatrixXd P(4, 2);
   P << 15, 20, 15, -20, -15, -20, -15, 20;
   m.surface = geom::polygon(P);
-  m.material.young_modulus.setConstant(360.0);
+  m.material.law = model::FiberLaw::constant(360.0);
   m.constraints = {{2, 0, 0.0, {}}, {2, 1, 0.0, {}}, {1, 1, 0.0, {}}};
   for (int v : {0, 3}) {
     model::Load load;
@@ -29,7 +29,7 @@ inline model::Model paper_rectangle_model() {
 inline model::Model paper_sphere_model() {
   model::Model m;
   m.surface = geom::icosphere(2, 1.0);
-  m.material.young_modulus.setConstant(3000.0);
+  m.material.law = model::FiberLaw::constant(3000.0);
   m.material.surface_tension = 3000.0;
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.8", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});

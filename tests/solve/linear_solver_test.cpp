@@ -25,7 +25,7 @@ model::Model mesh_model(const char* file, const char* support) {
   m.surface = geom::remove_unused_vertices(
                   geom::read_surface(testing::data_mesh(file)).surface)
                   .surface;
-  m.material.young_modulus.setConstant(5000.0);
+  m.material.law = model::FiberLaw::constant(5000.0);
   m.material.surface_tension = 20.0;
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space(support, 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
@@ -47,7 +47,7 @@ model::Model cube_with_prescribed_corner() {
   for (int i = 0; i < m.num_vertices(); ++i)
     if (m.surface.V(i, 2) > 0.9) top = i;
   m.constraints.push_back({top, 0, 0.05, {}});
-  m.material.young_modulus = {5000.0, 4000.0, 3000.0};
+  m.material.axis_factors = {1.0, 0.8, 0.6};
   return m;
 }
 
@@ -166,7 +166,7 @@ void expect_failure(const SteppingSummary& s, const std::string& part) {
 
 TEST(BackendFailures, NotPositiveDefinite) {
   model::Model m = testing::paper_sphere_model();
-  m.material.young_modulus.setConstant(-3000.0);  // the input reader forbids this
+  m.material.law = model::FiberLaw::constant(-3000.0);  // the input reader forbids this
   m.material.surface_tension = 0.0;
   expect_failure(run(m, SolverKind::BlockCholesky), "not positive definite");
   expect_failure(run(m, SolverKind::Cholmod), "not positive definite");

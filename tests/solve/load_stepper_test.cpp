@@ -203,7 +203,7 @@ namespace {
 TEST(LoadStepper, RefusesADenseSystemLargerThanMemory) {
   model::Model m;
   m.surface = geom::icosphere(7, 1.0);  // 163842 vertices: ~1.4 TB as a dense system
-  m.material.young_modulus.setConstant(1.0);
+  m.material.law = model::FiberLaw::constant(1.0);
   for (int a = 0; a < 3; ++a) m.constraints.push_back({0, a, 0.0, {}});
   for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod}) {
     SteppingOptions o;
