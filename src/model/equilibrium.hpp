@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <string>
+#include <vector>
+
+#include "model/fiber_network.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::model {
+
+// The equilibrium equations of the Newton scheme (model.md section 7) at any
+// state x = [u; P] of the paper's layout and load factors lambda:
+//
+//   R_i = sum_j a_ij m Y(e_ij) (u_i - u_j) + gamma sum_k b_ik (u_i - u_k)
+//         + (P - q_i(x)) S_i(x) - F_i(lambda)
+//   g   = dim C0 (V(x) - V0)
+//
+// with the weights a_ij, b_ik of the reference (so a constant law gives
+// exactly K u), S_i(x) = C0 sum_{f at i} A_f(x) from the current geometry and
+// the reference constant C0 (so dg/dx_i = S_i(x)), q_i = sum over hydrostatic
+// loads of lambda rho |a| (depth of x_i below the highest reference point),
+// and F the point loads. At the reference with P = 0 and no load, the
+// tangent is the paper's A.
+//
+// Rows of R at held unknowns are the forces the supports (or paddles) exert.
+class Equilibrium {
+ public:
+  // Throws InputError when two vertices coincide.
+  explicit Equilibrium(const Model& model);
+
+  const Model& model() const { return model_; }
+  int num_unknowns() const { return model_.num_unknowns(); }
+  double reference_volume() const { return volume0_; }
+  // dim C0 V0: the size of g for a relative measure.
+  double volume_scale() const { return model_.dim() * C0_ * std::abs(volume0_); }
+  double area_constant() const { return C0_; }
+
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
+  // The loads alone, F_i + q_i S_i (follower), full layout with 0 for g.
+  Eigen::VectorXd external_forces(const Eigen::VectorXd& x,
+                                  const std::vector<double>& factors) const;
+  // The fiber forces alone (bulk and surface), #V by dim.
+  Eigen::MatrixXd fiber_forces(const Eigen::VectorXd& x) const;
+
+  // dR/dx, dense, full layout: the consistent tangent with the dY/de terms,
+  // the pressure terms P dS/dx and the follower-load terms.
+  Eigen::MatrixXd tangent(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
+  // dR/dx v without forming the matrix (O(N^2) pairs, no storage).
+  Eigen::VectorXd tangent_product(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                                  const Eigen::VectorXd& v) const;
+
+  // dR/dtheta, one column per name: a parameter of the law ("Y", "Y0",
+  // "beta", "Y_t", "Y_c", "scale"), "gamma", or "factor_x" / "factor_y" /
+  // "factor_z". Throws std::invalid_argument for another name.
+  Eigen::MatrixXd parameter_derivatives(const Eigen::VectorXd& x,
+                                        const std::vector<std::string>& names) const;
+
+ private:
+  struct Hydrostatics;  // per-vertex q_i and its gradient, at x
+  Hydrostatics hydrostatics(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
+  Eigen::MatrixXd current_area_vectors(const Eigen::MatrixXd& X) const;  // S_i(x)
+  // Visits every ordered bulk pair (i, j), j != i, of row i with its fiber state.
+  template <class Visit>
+  void for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                      std::vector<double>& row, Visit&& visit) const;
+
+  const Model& model_;
+  PairFactors factors_;
+  Eigen::VectorXd area0_;                 // |S_i| at the reference
+  Eigen::SparseMatrix<double> surface_;   // gamma-free surface Laplacian of the reference
+  double C0_ = 0.0, volume0_ = 0.0;
+  std::vector<double> levels_;            // per load: the highest reference point along a
+};
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The Newton scheme's equations: the tangent against central finite
+// differences for every law, the reference tangent against the paper's A, and
+// the parameter derivatives.
+#include "model/equilibrium.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "model/assembly.hpp"
+#include "model/model_fixtures.hpp"
+
+namespace fiberfluid::model {
+namespace {
+
+// A 42-vertex sphere with a cap held, gravity, a point load and surface tension.
+Model small_sphere(const FiberLaw& law) {
+  Model m = testing::paper_sphere_model();
+  m.surface = geom::icosphere(1, 1.0);
+  m.constraints.clear();
+  for (int v : select_half_space(m.surface.V, parse_half_space("z >= 0.8", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  m.material.law = law;
+  m.material.axis_factors = {1.0, 0.8, 1.3};  // the factors enter every term
+  m.material.surface_tension = 500.0;
+  m.loads[1].vertex = 7;
+  return m;
+}
+
+std::vector<FiberLaw> every_law() {
+  return {FiberLaw::constant(3000.0), FiberLaw::exponential(3000.0, 4.0),
+          FiberLaw::bilinear(3000.0, 1500.0),
+          FiberLaw::tabulated({-0.5, -0.1, 0.0, 0.05, 0.2, 1.0},
+                              {-900.0, -250.0, 0.0, 150.0, 800.0, 9000.0})};
+}
+
+// A random state: displacements of a few percent of the size, a pressure.
+Eigen::VectorXd random_state(const Model& m, unsigned seed, double size = 0.04) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd x(m.num_unknowns());
+  for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = size * uniform(rng);
+  x[m.pressure_dof()] = 800.0 * uniform(rng);
+  return x;
+}
+
+Eigen::MatrixXd finite_difference_tangent(const Equilibrium& eq, const Eigen::VectorXd& x,
+                                          const std::vector<double>& factors) {
+  Eigen::MatrixXd J(x.size(), x.size());
+  for (Eigen::Index k = 0; k < x.size(); ++k) {
+    const double h = k == x.size() - 1 ? 1e-3 : 1e-6;
+    Eigen::VectorXd plus = x, minus = x;
+    plus[k] += h;
+    minus[k] -= h;
+    J.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
+  }
+  return J;
+}
+
+TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLaw) {
+  for (const FiberLaw& law : every_law()) {
+    const Model m = small_sphere(law);
+    const Equilibrium eq(m);
+    for (unsigned seed : {1u, 2u, 3u}) {
+      const Eigen::VectorXd x = random_state(m, seed);
+      const std::vector<double> factors = {0.7, 0.4};
+      const Eigen::MatrixXd J = eq.tangent(x, factors);
+      const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+      const double error = (J - fd).norm() / fd.norm();
+      EXPECT_LT(error, 1e-6) << law.name() << " seed " << seed;
+      // The matrix-free product is the same operator.
+      const Eigen::VectorXd v = random_state(m, seed + 10, 1.0);
+      EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm())
+          << law.name();
+    }
+  }
+}
+
+TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
+  Model m = testing::paper_rectangle_model();
+  m.surface = geom::polygon((Eigen::MatrixXd(6, 2) << 15, 20, 18, 0, 15, -20, -15, -20, -18, 0,
+                             -15, 20).finished());
+  m.material.law = FiberLaw::exponential(360.0, 3.0);
+  m.material.surface_tension = 20.0;
+  Load gravity;
+  gravity.kind = Load::Kind::Hydrostatic;
+  gravity.acceleration = {0.0, -9.81, 0.0};
+  gravity.density = 2.0;
+  m.loads.push_back(gravity);
+  const Equilibrium eq(m);
+  const Eigen::VectorXd x = random_state(m, 5, 1.0);
+  const std::vector<double> factors = {0.5, 0.5, 1.0};
+  const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+  EXPECT_LT((eq.tangent(x, factors) - fd).norm() / fd.norm(), 1e-6);
+}
+
+TEST(Equilibrium, ReferenceTangentIsThePapersMatrix) {
+  for (Model m : {testing::paper_rectangle_model(), testing::paper_sphere_model()}) {
+    m.material.axis_factors = {1.0, 2.0, 3.0};
+    const Equilibrium eq(m);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m.num_unknowns());
+    const std::vector<double> no_load(m.loads.size(), 0.0);
+    const Eigen::MatrixXd A = system_matrix(m, m.surface.V);
+    const Eigen::MatrixXd J = eq.tangent(zero, no_load);
+    EXPECT_LT((J - A).cwiseAbs().maxCoeff(), 1e-12 * A.cwiseAbs().maxCoeff());
+    EXPECT_EQ(eq.residual(zero, no_load).norm(), 0.0);
+  }
+}
+
+TEST(Equilibrium, ConstantLawFiberForcesAreKu) {
+  const Model m = small_sphere(FiberLaw::constant(3000.0));
+  const Equilibrium eq(m);
+  const Eigen::VectorXd x = random_state(m, 9, 0.2);
+  const Eigen::MatrixXd A = system_matrix(m, m.surface.V);
+  const Eigen::MatrixXd forces = eq.fiber_forces(x);
+  const int n = m.num_vertices();
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::VectorXd Ku = A.block(a * n, 0, n, 3 * n) * x.head(3 * n);
+    EXPECT_LT((forces.col(a) - Ku).norm(), 1e-11 * Ku.norm());
+  }
+}
+
+TEST(Equilibrium, ParameterDerivativesMatchCentralDifferences) {
+  for (const FiberLaw& law : every_law()) {
+    Model m = small_sphere(law);
+    const Eigen::VectorXd x = random_state(m, 4);
+    const std::vector<double> factors = {0.7, 0.4};
+    std::vector<std::string> names = law.parameter_names();
+    names.insert(names.end(), {"gamma", "factor_y"});
+    const Eigen::MatrixXd D = Equilibrium(m).parameter_derivatives(x, names);
+    for (size_t k = 0; k < names.size(); ++k) {
+      auto with = [&](double delta) {
+        Model changed = m;
+        if (names[k] == "gamma") changed.material.surface_tension += delta;
+        else if (names[k] == "factor_y") changed.material.axis_factors.y() += delta;
+        else changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
+        return Equilibrium(changed).residual(x, factors);
+      };
+      const double h = 1e-5 * std::max(1.0, std::abs(names[k] == "gamma" ? 500.0
+                                                      : names[k] == "factor_y"
+                                                          ? 0.8
+                                                          : law.parameter(names[k])));
+      const Eigen::VectorXd fd = (with(h) - with(-h)) / (2.0 * h);
+      EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - fd).norm(), 1e-6 * fd.norm() + 1e-12)
+          << law.name() << " " << names[k];
+    }
+  }
+  EXPECT_THROW(Equilibrium(small_sphere(FiberLaw::constant(1.0)))
+                   .parameter_derivatives(Eigen::VectorXd::Zero(127), {"beta"}),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fiberfluid::model

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/fiber_law.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace fiberfluid::model {
+namespace {
+
+TEST(FiberLaw, ValuesOfEachLaw) {
+  EXPECT_EQ(FiberLaw::constant(3000.0).modulus(0.37), 3000.0);
+  const FiberLaw exp_law = FiberLaw::exponential(2000.0, 5.0);
+  EXPECT_DOUBLE_EQ(exp_law.modulus(0.1), 2000.0 * std::exp(0.5));
+  EXPECT_DOUBLE_EQ(exp_law.modulus(0.0), 2000.0);
+  const FiberLaw bilinear = FiberLaw::bilinear(3000.0, 1000.0);
+  EXPECT_EQ(bilinear.modulus(0.2), 3000.0);
+  EXPECT_EQ(bilinear.modulus(0.0), 3000.0);
+  EXPECT_EQ(bilinear.modulus(-0.2), 1000.0);
+  // sigma: (-0.2, -200), (0, 0), (0.1, 100), (0.3, 500): secants 1000, 1000, 1000 and
+  // at e = 0.2 sigma = 300, Y = 1500; beyond the table the last segment continues.
+  const FiberLaw table = FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0});
+  EXPECT_DOUBLE_EQ(table.modulus(0.0), 1000.0);
+  EXPECT_DOUBLE_EQ(table.modulus(-0.1), 1000.0);
+  EXPECT_DOUBLE_EQ(table.modulus(0.2), 1500.0);
+  EXPECT_DOUBLE_EQ(table.modulus(0.5), 900.0 / 0.5);
+  EXPECT_DOUBLE_EQ(table.modulus(-0.5), 1000.0);
+}
+
+TEST(FiberLaw, SlopesAndParameterDerivativesMatchCentralDifferences) {
+  const FiberLaw laws[] = {
+      FiberLaw::constant(3000.0), FiberLaw::exponential(2000.0, 5.0),
+      FiberLaw::bilinear(3000.0, 1000.0),
+      FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
+  for (const FiberLaw& law : laws)
+    for (double e : {-0.37, -0.05, 0.03, 0.17, 0.6}) {
+      const double h = 1e-6;
+      const double fd = (law.modulus(e + h) - law.modulus(e - h)) / (2 * h);
+      EXPECT_NEAR(law.slope(e), fd, 1e-6 * std::abs(law.modulus(e)) + 1e-9) << law.name() << e;
+      for (const std::string& name : law.parameter_names()) {
+        const double p = law.parameter(name), step = 1e-6 * std::max(1.0, std::abs(p));
+        FiberLaw up = law, down = law;
+        up.set_parameter(name, p + step);
+        down.set_parameter(name, p - step);
+        const double dfd = (up.modulus(e) - down.modulus(e)) / (2 * step);
+        EXPECT_NEAR(law.modulus_derivative(name, e), dfd, 1e-6 * std::abs(dfd) + 1e-9)
+            << law.name() << " " << name << " at " << e;
+      }
+    }
+}
+
+TEST(FiberLaw, NamedParameters) {
+  FiberLaw law = FiberLaw::exponential(2000.0, 5.0);
+  EXPECT_EQ(law.parameter_names(), (std::vector<std::string>{"Y0", "beta"}));
+  law.set_parameter("beta", 2.0);
+  EXPECT_EQ(law.parameter("beta"), 2.0);
+  EXPECT_THROW(law.parameter("Y_t"), std::invalid_argument);
+  EXPECT_THROW(law.set_parameter("gamma", 1.0), std::invalid_argument);
+}
+
+TEST(FiberLaw, BadLawsAreRejectedNamingTheParameter) {
+  auto expect_rejected = [](const FiberLaw& law, const std::string& part) {
+    const std::string why = law.check();
+    EXPECT_NE(why.find(part), std::string::npos) << law.name() << ": '" << why << "'";
+  };
+  EXPECT_EQ(FiberLaw::exponential(2000.0, 5.0).check(), "");
+  expect_rejected(FiberLaw::exponential(-1.0, 5.0), "Y0 must be positive");
+  expect_rejected(FiberLaw::exponential(1.0, 800.0), "check beta");  // overflows at e = 2
+  expect_rejected(FiberLaw::bilinear(1.0, 0.0), "Y_c must be positive");
+  expect_rejected(FiberLaw::constant(-5.0), "Y must be a number >= 0");
+  expect_rejected(FiberLaw::tabulated({0.0, 0.1, 0.1}, {0.0, 1.0, 2.0}), "strictly increasing");
+  expect_rejected(FiberLaw::tabulated({0.0, 0.1, 0.2}, {0.0, 2.0, 1.0}), "monotone");
+  expect_rejected(FiberLaw::tabulated({0.05, 0.1}, {1.0, 2.0}), "(0, 0)");
+  expect_rejected(FiberLaw::tabulated({0.0, 0.1}, {0.5, 2.0}), "(0, 0)");
+  expect_rejected(FiberLaw::tabulated({0.0}, {0.0}), "at least two");
+  expect_rejected(FiberLaw::tabulated({0.0, NAN}, {0.0, 1.0}), "non-finite");
+}
+
+}  // namespace
+}  // namespace fiberfluid::model
