@@ -71,6 +71,25 @@ struct Constraint {
   int group = 0;      // index into Model::constraint_groups: whose reaction this adds to
 };
 
+// A rigid paddle (the paper's liver validation): a plane normal to a
+// coordinate axis, on one side of the body, moving along the axis. Contact is
+// an active set in the Newton scheme (model.md section 7).
+struct Paddle {
+  std::string label;
+  int axis = 2;            // 0, 1, 2 = x, y, z: the plane's normal
+  bool above = true;       // on the high side of the body (it keeps x_axis <= plane), or below
+  double position = 0.0;   // the plane's coordinate before the first step (m)
+  double travel = 0.0;     // its displacement along the axis at full schedule (m)
+  Schedule schedule;
+  bool sticking = false;   // hold every component of a vertex in contact, not only the normal
+
+  double plane(double factor) const { return position + factor * travel; }
+  // How far a coordinate is past the plane (> 0: penetrating).
+  double penetration(double coordinate, double plane_position) const {
+    return above ? coordinate - plane_position : plane_position - coordinate;
+  }
+};
+
 // How the bulk fibers are normalised once some are pruned: the paper divides
 // by N-1, "the number of effective connections" for a concave body.
 enum class ConnectionCount {
@@ -86,6 +105,7 @@ struct Model {
   Material material;
   std::vector<Load> loads;
   std::vector<Constraint> constraints;
+  std::vector<Paddle> paddles;
   // Names of the support and prescribed groups (one per experiment entry), for
   // reporting the reaction force of each; constraints refer to them by index.
   std::vector<std::string> constraint_groups;

@@ -14,6 +14,7 @@
 #include "geom/error.hpp"
 #include "model/fiber_system.hpp"
 #include "geom/progress.hpp"
+#include "solve/runaway.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -79,6 +80,8 @@ class Reactions {
   Eigen::MatrixXd per_vertex_;
 };
 
+}  // namespace
+
 // Why the state reached after a step is a runaway rather than a result, or "".
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
                            const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X,
@@ -103,7 +106,6 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
   return {};
 }
 
-}  // namespace
 
 bool SteppingOptions::IsValid(std::string* why) const {
   if (steps < 1) return *why = "steps must be at least 1", false;
@@ -112,13 +114,45 @@ bool SteppingOptions::IsValid(std::string* why) const {
   if (!(pcg.tolerance > 0.0) || pcg.max_iterations < 1)
     return *why = "pcg tolerance must be positive and max_iterations at least 1", false;
   if (!(max_volume_change > 0.0)) return *why = "max_volume_change must be positive", false;
+  return scheme != Scheme::Newton || newton.IsValid(why);
+}
+
+bool NewtonOptions::IsValid(std::string* why) const {
+  if (!(residual_tolerance > 0.0) || !(increment_tolerance > 0.0) || !(krylov_tolerance > 0.0))
+    return *why = "newton tolerances must be positive", false;
+  if (max_iterations < 1 || max_step_cuts < 0 || krylov_restart < 1 ||
+      krylov_max_iterations < 1 || max_contact_rounds < 1)
+    return *why = "newton iteration limits must be at least 1 (max_step_cuts at least 0)", false;
   return true;
+}
+
+const char* to_string(Scheme scheme) {
+  return scheme == Scheme::Newton ? "newton" : "incremental";
+}
+
+const char* to_string(TangentSolver solver) {
+  switch (solver) {
+    case TangentSolver::Auto: return "auto";
+    case TangentSolver::Dense: return "dense";
+    case TangentSolver::Krylov: return "krylov";
+  }
+  return "?";
 }
 
 std::string SteppingSummary::BriefReport() const {
   std::ostringstream out;
-  out << (success ? "success" : "failure") << ": " << to_string(solver) << ", " << steps.size()
-      << " steps, " << factorizations << " factorizations";
+  out << (success ? "success" : "failure") << ": ";
+  if (scheme == Scheme::Newton) {
+    out << "newton (" << to_string(tangent);
+    if (tangent == TangentSolver::Krylov) out << ", preconditioner " << to_string(solver);
+    out << "), " << steps.size() << " steps, " << newton_iterations << " newton iterations";
+    if (tangent == TangentSolver::Krylov)
+      out << ", " << krylov_iterations << " gmres iterations, " << factorizations
+          << " preconditioner factorizations";
+  } else {
+    out << to_string(solver) << ", " << steps.size() << " steps, " << factorizations
+        << " factorizations";
+  }
   if (solver == SolverKind::PCG) out << ", " << solver_statistics.iterations << " pcg iterations";
   out << ", " << total_seconds << " s";
   if (!success) out << ": " << message;
@@ -127,6 +161,7 @@ std::string SteppingSummary::BriefReport() const {
 
 SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
                                  const StepObserver& observer) {
+  if (options.scheme == Scheme::Newton) return solve_newton_steps(model, options, observer);
   const Clock::time_point start = Clock::now();
   SteppingSummary summary;
   summary.unknowns = Eigen::VectorXd::Zero(model.num_unknowns());
@@ -139,6 +174,9 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   if (!options.IsValid(&why)) return fail(why);
   why = model::singular_setup_reason(model);
   if (!why.empty()) return fail(why);
+  if (!model.paddles.empty())
+    return fail("paddles need the Newton scheme (stepping.scheme \"newton\"): contact is an "
+                "active set inside its equilibrium iterations");
 
   const int n = options.steps;
   const Eigen::MatrixXd& reference = model.surface.V;

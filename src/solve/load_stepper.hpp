@@ -14,10 +14,48 @@
 
 namespace fiberfluid::solve {
 
-// The paper's incremental scheme (model.md section 6): at step k,
-//   A(x_{k-1}) dx_k = B(x_{k-1}, f_k) - B(x_{k-1}, f_{k-1}),
-// a forward-Euler walk along the load path.
+enum class Scheme {
+  // The paper's (model.md section 6): at step k,
+  //   A(x_{k-1}) dx_k = B(x_{k-1}, f_k) - B(x_{k-1}, f_{k-1}),
+  // a forward-Euler walk along the load path.
+  Incremental,
+  // Equilibrium R(x; lambda_k) = 0 at every step (model.md section 7), with
+  // rigid paddles in contact as an active set.
+  Newton,
+};
+const char* to_string(Scheme scheme);
+
+// How each Newton step's linear system with the tangent is solved.
+enum class TangentSolver {
+  Auto,    // dense below about 2000 unknowns, krylov above
+  Dense,   // LU of the dense tangent (LAPACK)
+  Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
+};
+const char* to_string(TangentSolver solver);
+
+struct NewtonOptions {
+  // Converged when the relative residual (force rows over the largest of the
+  // loads and reactions seen, the volume row over dim C0 V0) is at most
+  // residual_tolerance; or when it has stalled at rounding level (at most
+  // 1000 times that) while the last correction moved no coordinate by more
+  // than increment_tolerance times the body's bounding-box diagonal.
+  double residual_tolerance = 1e-10;
+  double increment_tolerance = 1e-12;
+  int max_iterations = 25;      // per load step (or cut piece of one)
+  int max_step_cuts = 6;        // halvings of a failing step before giving up
+  bool line_search = true;      // backtracking on the residual norm
+  TangentSolver tangent = TangentSolver::Auto;
+  double krylov_tolerance = 1e-10;  // relative GMRES residual
+  int krylov_restart = 50;
+  int krylov_max_iterations = 500;
+  int max_contact_rounds = 30;  // active-set updates per step
+
+  bool IsValid(std::string* why) const;
+};
+
 struct SteppingOptions {
+  Scheme scheme = Scheme::Incremental;
+  NewtonOptions newton;
   int steps = 1;                  // number of load steps n
   bool rebuild_matrix = false;    // rebuild A (lengths, area vectors) from x_{k-1} each step
   bool update_load_geometry = true;  // loads from x_{k-1} (the paper) or from the reference
@@ -44,6 +82,21 @@ struct StepRecord {
   // body, and the sum of the external loads; they sum to zero at equilibrium.
   std::vector<Eigen::Vector3d> reactions;
   Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();
+
+  // Newton scheme only.
+  int newton_iterations = 0;            // over the step's pieces
+  std::vector<double> residual_norms;   // relative, at every iteration (before its correction)
+  int line_search_halvings = 0;
+  int krylov_iterations = 0;
+  int step_cuts = 0;                    // halvings of this step
+  double volume_drift = 0.0;            // (V - V0) / V0 after the step
+  struct PaddleState {
+    double plane = 0.0;                 // the plane's coordinate
+    double travel = 0.0;                // how far it has moved
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the body
+    int contacts = 0;                   // vertices held on it
+  };
+  std::vector<PaddleState> paddles;     // one per Model::paddles
 };
 
 struct SteppingSummary {
@@ -52,7 +105,11 @@ struct SteppingSummary {
   std::vector<StepRecord> steps;
   Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
   Eigen::MatrixXd reaction_forces;    // #V by dim: the support force on each vertex at the end
-  SolverKind solver = SolverKind::Auto;  // the backend that ran
+  Scheme scheme = Scheme::Incremental;
+  SolverKind solver = SolverKind::Auto;  // the backend that ran (newton: the preconditioner's)
+  TangentSolver tangent = TangentSolver::Auto;  // newton: how the tangent was solved
+  int newton_iterations = 0;              // newton: over all steps
+  int krylov_iterations = 0;              // newton with krylov: over all solves
   // The bordered system the backend factored last (reduced, boundary
   // conditions applied): what was actually solved.
   std::shared_ptr<const model::FiberSystem> system;
@@ -75,5 +132,9 @@ using StepObserver = std::function<void(const StepRecord&, const Eigen::VectorXd
 // message naming the step and the cause.
 SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
                                  const StepObserver& observer = {});
+
+// The Newton scheme (what solve_load_steps runs for Scheme::Newton).
+SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
+                                   const StepObserver& observer = {});
 
 }  // namespace fiberfluid::solve

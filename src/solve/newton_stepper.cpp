@@ -1,0 +1,496 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The Newton scheme (model.md section 7): equilibrium at every load step,
+// with a line search, step cutting, and rigid paddles as an active set.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "geom/area_vectors.hpp"
+#include "geom/error.hpp"
+#include "geom/progress.hpp"
+#include "model/assembly.hpp"
+#include "model/dof_map.hpp"
+#include "model/equilibrium.hpp"
+#include "model/fiber_system.hpp"
+#include "model/loads.hpp"
+#include "solve/dense_lu.hpp"
+#include "solve/gmres.hpp"
+#include "solve/load_stepper.hpp"
+#include "solve/runaway.hpp"
+
+namespace fiberfluid::solve {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using model::DofMap;
+using model::Model;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Loads, prescribed displacements and paddle planes at a point t of the load
+// path: t = k after step k, linear in between (for the pieces of a cut step).
+struct PathPoint {
+  std::vector<double> factors;  // per load
+  Eigen::VectorXd held_values;  // dim N: prescribed displacements, zero where free
+  std::vector<double> planes;   // per paddle
+};
+
+PathPoint path_point(const Model& m, double t, int steps) {
+  const int k0 = std::clamp(static_cast<int>(std::floor(t)), 0, steps);
+  const int k1 = std::min(k0 + 1, steps);
+  const double s = t - k0;
+  PathPoint at;
+  const std::vector<double> f0 = model::load_factors(m, k0, steps),
+                            f1 = model::load_factors(m, k1, steps);
+  for (size_t l = 0; l < f0.size(); ++l) at.factors.push_back(f0[l] + s * (f1[l] - f0[l]));
+  const Eigen::VectorXd u0 = model::constrained_displacements(m, k0, steps),
+                        u1 = model::constrained_displacements(m, k1, steps);
+  at.held_values = u0 + s * (u1 - u0);
+  for (const model::Paddle& p : m.paddles) {
+    const double a = p.schedule.factor(k0, steps), b = p.schedule.factor(k1, steps);
+    at.planes.push_back(p.plane(a + s * (b - a)));
+  }
+  return at;
+}
+
+class NewtonSolver {
+ public:
+  NewtonSolver(const Model& model, const SteppingOptions& options, SteppingSummary& summary)
+      : model_(model),
+        options_(options),
+        newton_(options.newton),
+        summary_(summary),
+        equilibrium_(model),
+        supports_(DofMap::from_constraints(model)),
+        contact_paddle_(static_cast<size_t>(model.num_vertices()), -1),
+        stuck_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
+    const Eigen::MatrixXd& V = model.surface.V;
+    diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+    const int reduced = supports_.num_reduced();
+    tangent_ = newton_.tangent != TangentSolver::Auto ? newton_.tangent
+               : reduced <= 2000                     ? TangentSolver::Dense
+                                                     : TangentSolver::Krylov;
+    summary_.tangent = tangent_;
+    summary_.solver = tangent_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
+  }
+
+  const model::Equilibrium& equilibrium() const { return equilibrium_; }
+
+  // Solves R = 0 at `at` from x (updated in place): Newton inside an
+  // active-set loop for the paddles. "" or why it failed.
+  std::string solve(const PathPoint& at, Eigen::VectorXd& x, StepRecord& record) {
+    add_penetrating(at, x);
+    for (int round = 0; round < newton_.max_contact_rounds; ++round) {
+      const DofMap dofs = held_map();
+      apply_held_values(at, dofs, x);
+      const std::string why = newton(at, dofs, x, record);
+      if (!why.empty()) return why;
+      const bool released = release_pulling();
+      const bool added = add_penetrating(at, x);
+      if (!released && !added) return {};
+    }
+    return "the paddle contact did not settle in " + std::to_string(newton_.max_contact_rounds) +
+           " active-set rounds (newton.max_contact_rounds)";
+  }
+
+  // After a successful solve: the residual at the held unknowns is the force
+  // each support or paddle exerts on the body.
+  const Eigen::VectorXd& last_residual() const { return residual_; }
+  const std::vector<int>& contact_paddle() const { return contact_paddle_; }
+  DofMap held_map() const {
+    std::vector<char> held = supports_.held_flags();
+    const int n = model_.num_vertices();
+    for (int v = 0; v < n; ++v) {
+      const int p = contact_paddle_[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
+      for (int a = 0; a < model_.dim(); ++a)
+        if (a == paddle.axis || paddle.sticking) held[static_cast<size_t>(a * n + v)] = 1;
+    }
+    return DofMap(model_.dim(), n, std::move(held));
+  }
+  // Snapshot and restore of the contact state, for a step that is cut.
+  struct ContactState {
+    std::vector<int> paddle;
+    Eigen::MatrixXd stuck;
+  };
+  ContactState contact_state() const { return {contact_paddle_, stuck_}; }
+  void restore(const ContactState& state) {
+    contact_paddle_ = state.paddle;
+    stuck_ = state.stuck;
+  }
+
+ private:
+  // Held values: supports and prescribed values from the path, contact
+  // vertices on their planes (and, sticking, where they first touched).
+  void apply_held_values(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x) const {
+    const int n = model_.num_vertices();
+    for (int d = 0; d < model_.dim() * n; ++d)
+      if (supports_.held(d)) x[d] = at.held_values[d];
+    for (int v = 0; v < n; ++v) {
+      const int p = contact_paddle_[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
+      for (int a = 0; a < model_.dim(); ++a) {
+        const int d = a * n + v;
+        if (supports_.held(d) || !dofs.held(d)) continue;
+        x[d] = a == paddle.axis ? at.planes[static_cast<size_t>(p)] - model_.surface.V(v, a)
+                                : stuck_(v, a);
+      }
+    }
+  }
+
+  // Vertices past a paddle join its contact set; true when any did.
+  bool add_penetrating(const PathPoint& at, const Eigen::VectorXd& x) {
+    const Eigen::MatrixXd X = model::positions(model_, x);
+    const int n = model_.num_vertices();
+    bool added = false;
+    for (size_t p = 0; p < model_.paddles.size(); ++p) {
+      const model::Paddle& paddle = model_.paddles[p];
+      for (int v = 0; v < n; ++v) {
+        if (contact_paddle_[static_cast<size_t>(v)] >= 0 || supports_.held(paddle.axis * n + v))
+          continue;
+        if (paddle.penetration(X(v, paddle.axis), at.planes[p]) > 1e-12 * diagonal_) {
+          contact_paddle_[static_cast<size_t>(v)] = static_cast<int>(p);
+          for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
+          added = true;
+        }
+      }
+    }
+    return added;
+  }
+
+  // Contact vertices whose paddle would have to pull them leave the set.
+  bool release_pulling() {
+    const int n = model_.num_vertices();
+    bool released = false;
+    for (int v = 0; v < n; ++v) {
+      const int p = contact_paddle_[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
+      const double force = residual_[paddle.axis * n + v];  // on the body, along the axis
+      if (paddle.above ? force > 0.0 : force < 0.0) {
+        contact_paddle_[static_cast<size_t>(v)] = -1;
+        released = true;
+      }
+    }
+    return released;
+  }
+
+  // The relative residual: force rows over the force scale, the volume row
+  // over dim C0 V0.
+  double measure(const Eigen::VectorXd& reduced) const {
+    const Eigen::Index m = reduced.size() - 1;
+    const double force = reduced.head(m).norm() / std::max(peak_force_, 1e-300);
+    const double volume = reduced[m] / equilibrium_.volume_scale();
+    return std::hypot(force, volume);
+  }
+
+  // The force scale: the largest of the loads and the held rows (reactions) seen.
+  void update_force_scale(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
+                          const Eigen::VectorXd& R) {
+    const Eigen::VectorXd F = equilibrium_.external_forces(x, at.factors);
+    double held = 0.0;
+    for (int d : dofs.held_dofs()) held += R[d] * R[d];
+    peak_force_ = std::max({peak_force_, F.head(F.size() - 1).norm(), std::sqrt(held)});
+  }
+
+  std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
+                     StepRecord& record) {
+    Eigen::VectorXd R = equilibrium_.residual(x, at.factors);
+    update_force_scale(at, dofs, x, R);
+    double last_move = std::numeric_limits<double>::infinity();
+    for (int it = 0;; ++it) {
+      const Eigen::VectorXd r = dofs.reduce(R);
+      const double norm = measure(r);
+      record.residual_norms.push_back(norm);
+      if (!std::isfinite(norm)) return "the residual is not finite";
+      // Converged: the residual is small, or it has stalled at rounding
+      // level (a little above the tolerance) while the corrections vanish.
+      const bool small_move = last_move <= newton_.increment_tolerance * diagonal_;
+      if (norm <= newton_.residual_tolerance ||
+          (small_move && norm <= 1e3 * newton_.residual_tolerance)) {
+        residual_ = R;
+        return {};
+      }
+      if (it == newton_.max_iterations) {
+        std::ostringstream out;
+        out << "newton: no convergence in " << it << " iterations (relative residual " << norm
+            << ", newton.residual_tolerance " << newton_.residual_tolerance << ")";
+        return out.str();
+      }
+      Eigen::VectorXd dx;
+      const Status status = solve_tangent(at, dofs, x, r, dx, record);
+      if (!status.ok) return status.message;
+      // Backtracking: halve the step until the residual falls (Armijo).
+      Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
+      dofs.scatter(dx, step);
+      double alpha = 1.0;
+      Eigen::VectorXd trial, R_trial;
+      for (int halving = 0;; ++halving) {
+        trial = x + alpha * step;
+        R_trial = equilibrium_.residual(trial, at.factors);
+        const double trial_norm = measure(dofs.reduce(R_trial));
+        if (!newton_.line_search || trial_norm <= (1.0 - 1e-4 * alpha) * norm ||
+            trial_norm <= newton_.residual_tolerance)
+          break;
+        if (halving == 12)
+          return "newton: the line search found no decrease of the residual (relative " +
+                 std::to_string(norm) + ")";
+        alpha *= 0.5;
+        ++record.line_search_halvings;
+      }
+      x = trial;
+      R = R_trial;
+      update_force_scale(at, dofs, x, R);
+      last_move = alpha * dx.head(dx.size() - 1).cwiseAbs().maxCoeff();
+      ++record.newton_iterations;
+      ++summary_.newton_iterations;
+      report_progress("newton iteration", record.newton_iterations, 0.0);
+    }
+  }
+
+  Status solve_tangent(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
+                       const Eigen::VectorXd& r, Eigen::VectorXd& dx, StepRecord& record) {
+    if (tangent_ == TangentSolver::Dense) {
+      DenseLU lu;
+      const Status status = lu.factorize(dofs.reduce(equilibrium_.tangent(x, at.factors)));
+      if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+      dx = lu.solve(-r);
+      return {};
+    }
+    const bool same_set = preconditioner_ && dofs.held_flags() == preconditioned_held_;
+    if (!same_set || refactor_) {
+      const Status status = factor_preconditioner(dofs, x);
+      if (!status.ok) return status;
+    }
+    const int full = model_.num_unknowns();
+    const LinearOperator apply = [&](const Eigen::VectorXd& v) {
+      Eigen::VectorXd w = Eigen::VectorXd::Zero(full);
+      dofs.scatter(v, w);  // held entries stay zero
+      return dofs.reduce(equilibrium_.tangent_product(x, at.factors, w));
+    };
+    const LinearOperator precondition = [&](const Eigen::VectorXd& v) {
+      Eigen::VectorXd out;
+      const Status status = preconditioner_->solve(v, &out);
+      return status.ok ? out : Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), NAN));
+    };
+    GmresOptions gmres_options;
+    gmres_options.tolerance = newton_.krylov_tolerance;
+    gmres_options.restart = newton_.krylov_restart;
+    gmres_options.max_iterations = newton_.krylov_max_iterations;
+    dx.resize(0);
+    GmresResult result = gmres(apply, precondition, -r, dx, gmres_options);
+    record.krylov_iterations += result.iterations;
+    summary_.krylov_iterations += result.iterations;
+    // The secant factor ages as the strains move: refactor when gmres needs
+    // clearly more iterations than it did just after the last factorisation.
+    if (baseline_iterations_ < 0) baseline_iterations_ = result.iterations;
+    else if (result.iterations > 2 * baseline_iterations_ + 5) refactor_ = true;
+    if (!result.status.ok && !just_factored_) {
+      const Status status = factor_preconditioner(dofs, x);
+      if (!status.ok) return status;
+      dx.resize(0);
+      result = gmres(apply, precondition, -r, dx, gmres_options);
+      record.krylov_iterations += result.iterations;
+      summary_.krylov_iterations += result.iterations;
+    }
+    just_factored_ = false;
+    return result.status.ok ? Status{} : Status::failure("newton: " + result.status.message);
+  }
+
+  // The structured secant solve at the current strains: the reference
+  // bordered system with each bulk weight times Y(e_ij).
+  Status factor_preconditioner(const DofMap& dofs, const Eigen::VectorXd& x) {
+    const Eigen::MatrixXd X = model::positions(model_, x);
+    secant_ = std::make_unique<model::FiberSystem>(model_, model_.surface.V, dofs,
+                                                   model::BoundaryMethod::Elimination,
+                                                   options_.penalty, &X);
+    if (!preconditioner_ || !(dofs.held_flags() == preconditioned_held_)) {
+      SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
+                                                            : options_.solver;
+      preconditioner_ = make_linear_solver(kind, options_.pcg);
+      summary_.solver = kind;
+      const Status status = preconditioner_->analyze_pattern(*secant_);
+      if (!status.ok) return status;
+    }
+    const Status status = preconditioner_->factorize(*secant_);
+    if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
+    ++summary_.factorizations;
+    preconditioned_held_ = dofs.held_flags();
+    baseline_iterations_ = -1;
+    refactor_ = false;
+    just_factored_ = true;
+    return {};
+  }
+
+  const Model& model_;
+  const SteppingOptions& options_;
+  const NewtonOptions& newton_;
+  SteppingSummary& summary_;
+  model::Equilibrium equilibrium_;
+  DofMap supports_;                    // supports and prescribed values
+  std::vector<int> contact_paddle_;    // per vertex: its paddle, or -1
+  Eigen::MatrixXd stuck_;              // sticking contact: displacement at first touch
+  Eigen::VectorXd residual_;
+  double diagonal_ = 1.0, peak_force_ = 0.0;
+  TangentSolver tangent_ = TangentSolver::Dense;
+  // Krylov: the secant system and its factorisation.
+  std::unique_ptr<model::FiberSystem> secant_;
+  std::unique_ptr<LinearSolver> preconditioner_;
+  std::vector<char> preconditioned_held_;
+  int baseline_iterations_ = -1;
+  bool refactor_ = false, just_factored_ = false;
+};
+
+bool partition_holds(const model::DofPartition& partition, int dof) {
+  return std::binary_search(partition.constrained.begin(), partition.constrained.end(), dof);
+}
+
+// Why a paddle setup cannot work, or "".
+std::string paddle_problem(const Model& model, int steps) {
+  const Eigen::MatrixXd& V = model.surface.V;
+  for (size_t p = 0; p < model.paddles.size(); ++p) {
+    const model::Paddle& a = model.paddles[p];
+    if (a.axis < 0 || a.axis >= model.dim()) return "paddle " + a.label + ": axis out of range";
+    const double extreme = a.above ? V.col(a.axis).maxCoeff() : V.col(a.axis).minCoeff();
+    if (a.penetration(extreme, a.position) > 1e-9 * std::abs(extreme) + 1e-300)
+      return "paddle " + a.label + ": it starts inside the body (position " +
+             std::to_string(a.position) + ", body extends to " + std::to_string(extreme) + ")";
+    for (size_t q = p + 1; q < model.paddles.size(); ++q) {
+      const model::Paddle& b = model.paddles[q];
+      if (b.axis != a.axis || b.above == a.above) continue;
+      const model::Paddle& top = a.above ? a : b;
+      const model::Paddle& bottom = a.above ? b : a;
+      for (int k = 0; k <= steps; ++k) {
+        const double gap = top.plane(top.schedule.factor(k, steps)) -
+                           bottom.plane(bottom.schedule.factor(k, steps));
+        if (!(gap > 0.0))
+          return "paddles " + top.label + " and " + bottom.label + " meet or pass each other " +
+                 "at step " + std::to_string(k) + " (gap " + std::to_string(gap) + ")";
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
+                                   const StepObserver& observer) {
+  const Clock::time_point start = Clock::now();
+  SteppingSummary summary;
+  summary.scheme = Scheme::Newton;
+  summary.unknowns = Eigen::VectorXd::Zero(model.num_unknowns());
+  auto fail = [&](const std::string& why) {
+    summary.message = why;
+    summary.total_seconds = seconds_since(start);
+    return summary;
+  };
+  std::string why;
+  if (!options.IsValid(&why)) return fail(why);
+  why = model::singular_setup_reason(model);
+  if (!why.empty()) return fail(why);
+  why = paddle_problem(model, options.steps);
+  if (!why.empty()) return fail(why);
+  model::DofPartition partition;
+  std::unique_ptr<NewtonSolver> solver;
+  try {
+    partition = model::partition_dofs(model);  // one unknown held at two values throws
+    solver = std::make_unique<NewtonSolver>(model, options, summary);
+  } catch (const InputError& e) {
+    return fail(e.what());
+  }
+
+  const int n = options.steps, nv = model.num_vertices(), dim = model.dim();
+  const Eigen::MatrixXd& reference = model.surface.V;
+  const double reference_volume = solver->equilibrium().reference_volume();
+  const Eigen::MatrixXd reference_face_areas = geom::face_area_vectors(reference, model.surface.F);
+  const size_t groups = std::max<size_t>(1, model.constraint_groups.size());
+  Eigen::VectorXd& x = summary.unknowns;
+
+  report_progress("step", 0, n);
+  for (int k = 1; k <= n; ++k) {
+    const Clock::time_point step_start = Clock::now();
+    StepRecord record;
+    record.step = k;
+    // Pieces of the step: the whole step, halved on failure.
+    double reached = k - 1, piece = 1.0;
+    while (reached < k) {
+      const double target = std::min<double>(k, reached + piece);
+      const PathPoint at = path_point(model, target, n);
+      const Eigen::VectorXd saved = x;
+      const auto contact = solver->contact_state();
+      why = solver->solve(at, x, record);
+      if (why.empty()) {
+        reached = target;
+        continue;
+      }
+      x = saved;
+      solver->restore(contact);
+      if (record.step_cuts == options.newton.max_step_cuts)
+        return fail("step " + std::to_string(k) + ": " + why + "; the step was halved " +
+                    std::to_string(record.step_cuts) +
+                    " times (newton.max_step_cuts): the load step is too large or the "
+                    "material too soft");
+      ++record.step_cuts;
+      piece *= 0.5;
+    }
+
+    const Eigen::MatrixXd X = model::positions(model, x);
+    const double volume = geom::enclosed_volume(X, model.surface.F);
+    why = runaway_reason(model, options, x, X, volume, reference_volume, reference_face_areas);
+    if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
+
+    // Forces on the body: supports per group, paddles, and the loads.
+    const PathPoint at = path_point(model, k, n);
+    const Eigen::VectorXd& R = solver->last_residual();
+    const Eigen::VectorXd F = solver->equilibrium().external_forces(x, at.factors);
+    record.reactions.assign(groups, Eigen::Vector3d::Zero());
+    summary.reaction_forces = Eigen::MatrixXd::Zero(nv, dim);
+    for (size_t c = 0; c < partition.constrained.size(); ++c) {
+      const int d = partition.constrained[c];
+      const model::Constraint& constraint =
+          model.constraints[static_cast<size_t>(partition.constraint_of[c])];
+      record.reactions[static_cast<size_t>(constraint.group) % groups][d / nv] += R[d];
+      summary.reaction_forces(d % nv, d / nv) = R[d];
+    }
+    record.paddles.resize(model.paddles.size());
+    for (size_t p = 0; p < model.paddles.size(); ++p) {
+      record.paddles[p].plane = at.planes[p];
+      record.paddles[p].travel = at.planes[p] - model.paddles[p].position;
+    }
+    const model::DofMap held = solver->held_map();
+    for (int v = 0; v < nv; ++v) {
+      const int p = solver->contact_paddle()[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      StepRecord::PaddleState& state = record.paddles[static_cast<size_t>(p)];
+      ++state.contacts;
+      for (int a = 0; a < dim; ++a)
+        if (held.held(a * nv + v) && !partition_holds(partition, a * nv + v)) {
+          state.force[a] += R[a * nv + v];
+          summary.reaction_forces(v, a) = R[a * nv + v];
+        }
+    }
+    for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
+    for (size_t l = 0; l < model.loads.size(); ++l) record.load_factors.push_back(at.factors[l]);
+    record.pressure = x[model.pressure_dof()];
+    record.volume = volume;
+    record.volume_drift = (volume - reference_volume) / reference_volume;
+    record.max_displacement = (X - reference).rowwise().norm().maxCoeff();
+    record.seconds = seconds_since(step_start);
+    summary.steps.push_back(record);
+    report_progress("step", k, n);
+    if (observer) observer(record, x);
+  }
+  summary.success = true;
+  summary.total_seconds = seconds_since(start);
+  return summary;
+}
+
+}  // namespace fiberfluid::solve

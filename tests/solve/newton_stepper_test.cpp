@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The Newton scheme: the linear limit, quadratic convergence, path
+// independence, step cutting, contact with paddles, and its failures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "geom/area_vectors.hpp"
+#include "model/assembly.hpp"
+#include "model/model_fixtures.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::solve {
+namespace {
+
+// The paper's sphere (162 vertices, cap held) under gravity alone.
+model::Model hanging_sphere(const model::FiberLaw& law, double density = 300.0) {
+  model::Model m = testing::paper_sphere_model();
+  m.material.law = law;
+  m.loads.resize(1);  // gravity only
+  m.loads[0].density = density;
+  return m;
+}
+
+SteppingOptions newton(int steps, TangentSolver tangent = TangentSolver::Dense) {
+  SteppingOptions o;
+  o.scheme = Scheme::Newton;
+  o.steps = steps;
+  o.newton.tangent = tangent;
+  return o;
+}
+
+double displacement_norm(const model::Model& m, const Eigen::VectorXd& x) {
+  return x.head(m.num_unknowns() - 1).norm();
+}
+
+TEST(Newton, TendsToTheLinearSolutionAsTheLoadShrinks) {
+  // The difference is second order in the load: halving the load quarters it.
+  std::vector<double> differences;
+  for (double density : {40.0, 20.0, 10.0}) {
+    const model::Model m = hanging_sphere(model::FiberLaw::constant(3000.0), density);
+    SteppingOptions linear;
+    linear.steps = 1;
+    const SteppingSummary a = solve_load_steps(m, linear);
+    const SteppingSummary b = solve_load_steps(m, newton(1));
+    ASSERT_TRUE(a.success && b.success) << a.message << b.message;
+    differences.push_back(displacement_norm(m, a.unknowns - b.unknowns));
+    EXPECT_LT(differences.back(), 0.05 * displacement_norm(m, a.unknowns));
+  }
+  for (size_t k = 1; k < differences.size(); ++k)
+    EXPECT_NEAR(differences[k - 1] / differences[k], 4.0, 0.3) << k;
+}
+
+TEST(Newton, ConvergesQuadratically) {
+  for (const model::FiberLaw& law :
+       {model::FiberLaw::constant(3000.0), model::FiberLaw::exponential(3000.0, 5.0)}) {
+    const model::Model m = hanging_sphere(law);
+    SteppingOptions o = newton(1);
+    o.newton.residual_tolerance = 1e-14;
+    const SteppingSummary s = solve_load_steps(m, o);
+    ASSERT_TRUE(s.success) << s.message;
+    const std::vector<double>& r = s.steps[0].residual_norms;
+    ASSERT_GE(r.size(), 4u);
+    // Once in the basin, each residual is about the square of the one before.
+    int quadratic = 0;
+    for (size_t k = 1; k < r.size(); ++k)
+      if (r[k - 1] < 1e-2 && r[k] > 1e-12) {  // above the rounding floor
+        EXPECT_LT(r[k], 50.0 * r[k - 1] * r[k - 1]) << law.name() << " iteration " << k;
+        ++quadratic;
+      }
+    EXPECT_GE(quadratic, 1) << law.name();
+    EXPECT_LT(r.back(), 1e-11);
+    EXPECT_EQ(s.steps[0].line_search_halvings, 0);
+  }
+}
+
+TEST(Newton, RoundTripReturnsToTheStartForAnyStepCount) {
+  for (int n : {2, 10, 100}) {
+    model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+    m.loads[0].schedule.kind = model::Schedule::Kind::UpDown;
+    const SteppingSummary s = solve_load_steps(m, newton(n));
+    ASSERT_TRUE(s.success) << s.message;
+    const double peak = s.steps[static_cast<size_t>(n / 2 - 1)].max_displacement;
+    EXPECT_GT(peak, 0.05);
+    EXPECT_LT(s.steps.back().max_displacement, 1e-9 * peak) << n;
+  }
+}
+
+TEST(Newton, KrylovAgreesWithTheDenseTangent) {
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+  const SteppingSummary dense = solve_load_steps(m, newton(2, TangentSolver::Dense));
+  for (SolverKind preconditioner : {SolverKind::BlockCholesky, SolverKind::Cholmod}) {
+    SteppingOptions o = newton(2, TangentSolver::Krylov);
+    o.solver = preconditioner;
+    const SteppingSummary krylov = solve_load_steps(m, o);
+    ASSERT_TRUE(dense.success && krylov.success) << dense.message << krylov.message;
+    EXPECT_EQ(krylov.solver, preconditioner);
+    EXPECT_GT(krylov.krylov_iterations, 0);
+    EXPECT_LT(displacement_norm(m, krylov.unknowns - dense.unknowns),
+              1e-8 * displacement_norm(m, dense.unknowns));
+  }
+}
+
+TEST(Newton, CutsAStepThatFailsAndStillSucceeds) {
+  // A heavy load in one step: from the start, Newton needs seven iterations;
+  // allowed four, the step is cut, and its pieces converge.
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0), 1000.0);
+  SteppingOptions o = newton(1);
+  o.newton.max_iterations = 4;
+  const SteppingSummary s = solve_load_steps(m, o);
+  ASSERT_TRUE(s.success) << s.message;
+  EXPECT_GE(s.steps[0].step_cuts, 1);
+  // The same answer as an uncut run with enough iterations.
+  const SteppingSummary reference = solve_load_steps(m, newton(1));
+  ASSERT_TRUE(reference.success) << reference.message;
+  EXPECT_LT(displacement_norm(m, s.unknowns - reference.unknowns),
+            1e-7 * displacement_norm(m, reference.unknowns));
+  // And with no cuts allowed it fails, naming the step and the option.
+  o.newton.max_step_cuts = 0;
+  const SteppingSummary failed = solve_load_steps(m, o);
+  EXPECT_FALSE(failed.success);
+  EXPECT_NE(failed.message.find("step 1: newton: no convergence"), std::string::npos)
+      << failed.message;
+  EXPECT_NE(failed.message.find("newton.max_step_cuts"), std::string::npos);
+}
+
+// A sphere resting on supports at its bottom, pressed by a paddle from above.
+model::Model pressed_sphere(bool sticking) {
+  model::Model m = testing::paper_sphere_model();
+  m.loads.clear();
+  m.constraints.clear();
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  model::Paddle paddle;
+  paddle.label = "top";
+  paddle.axis = 2;
+  paddle.above = true;
+  paddle.position = m.surface.V.col(2).maxCoeff();
+  paddle.travel = -0.3;
+  paddle.sticking = sticking;
+  m.paddles = {paddle};
+  return m;
+}
+
+TEST(Newton, PaddleContactPushesHoldsAndBalances) {
+  for (bool sticking : {false, true}) {
+    const model::Model m = pressed_sphere(sticking);
+    const int n = m.num_vertices();
+    const SteppingSummary s = solve_load_steps(m, newton(5));
+    ASSERT_TRUE(s.success) << s.message;
+    const StepRecord& last = s.steps.back();
+    ASSERT_EQ(last.paddles.size(), 1u);
+    const StepRecord::PaddleState& top = last.paddles[0];
+    EXPECT_NEAR(top.plane, m.paddles[0].position - 0.3, 1e-15);
+    EXPECT_GT(top.contacts, 3);
+    EXPECT_LT(top.force.z(), 0.0);  // the paddle pushes down on the body
+    const Eigen::MatrixXd X = model::positions(m, s.unknowns);
+    EXPECT_LE(X.col(2).maxCoeff(), top.plane + 1e-12);  // nothing beyond the paddle
+    // Every contact force pushes: on the top paddle, no vertex is pulled up.
+    for (int v = 0; v < n; ++v)
+      if (std::abs(X(v, 2) - top.plane) < 1e-12) EXPECT_LE(s.reaction_forces(v, 2), 1e-9);
+    // Global equilibrium: supports + paddle + loads (none) = 0.
+    const Eigen::Vector3d total = last.reactions[0] + top.force + last.applied_force;
+    EXPECT_LT(total.norm(), 1e-8 * top.force.norm()) << "sticking " << sticking;
+    // The force grows with the compression.
+    for (size_t k = 1; k < s.steps.size(); ++k)
+      EXPECT_LT(s.steps[k].paddles[0].force.z(), s.steps[k - 1].paddles[0].force.z());
+    // Volume held by the fluid.
+    EXPECT_LT(std::abs(last.volume_drift), 1e-8);
+  }
+}
+
+TEST(Newton, BadPaddlesAreRejected) {
+  model::Model inside = pressed_sphere(false);
+  inside.paddles[0].position = 0.5;
+  SteppingSummary s = solve_load_steps(inside, newton(2));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("paddle top: it starts inside the body"), std::string::npos)
+      << s.message;
+
+  model::Model crossing = pressed_sphere(false);
+  model::Paddle bottom = crossing.paddles[0];
+  bottom.label = "bottom";
+  bottom.above = false;
+  bottom.position = -1.0;
+  bottom.travel = 1.8;  // at step 2: 0.8, above the top paddle's 0.7
+  crossing.paddles.push_back(bottom);
+  s = solve_load_steps(crossing, newton(2));
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("paddles top and bottom meet or pass each other at step 2"),
+            std::string::npos)
+      << s.message;
+
+  SteppingOptions incremental;
+  s = solve_load_steps(pressed_sphere(false), incremental);
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("paddles need the Newton scheme"), std::string::npos) << s.message;
+}
+
+}  // namespace
+}  // namespace fiberfluid::solve
