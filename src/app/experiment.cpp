@@ -268,7 +268,84 @@ void read_constraints(Fields& root, const geom::Surface& surface,
   }
 }
 
+// Rigid paddles: planes normal to an axis on one side of the body, moving by
+// "travel" (m) or by "compression" (a share of the body's extent along the
+// axis, towards the body). "position" defaults to touching the body.
+std::vector<model::Paddle> read_paddles(Fields& root, const geom::Surface& surface) {
+  std::vector<model::Paddle> paddles;
+  for (Fields f : root.objects("paddles")) {
+    model::Paddle p;
+    p.label = f.string("label", "paddle_" + std::to_string(paddles.size()));
+    for (const model::Paddle& other : paddles)
+      if (other.label == p.label) f.fail("label", "\"" + p.label + "\" names another paddle");
+    const std::string axis = f.string("axis");
+    if (axis.size() != 1 || axis[0] < 'x' || axis[0] >= 'x' + surface.dim)
+      f.fail("axis", "expected one of \"" + std::string("xyz").substr(0, surface.dim) +
+                         "\" (the paddle's normal), got \"" + axis + "\"");
+    p.axis = axis[0] - 'x';
+    p.above = f.choice("side", "", {"above", "below"}) == "above";
+    const Eigen::VectorXd along = surface.V.col(p.axis);
+    const double extent = along.maxCoeff() - along.minCoeff();
+    p.position = f.number("position", p.above ? along.maxCoeff() : along.minCoeff());
+    if (p.penetration(p.above ? along.maxCoeff() : along.minCoeff(), p.position) >
+        1e-9 * extent)
+      f.fail("position", "the paddle starts inside the body: it must be " +
+                             std::string(p.above ? "at or above " : "at or below ") +
+                             std::to_string(p.above ? along.maxCoeff() : along.minCoeff()));
+    if (f.has("travel") == f.has("compression"))
+      f.fail("travel", "give either travel (m, along the axis) or compression (a share of "
+                       "the body's extent), one of them");
+    if (f.has("travel")) {
+      p.travel = f.number("travel");
+    } else {
+      const double share = f.number("compression");
+      if (!(share > 0.0 && share < 1.0))
+        f.fail("compression", "expected a share of the body's extent between 0 and 1");
+      p.travel = (p.above ? -1.0 : 1.0) * share * extent;
+    }
+    p.schedule = read_schedule(f, "ramp");
+    p.sticking = f.choice("contact", "frictionless", {"frictionless", "sticking"}) == "sticking";
+    f.finish();
+    paddles.push_back(p);
+  }
+  // Two paddles on one axis may not meet (checked at every step by the solver too).
+  for (const model::Paddle& a : paddles)
+    for (const model::Paddle& b : paddles)
+      if (a.axis == b.axis && a.above && !b.above &&
+          !(a.plane(1.0) > b.plane(1.0) && a.position > b.position))
+        root.fail("paddles", "paddles " + a.label + " and " + b.label +
+                                 " meet or pass each other: their travels leave no room for "
+                                 "the body");
+  return paddles;
+}
+
+solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
+  o.residual_tolerance = f.positive("residual_tolerance", o.residual_tolerance);
+  o.increment_tolerance = f.positive("increment_tolerance", o.increment_tolerance);
+  o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
+  o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
+  o.line_search = f.boolean("line_search", o.line_search);
+  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov"});
+  o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
+              : tangent == "krylov" ? solve::TangentSolver::Krylov
+                                    : solve::TangentSolver::Auto;
+  o.krylov_tolerance = f.positive("krylov_tolerance", o.krylov_tolerance);
+  o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
+  o.krylov_max_iterations = f.integer("krylov_max_iterations", o.krylov_max_iterations, 1, 100000);
+  o.max_contact_rounds = f.integer("max_contact_rounds", o.max_contact_rounds, 1, 1000);
+  f.finish();
+  return o;
+}
+
 solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
+  options.scheme = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton"
+                       ? solve::Scheme::Newton
+                       : solve::Scheme::Incremental;
+  if (f.has("newton")) {
+    if (options.scheme != solve::Scheme::Newton)
+      f.fail("newton", "Newton options need \"scheme\": \"newton\"");
+    options.newton = read_newton(f.object("newton"), options.newton);
+  }
   options.steps = f.integer("steps", options.steps, 1, 100000);
   options.rebuild_matrix = f.boolean("rebuild_matrix", options.rebuild_matrix);
   options.update_load_geometry = f.boolean("update_load_geometry", options.update_load_geometry);
@@ -300,6 +377,8 @@ void check_tables(const Fields& root, const Case& c) {
   for (size_t l = 0; l < c.model.loads.size(); ++l)
     check(c.model.loads[l].schedule, "loads[" + std::to_string(l) + "].schedule");
   for (const model::Constraint& k : c.model.constraints) check(k.schedule, "prescribed.schedule");
+  for (size_t p = 0; p < c.model.paddles.size(); ++p)
+    check(c.model.paddles[p].schedule, "paddles[" + std::to_string(p) + "].schedule");
 }
 
 std::vector<ExpectedFigure> read_expected(Fields& root) {
@@ -418,8 +497,17 @@ void build_case(Fields& root, const std::filesystem::path& folder, std::vector<C
   c.model.material = read_material(root.object("material"), dim);
   c.model.loads = read_loads(root, c.model.surface, from_input);
   read_constraints(root, c.model.surface, from_input, c.model);
+  c.model.paddles = read_paddles(root, c.model.surface);
   c.stepping = root.has("stepping") ? read_stepping(root.object("stepping"), {})
                                     : solve::SteppingOptions{};
+  if (!c.model.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
+    root.fail("paddles", "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
+                         "an active set inside the equilibrium iterations)");
+  if (!c.model.material.law.is_constant() && c.stepping.scheme == solve::Scheme::Incremental &&
+      !c.stepping.rebuild_matrix && warnings != nullptr)
+    warnings->push_back("material.law: the incremental scheme without stepping.rebuild_matrix "
+                        "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
+                        "scheme \"newton\" for the strain-dependent law");
   check_tables(root, c);
   root.finish();
   keys.push_back(key);

@@ -26,8 +26,24 @@ namespace fs = std::filesystem;
 
 const char kAxes[] = "xyz";
 
+json vector_json(const Eigen::Vector3d& v, int dim);
+
+json newton_options_json(const solve::NewtonOptions& n) {
+  return {{"residual_tolerance", n.residual_tolerance},
+          {"increment_tolerance", n.increment_tolerance},
+          {"max_iterations", n.max_iterations},
+          {"max_step_cuts", n.max_step_cuts},
+          {"line_search", n.line_search},
+          {"tangent", solve::to_string(n.tangent)},
+          {"krylov_tolerance", n.krylov_tolerance},
+          {"krylov_restart", n.krylov_restart},
+          {"krylov_max_iterations", n.krylov_max_iterations},
+          {"max_contact_rounds", n.max_contact_rounds}};
+}
+
 json stepping_json(const solve::SteppingOptions& s) {
-  return {{"steps", s.steps},
+  json out = {{"scheme", solve::to_string(s.scheme)},
+          {"steps", s.steps},
           {"rebuild_matrix", s.rebuild_matrix},
           {"update_load_geometry", s.update_load_geometry},
           {"boundary_method", model::to_string(s.boundary_method)},
@@ -37,6 +53,37 @@ json stepping_json(const solve::SteppingOptions& s) {
           {"max_iterations", s.pcg.max_iterations},
           {"max_volume_change", s.max_volume_change},
           {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
+  if (s.scheme == solve::Scheme::Newton) out["newton"] = newton_options_json(s.newton);
+  return out;
+}
+
+json law_json(const model::Material& material, int dim) {
+  const model::FiberLaw& law = material.law;
+  json out = {{"type", law.name()}};
+  for (const std::string& name : law.parameter_names()) out[name] = law.parameter(name);
+  if (law.kind() == model::FiberLaw::Kind::Tabulated) {
+    out["strain"] = law.table_strain();
+    out["stress"] = law.table_stress();
+  }
+  out["axis_factors"] = vector_json(material.axis_factors, dim);
+  return out;
+}
+
+// The Newton and contact records of a step (Newton scheme only).
+void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& step) {
+  step["newton"] = {{"iterations", r.newton_iterations},
+                    {"residual_norms", r.residual_norms},
+                    {"line_search_halvings", r.line_search_halvings},
+                    {"krylov_iterations", r.krylov_iterations},
+                    {"step_cuts", r.step_cuts},
+                    {"volume_drift", r.volume_drift}};
+  json paddles = json::object();
+  for (size_t p = 0; p < r.paddles.size() && p < m.paddles.size(); ++p)
+    paddles[m.paddles[p].label] = {{"plane", r.paddles[p].plane},
+                                   {"travel", r.paddles[p].travel},
+                                   {"force", vector_json(r.paddles[p].force, m.dim())},
+                                   {"contacts", r.paddles[p].contacts}};
+  if (!m.paddles.empty()) step["paddles"] = paddles;
 }
 
 std::string group_name(const model::Model& m, size_t g) {
@@ -70,6 +117,7 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
                      {"applied_force", vector_json(r.applied_force, m.dim())},
                      {"reactions", reactions_json(m, r)},
                      {"seconds", r.seconds}});
+    if (run.summary.scheme == solve::Scheme::Newton) add_newton_json(m, r, steps.back());
   }
   json final_figures = json::object();
   const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
@@ -82,6 +130,9 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"pcg_iterations", run.summary.solver_statistics.iterations},
           {"factorization_flops", run.summary.solver_statistics.factorization_flops},
           {"stepping", stepping_json(c.stepping)},
+          {"material", law_json(m.material, m.dim())},
+          {"newton_iterations", run.summary.newton_iterations},
+          {"krylov_iterations", run.summary.krylov_iterations},
           {"success", run.summary.success},
           {"message", run.summary.message},
           {"factorizations", run.summary.factorizations},
@@ -203,6 +254,36 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   return doc;
 }
 
+// Per paddle: its travel and the force on the body along its axis (all
+// components and the contact count when `full`).
+static void paddle_headers(CsvTable& t, const model::Paddle& p, int dim, bool full) {
+  t.header("paddle_" + p.label + "_travel_m");
+  if (full) {
+    t.header("paddle_" + p.label + "_plane_m");
+    for (int a = 0; a < dim; ++a)
+      t.header("paddle_" + p.label + "_force_" + kAxes[a] + "_N");
+    t.header("paddle_" + p.label + "_contacts");
+  } else {
+    t.header("paddle_" + p.label + "_force_N");
+  }
+}
+
+static void paddle_numbers(CsvTable& t, const model::Model& m, const solve::StepRecord& r, int dim,
+                    bool full) {
+  for (size_t p = 0; p < m.paddles.size(); ++p) {
+    const solve::StepRecord::PaddleState s =
+        p < r.paddles.size() ? r.paddles[p] : solve::StepRecord::PaddleState{};
+    t.number(s.travel);
+    if (full) {
+      t.number(s.plane);
+      for (int a = 0; a < dim; ++a) t.number(s.force[a]);
+      t.number(s.contacts);
+    } else {
+      t.number(s.force[m.paddles[p].axis]);
+    }
+  }
+}
+
 std::string steps_csv(const Case& c, const RunResult& run) {
   const model::Model& m = c.model;
   const int dim = m.dim();
@@ -217,6 +298,12 @@ std::string steps_csv(const Case& c, const RunResult& run) {
   for (size_t g = 0; g < groups; ++g)
     for (int a = 0; a < dim; ++a)
       t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
+  for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, true);
+  const bool newton = run.summary.scheme == solve::Scheme::Newton;
+  if (newton)
+    for (const char* h : {"newton_iterations", "final_relative_residual", "line_search_halvings",
+                          "krylov_iterations", "step_cuts", "volume_drift"})
+      t.header(h);
   t.header("seconds");
   t.end_row();
   for (const solve::StepRecord& r : run.summary.steps) {
@@ -228,7 +315,39 @@ std::string steps_csv(const Case& c, const RunResult& run) {
     for (int a = 0; a < dim; ++a) t.number(r.applied_force[a]);
     for (size_t g = 0; g < groups; ++g)
       for (int a = 0; a < dim; ++a) t.number(g < r.reactions.size() ? r.reactions[g][a] : 0.0);
+    paddle_numbers(t, m, r, dim, true);
+    if (newton) {
+      t.number(r.newton_iterations);
+      t.number(r.residual_norms.empty() ? 0.0 : r.residual_norms.back());
+      t.number(r.line_search_halvings);
+      t.number(r.krylov_iterations);
+      t.number(r.step_cuts);
+      t.number(r.volume_drift);
+    }
     t.number(r.seconds);
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::string load_displacement_csv(const Case& c, const RunResult& run) {
+  const model::Model& m = c.model;
+  const int dim = m.dim();
+  CsvTable t;
+  t.header("step");
+  for (const model::Load& load : m.loads) t.header("load_factor_" + load.label);
+  for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, false);
+  t.header("max_displacement_m");
+  t.header("pressure_Pa");
+  t.header(dim == 3 ? "volume_m3" : "area_m2");
+  t.end_row();
+  for (const solve::StepRecord& r : run.summary.steps) {
+    t.number(r.step);
+    for (double f : r.load_factors) t.number(f);
+    paddle_numbers(t, m, r, dim, false);
+    t.number(r.max_displacement);
+    t.number(r.pressure);
+    t.number(r.volume);
     t.end_row();
   }
   return t.str();
@@ -393,6 +512,7 @@ void OutputWriter::finish(const ExperimentResult& result) {
     const RunResult& run = result.runs[r];
     if (experiment_.output.vtk) geom::write_pvd(run_folder(r) / "series.pvd", series_[r]);
     geom::write_text_file(run_folder(r) / "steps.csv", steps_csv(c, run));
+    geom::write_text_file(run_folder(r) / "load_displacement.csv", load_displacement_csv(c, run));
     if (!run.summary.success) continue;
     geom::write_text_file(run_folder(r) / "vertices.csv", vertices_csv(c, run));
     if (experiment_.output.obj) {

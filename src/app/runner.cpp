@@ -155,6 +155,28 @@ std::optional<double> run_figure(const Case& ex, const RunResult& run, const std
   if (name == "surface_area") return geom::surface_area(m.surface.V, m.surface.F);
   if (name == "steps") return static_cast<double>(run.summary.steps.size());
   if (name == "factorizations") return run.summary.factorizations;
+  if (name == "newton_iterations") return run.summary.newton_iterations;
+  if (name == "max_newton_iterations_per_step" || name == "step_cuts" ||
+      name == "max_final_relative_residual") {
+    double value = 0.0;
+    for (const solve::StepRecord& r : run.summary.steps)
+      value = std::max(value, name == "step_cuts" ? r.step_cuts
+                              : name == "max_newton_iterations_per_step"
+                                  ? r.newton_iterations
+                                  : (r.residual_norms.empty() ? 0.0 : r.residual_norms.back()));
+    return value;
+  }
+  if (name.rfind("paddle_force.", 0) == 0 || name.rfind("paddle_contacts.", 0) == 0) {
+    // The final force of a paddle on the body along its axis, or its contacts.
+    const bool force = name[7] == 'f';
+    const std::string label = name.substr(force ? 13 : 16);
+    for (size_t p = 0; p < m.paddles.size(); ++p)
+      if (m.paddles[p].label == label && !run.summary.steps.empty()) {
+        const auto& state = run.summary.steps.back().paddles.at(p);
+        return force ? state.force[m.paddles[p].axis] : state.contacts;
+      }
+    return std::nullopt;
+  }
 
   for (const std::string prefix : {"position.", "displacement."}) {
     if (name.rfind(prefix, 0) != 0) continue;
