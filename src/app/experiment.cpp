@@ -157,16 +157,25 @@ std::vector<int> read_axes(Fields& f, int dim) {
 }
 
 // ------------------------------------------------------------ model parts
+double required_positive(Fields& f, const std::string& key) {
+  const double x = f.number(key);
+  if (!(x > 0.0)) f.fail(key, "expected a positive number, got " + std::to_string(x));
+  return x;
+}
+
 model::FiberLaw read_law(Fields f) {
   const std::string type =
       f.choice("type", "constant", {"constant", "exponential", "bilinear", "tabulated"});
   model::FiberLaw law;
   if (type == "constant") {
-    law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
+    const double Y = f.number("Y");
+    if (Y < 0.0) f.fail("Y", "expected a number >= 0, got " + std::to_string(Y));
+    law = model::FiberLaw::constant(Y);
   } else if (type == "exponential") {
-    law = model::FiberLaw::exponential(f.positive("Y0", 1.0), f.number("beta"));
+    law = model::FiberLaw::exponential(required_positive(f, "Y0"), f.number("beta"));
   } else if (type == "bilinear") {
-    law = model::FiberLaw::bilinear(f.positive("Y_t", 1.0), f.positive("Y_c", 1.0));
+    const double Y_t = required_positive(f, "Y_t"), Y_c = required_positive(f, "Y_c");
+    law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
   } else {
     const Eigen::VectorXd strain = f.vector("strain", -1), stress = f.vector("stress", -1);
     if (stress.size() != strain.size())

@@ -61,6 +61,7 @@ json law_json(const model::Material& material, int dim) {
   const model::FiberLaw& law = material.law;
   json out = {{"type", law.name()}};
   for (const std::string& name : law.parameter_names()) out[name] = law.parameter(name);
+  if (law.kind() == model::FiberLaw::Kind::Bilinear) out["transition"] = law.transition();
   if (law.kind() == model::FiberLaw::Kind::Tabulated) {
     out["strain"] = law.table_strain();
     out["stress"] = law.table_stress();

@@ -23,13 +23,32 @@ FiberLaw FiberLaw::exponential(double Y0, double beta) {
   return law;
 }
 
-FiberLaw FiberLaw::bilinear(double Y_t, double Y_c) {
+FiberLaw FiberLaw::bilinear(double Y_t, double Y_c, double transition) {
   FiberLaw law;
   law.kind_ = Kind::Bilinear;
   law.a_ = Y_t;
   law.b_ = Y_c;
+  law.c_ = transition;
   return law;
 }
+
+namespace {
+
+// The share of Y_t in the bilinear law: 0 below -w, 1 above w, and the C1
+// cubic 1/2 + 3t/4 - t^3/4 (t = e / w) between; w = 0 is a sharp step.
+double tension_share(double e, double w) {
+  if (w <= 0.0) return e >= 0.0 ? 1.0 : 0.0;
+  const double t = std::clamp(e / w, -1.0, 1.0);
+  return 0.5 + 0.75 * t - 0.25 * t * t * t;
+}
+
+double tension_share_slope(double e, double w) {
+  if (w <= 0.0 || std::abs(e) >= w) return 0.0;
+  const double t = e / w;
+  return 0.75 * (1.0 - t * t) / w;
+}
+
+}  // namespace
 
 FiberLaw FiberLaw::tabulated(std::vector<double> strain, std::vector<double> stress) {
   FiberLaw law;
@@ -62,7 +81,7 @@ double FiberLaw::modulus(double e) const {
   switch (kind_) {
     case Kind::Constant: return a_;
     case Kind::Exponential: return a_ * std::exp(b_ * e);
-    case Kind::Bilinear: return e >= 0.0 ? a_ : b_;
+    case Kind::Bilinear: return b_ + (a_ - b_) * tension_share(e, c_);
     case Kind::Tabulated: {
       // sigma = s_k + m (e - e_k) = m e + c on the segment: Y = m + c / e. The
       // segments that end at (0, 0) have c = 0 exactly, so Y is finite there.
@@ -78,8 +97,8 @@ double FiberLaw::modulus(double e) const {
 
 double FiberLaw::slope(double e) const {
   switch (kind_) {
-    case Kind::Constant:
-    case Kind::Bilinear: return 0.0;
+    case Kind::Constant: return 0.0;
+    case Kind::Bilinear: return (a_ - b_) * tension_share_slope(e, c_);
     case Kind::Exponential: return a_ * b_ * std::exp(b_ * e);
     case Kind::Tabulated: {
       const size_t k = segment(e);
@@ -128,7 +147,10 @@ double FiberLaw::modulus_derivative(const std::string& name, double e) const {
   switch (kind_) {
     case Kind::Constant: return 1.0;
     case Kind::Exponential: return first ? std::exp(b_ * e) : a_ * e * std::exp(b_ * e);
-    case Kind::Bilinear: return first ? (e >= 0.0 ? 1.0 : 0.0) : (e >= 0.0 ? 0.0 : 1.0);
+    case Kind::Bilinear: {
+      const double share = tension_share(e, c_);
+      return first ? share : 1.0 - share;
+    }
     case Kind::Tabulated: return modulus(e) / a_;
   }
   return 0.0;
@@ -158,6 +180,8 @@ std::string FiberLaw::check(double lowest, double highest) const {
     if (!std::isfinite(parameter(name))) return name + " must be a finite number";
   if (kind_ == Kind::Constant)
     return a_ >= 0.0 ? "" : "Y must be a number >= 0";
+  if (kind_ == Kind::Bilinear && !(c_ >= 0.0 && c_ < 1.0))
+    return "transition must be a strain from 0 to 1";
   for (const std::string& name : {names.front(), kind_ == Kind::Bilinear ? names.back() : ""})
     if (!name.empty() && !(parameter(name) > 0.0)) return name + " must be positive";
   // The modulus is monotone in e for these laws: its ends bound it.

@@ -16,13 +16,18 @@ class FiberLaw {
   enum class Kind {
     Constant,     // Y: the paper's linear model
     Exponential,  // Y0 exp(beta e): stiffening in tension, softening in compression
-    Bilinear,     // Y_t for e >= 0, Y_c for e < 0
+    Bilinear,     // Y_t in tension, Y_c in compression, joined smoothly over |e| < transition
     Tabulated,    // a piecewise-linear sigma(e), e.g. from a tensile test, times `scale`
   };
 
   static FiberLaw constant(double Y);
   static FiberLaw exponential(double Y0, double beta);
-  static FiberLaw bilinear(double Y_t, double Y_c);
+  // The secant modulus jumps at e = 0, and with the paper's vector spring so
+  // does the force (u_i - u_j need not vanish where e does), which stalls
+  // Newton. A C1 blend over |e| < transition (a strain; 0 for the sharp law)
+  // removes the jump; Y(0) is then the mean of Y_t and Y_c.
+  static FiberLaw bilinear(double Y_t, double Y_c, double transition = 0.005);
+  double transition() const { return c_; }
   // strain strictly increasing, one point (0, 0); outside the table the end
   // segments are extended.
   static FiberLaw tabulated(std::vector<double> strain, std::vector<double> stress);
@@ -55,6 +60,7 @@ class FiberLaw {
   Kind kind_ = Kind::Constant;
   double a_ = 1.0;  // Y, Y0, Y_t, or the table's scale
   double b_ = 0.0;  // beta or Y_c
+  double c_ = 0.0;  // the bilinear law's transition width
   std::vector<double> strain_, stress_;  // Tabulated
 };
 

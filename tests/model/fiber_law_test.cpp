@@ -13,10 +13,15 @@ TEST(FiberLaw, ValuesOfEachLaw) {
   const FiberLaw exp_law = FiberLaw::exponential(2000.0, 5.0);
   EXPECT_DOUBLE_EQ(exp_law.modulus(0.1), 2000.0 * std::exp(0.5));
   EXPECT_DOUBLE_EQ(exp_law.modulus(0.0), 2000.0);
-  const FiberLaw bilinear = FiberLaw::bilinear(3000.0, 1000.0);
+  const FiberLaw bilinear = FiberLaw::bilinear(3000.0, 1000.0);  // blended over |e| < 0.005
   EXPECT_EQ(bilinear.modulus(0.2), 3000.0);
-  EXPECT_EQ(bilinear.modulus(0.0), 3000.0);
+  EXPECT_EQ(bilinear.modulus(0.005), 3000.0);
+  EXPECT_EQ(bilinear.modulus(0.0), 2000.0);
   EXPECT_EQ(bilinear.modulus(-0.2), 1000.0);
+  EXPECT_DOUBLE_EQ(bilinear.modulus(0.0025), 1000.0 + 2000.0 * (0.5 + 0.375 - 0.25 / 8));
+  const FiberLaw sharp = FiberLaw::bilinear(3000.0, 1000.0, 0.0);
+  EXPECT_EQ(sharp.modulus(0.0), 3000.0);
+  EXPECT_EQ(sharp.modulus(-1e-9), 1000.0);
   // sigma: (-0.2, -200), (0, 0), (0.1, 100), (0.3, 500): secants 1000, 1000, 1000 and
   // at e = 0.2 sigma = 300, Y = 1500; beyond the table the last segment continues.
   const FiberLaw table = FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0});
@@ -33,10 +38,10 @@ TEST(FiberLaw, SlopesAndParameterDerivativesMatchCentralDifferences) {
       FiberLaw::bilinear(3000.0, 1000.0),
       FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
   for (const FiberLaw& law : laws)
-    for (double e : {-0.37, -0.05, 0.03, 0.17, 0.6}) {
+    for (double e : {-0.37, -0.05, -0.004, 0.001, 0.03, 0.17, 0.6}) {
       const double h = 1e-6;
       const double fd = (law.modulus(e + h) - law.modulus(e - h)) / (2 * h);
-      EXPECT_NEAR(law.slope(e), fd, 1e-6 * std::abs(law.modulus(e)) + 1e-9) << law.name() << e;
+      EXPECT_NEAR(law.slope(e), fd, 1e-6 * (std::abs(law.modulus(e)) + std::abs(fd)) + 1e-9) << law.name() << e;
       for (const std::string& name : law.parameter_names()) {
         const double p = law.parameter(name), step = 1e-6 * std::max(1.0, std::abs(p));
         FiberLaw up = law, down = law;
@@ -67,6 +72,7 @@ TEST(FiberLaw, BadLawsAreRejectedNamingTheParameter) {
   expect_rejected(FiberLaw::exponential(-1.0, 5.0), "Y0 must be positive");
   expect_rejected(FiberLaw::exponential(1.0, 800.0), "check beta");  // overflows at e = 2
   expect_rejected(FiberLaw::bilinear(1.0, 0.0), "Y_c must be positive");
+  expect_rejected(FiberLaw::bilinear(1.0, 2.0, -0.1), "transition");
   expect_rejected(FiberLaw::constant(-5.0), "Y must be a number >= 0");
   expect_rejected(FiberLaw::tabulated({0.0, 0.1, 0.1}, {0.0, 1.0, 2.0}), "strictly increasing");
   expect_rejected(FiberLaw::tabulated({0.0, 0.1, 0.2}, {0.0, 2.0, 1.0}), "monotone");

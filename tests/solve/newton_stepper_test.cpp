@@ -157,8 +157,11 @@ TEST(Newton, PaddleContactPushesHoldsAndBalances) {
     const Eigen::MatrixXd X = model::positions(m, s.unknowns);
     EXPECT_LE(X.col(2).maxCoeff(), top.plane + 1e-12);  // nothing beyond the paddle
     // Every contact force pushes: on the top paddle, no vertex is pulled up.
-    for (int v = 0; v < n; ++v)
-      if (std::abs(X(v, 2) - top.plane) < 1e-12) EXPECT_LE(s.reaction_forces(v, 2), 1e-9);
+    for (int v = 0; v < n; ++v) {
+      if (std::abs(X(v, 2) - top.plane) < 1e-12) {
+        EXPECT_LE(s.reaction_forces(v, 2), 1e-9);
+      }
+    }
     // Global equilibrium: supports + paddle + loads (none) = 0.
     const Eigen::Vector3d total = last.reactions[0] + top.force + last.applied_force;
     EXPECT_LT(total.norm(), 1e-8 * top.force.norm()) << "sticking " << sticking;
