@@ -7,7 +7,9 @@
 Panels: the deformed surface coloured by |u| with the undeformed outline drawn
 over it (for a sweep, the variant that moved most); per load step the largest
 displacement and the pressure of every run, one curve per variant; the
-reactions of the supports; and for a round-trip sweep, Eq. 9 against n.
+reactions of the supports; for paddle experiments, the force of each moving
+paddle against its travel (the force-compression curve), one curve per variant;
+and for a round-trip sweep, Eq. 9 against n for each scheme.
 """
 import csv
 import json
@@ -86,6 +88,26 @@ def draw_deformed(fig, position, run_folder, title):
     ax.set_title(title + "\n(grey: undeformed outline)", fontsize=9)
 
 
+def draw_paddle_forces(ax, runs):
+    """Force on the body along each moving paddle's axis against its travel."""
+    for run in runs:
+        for label, first in run["steps"][-1]["paddles"].items():
+            if first["travel"] == 0:
+                continue  # a fixed paddle: its force is the other's, less the supports'
+            axis = "xyz".index(run["paddle_axes"][label]) if "paddle_axes" in run else None
+            travel = [0.0] + [abs(s["paddles"][label]["travel"]) for s in run["steps"]]
+            force = [0.0] + [abs(s["paddles"][label]["force"][axis]) if axis is not None
+                             else sum(c * c for c in s["paddles"][label]["force"]) ** 0.5
+                             for s in run["steps"]]
+            name = (run["variant"] + ": " if run["variant"] else "") + label
+            ax.plot([1000 * t for t in travel], force, marker=".", label=name)
+    ax.set_xlabel("paddle travel [mm]")
+    ax.set_ylabel("paddle force on the body [N]")
+    ax.set_title("force-compression")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+
+
 def run_folder(folder, run):
     return os.path.join(folder, run["variant"]) if run["variant"] else folder
 
@@ -100,11 +122,13 @@ def main(summary_path, png_path):
     sweep = len(summary.get("runs", [])) > 1
     # A round trip: every load back to zero at the end of every run.
     round_trip = sweep and all(
-        r["success"] and not any(r["steps"][-1]["load_factors"].values()) for r in runs)
+        r["success"] and r["steps"][-1]["load_factors"] and
+        not any(r["steps"][-1]["load_factors"].values()) for r in runs)
     drawable = [r for r in runs if r["success"] and
                 os.path.exists(os.path.join(run_folder(folder, r), "vertices.csv")) and
                 os.path.exists(os.path.join(run_folder(folder, r), "final.obj"))]
-    panels = (1 if drawable else 0) + 3 + (1 if round_trip else 0)
+    paddles = [r for r in runs if r["steps"][-1].get("paddles")]
+    panels = (1 if drawable else 0) + 3 + (1 if paddles else 0) + (1 if round_trip else 0)
     fig = plt.figure(figsize=(4.8 * panels, 4.5))
     k = 1
     if drawable:
@@ -136,13 +160,21 @@ def main(summary_path, png_path):
     ax.set_ylabel("support reaction |R| [N]")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
+    if paddles:
+        draw_paddle_forces(fig.add_subplot(1, panels, k), paddles)
+        k += 1
     if round_trip:
         ax = fig.add_subplot(1, panels, k)
         by_kind = {}
         for run in runs:
             n = run["stepping"]["steps"] // 2
-            kind = "A rebuilt" if run["stepping"]["rebuild_matrix"] else "A constant"
-            by_kind.setdefault(kind, []).append((n, run["final"]["mean_displacement_over_diagonal"]))
+            if run["stepping"].get("scheme") == "newton":
+                kind = "Newton"
+            else:
+                kind = "incremental, A rebuilt" if run["stepping"]["rebuild_matrix"] \
+                    else "incremental, A constant"
+            error = max(run["final"]["mean_displacement_over_diagonal"], 1e-17)  # log scale
+            by_kind.setdefault(kind, []).append((n, error))
         for kind, points in by_kind.items():
             points.sort()
             ax.loglog([p[0] for p in points], [p[1] for p in points], marker="o", label=kind)

@@ -125,8 +125,11 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
   for (const auto& [name, value] : result.figures)
     if (name.rfind(prefix, 0) == 0 && (!run.variant.empty() || name.rfind("fibers.", 0) != 0))
       final_figures[name.substr(prefix.size())] = value;
+  json paddle_axes = json::object();  // which force component each paddle's curve shows
+  for (const model::Paddle& p : m.paddles) paddle_axes[p.label] = std::string(1, kAxes[p.axis]);
   return {{"variant", run.variant},
           {"patch", c.patch},
+          {"paddle_axes", paddle_axes},
           {"solver", solve::to_string(run.summary.solver)},
           {"pcg_iterations", run.summary.solver_statistics.iterations},
           {"factorization_flops", run.summary.solver_statistics.factorization_flops},
