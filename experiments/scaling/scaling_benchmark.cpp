@@ -5,6 +5,7 @@
 // the peak memory of this process and the factorisation rate; run.py runs
 // one process per case, so that each peak is its own.
 //   fiberfluid_scaling --subdivisions 4 --solver block-cholesky [--save u.bin]
+//   fiberfluid_scaling --subdivisions 4 --newton exponential [--tangent krylov]
 //   fiberfluid_scaling --gemm-peak     (this machine's BLAS dgemm rate)
 #include <sys/resource.h>
 #include <unistd.h>
@@ -54,10 +55,16 @@ int main(int argc, char** argv) {
   int subdivisions = 2;
   std::string solver = "dense-lu", save;
   bool gemm_peak = false;
+  std::string newton_law, tangent = "auto";
+  double beta = 5.0;
   cli.add_option("--subdivisions", subdivisions, "icosphere subdivisions (2: 162 vertices)");
   cli.add_option("--solver", solver, "dense-lu, block-cholesky, cholmod or pcg");
   cli.add_option("--save", save, "write the final unknowns as raw doubles");
   cli.add_flag("--gemm-peak", gemm_peak, "measure this machine's dgemm GFLOP/s");
+  cli.add_option("--newton", newton_law,
+                 "run the Newton scheme with this law: constant or exponential (Y0 = Y)");
+  cli.add_option("--beta", beta, "the exponential law's beta");
+  cli.add_option("--tangent", tangent, "newton tangent solve: auto, dense or krylov");
   CLI11_PARSE(cli, argc, argv);
 
   if (gemm_peak) {
@@ -74,6 +81,15 @@ int main(int argc, char** argv) {
   // over on meshes of 10,242 vertices and more (a point load on ever smaller
   // areas), which the runaway guard rightly stops.
   config["loads"] = nlohmann::json::array({config["loads"][0]});
+  if (!newton_law.empty()) {
+    config["stepping"]["scheme"] = "newton";
+    config["stepping"]["newton"] = {{"tangent", tangent}};
+    if (newton_law == "exponential") {
+      const double Y = config["material"]["Y"];
+      config["material"].erase("Y");
+      config["material"]["law"] = {{"type", "exponential"}, {"Y0", Y}, {"beta", beta}};
+    }
+  }
   const fiberfluid::app::Experiment ex =
       fiberfluid::app::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
 
@@ -99,6 +115,12 @@ int main(int argc, char** argv) {
                  s.solver_statistics.factorization_kernel_seconds / 1e9
            : 0.0},
       {"pcg_iterations", s.solver_statistics.iterations},
+      {"scheme", fiberfluid::solve::to_string(s.scheme)},
+      {"tangent", fiberfluid::solve::to_string(s.tangent)},
+      {"newton_iterations", s.newton_iterations},
+      {"krylov_iterations", s.krylov_iterations},
+      {"factorizations", s.factorizations},
+      {"steps", s.steps.size()},
       {"max_displacement", s.success ? result.figures.at("max_displacement") : 0.0}};
   std::cout << line.dump() << std::endl;
   if (!save.empty() && s.success)

@@ -132,19 +132,99 @@ void Equilibrium::for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::M
   }
 }
 
+// Column pointers of the reference, current, displacement and product
+// vectors (three each; the third is all zeros in 2D).
+struct Equilibrium::Columns {
+  const double* s[3];
+  const double* x[3];
+  const double* u[3];
+  const double* w[3] = {nullptr, nullptr, nullptr};
+  std::vector<double> zeros;
+
+  Columns(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+          const Eigen::MatrixXd* W)
+      : zeros(static_cast<size_t>(S.rows()), 0.0) {
+    for (int a = 0; a < 3; ++a) {
+      const bool has = a < S.cols();
+      s[a] = has ? S.col(a).data() : zeros.data();
+      x[a] = has ? X.col(a).data() : zeros.data();
+      u[a] = has ? U.col(a).data() : zeros.data();
+      if (W != nullptr) w[a] = has ? W->col(a).data() : zeros.data();
+    }
+  }
+};
+
+void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch,
+                           double force[3], double product[3]) const {
+  const size_t n = static_cast<size_t>(model_.num_vertices()), u = static_cast<size_t>(i);
+  double* h = scratch[0].data();   // h_ij
+  double* L = scratch[1].data();   // reference lengths
+  double* r = scratch[2].data();   // current lengths
+  double* Y = scratch[3].data();   // Y(e_ij)
+  double* Yp = scratch[4].data();  // Y'(e_ij)
+  factors_.row(i, h);
+  const double *s0 = c.s[0], *s1 = c.s[1], *s2 = c.s[2];
+  const double *x0 = c.x[0], *x1 = c.x[1], *x2 = c.x[2];
+#pragma omp simd
+  for (size_t j = 0; j < n; ++j) {
+    // j == i: h = 0 makes the pair vanish; lengths 1 there only avoid 0/0.
+    const double a0 = s0[u] - s0[j], a1 = s1[u] - s1[j], a2 = s2[u] - s2[j];
+    const double b0 = x0[u] - x0[j], b1 = x1[u] - x1[j], b2 = x2[u] - x2[j];
+    L[j] = j == u ? 1.0 : std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
+    r[j] = j == u ? 1.0 : std::sqrt(b0 * b0 + b1 * b1 + b2 * b2);
+  }
+  const FiberLaw& law = model_.material.law;
+  if (!law.is_constant()) {
+    double* strain = scratch[5].data();
+#pragma omp simd
+    for (size_t j = 0; j < n; ++j) strain[j] = r[j] / L[j] - 1.0;
+  }
+  law.evaluate(scratch[5].data(), n, Y, Yp);
+  const double* area = area0_.data();
+  const double *u0 = c.u[0], *u1 = c.u[1], *u2 = c.u[2];
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+#pragma omp simd reduction(+ : f0, f1, f2)
+  for (size_t j = 0; j < n; ++j) {
+    const double aY = bulk_weight(h[j], area[u], area[j], L[j]) * Y[j];
+    f0 += aY * (u0[u] - u0[j]);
+    f1 += aY * (u1[u] - u1[j]);
+    f2 += aY * (u2[u] - u2[j]);
+  }
+  force[0] = f0, force[1] = f1, force[2] = f2;
+  if (product == nullptr) return;
+  const double *w0 = c.w[0], *w1 = c.w[1], *w2 = c.w[2];
+  double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2)
+  for (size_t j = 0; j < n; ++j) {
+    const double a = bulk_weight(h[j], area[u], area[j], L[j]);
+    const double d0 = u0[u] - u0[j], d1 = u1[u] - u1[j], d2 = u2[u] - u2[j];
+    const double v0 = w0[u] - w0[j], v1 = w1[u] - w1[j], v2 = w2[u] - w2[j];
+    // Y' (n.w) / L with n = (x_i - x_j) / r.
+    const double along = Yp[j] *
+                         ((x0[u] - x0[j]) * v0 + (x1[u] - x1[j]) * v1 + (x2[u] - x2[j]) * v2) /
+                         (r[j] * L[j]);
+    p0 += a * (Y[j] * v0 + along * d0);
+    p1 += a * (Y[j] * v1 + along * d1);
+    p2 += a * (Y[j] * v2 + along * d2);
+  }
+  product[0] = p0, product[1] = p1, product[2] = p2;
+}
+
 Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
   const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
   const int n = model_.num_vertices(), dim = model_.dim();
   const Eigen::Vector3d m = model_.material.axis_factors;
+  const Columns columns(model_.surface.V, X, U, nullptr);
   Eigen::MatrixXd forces(n, dim);
 #pragma omp parallel
   {
-    std::vector<double> row(static_cast<size_t>(n));
+    std::vector<double> scratch[6];
+    for (auto& v : scratch) v.resize(static_cast<size_t>(n));
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      Eigen::Vector3d f = Eigen::Vector3d::Zero();
-      for_each_fiber(i, X, U, row, [&](int, const BulkFiber& fiber) { f += fiber.force(m); });
-      forces.row(i) = f.head(dim).transpose();
+      double f[3];
+      bulk_row(i, columns, scratch, f, nullptr);
+      for (int a = 0; a < dim; ++a) forces(i, a) = m[a] * f[a];
     }
   }
   return forces + model_.material.surface_tension * (surface_ * U);
@@ -239,22 +319,31 @@ Eigen::VectorXd Equilibrium::tangent_product(const Eigen::VectorXd& x,
                                              const Eigen::VectorXd& v) const {
   const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
   const Eigen::MatrixXd W = displacements(model_, v);
-  const int n = model_.num_vertices(), dim = model_.dim(), p = model_.pressure_dof();
+  const int n = model_.num_vertices(), dim = model_.dim();
   const Eigen::Vector3d m = model_.material.axis_factors;
   Eigen::VectorXd out = Eigen::VectorXd::Zero(num_unknowns());
+  const Columns columns(model_.surface.V, X, U, &W);
 #pragma omp parallel
   {
-    std::vector<double> row(static_cast<size_t>(n));
+    std::vector<double> scratch[6];
+    for (auto& s : scratch) s.resize(static_cast<size_t>(n));
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d wi = row3(W, i);
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for_each_fiber(i, X, U, row, [&](int j, const BulkFiber& fiber) {
-        sum += fiber.tangent_times(m, wi - row3(W, j));
-      });
-      for (int a = 0; a < dim; ++a) out[a * n + i] = sum[a];
+      double f[3], product[3];
+      bulk_row(i, columns, scratch, f, product);
+      for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
     }
   }
+  add_non_bulk_product(x, factors, X, v, out);
+  return out;
+}
+
+void Equilibrium::add_non_bulk_product(const Eigen::VectorXd& x,
+                                       const std::vector<double>& factors,
+                                       const Eigen::MatrixXd& X, const Eigen::VectorXd& v,
+                                       Eigen::VectorXd& out) const {
+  const int n = model_.num_vertices(), dim = model_.dim(), p = model_.pressure_dof();
+  const Eigen::MatrixXd W = displacements(model_, v);
   const Eigen::MatrixXd surface = model_.material.surface_tension * (surface_ * W);
   const Hydrostatics hydro = hydrostatics(X, factors);
   const Eigen::VectorXd c = x[p] - hydro.q.array();
@@ -278,6 +367,86 @@ Eigen::VectorXd Equilibrium::tangent_product(const Eigen::VectorXd& x,
     }
   }
   out[p] = volume_rate;
+}
+
+double TangentOperator::bytes_for(int num_vertices) {
+  return 2.0 * 8.0 * num_vertices * static_cast<double>(num_vertices);
+}
+
+TangentOperator Equilibrium::linearize(const Eigen::VectorXd& x,
+                                       const std::vector<double>& factors) const {
+  TangentOperator op;
+  linearize(x, factors, op);
+  return op;
+}
+
+void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                            TangentOperator& op) const {
+  op.equilibrium_ = this;
+  op.x_ = x;
+  op.factors_ = factors;
+  op.X_ = positions(model_, x);
+  op.U_ = displacements(model_, x);
+  const int n = model_.num_vertices();
+  op.weighted_modulus_.resize(n, n);
+  op.weighted_slope_.resize(n, n);
+  const Columns columns(model_.surface.V, op.X_, op.U_, nullptr);
+#pragma omp parallel
+  {
+    std::vector<double> scratch[6];
+    for (auto& s : scratch) s.resize(static_cast<size_t>(n));
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      double f[3];
+      bulk_row(i, columns, scratch, f, nullptr);
+      // bulk_row leaves h, L, r, Y, Y' of the row in the scratch arrays.
+      const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
+      const double *Y = scratch[3].data(), *Yp = scratch[4].data(), *area = area0_.data();
+      double* c1 = op.weighted_modulus_.col(i).data();
+      double* c2 = op.weighted_slope_.col(i).data();
+      const auto u = static_cast<size_t>(i);
+#pragma omp simd
+      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+        const double a = bulk_weight(h[j], area[u], area[j], L[j]);
+        c1[j] = a * Y[j];
+        c2[j] = a * Yp[j] / (r[j] * L[j]);
+      }
+    }
+  }
+}
+
+Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
+  const model::Model& model = equilibrium_->model();
+  const int n = model.num_vertices(), dim = model.dim();
+  const Eigen::Vector3d m = model.material.axis_factors;
+  const Eigen::MatrixXd W = displacements(model, v);
+  const std::vector<double> zeros(static_cast<size_t>(n), 0.0);
+  const double *x[3], *d[3], *w[3];
+  for (int a = 0; a < 3; ++a) {
+    x[a] = a < dim ? X_.col(a).data() : zeros.data();
+    d[a] = a < dim ? U_.col(a).data() : zeros.data();
+    w[a] = a < dim ? W.col(a).data() : zeros.data();
+  }
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < n; ++i) {
+    const double* c1 = weighted_modulus_.col(i).data();
+    const double* c2 = weighted_slope_.col(i).data();
+    const auto u = static_cast<size_t>(i);
+    double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2)
+    for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+      const double v0 = w[0][u] - w[0][j], v1 = w[1][u] - w[1][j], v2 = w[2][u] - w[2][j];
+      const double along = c2[j] * ((x[0][u] - x[0][j]) * v0 + (x[1][u] - x[1][j]) * v1 +
+                                    (x[2][u] - x[2][j]) * v2);
+      p0 += c1[j] * v0 + along * (d[0][u] - d[0][j]);
+      p1 += c1[j] * v1 + along * (d[1][u] - d[1][j]);
+      p2 += c1[j] * v2 + along * (d[2][u] - d[2][j]);
+    }
+    const double product[3] = {p0, p1, p2};
+    for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
+  }
+  equilibrium_->add_non_bulk_product(x_, factors_, X_, v, out);
   return out;
 }
 

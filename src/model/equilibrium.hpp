@@ -11,6 +11,26 @@
 
 namespace fiberfluid::model {
 
+class Equilibrium;
+
+// The tangent at one state as an operator: the bulk fibers' pair
+// coefficients a Y(e) and a Y'(e) / (r L) stored once (two N x N arrays,
+// bytes_for(N)), so that each product is one pass over memory rather than
+// square roots and law evaluations per pair. Equilibrium::linearize builds it.
+class TangentOperator {
+ public:
+  Eigen::VectorXd apply(const Eigen::VectorXd& v) const;  // dR/dx v, full layout
+  static double bytes_for(int num_vertices);
+
+ private:
+  friend class Equilibrium;
+  const Equilibrium* equilibrium_ = nullptr;
+  Eigen::VectorXd x_;
+  std::vector<double> factors_;
+  Eigen::MatrixXd X_, U_;
+  Eigen::MatrixXd weighted_modulus_, weighted_slope_;  // column i: the pairs (i, j)
+};
+
 // The equilibrium equations of the Newton scheme (model.md section 7) at any
 // state x = [u; P] of the paper's layout and load factors lambda:
 //
@@ -51,6 +71,12 @@ class Equilibrium {
   // dR/dx v without forming the matrix (O(N^2) pairs, no storage).
   Eigen::VectorXd tangent_product(const Eigen::VectorXd& x, const std::vector<double>& factors,
                                   const Eigen::VectorXd& v) const;
+  // The tangent at x as an operator with its pair coefficients stored: for
+  // the many products of one Krylov solve.
+  TangentOperator linearize(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
+  // The same into an existing operator, reusing its arrays (no new pages to fault in).
+  void linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                 TangentOperator& op) const;
 
   // dR/dtheta, one column per name: a parameter of the law ("Y", "Y0",
   // "beta", "Y_t", "Y_c", "scale"), "gamma", or "factor_x" / "factor_y" /
@@ -59,9 +85,21 @@ class Equilibrium {
                                         const std::vector<std::string>& names) const;
 
  private:
+  friend class TangentOperator;
+  // The surface-tension, pressure, follower-load and volume rows of dR/dx v.
+  void add_non_bulk_product(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                            const Eigen::MatrixXd& X, const Eigen::VectorXd& v,
+                            Eigen::VectorXd& out) const;
   struct Hydrostatics;  // per-vertex q_i and its gradient, at x
   Hydrostatics hydrostatics(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
   Eigen::MatrixXd current_area_vectors(const Eigen::MatrixXd& X) const;  // S_i(x)
+  // The bulk fibers of row i in flat loops that vectorise: the force sum
+  // sum_j a Y d and, when W has columns, the tangent-product sum
+  // sum_j a (Y w + Y' (n.w) d / L) (the stencil of pair_stencil.hpp written
+  // out; the axis factors are applied by the caller).
+  struct Columns;
+  void bulk_row(int i, const Columns& c, std::vector<double>* scratch, double force[3],
+                double product[3]) const;
   // Visits every ordered bulk pair (i, j), j != i, of row i with its fiber state.
   template <class Visit>
   void for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,

@@ -111,6 +111,26 @@ double FiberLaw::slope(double e) const {
   return 0.0;
 }
 
+void FiberLaw::evaluate(const double* strain, size_t n, double* Y, double* Yp) const {
+  switch (kind_) {
+    case Kind::Constant:
+      std::fill(Y, Y + n, a_);
+      std::fill(Yp, Yp + n, 0.0);
+      return;
+    case Kind::Exponential:
+      for (size_t k = 0; k < n; ++k) {
+        Y[k] = a_ * std::exp(b_ * strain[k]);
+        Yp[k] = b_ * Y[k];
+      }
+      return;
+    default:
+      for (size_t k = 0; k < n; ++k) {
+        Y[k] = modulus(strain[k]);
+        Yp[k] = slope(strain[k]);
+      }
+  }
+}
+
 const std::vector<std::string>& FiberLaw::parameter_names() const {
   static const std::vector<std::string> constant{"Y"}, exponential{"Y0", "beta"},
       bilinear{"Y_t", "Y_c"}, tabulated{"scale"};

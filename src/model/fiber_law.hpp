@@ -38,6 +38,9 @@ class FiberLaw {
 
   double modulus(double strain) const;  // Y(e)
   double slope(double strain) const;    // dY/de
+  // Y and dY/de at n strains (strain may alias neither output): the pair
+  // kernels call this once per row, with the law's switch outside the loop.
+  void evaluate(const double* strain, size_t n, double* modulus, double* slope) const;
 
   const std::vector<std::string>& parameter_names() const;
   double parameter(const std::string& name) const;  // throws std::invalid_argument

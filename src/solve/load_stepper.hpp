@@ -45,7 +45,9 @@ struct NewtonOptions {
   int max_step_cuts = 6;        // halvings of a failing step before giving up
   bool line_search = true;      // backtracking on the residual norm
   TangentSolver tangent = TangentSolver::Auto;
-  double krylov_tolerance = 1e-10;  // relative GMRES residual
+  // GMRES stops at a relative residual of max(krylov_tolerance, 0.1 r) for a
+  // Newton residual r (inexact Newton: no sharper than the step needs).
+  double krylov_tolerance = 1e-10;
   int krylov_restart = 50;
   int krylov_max_iterations = 500;
   int max_contact_rounds = 30;  // active-set updates per step

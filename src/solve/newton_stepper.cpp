@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "geom/area_vectors.hpp"
@@ -225,7 +226,10 @@ class NewtonSolver {
         return out.str();
       }
       Eigen::VectorXd dx;
-      const Status status = solve_tangent(at, dofs, x, r, dx, record);
+      // Inexact Newton: a Krylov solve only as accurate as the residual it
+      // corrects (relative to it), which keeps the convergence quadratic.
+      const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
+      const Status status = solve_tangent(at, dofs, x, r, forcing, dx, record);
       if (!status.ok) return status.message;
       // Backtracking: halve the step until the residual falls (Armijo).
       Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
@@ -256,7 +260,8 @@ class NewtonSolver {
   }
 
   Status solve_tangent(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
-                       const Eigen::VectorXd& r, Eigen::VectorXd& dx, StepRecord& record) {
+                       const Eigen::VectorXd& r, double tolerance, Eigen::VectorXd& dx,
+                       StepRecord& record) {
     if (tangent_ == TangentSolver::Dense) {
       DenseLU lu;
       const Status status = lu.factorize(dofs.reduce(equilibrium_.tangent(x, at.factors)));
@@ -270,10 +275,15 @@ class NewtonSolver {
       if (!status.ok) return status;
     }
     const int full = model_.num_unknowns();
+    // The pair coefficients stored once for all the products of this solve,
+    // when two N x N arrays fit in a quarter of the memory; else on the fly.
+    const bool store =
+        model::TangentOperator::bytes_for(model_.num_vertices()) < 0.25 * physical_memory_bytes();
+    if (store) equilibrium_.linearize(x, at.factors, stored_);  // reuses the arrays
     const LinearOperator apply = [&](const Eigen::VectorXd& v) {
       Eigen::VectorXd w = Eigen::VectorXd::Zero(full);
       dofs.scatter(v, w);  // held entries stay zero
-      return dofs.reduce(equilibrium_.tangent_product(x, at.factors, w));
+      return dofs.reduce(store ? stored_.apply(w) : equilibrium_.tangent_product(x, at.factors, w));
     };
     const LinearOperator precondition = [&](const Eigen::VectorXd& v) {
       Eigen::VectorXd out;
@@ -281,7 +291,7 @@ class NewtonSolver {
       return status.ok ? out : Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), NAN));
     };
     GmresOptions gmres_options;
-    gmres_options.tolerance = newton_.krylov_tolerance;
+    gmres_options.tolerance = tolerance;
     gmres_options.restart = newton_.krylov_restart;
     gmres_options.max_iterations = newton_.krylov_max_iterations;
     dx.resize(0);
@@ -289,9 +299,11 @@ class NewtonSolver {
     record.krylov_iterations += result.iterations;
     summary_.krylov_iterations += result.iterations;
     // The secant factor ages as the strains move: refactor when gmres needs
-    // clearly more iterations than it did just after the last factorisation.
-    if (baseline_iterations_ < 0) baseline_iterations_ = result.iterations;
-    else if (result.iterations > 2 * baseline_iterations_ + 5) refactor_ = true;
+    // clearly more iterations per decade of residual reduction than it did
+    // just after the last factorisation.
+    const double rate = result.iterations / std::max(1.0, -std::log10(tolerance));
+    if (baseline_rate_ < 0.0) baseline_rate_ = rate;
+    else if (rate > 2.0 * baseline_rate_ + 1.0) refactor_ = true;
     if (!result.status.ok && !just_factored_) {
       const Status status = factor_preconditioner(dofs, x);
       if (!status.ok) return status;
@@ -323,7 +335,7 @@ class NewtonSolver {
     if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
     ++summary_.factorizations;
     preconditioned_held_ = dofs.held_flags();
-    baseline_iterations_ = -1;
+    baseline_rate_ = -1.0;
     refactor_ = false;
     just_factored_ = true;
     return {};
@@ -344,7 +356,8 @@ class NewtonSolver {
   std::unique_ptr<model::FiberSystem> secant_;
   std::unique_ptr<LinearSolver> preconditioner_;
   std::vector<char> preconditioned_held_;
-  int baseline_iterations_ = -1;
+  double baseline_rate_ = -1.0;  // gmres iterations per decade after the last factorisation
+  model::TangentOperator stored_;  // the tangent's pair coefficients, reused between solves
   bool refactor_ = false, just_factored_ = false;
 };
 

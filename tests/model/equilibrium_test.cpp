@@ -73,6 +73,8 @@ TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLaw) {
       const Eigen::VectorXd v = random_state(m, seed + 10, 1.0);
       EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm())
           << law.name();
+      EXPECT_LT((eq.linearize(x, factors).apply(v) - J * v).norm(), 1e-10 * (J * v).norm())
+          << law.name();
     }
   }
 }
