@@ -31,7 +31,9 @@ TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
 INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                          ::testing::Values("rectangle.json", "areas.json", "sphere.json",
                                            "round_trip.json", "liver_gravity.json",
-                                           "bunny_gravity.json", "liver_sweep.json"));
+                                           "bunny_gravity.json", "liver_sweep.json",
+                                           "nonlinear_round_trip.json", "liver_paddles.json",
+                                           "stress_strain.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
@@ -132,6 +134,92 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   expect_config_error(dir, nlohmann::json::array(), "expected an object");
   const auto broken = dir.write("broken.json", "{\"name\": ");
   EXPECT_THROW(load_experiment(broken), InputError);
+}
+
+TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 5000}, {"beta", 4}}},
+                   {"axis_factors", {1, 1, 0.5}},
+                   {"gamma", 3}};
+  c["paddles"] = {{{"label", "press"}, {"axis", "z"}, {"side", "below"}, {"compression", 0.2},
+                   {"contact", "sticking"}}};
+  c["stepping"] = {{"steps", 4}, {"scheme", "newton"},
+                   {"newton", {{"tangent", "krylov"}, {"max_step_cuts", 3}}}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const model::Model& m = ex.cases[0].model;
+  EXPECT_EQ(m.material.law.kind(), model::FiberLaw::Kind::Exponential);
+  EXPECT_EQ(m.material.law.parameter("beta"), 4.0);
+  EXPECT_EQ(m.material.axis_factors.z(), 0.5);
+  ASSERT_EQ(m.paddles.size(), 1u);
+  EXPECT_EQ(m.paddles[0].axis, 2);
+  EXPECT_FALSE(m.paddles[0].above);
+  EXPECT_TRUE(m.paddles[0].sticking);
+  const double bottom = m.surface.V.col(2).minCoeff(), top = m.surface.V.col(2).maxCoeff();
+  EXPECT_EQ(m.paddles[0].position, bottom);  // touching by default
+  EXPECT_NEAR(m.paddles[0].travel, 0.2 * (top - bottom), 1e-15);  // upwards, into the body
+  EXPECT_EQ(ex.cases[0].stepping.scheme, solve::Scheme::Newton);
+  EXPECT_EQ(ex.cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
+  EXPECT_EQ(ex.cases[0].stepping.newton.max_step_cuts, 3);
+}
+
+TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"]["law"] = {{"type", "exponential"}, {"Y0", 5000}, {"beta", 2}};
+  expect_config_error(dir, c, "material.Y: give either Y");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"beta", 2}}}};
+  expect_config_error(dir, c, "material.law.Y0: missing");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "tabulated"}, {"strain", {0, 0.1, 0.2}},
+                            {"stress", {0, 200, 150}}}}};
+  expect_config_error(dir, c, "material.law.stress: the stresses must be strictly increasing");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "tabulated"}, {"strain", {0, 0.1}}, {"stress", {0}}}}};
+  expect_config_error(dir, c, "material.law.stress: expected as many stresses as strains");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 1}, {"beta", 900}}}};
+  expect_config_error(dir, c, "check beta");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "hyperelastic"}}}};
+  expect_config_error(dir, c, "material.law.type: expected one of");
+
+  nlohmann::json paddle = {{"axis", "z"}, {"side", "above"}, {"travel", -0.2}};
+  c = base_config();
+  c["paddles"] = {paddle};
+  expect_config_error(dir, c, "paddles: paddles need \"stepping\": {\"scheme\": \"newton\"}");
+
+  c = base_config();
+  c["stepping"]["scheme"] = "newton";
+  c["paddles"] = {paddle};
+  c["paddles"][0]["axis"] = "n";
+  expect_config_error(dir, c, "paddles[0].axis: expected one of \"xyz\"");
+
+  c["paddles"] = {paddle};
+  c["paddles"][0]["position"] = 0.5;
+  expect_config_error(dir, c, "paddles[0].position: the paddle starts inside the body");
+
+  c["paddles"] = {paddle};
+  c["paddles"][0]["compression"] = 0.3;
+  expect_config_error(dir, c, "paddles[0].travel: give either travel");
+
+  c["paddles"] = {paddle, {{"label", "floor"}, {"axis", "z"}, {"side", "below"},
+                           {"travel", 2.0}}};
+  expect_config_error(dir, c, "paddles: paddles paddle_0 and floor meet or pass each other");
+
+  c = base_config();
+  c["stepping"]["newton"] = {{"max_iterations", 5}};
+  expect_config_error(dir, c, "stepping.newton: Newton options need");
+
+  c = base_config();
+  c["stepping"] = {{"scheme", "newton"}, {"newton", {{"tangent", "cg"}}}};
+  expect_config_error(dir, c, "stepping.newton.tangent: expected one of auto, dense, krylov");
 }
 
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
