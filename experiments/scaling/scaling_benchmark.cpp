@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   std::string solver = "dense-lu", save;
   bool gemm_peak = false;
   std::string newton_law, tangent = "auto";
-  double beta = 5.0;
+  double beta = 5.0, gravity_scale = 1.0;
   cli.add_option("--subdivisions", subdivisions, "icosphere subdivisions (2: 162 vertices)");
   cli.add_option("--solver", solver, "dense-lu, block-cholesky, cholmod or pcg");
   cli.add_option("--save", save, "write the final unknowns as raw doubles");
@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   cli.add_option("--newton", newton_law,
                  "run the Newton scheme with this law: constant or exponential (Y0 = Y)");
   cli.add_option("--beta", beta, "the exponential law's beta");
+  cli.add_option("--gravity-scale", gravity_scale, "multiplies the sphere's gravity");
   cli.add_option("--tangent", tangent, "newton tangent solve: auto, dense or krylov");
   CLI11_PARSE(cli, argc, argv);
 
@@ -81,6 +82,8 @@ int main(int argc, char** argv) {
   // over on meshes of 10,242 vertices and more (a point load on ever smaller
   // areas), which the runaway guard rightly stops.
   config["loads"] = nlohmann::json::array({config["loads"][0]});
+  for (auto& component : config["loads"][0]["acceleration"])
+    component = component.get<double>() * gravity_scale;
   if (!newton_law.empty()) {
     config["stepping"]["scheme"] = "newton";
     config["stepping"]["newton"] = {{"tangent", tangent}};
@@ -121,6 +124,10 @@ int main(int argc, char** argv) {
       {"krylov_iterations", s.krylov_iterations},
       {"factorizations", s.factorizations},
       {"steps", s.steps.size()},
+      {"newton_iterations_per_step", s.steps.empty() ? 0.0
+                                     : double(s.newton_iterations) / double(s.steps.size())},
+      {"krylov_iterations_per_solve",
+       s.newton_iterations > 0 ? double(s.krylov_iterations) / s.newton_iterations : 0.0},
       {"max_displacement", s.success ? result.figures.at("max_displacement") : 0.0}};
   std::cout << line.dump() << std::endl;
   if (!save.empty() && s.success)

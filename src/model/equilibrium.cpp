@@ -264,25 +264,45 @@ Eigen::VectorXd Equilibrium::residual(const Eigen::VectorXd& x,
 
 Eigen::MatrixXd Equilibrium::tangent(const Eigen::VectorXd& x,
                                      const std::vector<double>& factors) const {
-  const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
+  const TangentOperator op = linearize(x, factors);
+  const Eigen::MatrixXd& X = op.X_;
+  const Eigen::MatrixXd& U = op.U_;
   const int n = model_.num_vertices(), dim = model_.dim(), p = model_.pressure_dof();
   const Eigen::Vector3d m = model_.material.axis_factors;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(num_unknowns(), num_unknowns());
-#pragma omp parallel
-  {
-    std::vector<double> row(static_cast<size_t>(n));
-#pragma omp for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      Eigen::Matrix3d diagonal = Eigen::Matrix3d::Zero();
-      for_each_fiber(i, X, U, row, [&](int j, const BulkFiber& fiber) {
-        const Eigen::Matrix3d T = fiber.tangent(m);
-        diagonal += T;
-        for (int a = 0; a < dim; ++a)
-          for (int b = 0; b < dim; ++b) J(a * n + i, b * n + j) -= T(a, b);
-      });
-      for (int a = 0; a < dim; ++a)
-        for (int b = 0; b < dim; ++b) J(a * n + i, b * n + i) += diagonal(a, b);
-    }
+  // Bulk blocks, column by column (the pair coefficients are symmetric, so
+  // column j of the stored arrays runs over i): for j != i,
+  //   J(a i, b j) = -m_a (c1_ij delta_ab + c2_ij d_a (x_i - x_j)_b),
+  // and each diagonal block is minus the sum of its row's off-diagonal ones.
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int j = 0; j < n; ++j) {
+    const double* c1 = op.weighted_modulus_.col(j).data();
+    const double* c2 = op.weighted_slope_.col(j).data();
+    for (int a = 0; a < dim; ++a)
+      for (int b = 0; b < dim; ++b) {
+        double* column = J.col(b * n + j).data() + a * n;
+        const double* ua = U.col(a).data();
+        const double* xb = X.col(b).data();
+        const double identity = a == b ? 1.0 : 0.0;
+        for (int i = 0; i < n; ++i)
+          if (i != j)
+            column[i] = -m[a] * (c1[i] * identity + c2[i] * (ua[i] - ua[j]) * (xb[i] - xb[j]));
+      }
+  }
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < n; ++i) {
+    const double* c1 = op.weighted_modulus_.col(i).data();
+    const double* c2 = op.weighted_slope_.col(i).data();
+    for (int a = 0; a < dim; ++a)
+      for (int b = 0; b < dim; ++b) {
+        const double* ua = U.col(a).data();
+        const double* xb = X.col(b).data();
+        const double identity = a == b ? 1.0 : 0.0;
+        double sum = 0.0;  // c1_ii = c2_ii = 0: the pair (i, i) adds nothing
+        for (int j = 0; j < n; ++j)
+          sum += c1[j] * identity + c2[j] * (ua[i] - ua[j]) * (xb[i] - xb[j]);
+        J(a * n + i, b * n + i) = m[a] * sum;
+      }
   }
   const double gamma = model_.material.surface_tension;
   for (int col = 0; col < surface_.outerSize(); ++col)

@@ -27,7 +27,7 @@ const char* to_string(Scheme scheme);
 
 // How each Newton step's linear system with the tangent is solved.
 enum class TangentSolver {
-  Auto,    // dense below about 2000 unknowns, krylov above
+  Auto,    // dense up to 600 unknowns (about 200 vertices), krylov above
   Dense,   // LU of the dense tangent (LAPACK)
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
 };

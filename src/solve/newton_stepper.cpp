@@ -74,7 +74,7 @@ class NewtonSolver {
     diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
     const int reduced = supports_.num_reduced();
     tangent_ = newton_.tangent != TangentSolver::Auto ? newton_.tangent
-               : reduced <= 2000                     ? TangentSolver::Dense
+               : reduced <= 600                      ? TangentSolver::Dense
                                                      : TangentSolver::Krylov;
     summary_.tangent = tangent_;
     summary_.solver = tangent_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
@@ -324,8 +324,12 @@ class NewtonSolver {
                                                    model::BoundaryMethod::Elimination,
                                                    options_.penalty, &X);
     if (!preconditioner_ || !(dofs.held_flags() == preconditioned_held_)) {
+      // By size as for the linear scheme, but never the dense LU of the whole
+      // bordered system: block Cholesky does the same job in a fraction of the flops.
       SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
                                                             : options_.solver;
+      if (options_.solver == SolverKind::Auto && kind == SolverKind::DenseLU)
+        kind = SolverKind::BlockCholesky;
       preconditioner_ = make_linear_solver(kind, options_.pcg);
       summary_.solver = kind;
       const Status status = preconditioner_->analyze_pattern(*secant_);

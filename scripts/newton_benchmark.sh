@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The Newton benchmark (issue 8): the sphere experiment at half its gravity with
+# an exponential law on icospheres of 642, 2562 and 10242 vertices, 10 load
+# steps, Newton-Krylov with a block-cholesky preconditioner. Builds Release and
+# prints a table (Newton iterations per step, GMRES iterations per solve, time
+# per step, peak memory).
+#   scripts/newton_benchmark.sh [--max-subdivisions 5]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DFIBERFLUID_BUILD_TESTS=OFF \
+      -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build-release -j"$(nproc)"
+max=5
+if [[ "${1:-}" == "--max-subdivisions" ]]; then max="$2"; fi
+printf '| vertices | steps | newton iterations / step | gmres iterations / solve | preconditioner factorizations | s / step | whole run s | peak MiB |\n'
+printf '|---|---|---|---|---|---|---|---|\n'
+for sub in $(seq 3 "$max"); do
+  line=$(build-release/experiments/scaling/fiberfluid_scaling --subdivisions "$sub" \
+           --newton exponential --solver block-cholesky --gravity-scale 0.5 | grep '^{' || true)
+  /usr/bin/python3 - "$line" <<'PY'
+import json, sys
+r = json.loads(sys.argv[1])
+if not r["success"]:
+    print(f'| {r["vertices"]} | failed: {r["message"]} |')
+else:
+    print(f'| {r["vertices"]} | {r["steps"]} | {r["newton_iterations_per_step"]:.1f} | '
+          f'{r["krylov_iterations_per_solve"]:.1f} | {r["factorizations"]} | '
+          f'{r["run_s"] / r["steps"]:.2f} | {r["run_s"]:.1f} | {r["peak_mib"]:.0f} |')
+PY
+done
