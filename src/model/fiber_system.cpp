@@ -295,17 +295,21 @@ Eigen::SparseMatrix<double> FiberSystem::sparse_block(int axis, bool include_bul
   return K;
 }
 
-Eigen::MatrixXd FiberSystem::dense_matrix() const {
-  const int total = num_unknowns(), p = total - 1;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(total, total);
-  const Eigen::VectorXd s = border();
-  for (int a = 0; a < dim_; ++a) {
-    const auto m = static_cast<Eigen::Index>(active(a).size());
-    A.block(offset(a), offset(a), m, m) = dense_block(a);
-  }
-  A.col(p).head(p) = s;
-  A.row(p).head(p) = s.transpose();
-  return A;
+Eigen::SparseMatrix<double> FiberSystem::preconditioner_block(int axis) const {
+  Eigen::SparseMatrix<double> M = sparse_block(axis, false);
+  std::vector<char> is_penalised(active(axis).size(), 0);
+  for (int k : penalised(axis)) is_penalised[static_cast<size_t>(k)] = 1;
+  for (size_t k = 0; k < active(axis).size(); ++k)
+    if (!is_penalised[k])
+      M.coeffRef(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) +=
+          young(axis) * bulk_diagonal()[active(axis)[k]];
+  return M;
+}
+
+bool FiberSystem::dense_blocks() const {
+  for (int a = 0; a < dim_; ++a)
+    if (young(a) != 0.0) return true;
+  return false;
 }
 
 Eigen::VectorXd FiberSystem::border() const {

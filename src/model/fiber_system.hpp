@@ -5,6 +5,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "model/bordered_system.hpp"
 #include "model/boundary_conditions.hpp"
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
@@ -24,7 +25,7 @@ namespace fiberfluid::model {
 //
 // The dense N x N bulk Laplacian is never stored here: dense_block() forms
 // one block on request and bulk_product() applies it on the fly.
-class FiberSystem {
+class FiberSystem final : public BorderedSystem {
  public:
   // The supports and prescribed values of the model held.
   FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
@@ -38,10 +39,15 @@ class FiberSystem {
 
   int dim() const { return dim_; }
   int num_vertices() const { return n_; }
-  int num_unknowns() const { return offsets_.back() + 1; }  // reduced, with P
   int offset(int axis) const { return offsets_[static_cast<size_t>(axis)]; }
+  // BorderedSystem: one block per axis, the reduced unknowns of each axis.
+  int num_blocks() const override { return dim_; }
   // Start of each axis block in the reduced unknowns, then the end of the last.
-  const std::vector<int>& block_offsets() const { return offsets_; }
+  const std::vector<int>& block_offsets() const override { return offsets_; }
+  bool dense_blocks() const override;
+  std::string block_name(int axis) const override {
+    return std::string("the ") + "xyz"[axis] + " block";
+  }
   const std::vector<int>& active(int axis) const { return active_[static_cast<size_t>(axis)]; }
   // Positions within active(axis) whose diagonal is the penalty (penalty method only).
   const std::vector<int>& penalised(int axis) const {
@@ -49,7 +55,7 @@ class FiberSystem {
   }
   // Every axis has the same active and penalised vertices and the same Y, so
   // one factor of K_x serves all blocks.
-  bool blocks_equal() const;
+  bool blocks_equal() const override;
 
   double young(int axis) const { return young_[axis]; }
   double surface_tension() const { return gamma_; }
@@ -62,18 +68,24 @@ class FiberSystem {
   const Eigen::SparseMatrix<double>& surface_laplacian() const { return surface_; }
 
   // K_a over the active vertices, dense.
-  Eigen::MatrixXd dense_block(int axis) const;
+  Eigen::MatrixXd dense_block(int axis) const override;
+  // K_a as a sparse matrix (with the bulk fibers: N^2 entries).
+  Eigen::SparseMatrix<double> sparse_block(int axis) const override {
+    return sparse_block(axis, true);
+  }
   // The sparse part of K_a over the active vertices: gamma L_surf plus the
   // bulk fibers when include_bulk (all pairs: N^2 entries), with the penalty.
   Eigen::SparseMatrix<double> sparse_block(int axis, bool include_bulk) const;
-  // The whole reduced bordered matrix, dense (the paper's method).
-  Eigen::MatrixXd dense_matrix() const;
+  // The surface-tension Laplacian plus the bulk diagonal (and the penalty):
+  // sparse, and close to K_a because the complete bulk graph is so well
+  // connected (model.md section 5).
+  Eigen::SparseMatrix<double> preconditioner_block(int axis) const override;
   // Diagonal of L_bulk (#V), computed on first use (one pass over the pairs).
   const Eigen::VectorXd& bulk_diagonal() const;
   // L_bulk V for #V by k vectors, computed pair by pair without storing L_bulk.
   Eigen::MatrixXd bulk_product(const Eigen::MatrixXd& V) const;
   // K u over the reduced unknowns except P, matrix-free.
-  Eigen::VectorXd apply_K(const Eigen::VectorXd& u) const;
+  Eigen::VectorXd apply_K(const Eigen::VectorXd& u) const override;
 
   // Rows of the unreduced A(X) [U; P] at the listed vertices: per vertex i and
   // axis a, Y_a (L_bulk U)_ia + gamma (L_surf U)_ia + S_ia P, the force that the
@@ -83,7 +95,7 @@ class FiberSystem {
                                  double P) const;
 
   // The border s over the reduced unknowns except P.
-  Eigen::VectorXd border() const;
+  Eigen::VectorXd border() const override;
 
   // The reduced right-hand side [f; c] for loads F (dim N, the paper's
   // layout) and constrained displacements U_c (dim N, zero where free).

@@ -20,17 +20,17 @@ class BlockCholeskySolver final : public SchurSolver {
  public:
   SolverKind kind() const override { return SolverKind::BlockCholesky; }
 
-  Status analyze_pattern(const model::FiberSystem& system) override {
-    const double n = system.num_vertices();
-    const int factors = system.blocks_equal() ? 1 : system.dim();
+  Status analyze_pattern(const model::BorderedSystem& system) override {
+    const double n = system.largest_block();
+    const int factors = system.blocks_equal() ? 1 : system.num_blocks();
     return require_memory(8.0 * n * n * (factors + 1),
                           "block Cholesky with " + std::to_string(factors) + " dense " +
-                              std::to_string(system.num_vertices()) + "-square factors");
+                              std::to_string(system.largest_block()) + "-square factors");
   }
 
  protected:
-  Status factorize_K(const model::FiberSystem& system) override {
-    const int count = system.blocks_equal() ? 1 : system.dim();
+  Status factorize_K(const model::BorderedSystem& system) override {
+    const int count = system.blocks_equal() ? 1 : system.num_blocks();
     factors_.clear();
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
@@ -43,8 +43,8 @@ class BlockCholeskySolver final : public SchurSolver {
       statistics_.factorization_kernel_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (info > 0)
-        return Status::failure(std::string("block-cholesky: the ") + "xyz"[a] +
-                               " block is not positive definite (leading minor " +
+        return Status::failure("block-cholesky: " + system.block_name(a) +
+                               " is not positive definite (leading minor " +
                                std::to_string(info) + ")");
       statistics_.factorization_flops += static_cast<double>(n) * n * n / 3.0;
       factors_.push_back(std::move(K));

@@ -16,26 +16,24 @@ class CholmodSolver final : public SchurSolver {
  public:
   SolverKind kind() const override { return SolverKind::Cholmod; }
 
-  Status analyze_pattern(const model::FiberSystem& system) override {
+  Status analyze_pattern(const model::BorderedSystem& system) override {
     double bytes = 0.0;
-    for (int a = 0; a < system.dim(); ++a) {
-      const double m = system.active(a).size();
-      // Bulk fibers: every pair is a nonzero (12 bytes each), and the factor is dense too.
-      if (system.young(a) != 0.0) bytes += 12.0 * m * m + 8.0 * m * m / 2.0;
+    for (int a = 0; a < system.num_blocks(); ++a) {
+      const double m = system.block_size(a);
+      // Dense blocks: every pair is a nonzero (12 bytes each), and the factor is dense too.
+      if (system.dense_blocks()) bytes += 12.0 * m * m + 8.0 * m * m / 2.0;
     }
     return require_memory(bytes, "CHOLMOD on the dense bulk blocks");
   }
 
  protected:
-  Status factorize_K(const model::FiberSystem& system) override {
-    const int count = system.blocks_equal() ? 1 : system.dim();
+  Status factorize_K(const model::BorderedSystem& system) override {
+    const int count = system.blocks_equal() ? 1 : system.num_blocks();
     factors_.resize(static_cast<size_t>(count));
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
-      const Status status = factors_[static_cast<size_t>(a)].factorize(system.sparse_block(a, true));
-      if (!status.ok)
-        return Status::failure(std::string("cholmod: the ") + "xyz"[a] + " block: " +
-                               status.message);
+      const Status status = factors_[static_cast<size_t>(a)].factorize(system.sparse_block(a));
+      if (!status.ok) return Status::failure("cholmod: " + system.block_name(a) + ": " + status.message);
     }
     return {};
   }

@@ -12,7 +12,7 @@ class DenseLUSolver final : public LinearSolver {
  public:
   SolverKind kind() const override { return SolverKind::DenseLU; }
 
-  Status analyze_pattern(const model::FiberSystem& system) override {
+  Status analyze_pattern(const model::BorderedSystem& system) override {
     const double n = system.num_unknowns();
     // The assembled matrix and its LU factors.
     return require_memory(2.0 * 8.0 * n * n, "the dense LU of " +
@@ -20,7 +20,7 @@ class DenseLUSolver final : public LinearSolver {
                                                  " unknowns");
   }
 
-  Status factorize(const model::FiberSystem& system) override {
+  Status factorize(const model::BorderedSystem& system) override {
     const Eigen::MatrixXd A = system.dense_matrix();
     const auto start = std::chrono::steady_clock::now();
     const Status status = lu_.factorize(A);

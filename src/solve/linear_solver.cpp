@@ -37,15 +37,15 @@ std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptio
   return nullptr;
 }
 
-SolverKind choose_solver(const model::FiberSystem& system, double memory_bytes) {
-  const double n = system.num_vertices();
+SolverKind choose_solver(const model::BorderedSystem& system, double memory_bytes) {
+  const double n = system.largest_block();
   if (n <= 600) return SolverKind::DenseLU;  // the paper's method, well within a second
-  const int factors = system.blocks_equal() ? 1 : system.dim();
+  const int factors = system.blocks_equal() ? 1 : system.num_blocks();
   if (8.0 * n * n * (factors + 1) < 0.3 * memory_bytes) return SolverKind::BlockCholesky;
   return SolverKind::PCG;
 }
 
-SolverKind choose_solver(const model::FiberSystem& system) {
+SolverKind choose_solver(const model::BorderedSystem& system) {
   return choose_solver(system, physical_memory_bytes());
 }
 

@@ -6,12 +6,13 @@
 #include <optional>
 #include <string>
 
-#include "model/fiber_system.hpp"
+#include "model/bordered_system.hpp"
 #include "solve/status.hpp"
 
 namespace fiberfluid::solve {
 
-// The linear backends for the bordered system of a model::FiberSystem.
+// The linear backends for a bordered system (model::BorderedSystem: the
+// fibers-and-fluid model's FiberSystem, or any K and border).
 enum class SolverKind {
   Auto,           // chosen by size: choose_solver()
   DenseLU,        // the paper's method: LU of the whole reduced system (LAPACK)
@@ -42,9 +43,9 @@ class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
   virtual SolverKind kind() const = 0;
-  virtual Status analyze_pattern(const model::FiberSystem& system) = 0;
+  virtual Status analyze_pattern(const model::BorderedSystem& system) = 0;
   // The system must outlive the factorisation (pcg applies it in solve()).
-  virtual Status factorize(const model::FiberSystem& system) = 0;
+  virtual Status factorize(const model::BorderedSystem& system) = 0;
   // rhs = [f; c] over the system's reduced unknowns; requires factorize().
   virtual Status solve(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) = 0;
   const SolverStatistics& statistics() const { return statistics_; }
@@ -57,9 +58,9 @@ std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptio
 
 // The default by size: the paper's dense LU for small systems, block
 // Cholesky while its dense N x N blocks fit in 30% of `memory_bytes`, pcg beyond.
-SolverKind choose_solver(const model::FiberSystem& system, double memory_bytes);
+SolverKind choose_solver(const model::BorderedSystem& system, double memory_bytes);
 // The same for this machine's physical memory.
-SolverKind choose_solver(const model::FiberSystem& system);
+SolverKind choose_solver(const model::BorderedSystem& system);
 
 // Physical memory of this machine in bytes.
 double physical_memory_bytes();

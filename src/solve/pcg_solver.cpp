@@ -20,30 +20,24 @@ class PcgSolver final : public SchurSolver {
   explicit PcgSolver(const PcgOptions& options) : options_(options) {}
   SolverKind kind() const override { return SolverKind::PCG; }
 
-  Status analyze_pattern(const model::FiberSystem&) override {
+  Status analyze_pattern(const model::BorderedSystem&) override {
     if (!(options_.tolerance > 0.0) || options_.max_iterations < 1)
       return Status::failure("pcg: the tolerance must be positive and max_iterations at least 1");
     return {};
   }
 
  protected:
-  Status factorize_K(const model::FiberSystem& system) override {
+  Status factorize_K(const model::BorderedSystem& system) override {
     system_ = &system;
-    const int count = system.blocks_equal() ? 1 : system.dim();
+    const int count = system.blocks_equal() ? 1 : system.num_blocks();
     preconditioners_.resize(static_cast<size_t>(count));
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
-      Eigen::SparseMatrix<double> M = system.sparse_block(a, false);
-      std::vector<char> penalised(system.active(a).size(), 0);
-      for (int k : system.penalised(a)) penalised[static_cast<size_t>(k)] = 1;
-      for (size_t k = 0; k < system.active(a).size(); ++k)
-        if (!penalised[k])
-          M.coeffRef(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) +=
-              system.young(a) * system.bulk_diagonal()[system.active(a)[k]];
-      const Status status = preconditioners_[static_cast<size_t>(a)].factorize(M);
+      const Status status =
+          preconditioners_[static_cast<size_t>(a)].factorize(system.preconditioner_block(a));
       if (!status.ok)
-        return Status::failure(std::string("pcg: the preconditioner of the ") + "xyz"[a] +
-                               " block: " + status.message);
+        return Status::failure("pcg: the preconditioner of " + system.block_name(a) + ": " +
+                               status.message);
     }
     return {};
   }
@@ -91,7 +85,7 @@ class PcgSolver final : public SchurSolver {
   }
 
   PcgOptions options_;
-  const model::FiberSystem* system_ = nullptr;
+  const model::BorderedSystem* system_ = nullptr;
   std::vector<SparseCholesky> preconditioners_;
   std::vector<int> offsets_;
 };

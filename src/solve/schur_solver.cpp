@@ -5,7 +5,7 @@
 
 namespace fiberfluid::solve {
 
-Status SchurSolver::factorize(const model::FiberSystem& system) {
+Status SchurSolver::factorize(const model::BorderedSystem& system) {
   Status status = factorize_K(system);
   if (!status.ok) return status;
   border_ = system.border();

@@ -11,11 +11,11 @@ namespace fiberfluid::solve {
 // Subclasses provide the block solves with K.
 class SchurSolver : public LinearSolver {
  public:
-  Status factorize(const model::FiberSystem& system) final;
+  Status factorize(const model::BorderedSystem& system) final;
   Status solve(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) final;
 
  protected:
-  virtual Status factorize_K(const model::FiberSystem& system) = 0;
+  virtual Status factorize_K(const model::BorderedSystem& system) = 0;
   // Solves K w = f over the reduced displacement unknowns.
   virtual Status solve_K(const Eigen::VectorXd& f, Eigen::VectorXd* w) = 0;
 

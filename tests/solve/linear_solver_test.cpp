@@ -188,6 +188,35 @@ TEST(BackendFailures, SingularSetupForEveryBackend) {
     expect_failure(run(m, kind), "no supports");
 }
 
+// The backends solve any bordered system, not only the model's: random SPD
+// blocks (distinct, then equal) and a random border, against Eigen's LU.
+TEST(EveryBackend, SolvesAnyBorderedSystem) {
+  std::srand(7);
+  auto spd = [](int n) {
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, n);
+    return Eigen::MatrixXd(B * B.transpose() + n * Eigen::MatrixXd::Identity(n, n));
+  };
+  const Eigen::MatrixXd K = spd(30);
+  for (bool equal : {false, true}) {
+    std::vector<Eigen::MatrixXd> blocks = {K, equal ? K : spd(30), equal ? K : spd(30)};
+    const model::DenseBorderedSystem system(blocks, Eigen::VectorXd::Random(90));
+    EXPECT_EQ(system.blocks_equal(), equal);
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Random(91);
+    const Eigen::VectorXd expected = system.dense_matrix().partialPivLu().solve(rhs);
+    for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod,
+                            SolverKind::PCG}) {
+      PcgOptions pcg;
+      pcg.tolerance = 1e-13;
+      const auto solver = make_linear_solver(kind, pcg);
+      ASSERT_TRUE(solver->analyze_pattern(system).ok);
+      ASSERT_TRUE(solver->factorize(system).ok) << to_string(kind);
+      Eigen::VectorXd x;
+      ASSERT_TRUE(solver->solve(rhs, &x).ok) << to_string(kind);
+      EXPECT_LT((x - expected).norm(), 1e-10 * expected.norm()) << to_string(kind) << equal;
+    }
+  }
+}
+
 TEST(BackendChoice, BySize) {
   const model::Model small = testing::paper_sphere_model();
   const model::FiberSystem system(small, small.surface.V, BoundaryMethod::Elimination, 1e9);
