@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 namespace fiberfluid::testing {
 
 inline std::filesystem::path data_mesh(const std::string& name) {
@@ -18,13 +20,16 @@ inline std::filesystem::path experiment_file(const std::string& name) {
   return std::filesystem::path(FIBERFLUID_EXPERIMENTS) / name;
 }
 
-// A fresh folder per test, removed at the end of the test.
+// A fresh folder per test, removed at the end of the test. The process id is
+// part of its name: two test runs at once (two build folders, two clones)
+// must not remove each other's files.
 class ScratchDir {
  public:
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     path_ = std::filesystem::temp_directory_path() / "fiberfluid_tests" /
-            (std::string(info->test_suite_name()) + "." + info->name());
+            (std::string(info->test_suite_name()) + "." + info->name() + "." +
+             std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
