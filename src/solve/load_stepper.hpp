@@ -69,6 +69,9 @@ struct SteppingOptions {
   // fraction of the reference volume, or turns a face over, ends the run.
   double max_volume_change = 0.5;
   bool stop_on_inverted_faces = true;
+  // Newton: keep the tangent solve prepared at the solution in the summary
+  // (final_tangent), for sensitivities. It holds O(N^2) memory.
+  bool keep_final_tangent = false;
 
   bool IsValid(std::string* why) const;
 };
@@ -115,6 +118,9 @@ struct SteppingSummary {
   // The bordered system the backend factored last (reduced, boundary
   // conditions applied): what was actually solved.
   std::shared_ptr<const model::FiberSystem> system;
+  // Newton with keep_final_tangent: solves with dR/dx at the solution
+  // (du/dtheta = -final_tangent->solve_full(dR/dtheta)); refers to the model.
+  std::shared_ptr<class TangentSolve> final_tangent;
   SolverStatistics solver_statistics;
   int factorizations = 0;
   double assemble_seconds = 0.0;

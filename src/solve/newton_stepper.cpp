@@ -17,10 +17,9 @@
 #include "model/equilibrium.hpp"
 #include "model/fiber_system.hpp"
 #include "model/loads.hpp"
-#include "solve/dense_lu.hpp"
-#include "solve/gmres.hpp"
 #include "solve/load_stepper.hpp"
 #include "solve/runaway.hpp"
+#include "solve/tangent_solve.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -66,21 +65,27 @@ class NewtonSolver {
         options_(options),
         newton_(options.newton),
         summary_(summary),
-        equilibrium_(model),
+        equilibrium_(std::make_shared<const model::Equilibrium>(model)),
         supports_(DofMap::from_constraints(model)),
         contact_paddle_(static_cast<size_t>(model.num_vertices()), -1),
         stuck_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
     const Eigen::MatrixXd& V = model.surface.V;
     diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
     const int reduced = supports_.num_reduced();
-    tangent_ = newton_.tangent != TangentSolver::Auto ? newton_.tangent
-               : reduced <= 600                      ? TangentSolver::Dense
-                                                     : TangentSolver::Krylov;
-    summary_.tangent = tangent_;
-    summary_.solver = tangent_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
+    const TangentSolver kind = newton_.tangent != TangentSolver::Auto ? newton_.tangent
+                               : reduced <= 600                      ? TangentSolver::Dense
+                                                                     : TangentSolver::Krylov;
+    tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
+    summary_.tangent = kind;
+    summary_.solver = tangent_->preconditioner_kind();
   }
 
-  const model::Equilibrium& equilibrium() const { return equilibrium_; }
+  const model::Equilibrium& equilibrium() const { return *equilibrium_; }
+  // The tangent solve prepared at x (the solution), for the summary.
+  std::shared_ptr<TangentSolve> final_tangent(const PathPoint& at, const Eigen::VectorXd& x) {
+    if (!tangent_->prepare(x, at.factors, held_map()).ok) return nullptr;
+    return tangent_;
+  }
 
   // Solves R = 0 at `at` from x (updated in place): Newton inside an
   // active-set loop for the paddles. "" or why it failed.
@@ -188,14 +193,14 @@ class NewtonSolver {
   double measure(const Eigen::VectorXd& reduced) const {
     const Eigen::Index m = reduced.size() - 1;
     const double force = reduced.head(m).norm() / std::max(peak_force_, 1e-300);
-    const double volume = reduced[m] / equilibrium_.volume_scale();
+    const double volume = reduced[m] / equilibrium_->volume_scale();
     return std::hypot(force, volume);
   }
 
   // The force scale: the largest of the loads and the held rows (reactions) seen.
   void update_force_scale(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
                           const Eigen::VectorXd& R) {
-    const Eigen::VectorXd F = equilibrium_.external_forces(x, at.factors);
+    const Eigen::VectorXd F = equilibrium_->external_forces(x, at.factors);
     double held = 0.0;
     for (int d : dofs.held_dofs()) held += R[d] * R[d];
     peak_force_ = std::max({peak_force_, F.head(F.size() - 1).norm(), std::sqrt(held)});
@@ -203,7 +208,7 @@ class NewtonSolver {
 
   std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
                      StepRecord& record) {
-    Eigen::VectorXd R = equilibrium_.residual(x, at.factors);
+    Eigen::VectorXd R = equilibrium_->residual(x, at.factors);
     update_force_scale(at, dofs, x, R);
     double last_move = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
@@ -229,7 +234,15 @@ class NewtonSolver {
       // Inexact Newton: a Krylov solve only as accurate as the residual it
       // corrects (relative to it), which keeps the convergence quadratic.
       const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
-      const Status status = solve_tangent(at, dofs, x, r, forcing, dx, record);
+      Status status = tangent_->prepare(x, at.factors, dofs);
+      if (status.ok) {
+        int iterations = 0;
+        status = tangent_->solve(-r, forcing, &dx, &iterations);
+        record.krylov_iterations += iterations;
+        summary_.krylov_iterations += iterations;
+      }
+      summary_.factorizations = tangent_->factorizations();
+      summary_.solver = tangent_->preconditioner_kind();
       if (!status.ok) return status.message;
       // Backtracking: halve the step until the residual falls (Armijo).
       Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
@@ -238,7 +251,7 @@ class NewtonSolver {
       Eigen::VectorXd trial, R_trial;
       for (int halving = 0;; ++halving) {
         trial = x + alpha * step;
-        R_trial = equilibrium_.residual(trial, at.factors);
+        R_trial = equilibrium_->residual(trial, at.factors);
         const double trial_norm = measure(dofs.reduce(R_trial));
         if (!newton_.line_search || trial_norm <= (1.0 - 1e-4 * alpha) * norm ||
             trial_norm <= newton_.residual_tolerance)
@@ -259,110 +272,17 @@ class NewtonSolver {
     }
   }
 
-  Status solve_tangent(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
-                       const Eigen::VectorXd& r, double tolerance, Eigen::VectorXd& dx,
-                       StepRecord& record) {
-    if (tangent_ == TangentSolver::Dense) {
-      DenseLU lu;
-      const Status status = lu.factorize(dofs.reduce(equilibrium_.tangent(x, at.factors)));
-      if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
-      dx = lu.solve(-r);
-      return {};
-    }
-    const bool same_set = preconditioner_ && dofs.held_flags() == preconditioned_held_;
-    if (!same_set || refactor_) {
-      const Status status = factor_preconditioner(dofs, x);
-      if (!status.ok) return status;
-    }
-    const int full = model_.num_unknowns();
-    // The pair coefficients stored once for all the products of this solve,
-    // when two N x N arrays fit in a quarter of the memory; else on the fly.
-    const bool store =
-        model::TangentOperator::bytes_for(model_.num_vertices()) < 0.25 * physical_memory_bytes();
-    if (store) equilibrium_.linearize(x, at.factors, stored_);  // reuses the arrays
-    const LinearOperator apply = [&](const Eigen::VectorXd& v) {
-      Eigen::VectorXd w = Eigen::VectorXd::Zero(full);
-      dofs.scatter(v, w);  // held entries stay zero
-      return dofs.reduce(store ? stored_.apply(w) : equilibrium_.tangent_product(x, at.factors, w));
-    };
-    const LinearOperator precondition = [&](const Eigen::VectorXd& v) {
-      Eigen::VectorXd out;
-      const Status status = preconditioner_->solve(v, &out);
-      return status.ok ? out : Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), NAN));
-    };
-    GmresOptions gmres_options;
-    gmres_options.tolerance = tolerance;
-    gmres_options.restart = newton_.krylov_restart;
-    gmres_options.max_iterations = newton_.krylov_max_iterations;
-    dx.resize(0);
-    GmresResult result = gmres(apply, precondition, -r, dx, gmres_options);
-    record.krylov_iterations += result.iterations;
-    summary_.krylov_iterations += result.iterations;
-    // The secant factor ages as the strains move: refactor when gmres needs
-    // clearly more iterations per decade of residual reduction than it did
-    // just after the last factorisation.
-    const double rate = result.iterations / std::max(1.0, -std::log10(tolerance));
-    if (baseline_rate_ < 0.0) baseline_rate_ = rate;
-    else if (rate > 2.0 * baseline_rate_ + 1.0) refactor_ = true;
-    if (!result.status.ok && !just_factored_) {
-      const Status status = factor_preconditioner(dofs, x);
-      if (!status.ok) return status;
-      dx.resize(0);
-      result = gmres(apply, precondition, -r, dx, gmres_options);
-      record.krylov_iterations += result.iterations;
-      summary_.krylov_iterations += result.iterations;
-    }
-    just_factored_ = false;
-    return result.status.ok ? Status{} : Status::failure("newton: " + result.status.message);
-  }
-
-  // The structured secant solve at the current strains: the reference
-  // bordered system with each bulk weight times Y(e_ij).
-  Status factor_preconditioner(const DofMap& dofs, const Eigen::VectorXd& x) {
-    const Eigen::MatrixXd X = model::positions(model_, x);
-    secant_ = std::make_unique<model::FiberSystem>(model_, model_.surface.V, dofs,
-                                                   model::BoundaryMethod::Elimination,
-                                                   options_.penalty, &X);
-    if (!preconditioner_ || !(dofs.held_flags() == preconditioned_held_)) {
-      // By size as for the linear scheme, but never the dense LU of the whole
-      // bordered system: block Cholesky does the same job in a fraction of the flops.
-      SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
-                                                            : options_.solver;
-      if (options_.solver == SolverKind::Auto && kind == SolverKind::DenseLU)
-        kind = SolverKind::BlockCholesky;
-      preconditioner_ = make_linear_solver(kind, options_.pcg);
-      summary_.solver = kind;
-      const Status status = preconditioner_->analyze_pattern(*secant_);
-      if (!status.ok) return status;
-    }
-    const Status status = preconditioner_->factorize(*secant_);
-    if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
-    ++summary_.factorizations;
-    preconditioned_held_ = dofs.held_flags();
-    baseline_rate_ = -1.0;
-    refactor_ = false;
-    just_factored_ = true;
-    return {};
-  }
-
   const Model& model_;
   const SteppingOptions& options_;
   const NewtonOptions& newton_;
   SteppingSummary& summary_;
-  model::Equilibrium equilibrium_;
+  std::shared_ptr<const model::Equilibrium> equilibrium_;
   DofMap supports_;                    // supports and prescribed values
   std::vector<int> contact_paddle_;    // per vertex: its paddle, or -1
   Eigen::MatrixXd stuck_;              // sticking contact: displacement at first touch
   Eigen::VectorXd residual_;
   double diagonal_ = 1.0, peak_force_ = 0.0;
-  TangentSolver tangent_ = TangentSolver::Dense;
-  // Krylov: the secant system and its factorisation.
-  std::unique_ptr<model::FiberSystem> secant_;
-  std::unique_ptr<LinearSolver> preconditioner_;
-  std::vector<char> preconditioned_held_;
-  double baseline_rate_ = -1.0;  // gmres iterations per decade after the last factorisation
-  model::TangentOperator stored_;  // the tangent's pair coefficients, reused between solves
-  bool refactor_ = false, just_factored_ = false;
+  std::shared_ptr<TangentSolve> tangent_;
 };
 
 bool partition_holds(const model::DofPartition& partition, int dof) {
@@ -505,6 +425,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     report_progress("step", k, n);
     if (observer) observer(record, x);
   }
+  if (options.keep_final_tangent) summary.final_tangent = solver->final_tangent(path_point(model, n, n), x);
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;

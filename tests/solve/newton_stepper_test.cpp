@@ -8,7 +8,9 @@
 #include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
 #include "model/model_fixtures.hpp"
+#include "model/equilibrium.hpp"
 #include "solve/load_stepper.hpp"
+#include "solve/tangent_solve.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -98,6 +100,37 @@ TEST(Newton, KrylovAgreesWithTheDenseTangent) {
     EXPECT_GT(krylov.krylov_iterations, 0);
     EXPECT_LT(displacement_norm(m, krylov.unknowns - dense.unknowns),
               1e-8 * displacement_norm(m, dense.unknowns));
+  }
+}
+
+// The summary's final tangent gives the sensitivity of the solution to a
+// material parameter, du/dtheta = -K_T^{-1} dR/dtheta: against central
+// differences of whole Newton runs, with the dense and the krylov tangent.
+TEST(Newton, FinalTangentGivesParameterSensitivities) {
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+  for (TangentSolver kind : {TangentSolver::Dense, TangentSolver::Krylov}) {
+    SteppingOptions o = newton(2, kind);
+    o.newton.residual_tolerance = 1e-13;
+    o.keep_final_tangent = true;
+    const SteppingSummary s = solve_load_steps(m, o);
+    ASSERT_TRUE(s.success) << s.message;
+    ASSERT_TRUE(s.final_tangent);
+    for (const std::string name : {"beta", "gamma"}) {
+      const Eigen::VectorXd dR = model::Equilibrium(m).parameter_derivatives(s.unknowns, {name});
+      Eigen::VectorXd du;
+      ASSERT_TRUE(s.final_tangent->solve_full(-dR, &du).ok);
+      auto solve_with = [&](double delta) {
+        model::Model changed = m;
+        if (name == "gamma") changed.material.surface_tension += delta;
+        else changed.material.law.set_parameter(name, 5.0 + delta);
+        SteppingOptions plain = newton(2);
+        plain.newton.residual_tolerance = 1e-13;
+        return solve_load_steps(changed, plain).unknowns;
+      };
+      const double h = name == "gamma" ? 1.0 : 1e-3;
+      const Eigen::VectorXd fd = (solve_with(h) - solve_with(-h)) / (2.0 * h);
+      EXPECT_LT((du - fd).norm(), 1e-5 * fd.norm()) << name << " " << to_string(kind);
+    }
   }
 }
 

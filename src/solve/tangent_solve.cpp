@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "solve/tangent_solve.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "model/assembly.hpp"
+#include "solve/dense_lu.hpp"
+#include "solve/gmres.hpp"
+
+namespace fiberfluid::solve {
+
+TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium,
+                           const SteppingOptions& options, TangentSolver kind)
+    : equilibrium_(std::move(equilibrium)), options_(options), kind_(kind) {
+  const model::Model& model = equilibrium_->model();
+  // The pair coefficients are stored when two N x N arrays fit in a quarter
+  // of the memory; else each product recomputes them.
+  store_ = model::TangentOperator::bytes_for(model.num_vertices()) <
+           0.25 * physical_memory_bytes();
+  preconditioner_kind_ = kind_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
+}
+
+Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                             const model::DofMap& dofs) {
+  x_ = x;
+  factors_ = factors;
+  dofs_ = dofs;
+  ready_ = false;
+  if (kind_ == TangentSolver::Dense) {
+    lu_ = std::make_unique<DenseLU>();
+    const Status status = lu_->factorize(dofs_.reduce(equilibrium_->tangent(x_, factors_)));
+    if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+  } else {
+    if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
+    const bool same_set = preconditioner_ && dofs_.held_flags() == preconditioned_held_;
+    if (!same_set || refactor_) {
+      const Status status = factor_preconditioner();
+      if (!status.ok) return status;
+    }
+  }
+  ready_ = true;
+  return {};
+}
+
+Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
+  dofs_.scatter(reduced, w);  // held entries stay zero
+  return dofs_.reduce(store_ ? stored_.apply(w) : equilibrium_->tangent_product(x_, factors_, w));
+}
+
+Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::VectorXd* y,
+                           int* iterations) {
+  if (!ready_) return Status::failure("newton: the tangent was not prepared");
+  if (kind_ == TangentSolver::Dense) {
+    *y = lu_->solve(b);
+    return {};
+  }
+  const LinearOperator apply_tangent = [this](const Eigen::VectorXd& v) { return apply(v); };
+  const LinearOperator precondition = [this](const Eigen::VectorXd& v) {
+    Eigen::VectorXd out;
+    const Status status = preconditioner_->solve(v, &out);
+    return status.ok ? out : Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), NAN));
+  };
+  GmresOptions gmres_options;
+  gmres_options.tolerance = tolerance;
+  gmres_options.restart = options_.newton.krylov_restart;
+  gmres_options.max_iterations = options_.newton.krylov_max_iterations;
+  y->resize(0);
+  GmresResult result = gmres(apply_tangent, precondition, b, *y, gmres_options);
+  if (iterations != nullptr) *iterations += result.iterations;
+  // The secant factor ages as the strains move: refactor when gmres needs
+  // clearly more iterations per decade of residual reduction than it did
+  // just after the last factorisation.
+  const double rate = result.iterations / std::max(1.0, -std::log10(tolerance));
+  if (baseline_rate_ < 0.0) baseline_rate_ = rate;
+  else if (rate > 2.0 * baseline_rate_ + 1.0) refactor_ = true;
+  if (!result.status.ok && !just_factored_) {
+    const Status status = factor_preconditioner();
+    if (!status.ok) return status;
+    y->resize(0);
+    result = gmres(apply_tangent, precondition, b, *y, gmres_options);
+    if (iterations != nullptr) *iterations += result.iterations;
+  }
+  just_factored_ = false;
+  return result.status.ok ? Status{} : Status::failure("newton: " + result.status.message);
+}
+
+Status TangentSolve::solve_full(const Eigen::VectorXd& b, Eigen::VectorXd* y, double tolerance) {
+  Eigen::VectorXd reduced;
+  const Status status = solve(dofs_.reduce(b), tolerance, &reduced);
+  if (!status.ok) return status;
+  *y = Eigen::VectorXd::Zero(b.size());
+  dofs_.scatter(reduced, *y);
+  return {};
+}
+
+Status TangentSolve::factor_preconditioner() {
+  const model::Model& model = equilibrium_->model();
+  const Eigen::MatrixXd X = model::positions(model, x_);
+  secant_ = std::make_unique<model::FiberSystem>(model, model.surface.V, dofs_,
+                                                 model::BoundaryMethod::Elimination,
+                                                 options_.penalty, &X);
+  if (!preconditioner_ || !(dofs_.held_flags() == preconditioned_held_)) {
+    // By size as for the linear scheme, but never the dense LU of the whole
+    // bordered system: block Cholesky does the same job in a fraction of the flops.
+    SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
+                                                          : options_.solver;
+    if (options_.solver == SolverKind::Auto && kind == SolverKind::DenseLU)
+      kind = SolverKind::BlockCholesky;
+    preconditioner_ = make_linear_solver(kind, options_.pcg);
+    preconditioner_kind_ = kind;
+    const Status status = preconditioner_->analyze_pattern(*secant_);
+    if (!status.ok) return status;
+  }
+  const Status status = preconditioner_->factorize(*secant_);
+  if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
+  ++factorizations_;
+  preconditioned_held_ = dofs_.held_flags();
+  baseline_rate_ = -1.0;
+  refactor_ = false;
+  just_factored_ = true;
+  return {};
+}
+
+}  // namespace fiberfluid::solve

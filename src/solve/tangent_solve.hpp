@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "model/dof_map.hpp"
+#include "model/equilibrium.hpp"
+#include "model/fiber_system.hpp"
+#include "solve/dense_lu.hpp"
+#include "solve/linear_solver.hpp"
+#include "solve/load_stepper.hpp"
+#include "solve/status.hpp"
+
+namespace fiberfluid::solve {
+
+// Solves with the Newton tangent dR/dx at one state, over the unknowns a
+// DofMap leaves free: the dense LU of the reduced tangent, or GMRES on the
+// tangent as an operator (its pair coefficients stored), right-preconditioned
+// by the structured secant solve (the reference bordered system with each
+// bulk weight times Y(e_ij)). The preconditioner is kept between states and
+// refactored when the held set changes or GMRES needs clearly more
+// iterations per decade than just after its last factorisation.
+//
+// The Newton stepper prepares one per iteration. With
+// SteppingOptions::keep_final_tangent the summary keeps it prepared at the
+// solution, for sensitivities du/dtheta = -K_T^{-1} dR/dtheta (calibration).
+// It refers to the Equilibrium (shared) and through it to the Model, which
+// must outlive it.
+class TangentSolve {
+ public:
+  TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium,
+               const SteppingOptions& options, TangentSolver kind);
+
+  TangentSolver kind() const { return kind_; }
+  SolverKind preconditioner_kind() const { return preconditioner_kind_; }
+  int factorizations() const { return factorizations_; }
+  const model::DofMap& dofs() const { return dofs_; }
+  const Eigen::VectorXd& state() const { return x_; }
+
+  // Makes the tangent at x (loads `factors`, held set `dofs`) ready to solve.
+  Status prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                 const model::DofMap& dofs);
+  // J_ff y = b over the reduced unknowns (DofMap layout); krylov stops at the
+  // relative residual `tolerance`. iterations (krylov) is added to.
+  Status solve(const Eigen::VectorXd& b, double tolerance, Eigen::VectorXd* y,
+               int* iterations = nullptr);
+  // The same in the full layout: rows of b at held unknowns are ignored and
+  // y is zero there (a held unknown does not move). For dR/dtheta this gives
+  // du/dtheta = -solve_full(dR/dtheta).
+  Status solve_full(const Eigen::VectorXd& b, Eigen::VectorXd* y, double tolerance = 1e-12);
+
+ private:
+  Status factor_preconditioner();
+  Eigen::VectorXd apply(const Eigen::VectorXd& reduced) const;
+
+  std::shared_ptr<const model::Equilibrium> equilibrium_;
+  SteppingOptions options_;
+  TangentSolver kind_;
+  Eigen::VectorXd x_;
+  std::vector<double> factors_;
+  model::DofMap dofs_;
+  bool ready_ = false;
+  // Dense.
+  std::unique_ptr<DenseLU> lu_;
+  // Krylov.
+  bool store_ = true;
+  model::TangentOperator stored_;
+  std::unique_ptr<model::FiberSystem> secant_;
+  std::unique_ptr<LinearSolver> preconditioner_;
+  SolverKind preconditioner_kind_ = SolverKind::Auto;
+  std::vector<char> preconditioned_held_;
+  double baseline_rate_ = -1.0;  // gmres iterations per decade after the last factorisation
+  bool refactor_ = false, just_factored_ = false;
+  int factorizations_ = 0;
+};
+
+}  // namespace fiberfluid::solve
