@@ -192,7 +192,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   const int nv = model.num_vertices();
   Eigen::Vector3d applied = Eigen::Vector3d::Zero();  // the loads so far, summed over vertices
   std::shared_ptr<const model::FiberSystem> system;  // outlives its factorisation
-  std::unique_ptr<LinearSolver> solver;
+  std::shared_ptr<LinearSolver> solver;
 
   report_progress("step", 0, n);
   for (int k = 1; k <= n; ++k) {
@@ -272,6 +272,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   }
   summary.reaction_forces = reactions->per_vertex();
   summary.system = system;
+  summary.factorization = solver;
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;

@@ -118,6 +118,9 @@ struct SteppingSummary {
   // The bordered system the backend factored last (reduced, boundary
   // conditions applied): what was actually solved.
   std::shared_ptr<const model::FiberSystem> system;
+  // Incremental: the backend holding that system's factorisation, ready to
+  // solve more right-hand sides with it (the matrix of the last step).
+  std::shared_ptr<LinearSolver> factorization;
   // Newton with keep_final_tangent: solves with dR/dx at the solution
   // (du/dtheta = -final_tangent->solve_full(dR/dtheta)); refers to the model.
   std::shared_ptr<class TangentSolve> final_tangent;

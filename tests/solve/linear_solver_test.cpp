@@ -132,6 +132,13 @@ TEST_P(EveryBackend, AgreesWithAnIndependentDenseSolve) {
   EXPECT_LT(difference, kind == SolverKind::PCG ? 1e-8 : direct) << kCases[case_index].name;
   const double P = reference[u];
   EXPECT_NEAR(s.unknowns[u], P, 1e-8 * std::abs(P) + 1e-12);
+  // The summary hands back the factored system: it solves again, the same answer.
+  ASSERT_TRUE(s.system && s.factorization);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::Random(s.system->num_unknowns());
+  Eigen::VectorXd again;
+  ASSERT_TRUE(s.factorization->solve(rhs, &again).ok);
+  const Eigen::VectorXd lu = s.system->dense_matrix().partialPivLu().solve(rhs);
+  EXPECT_LT((again - lu).norm(), (kind == SolverKind::PCG ? 1e-7 : 1e-9) * lu.norm());
 }
 
 std::string param_name(const ::testing::TestParamInfo<Param>& info) {
