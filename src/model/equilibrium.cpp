@@ -210,23 +210,34 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
   product[0] = p0, product[1] = p1, product[2] = p2;
 }
 
-Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
-  const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
-  const int n = model_.num_vertices(), dim = model_.dim();
-  const Eigen::Vector3d m = model_.material.axis_factors;
-  const Columns columns(model_.surface.V, X, U, nullptr);
-  Eigen::MatrixXd forces(n, dim);
+// Runs bulk_row over every row on the OpenMP threads, each with its own
+// scratch arrays, and hands visit(i, scratch, force, product) the results.
+template <class Visit>
+void Equilibrium::parallel_rows(const Columns& columns, bool with_product, Visit&& visit) const {
+  const int n = model_.num_vertices();
 #pragma omp parallel
   {
     std::vector<double> scratch[6];
     for (auto& v : scratch) v.resize(static_cast<size_t>(n));
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      double f[3];
-      bulk_row(i, columns, scratch, f, nullptr);
-      for (int a = 0; a < dim; ++a) forces(i, a) = m[a] * f[a];
+      double force[3], product[3];
+      bulk_row(i, columns, scratch, force, with_product ? product : nullptr);
+      visit(i, scratch, force, product);
     }
   }
+}
+
+Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
+  const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
+  const int n = model_.num_vertices(), dim = model_.dim();
+  const Eigen::Vector3d m = model_.material.axis_factors;
+  const Columns columns(model_.surface.V, X, U, nullptr);
+  Eigen::MatrixXd forces(n, dim);
+  parallel_rows(columns, false, [&](int i, const std::vector<double>*, const double* f,
+                                    const double*) {
+    for (int a = 0; a < dim; ++a) forces(i, a) = m[a] * f[a];
+  });
   return forces + model_.material.surface_tension * (surface_ * U);
 }
 
@@ -343,17 +354,10 @@ Eigen::VectorXd Equilibrium::tangent_product(const Eigen::VectorXd& x,
   const Eigen::Vector3d m = model_.material.axis_factors;
   Eigen::VectorXd out = Eigen::VectorXd::Zero(num_unknowns());
   const Columns columns(model_.surface.V, X, U, &W);
-#pragma omp parallel
-  {
-    std::vector<double> scratch[6];
-    for (auto& s : scratch) s.resize(static_cast<size_t>(n));
-#pragma omp for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      double f[3], product[3];
-      bulk_row(i, columns, scratch, f, product);
-      for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
-    }
-  }
+  parallel_rows(columns, true, [&](int i, const std::vector<double>*, const double*,
+                                   const double* product) {
+    for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
+  });
   add_non_bulk_product(x, factors, X, v, out);
   return out;
 }
@@ -411,28 +415,21 @@ void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>&
   op.weighted_modulus_.resize(n, n);
   op.weighted_slope_.resize(n, n);
   const Columns columns(model_.surface.V, op.X_, op.U_, nullptr);
-#pragma omp parallel
-  {
-    std::vector<double> scratch[6];
-    for (auto& s : scratch) s.resize(static_cast<size_t>(n));
-#pragma omp for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      double f[3];
-      bulk_row(i, columns, scratch, f, nullptr);
-      // bulk_row leaves h, L, r, Y, Y' of the row in the scratch arrays.
-      const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
-      const double *Y = scratch[3].data(), *Yp = scratch[4].data(), *area = area0_.data();
-      double* c1 = op.weighted_modulus_.col(i).data();
-      double* c2 = op.weighted_slope_.col(i).data();
-      const auto u = static_cast<size_t>(i);
+  parallel_rows(columns, false, [&](int i, const std::vector<double>* scratch, const double*,
+                                    const double*) {
+    // bulk_row leaves h, L, r, Y, Y' of the row in the scratch arrays.
+    const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
+    const double *Y = scratch[3].data(), *Yp = scratch[4].data(), *area = area0_.data();
+    double* c1 = op.weighted_modulus_.col(i).data();
+    double* c2 = op.weighted_slope_.col(i).data();
+    const auto u = static_cast<size_t>(i);
 #pragma omp simd
-      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
-        const double a = bulk_weight(h[j], area[u], area[j], L[j]);
-        c1[j] = a * Y[j];
-        c2[j] = a * Yp[j] / (r[j] * L[j]);
-      }
+    for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+      const double a = bulk_weight(h[j], area[u], area[j], L[j]);
+      c1[j] = a * Y[j];
+      c2[j] = a * Yp[j] / (r[j] * L[j]);
     }
-  }
+  });
 }
 
 Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {

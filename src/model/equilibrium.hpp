@@ -100,6 +100,8 @@ class Equilibrium {
   struct Columns;
   void bulk_row(int i, const Columns& c, std::vector<double>* scratch, double force[3],
                 double product[3]) const;
+  template <class Visit>
+  void parallel_rows(const Columns& columns, bool with_product, Visit&& visit) const;
   // Visits every ordered bulk pair (i, j), j != i, of row i with its fiber state.
   template <class Visit>
   void for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,

@@ -107,6 +107,12 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
 }
 
 
+std::string setup_problem(const model::Model& model, const SteppingOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) return why;
+  return model::singular_setup_reason(model);
+}
+
 bool SteppingOptions::IsValid(std::string* why) const {
   if (steps < 1) return *why = "steps must be at least 1", false;
   if (!(penalty > 0.0) || !std::isfinite(penalty))
@@ -170,9 +176,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     summary.total_seconds = seconds_since(start);
     return summary;
   };
-  std::string why;
-  if (!options.IsValid(&why)) return fail(why);
-  why = model::singular_setup_reason(model);
+  std::string why = setup_problem(model, options);
   if (!why.empty()) return fail(why);
   if (!model.paddles.empty())
     return fail("paddles need the Newton scheme (stepping.scheme \"newton\"): contact is an "

@@ -329,9 +329,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     summary.total_seconds = seconds_since(start);
     return summary;
   };
-  std::string why;
-  if (!options.IsValid(&why)) return fail(why);
-  why = model::singular_setup_reason(model);
+  std::string why = setup_problem(model, options);
   if (!why.empty()) return fail(why);
   why = paddle_problem(model, options.steps);
   if (!why.empty()) return fail(why);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The runaway guards both steppers apply after every step (internal header).
+// What both steppers check before and after every step (internal header).
 #pragma once
 
 #include <Eigen/Core>
@@ -9,6 +9,9 @@
 #include "solve/load_stepper.hpp"
 
 namespace fiberfluid::solve {
+
+// Why the run cannot start, or "": invalid options, or a singular setup.
+std::string setup_problem(const model::Model& model, const SteppingOptions& options);
 
 // Why the state reached after a step is a runaway rather than a result, or
 // "": non-finite unknowns, a face turned over, a volume change beyond
