@@ -108,17 +108,18 @@ class NewtonSolver {
   // each support or paddle exerts on the body.
   const Eigen::VectorXd& last_residual() const { return residual_; }
   const std::vector<int>& contact_paddle() const { return contact_paddle_; }
+  // The supports' map with the contact unknowns held too.
   DofMap held_map() const {
-    std::vector<char> held = supports_.held_flags();
+    std::vector<int> contacts;
     const int n = model_.num_vertices();
     for (int v = 0; v < n; ++v) {
       const int p = contact_paddle_[static_cast<size_t>(v)];
       if (p < 0) continue;
       const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
       for (int a = 0; a < model_.dim(); ++a)
-        if (a == paddle.axis || paddle.sticking) held[static_cast<size_t>(a * n + v)] = 1;
+        if (a == paddle.axis || paddle.sticking) contacts.push_back(a * n + v);
     }
-    return DofMap(model_.dim(), n, std::move(held));
+    return supports_.with_held(contacts);
   }
   // Snapshot and restore of the contact state, for a step that is cut.
   struct ContactState {
