@@ -13,4 +13,8 @@ experiment="${1:-experiments/sphere.json}"
 name="$(basename "$experiment" .json)"
 build-release/src/app/fiberfluid run "$experiment" -o "out/$name" --check
 /usr/bin/python3 experiments/plot.py "out/$name/summary.json" "out/$name/plot.png"
-echo "plot: out/$name/plot.png; open out/$name/series.pvd in ParaView"
+if [[ -f "out/$name/series.pvd" ]]; then
+  echo "plot: out/$name/plot.png; open out/$name/series.pvd in ParaView"
+else  # a sweep: one series per variant
+  echo "plot: out/$name/plot.png; open out/$name/<variant>/series.pvd in ParaView"
+fi
