@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "model/equilibrium.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "geom/area_vectors.hpp"
@@ -69,11 +71,21 @@ Equilibrium::Equilibrium(const Model& model)
   area0_ = areas.magnitude;
   C0_ = areas.C;
   volume0_ = geom::enclosed_volume(V, model.surface.F);
-  for (int i = 0; i < V.rows(); ++i)
-    for (int j = i + 1; j < V.rows(); ++j)
-      if ((V.row(i) - V.row(j)).squaredNorm() == 0.0)
-        throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(j) +
-                         " coincide: the fiber between them has zero length");
+  // Two coincident vertices would make a fiber of zero length: sorted by
+  // their coordinates, equal ones are neighbours (N log N, not N^2).
+  std::vector<int> order(static_cast<size_t>(V.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  const auto before = [&V](int a, int b) {
+    for (Eigen::Index c = 0; c < V.cols(); ++c)
+      if (V(a, c) != V(b, c)) return V(a, c) < V(b, c);
+    return false;
+  };
+  std::sort(order.begin(), order.end(), before);
+  for (size_t k = 1; k < order.size(); ++k)
+    if (V.row(order[k - 1]) == V.row(order[k]))
+      throw InputError("vertices " + std::to_string(std::min(order[k - 1], order[k])) + " and " +
+                       std::to_string(std::max(order[k - 1], order[k])) +
+                       " coincide: the fiber between them has zero length");
   surface_ = reference_surface_laplacian(model, area0_);
   for (const Load& load : model.loads) {
     double level = 0.0;

@@ -8,6 +8,7 @@
 
 #include <random>
 
+#include "geom/error.hpp"
 #include "model/assembly.hpp"
 #include "model/model_fixtures.hpp"
 
@@ -107,6 +108,18 @@ TEST(Equilibrium, ReferenceTangentIsThePapersMatrix) {
     const Eigen::MatrixXd J = eq.tangent(zero, no_load);
     EXPECT_LT((J - A).cwiseAbs().maxCoeff(), 1e-12 * A.cwiseAbs().maxCoeff());
     EXPECT_EQ(eq.residual(zero, no_load).norm(), 0.0);
+  }
+}
+
+TEST(Equilibrium, CoincidentVerticesAreNamed) {
+  Model m = small_sphere(FiberLaw::constant(3000.0));
+  m.surface.V.row(30) = m.surface.V.row(4);
+  try {
+    const Equilibrium eq(m);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vertices 4 and 30 coincide"), std::string::npos)
+        << e.what();
   }
 }
 
