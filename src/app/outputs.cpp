@@ -26,7 +26,11 @@ namespace fs = std::filesystem;
 
 const char kAxes[] = "xyz";
 
-json vector_json(const Eigen::Vector3d& v, int dim);
+json vector_json(const Eigen::Vector3d& v, int dim) {
+  json out = json::array();
+  for (int a = 0; a < dim; ++a) out.push_back(v[a]);
+  return out;
+}
 
 json newton_options_json(const solve::NewtonOptions& n) {
   return {{"residual_tolerance", n.residual_tolerance},
@@ -43,16 +47,16 @@ json newton_options_json(const solve::NewtonOptions& n) {
 
 json stepping_json(const solve::SteppingOptions& s) {
   json out = {{"scheme", solve::to_string(s.scheme)},
-          {"steps", s.steps},
-          {"rebuild_matrix", s.rebuild_matrix},
-          {"update_load_geometry", s.update_load_geometry},
-          {"boundary_method", model::to_string(s.boundary_method)},
-          {"penalty", s.penalty},
-          {"solver", solve::to_string(s.solver)},
-          {"tolerance", s.pcg.tolerance},
-          {"max_iterations", s.pcg.max_iterations},
-          {"max_volume_change", s.max_volume_change},
-          {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
+             {"steps", s.steps},
+             {"rebuild_matrix", s.rebuild_matrix},
+             {"update_load_geometry", s.update_load_geometry},
+             {"boundary_method", model::to_string(s.boundary_method)},
+             {"penalty", s.penalty},
+             {"solver", solve::to_string(s.solver)},
+             {"tolerance", s.pcg.tolerance},
+             {"max_iterations", s.pcg.max_iterations},
+             {"max_volume_change", s.max_volume_change},
+             {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
   if (s.scheme == solve::Scheme::Newton) out["newton"] = newton_options_json(s.newton);
   return out;
 }
@@ -89,12 +93,6 @@ void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& st
 
 std::string group_name(const model::Model& m, size_t g) {
   return g < m.constraint_groups.size() ? m.constraint_groups[g] : "supports";
-}
-
-json vector_json(const Eigen::Vector3d& v, int dim) {
-  json out = json::array();
-  for (int a = 0; a < dim; ++a) out.push_back(v[a]);
-  return out;
 }
 
 json reactions_json(const model::Model& m, const solve::StepRecord& r) {

@@ -116,34 +116,6 @@ Equilibrium::Hydrostatics Equilibrium::hydrostatics(const Eigen::MatrixXd& X,
   return h;
 }
 
-template <class Visit>
-void Equilibrium::for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                                 std::vector<double>& row, Visit&& visit) const {
-  const Eigen::MatrixXd& S = model_.surface.V;
-  const FiberLaw& law = model_.material.law;
-  const bool constant = law.is_constant();
-  factors_.row(i, row.data());
-  const Eigen::Vector3d xi = row3(X, i), si = row3(S, i), ui = row3(U, i);
-  BulkFiber fiber;
-  fiber.modulus = law.modulus(0.0);
-  for (int j = 0; j < static_cast<int>(X.rows()); ++j) {
-    const double h = row[static_cast<size_t>(j)];
-    if (h == 0.0) continue;
-    fiber.length = (si - row3(S, j)).norm();
-    fiber.weight = bulk_weight(h, area0_[i], area0_[j], fiber.length);
-    fiber.d = ui - row3(U, j);
-    const Eigen::Vector3d between = xi - row3(X, j);
-    const double current = between.norm();
-    fiber.n = between / current;
-    if (!constant) {
-      const double strain = current / fiber.length - 1.0;
-      fiber.modulus = law.modulus(strain);
-      fiber.slope = law.slope(strain);
-    }
-    visit(j, fiber);
-  }
-}
-
 // Column pointers of the reference, current, displacement and product
 // vectors (three each; the third is all zeros in 2D).
 struct Equilibrium::Columns {
@@ -197,7 +169,7 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
   double f0 = 0.0, f1 = 0.0, f2 = 0.0;
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (size_t j = 0; j < n; ++j) {
-    const double aY = bulk_weight(h[j], area[u], area[j], L[j]) * Y[j];
+    const double aY = modulus_coefficient(bulk_weight(h[j], area[u], area[j], L[j]), Y[j]);
     f0 += aY * (u0[u] - u0[j]);
     f1 += aY * (u1[u] - u1[j]);
     f2 += aY * (u2[u] - u2[j]);
@@ -208,16 +180,16 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
   double p0 = 0.0, p1 = 0.0, p2 = 0.0;
 #pragma omp simd reduction(+ : p0, p1, p2)
   for (size_t j = 0; j < n; ++j) {
+    // T w = c1 w + c2 (b.w) d (pair_stencil.hpp), as TangentOperator::apply.
     const double a = bulk_weight(h[j], area[u], area[j], L[j]);
+    const double c1 = modulus_coefficient(a, Y[j]), c2 = slope_coefficient(a, Yp[j], r[j], L[j]);
     const double d0 = u0[u] - u0[j], d1 = u1[u] - u1[j], d2 = u2[u] - u2[j];
     const double v0 = w0[u] - w0[j], v1 = w1[u] - w1[j], v2 = w2[u] - w2[j];
-    // Y' (n.w) / L with n = (x_i - x_j) / r.
-    const double along = Yp[j] *
-                         ((x0[u] - x0[j]) * v0 + (x1[u] - x1[j]) * v1 + (x2[u] - x2[j]) * v2) /
-                         (r[j] * L[j]);
-    p0 += a * (Y[j] * v0 + along * d0);
-    p1 += a * (Y[j] * v1 + along * d1);
-    p2 += a * (Y[j] * v2 + along * d2);
+    const double along =
+        c2 * ((x0[u] - x0[j]) * v0 + (x1[u] - x1[j]) * v1 + (x2[u] - x2[j]) * v2);
+    p0 += c1 * v0 + along * d0;
+    p1 += c1 * v1 + along * d1;
+    p2 += c1 * v2 + along * d2;
   }
   product[0] = p0, product[1] = p1, product[2] = p2;
 }
@@ -438,8 +410,8 @@ void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>&
 #pragma omp simd
     for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
       const double a = bulk_weight(h[j], area[u], area[j], L[j]);
-      c1[j] = a * Y[j];
-      c2[j] = a * Yp[j] / (r[j] * L[j]);
+      c1[j] = modulus_coefficient(a, Y[j]);
+      c2[j] = slope_coefficient(a, Yp[j], r[j], L[j]);
     }
   });
 }
@@ -498,24 +470,25 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
     if (name.rfind("factor_", 0) == 0 && name.size() == 8) axis = name[7] - 'x';
     if (axis >= dim) axis = -1;
     if (axis < 0) law.modulus_derivative(name, 0.0);  // throws for an unknown name
-#pragma omp parallel
-    {
-      std::vector<double> row(static_cast<size_t>(n));
-#pragma omp for schedule(dynamic, 16)
-      for (int i = 0; i < n; ++i) {
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        const Eigen::Vector3d xi = row3(X, i);
-        for_each_fiber(i, X, U, row, [&](int j, const BulkFiber& fiber) {
-          if (axis >= 0) {
-            sum[axis] += fiber.weight * fiber.modulus * fiber.d[axis];
-          } else {
-            const double strain = (xi - row3(X, j)).norm() / fiber.length - 1.0;
-            sum += fiber.force_derivative(m, law.modulus_derivative(name, strain));
-          }
-        });
-        for (int a = 0; a < dim; ++a) D(a * n + i, column) = sum[a];
+    const Columns columns(model_.surface.V, X, U, nullptr);
+    parallel_rows(columns, false, [&](int i, const std::vector<double>* scratch,
+                                      const double* force, const double*) {
+      if (axis >= 0) {  // bulk_row's force is sum_j a Y d, before the factors
+        D(axis * n + i, column) = force[axis];
+        return;
       }
-    }
+      // m_a sum_j a dY/dtheta(e_ij) d_a, from the row's h, L and r.
+      const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
+      const auto u = static_cast<size_t>(i);
+      double sum[3] = {0.0, 0.0, 0.0};
+      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+        if (h[j] == 0.0) continue;
+        const double a = bulk_weight(h[j], area0_[i], area0_[static_cast<Eigen::Index>(j)], L[j]);
+        const double dY = law.modulus_derivative(name, r[j] / L[j] - 1.0);
+        for (int c = 0; c < 3; ++c) sum[c] += a * dY * (columns.u[c][u] - columns.u[c][j]);
+      }
+      for (int a = 0; a < dim; ++a) D(a * n + i, column) = m[a] * sum[a];
+    });
   }
   return D;
 }

@@ -102,10 +102,6 @@ class Equilibrium {
                 double product[3]) const;
   template <class Visit>
   void parallel_rows(const Columns& columns, bool with_product, Visit&& visit) const;
-  // Visits every ordered bulk pair (i, j), j != i, of row i with its fiber state.
-  template <class Visit>
-  void for_each_fiber(int i, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                      std::vector<double>& row, Visit&& visit) const;
 
   const Model& model_;
   PairFactors factors_;

@@ -14,16 +14,10 @@
 #include "geom/error.hpp"
 #include "model/fiber_system.hpp"
 #include "geom/progress.hpp"
-#include "solve/runaway.hpp"
+#include "solve/stepping_common.hpp"
 
 namespace fiberfluid::solve {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The force each support exerts on the body: at every held unknown, the
 // unreduced row of the step's A times the step's increment, less the load
@@ -169,13 +163,8 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
                                  const StepObserver& observer) {
   if (options.scheme == Scheme::Newton) return solve_newton_steps(model, options, observer);
   const Clock::time_point start = Clock::now();
-  SteppingSummary summary;
-  summary.unknowns = Eigen::VectorXd::Zero(model.num_unknowns());
-  auto fail = [&](const std::string& why) {
-    summary.message = why;
-    summary.total_seconds = seconds_since(start);
-    return summary;
-  };
+  SteppingSummary summary = empty_summary(model, Scheme::Incremental);
+  auto fail = [&](const std::string& why) { return failed(summary, why, start); };
   std::string why = setup_problem(model, options);
   if (!why.empty()) return fail(why);
   if (!model.paddles.empty())

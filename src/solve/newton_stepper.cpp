@@ -18,19 +18,14 @@
 #include "model/fiber_system.hpp"
 #include "model/loads.hpp"
 #include "solve/load_stepper.hpp"
-#include "solve/runaway.hpp"
+#include "solve/stepping_common.hpp"
 #include "solve/tangent_solve.hpp"
 
 namespace fiberfluid::solve {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using model::DofMap;
 using model::Model;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Loads, prescribed displacements and paddle planes at a point t of the load
 // path: t = k after step k, linear in between (for the pieces of a cut step).
@@ -322,14 +317,8 @@ std::string paddle_problem(const Model& model, int steps) {
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
                                    const StepObserver& observer) {
   const Clock::time_point start = Clock::now();
-  SteppingSummary summary;
-  summary.scheme = Scheme::Newton;
-  summary.unknowns = Eigen::VectorXd::Zero(model.num_unknowns());
-  auto fail = [&](const std::string& why) {
-    summary.message = why;
-    summary.total_seconds = seconds_since(start);
-    return summary;
-  };
+  SteppingSummary summary = empty_summary(model, Scheme::Newton);
+  auto fail = [&](const std::string& why) { return failed(summary, why, start); };
   std::string why = setup_problem(model, options);
   if (!why.empty()) return fail(why);
   why = paddle_problem(model, options.steps);
