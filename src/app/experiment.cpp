@@ -5,17 +5,13 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <fstream>
-#include <map>
+#include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
-#include <set>
 
 #include "geom/error.hpp"
-#include "geom/fiber_pruning.hpp"
 #include "geom/generators.hpp"
-#include "geom/mesh_check.hpp"
-#include "geom/mesh_io.hpp"
 #include "model/boundary_conditions.hpp"
 
 namespace fiberfluid::app {
@@ -24,16 +20,26 @@ namespace {
 using nlohmann::json;
 
 // ------------------------------------------------------------ surfaces
-geom::Surface read_generator(Fields& f) {
+// A generator's parameters, checked now; the surface is made when the case is built.
+std::function<geom::Surface()> read_generator(Fields& f) {
   const std::string kind =
       f.choice("generator", "", {"icosphere", "tetrahedron", "octahedron", "icosahedron", "cube",
                                  "box", "dome", "rectangle", "polygon"});
-  if (kind == "icosphere")
-    return geom::icosphere(f.integer("subdivisions", 2, 0, 7), f.positive("radius", 1.0));
-  if (kind == "tetrahedron") return geom::tetrahedron(f.positive("radius", 1.0));
-  if (kind == "octahedron") return geom::octahedron(f.positive("radius", 1.0));
-  if (kind == "icosahedron") return geom::icosahedron(f.positive("radius", 1.0));
-  if (kind == "cube") return geom::cube(f.positive("edge", 1.0));
+  if (kind == "icosphere") {
+    const int subdivisions = f.integer("subdivisions", 2, 0, 7);
+    const double radius = f.positive("radius", 1.0);
+    return [=] { return geom::icosphere(subdivisions, radius); };
+  }
+  if (kind == "tetrahedron" || kind == "octahedron" || kind == "icosahedron") {
+    const double radius = f.positive("radius", 1.0);
+    if (kind == "tetrahedron") return [=] { return geom::tetrahedron(radius); };
+    if (kind == "octahedron") return [=] { return geom::octahedron(radius); };
+    return [=] { return geom::icosahedron(radius); };
+  }
+  if (kind == "cube") {
+    const double edge = f.positive("edge", 1.0);
+    return [=] { return geom::cube(edge); };
+  }
   if (kind == "box") {
     const Eigen::Vector3d min = f.vector("min", 3), max = f.vector("max", 3);
     Eigen::Vector3i segments = Eigen::Vector3i::Ones();
@@ -41,17 +47,20 @@ geom::Surface read_generator(Fields& f) {
     if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on every axis");
     if ((segments.array() < 1).any() || (segments.array() > 200).any())
       f.fail("segments", "expected 3 whole numbers from 1 to 200");
-    return geom::box(min, max, segments);
+    return [=] { return geom::box(min, max, segments); };
   }
-  if (kind == "dome")
-    return geom::dome(f.vector("semi_axes", 3), f.integer("subdivisions", 2, 0, 6));
+  if (kind == "dome") {
+    const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
+    const int subdivisions = f.integer("subdivisions", 2, 0, 6);
+    return [=] { return geom::dome(semi_axes, subdivisions); };
+  }
   if (kind == "rectangle") {
     const Eigen::Vector2d min = f.vector("min", 2), max = f.vector("max", 2);
     Eigen::Vector2i segments = Eigen::Vector2i::Ones();
     if (f.has("segments")) segments = f.vector("segments", 2).cast<int>();
     if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on both axes");
     if ((segments.array() < 1).any()) f.fail("segments", "expected 2 whole numbers from 1");
-    return geom::rectangle(min, max, segments.x(), segments.y());
+    return [=] { return geom::rectangle(min, max, segments.x(), segments.y()); };
   }
   // polygon
   const json& points = f.raw("points");
@@ -64,31 +73,25 @@ geom::Surface read_generator(Fields& f) {
       f.fail("points", "expected [x, y] pairs, got " + points[k].dump());
     P.row(static_cast<Eigen::Index>(k)) << points[k][0].get<double>(), points[k][1].get<double>();
   }
-  return geom::polygon(P);
+  return [=] { return geom::polygon(P); };
 }
 
-// Reads a surface from "file" (with "flip") or "generator", then "scale".
-geom::Surface read_surface_spec(Fields& f, const std::filesystem::path& folder,
-                                std::vector<std::string>* warnings) {
-  geom::Surface surface;
+// "file" (with "flip") or "generator", then "scale".
+SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
+  SurfaceSpec spec;
+  spec.field = f.field();
   if (f.has("file") == f.has("generator"))
     f.fail("", "expected exactly one of \"file\" or \"generator\"");
   if (f.has("file")) {
-    std::filesystem::path path = f.string("file");
-    if (path.is_relative()) path = folder / path;
-    const bool flip = f.boolean("flip", false);
-    try {
-      surface = load_checked_surface(path, flip, warnings);
-    } catch (const InputError& e) {
-      f.fail("file", e.what());  // names the experiment field as well as the mesh
-    }
+    spec.file = f.string("file");
+    if (spec.file.is_relative()) spec.file = folder / spec.file;
+    spec.flip = f.boolean("flip", false);
   } else {
-    surface = read_generator(f);
-    const geom::MeshReport report = geom::inspect(surface);
-    geom::require_usable(report, f.file() + ": " + f.name("generator"));
+    spec.generate = read_generator(f);
+    spec.generator = f.string("generator");
   }
-  surface.V *= f.positive("scale", 1.0);
-  return surface;
+  spec.scale = f.positive("scale", 1.0);
+  return spec;
 }
 
 // ------------------------------------------------------------ selections
@@ -107,53 +110,46 @@ model::Schedule read_schedule(Fields& f, const std::string& fallback) {
   return schedule;
 }
 
-// The model vertices chosen by exactly one of "vertices" (input indices),
-// "where" (a half-space) or "box".
-std::vector<int> read_selection(Fields& f, const geom::Surface& model_surface,
-                                const std::vector<int>& input_to_model) {
+// A list with one number per axis: 2 or 3 now, the surface's dimension when built.
+Eigen::VectorXd per_axis_vector(Fields& f, const std::string& key) {
+  const Eigen::VectorXd v = f.vector(key, -1);
+  if (v.size() != 2 && v.size() != 3)
+    f.fail(key, "expected one number per axis (2 or 3), got " + std::to_string(v.size()));
+  return v;
+}
+
+// Exactly one of "vertices" (input indices), "where" (a half-space) or "box".
+SelectionSpec read_selection(Fields& f) {
   const int chosen = f.has("vertices") + f.has("where") + f.has("box");
   if (chosen != 1) f.fail("", "expected exactly one of \"vertices\", \"where\" or \"box\"");
-  std::vector<int> selected;
+  SelectionSpec spec;
+  spec.field = f.field();
   if (f.has("vertices")) {
-    for (int input : f.indices("vertices")) {
-      if (input >= static_cast<int>(input_to_model.size()))
-        f.fail("vertices", "vertex " + std::to_string(input) + " does not exist (the mesh has " +
-                               std::to_string(input_to_model.size()) + " vertices, from 0)");
-      if (input_to_model[static_cast<size_t>(input)] < 0)
-        f.fail("vertices", "vertex " + std::to_string(input) + " belongs to no face");
-      selected.push_back(input_to_model[static_cast<size_t>(input)]);
-    }
+    spec.vertices = f.indices("vertices");
   } else if (f.has("where")) {
-    const std::string text = f.string("where");
+    spec.where = f.string("where");
     try {
-      selected = model::select_half_space(model_surface.V,
-                                          model::parse_half_space(text, model_surface.dim));
+      model::parse_half_space(spec.where, 3);  // the syntax; the axis is checked when built
     } catch (const InputError& e) {
       f.fail("where", e.what());
     }
-    if (selected.empty()) f.fail("where", "\"" + text + "\" selects no vertex");
   } else {
     Fields box = f.object("box");
-    const Eigen::VectorXd min = box.vector("min", model_surface.dim);
-    const Eigen::VectorXd max = box.vector("max", model_surface.dim);
+    spec.box_min = per_axis_vector(box, "min");
+    spec.box_max = per_axis_vector(box, "max");
     box.finish();
-    selected = model::select_box(model_surface.V, min, max);
-    if (selected.empty()) f.fail("box", "the box selects no vertex");
   }
-  return selected;
+  return spec;
 }
 
-std::vector<int> read_axes(Fields& f, int dim) {
-  const std::string text = f.string("axes", dim == 3 ? "xyz" : "xy");
-  std::vector<int> axes;
-  for (char c : text) {
-    const int a = c - 'x';
-    if (a < 0 || a >= dim || std::count(text.begin(), text.end(), c) > 1)
-      f.fail("axes", "expected distinct letters from \"" + std::string("xyz").substr(0, dim) +
-                         "\", got \"" + text + "\"");
-    axes.push_back(a);
-  }
-  return axes;
+// The held axes: distinct letters of "xyz" ("" for all of the surface's axes).
+std::string read_axes(Fields& f) {
+  const std::string text = f.string("axes", "");
+  for (char c : text)
+    if (c < 'x' || c > 'z' || std::count(text.begin(), text.end(), c) > 1)
+      f.fail("axes", "expected distinct letters from \"xyz\", got \"" + text + "\"");
+  if (f.has("axes") && text.empty()) f.fail("axes", "expected at least one axis");
+  return text;
 }
 
 // ------------------------------------------------------------ model parts
@@ -191,140 +187,120 @@ model::FiberLaw read_law(Fields f) {
   return law;
 }
 
-model::Material read_material(Fields f, int dim) {
-  model::Material m;
+MaterialSpec read_material(Fields f) {
+  MaterialSpec spec;
+  spec.field = f.field();
+  model::Material& m = spec.material;
   if (f.has("law") && f.has("Y"))
     f.fail("Y", "give either Y (the linear model) or a law with its parameters, not both");
   if (f.has("law")) {
     m.law = read_law(f.object("law"));
     if (f.has("axis_factors")) {
-      const Eigen::VectorXd factors = f.vector("axis_factors", dim);
-      if (!(factors.array() > 0).all()) f.fail("axis_factors", "expected positive numbers");
-      m.axis_factors.head(dim) = factors;
+      spec.per_axis = per_axis_vector(f, "axis_factors");
+      if (!(spec.per_axis.array() > 0).all()) f.fail("axis_factors", "expected positive numbers");
     }
   } else if (f.raw("Y").is_array()) {
     // The paper's per-axis moduli: the constant law 1 times exact factors.
-    const Eigen::VectorXd values = f.vector("Y", dim);
-    if ((values.array() < 0).any()) f.fail("Y", "expected numbers >= 0");
+    spec.per_axis = per_axis_vector(f, "Y");
+    if ((spec.per_axis.array() < 0).any()) f.fail("Y", "expected numbers >= 0");
+    spec.per_axis_moduli = true;
     m.law = model::FiberLaw::constant(1.0);
-    m.axis_factors.setZero();
-    m.axis_factors.head(dim) = values;
   } else {
     m.law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
   }
   m.surface_tension = f.non_negative("gamma", 0.0);
   f.finish();
-  return m;
+  return spec;
 }
 
-std::vector<model::Load> read_loads(Fields& root, const geom::Surface& surface,
-                                    const std::vector<int>& input_to_model) {
-  std::vector<model::Load> loads;
+std::vector<LoadSpec> read_loads(Fields& root) {
+  std::vector<LoadSpec> loads;
   for (Fields f : root.objects("loads")) {
-    model::Load load;
+    LoadSpec spec;
+    spec.field = f.field();
+    model::Load& load = spec.load;
     const std::string type = f.choice("type", "", {"gravity", "point"});
     load.label = f.string("label", type + "_" + std::to_string(loads.size()));
     if (type == "gravity") {
       load.kind = model::Load::Kind::Hydrostatic;
-      load.acceleration.head(surface.dim) = f.vector("acceleration", surface.dim);
+      spec.vector = per_axis_vector(f, "acceleration");
       load.density = f.positive("density", 1000.0);
-      load.schedule = read_schedule(f, "ramp");
     } else {
       load.kind = model::Load::Kind::Point;
-      const int input = f.integer("vertex", 0, 0, static_cast<int>(input_to_model.size()) - 1);
-      if (input_to_model[static_cast<size_t>(input)] < 0)
-        f.fail("vertex", "vertex " + std::to_string(input) + " belongs to no face");
-      load.vertex = input_to_model[static_cast<size_t>(input)];
-      load.force.head(surface.dim) = f.vector("force", surface.dim);
-      load.schedule = read_schedule(f, "ramp");
+      spec.input_vertex = f.integer("vertex", 0, 0, std::numeric_limits<int>::max());
+      spec.vector = per_axis_vector(f, "force");
     }
+    load.schedule = read_schedule(f, "ramp");
     f.finish();
-    loads.push_back(load);
+    loads.push_back(spec);
   }
   return loads;
 }
 
 // Each entry of "supports" and "prescribed" is a group with its own reaction
 // force, named by "label" (default support_K / prescribed_K).
-void read_constraints(Fields& root, const geom::Surface& surface,
-                      const std::vector<int>& input_to_model, model::Model& model) {
-  auto add_group = [&](Fields& f, const std::string& fallback) {
-    const std::string label = f.string("label", fallback);
-    for (const std::string& other : model.constraint_groups)
-      if (other == label) f.fail("label", "\"" + label + "\" names another group already");
-    model.constraint_groups.push_back(label);
-    return static_cast<int>(model.constraint_groups.size()) - 1;
+std::vector<ConstraintSpec> read_constraints(Fields& root) {
+  std::vector<ConstraintSpec> groups;
+  auto read_group = [&](Fields& f, bool prescribed, const std::string& fallback) {
+    ConstraintSpec spec;
+    spec.field = f.field();
+    spec.prescribed = prescribed;
+    spec.label = f.string("label", fallback);
+    for (const ConstraintSpec& other : groups)
+      if (other.label == spec.label)
+        f.fail("label", "\"" + spec.label + "\" names another group already");
+    spec.selection = read_selection(f);
+    if (prescribed) {
+      spec.displacement = per_axis_vector(f, "displacement");
+      spec.schedule = read_schedule(f, "ramp");
+    } else {
+      spec.axes = read_axes(f);
+    }
+    f.finish();
+    groups.push_back(spec);
   };
   int k = 0;
-  for (Fields f : root.objects("supports")) {
-    const int group = add_group(f, "support_" + std::to_string(k++));
-    const std::vector<int> vertices = read_selection(f, surface, input_to_model);
-    const std::vector<int> axes = read_axes(f, surface.dim);
-    f.finish();
-    for (int v : vertices)
-      for (int a : axes) model.constraints.push_back({v, a, 0.0, {}, group});
-  }
+  for (Fields f : root.objects("supports")) read_group(f, false, "support_" + std::to_string(k++));
   k = 0;
-  for (Fields f : root.objects("prescribed")) {
-    const int group = add_group(f, "prescribed_" + std::to_string(k++));
-    const std::vector<int> vertices = read_selection(f, surface, input_to_model);
-    const Eigen::VectorXd displacement = f.vector("displacement", surface.dim);
-    const model::Schedule schedule = read_schedule(f, "ramp");
-    f.finish();
-    for (int v : vertices)
-      for (int a = 0; a < surface.dim; ++a)
-        model.constraints.push_back({v, a, displacement[a], schedule, group});
-  }
+  for (Fields f : root.objects("prescribed"))
+    read_group(f, true, "prescribed_" + std::to_string(k++));
+  return groups;
 }
 
 // Rigid paddles: planes normal to an axis on one side of the body, moving by
 // "travel" (m) or by "compression" (a share of the body's extent along the
 // axis, towards the body). "position" defaults to touching the body.
-std::vector<model::Paddle> read_paddles(Fields& root, const geom::Surface& surface) {
-  std::vector<model::Paddle> paddles;
+std::vector<PaddleSpec> read_paddles(Fields& root) {
+  std::vector<PaddleSpec> paddles;
   for (Fields f : root.objects("paddles")) {
-    model::Paddle p;
+    PaddleSpec spec;
+    spec.field = f.field();
+    model::Paddle& p = spec.paddle;
     p.label = f.string("label", "paddle_" + std::to_string(paddles.size()));
-    for (const model::Paddle& other : paddles)
-      if (other.label == p.label) f.fail("label", "\"" + p.label + "\" names another paddle");
+    for (const PaddleSpec& other : paddles)
+      if (other.paddle.label == p.label)
+        f.fail("label", "\"" + p.label + "\" names another paddle");
     const std::string axis = f.string("axis");
-    if (axis.size() != 1 || axis[0] < 'x' || axis[0] >= 'x' + surface.dim)
-      f.fail("axis", "expected one of \"" + std::string("xyz").substr(0, surface.dim) +
-                         "\" (the paddle's normal), got \"" + axis + "\"");
+    if (axis.size() != 1 || axis[0] < 'x' || axis[0] > 'z')
+      f.fail("axis", "expected one of \"xyz\" (the paddle's normal), got \"" + axis + "\"");
     p.axis = axis[0] - 'x';
     p.above = f.choice("side", "", {"above", "below"}) == "above";
-    const Eigen::VectorXd along = surface.V.col(p.axis);
-    const double extent = along.maxCoeff() - along.minCoeff();
-    p.position = f.number("position", p.above ? along.maxCoeff() : along.minCoeff());
-    if (p.penetration(p.above ? along.maxCoeff() : along.minCoeff(), p.position) >
-        1e-9 * extent)
-      f.fail("position", "the paddle starts inside the body: it must be " +
-                             std::string(p.above ? "at or above " : "at or below ") +
-                             std::to_string(p.above ? along.maxCoeff() : along.minCoeff()));
+    if (f.has("position")) spec.position = f.number("position");
     if (f.has("travel") == f.has("compression"))
       f.fail("travel", "give either travel (m, along the axis) or compression (a share of "
                        "the body's extent), one of them");
     if (f.has("travel")) {
-      p.travel = f.number("travel");
+      spec.travel = f.number("travel");
     } else {
-      const double share = f.number("compression");
-      if (!(share > 0.0 && share < 1.0))
+      spec.compression = f.number("compression");
+      if (!(*spec.compression > 0.0 && *spec.compression < 1.0))
         f.fail("compression", "expected a share of the body's extent between 0 and 1");
-      p.travel = (p.above ? -1.0 : 1.0) * share * extent;
     }
     p.schedule = read_schedule(f, "ramp");
     p.sticking = f.choice("contact", "frictionless", {"frictionless", "sticking"}) == "sticking";
     f.finish();
-    paddles.push_back(p);
+    paddles.push_back(spec);
   }
-  // Two paddles on one axis may not meet (checked at every step by the solver too).
-  for (const model::Paddle& a : paddles)
-    for (const model::Paddle& b : paddles)
-      if (a.axis == b.axis && a.above && !b.above &&
-          !(a.plane(1.0) > b.plane(1.0) && a.position > b.position))
-        root.fail("paddles", "paddles " + a.label + " and " + b.label +
-                                 " meet or pass each other: their travels leave no room for "
-                                 "the body");
   return paddles;
 }
 
@@ -376,18 +352,16 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   return options;
 }
 
-void check_tables(const Fields& root, const Case& c) {
+void check_tables(const Fields& root, const CaseSpec& c) {
   auto check = [&](const model::Schedule& s, const std::string& what) {
     if (s.kind == model::Schedule::Kind::Table &&
         static_cast<int>(s.values.size()) != c.stepping.steps)
       root.fail(what, "the schedule lists " + std::to_string(s.values.size()) +
                           " factors but stepping.steps is " + std::to_string(c.stepping.steps));
   };
-  for (size_t l = 0; l < c.model.loads.size(); ++l)
-    check(c.model.loads[l].schedule, "loads[" + std::to_string(l) + "].schedule");
-  for (const model::Constraint& k : c.model.constraints) check(k.schedule, "prescribed.schedule");
-  for (size_t p = 0; p < c.model.paddles.size(); ++p)
-    check(c.model.paddles[p].schedule, "paddles[" + std::to_string(p) + "].schedule");
+  for (const LoadSpec& l : c.loads) check(l.load.schedule, l.field.path + ".schedule");
+  for (const ConstraintSpec& k : c.constraints) check(k.schedule, k.field.path + ".schedule");
+  for (const PaddleSpec& p : c.paddles) check(p.paddle.schedule, p.field.path + ".schedule");
 }
 
 std::vector<ExpectedFigure> read_expected(Fields& root) {
@@ -423,103 +397,53 @@ std::vector<ExpectedFigure> read_expected(Fields& root) {
   return expected;
 }
 
-// Reads "fibers" and prunes the fibers that leave a concave body.
-void read_fibers(Fields& root, Case& c) {
-  std::string mode = "auto", count = "symmetric";
-  if (root.has("fibers")) {
-    Fields f = root.object("fibers");
-    mode = f.choice("pruning", "auto", {"auto", "off"});
-    count = f.choice("connection_count", "symmetric", {"symmetric", "global"});
-    c.fibers.write = f.choice("write", "none", {"none", "kept", "pruned"});
-    f.finish();
-  }
-  model::Model& m = c.model;
-  m.connection_count =
-      count == "global" ? model::ConnectionCount::Global : model::ConnectionCount::Symmetric;
-  FiberReport& report = c.fibers;
-  report.pruning = mode == "auto";
-  const int n = m.num_vertices();
-  report.pairs = static_cast<long long>(n) * (n - 1) / 2;
-  report.kept = report.pairs;
-  report.min_per_vertex = report.max_per_vertex = n - 1;
-  report.mean_per_vertex = n - 1;
-  if (!report.pruning) return;
-  report.convex = geom::is_convex(m.surface);
-  if (report.convex) return;
-  // N^2 pair tests (5,000 vertices: about 2 minutes here) and an N^2 byte table.
-  constexpr int kLargestPruned = 10000;
-  if (n > kLargestPruned)
-    root.fail("fibers.pruning", "a concave body of " + std::to_string(n) +
-                                    " vertices is beyond exact pruning (at most " +
-                                    std::to_string(kLargestPruned) + "); set \"off\"");
-  geom::PruningResult pruned = geom::prune_fibers(m.surface);
-  report.seconds = pruned.seconds;
-  report.exact_fallbacks = pruned.exact_fallbacks;
-  report.kept = pruned.mask.num_kept();
-  const std::vector<int> per_vertex = pruned.mask.kept_per_vertex();
-  report.min_per_vertex = *std::min_element(per_vertex.begin(), per_vertex.end());
-  report.max_per_vertex = *std::max_element(per_vertex.begin(), per_vertex.end());
-  report.mean_per_vertex = 2.0 * report.kept / n;
-  if (report.min_per_vertex == 0)
-    root.fail("fibers.pruning", "vertex " +
-                                    std::to_string(std::find(per_vertex.begin(), per_vertex.end(), 0) -
-                                                   per_vertex.begin()) +
-                                    " keeps no fiber: is the mesh self-intersecting?");
-  m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
+FiberSpec read_fibers(Fields& root) {
+  FiberSpec spec;
+  spec.field = {root.file(), root.name("fibers")};
+  if (!root.has("fibers")) return spec;
+  Fields f = root.object("fibers");
+  spec.pruning = f.choice("pruning", "auto", {"auto", "off"}) == "auto";
+  spec.count = f.choice("connection_count", "symmetric", {"symmetric", "global"}) == "global"
+                   ? model::ConnectionCount::Global
+                   : model::ConnectionCount::Symmetric;
+  spec.write = f.choice("write", "none", {"none", "kept", "pruned"});
+  f.finish();
+  return spec;
 }
 
-// The surface, its compaction and its fibers: what several variants that
-// share "surface" and "fibers" build once (pruning a large mesh takes seconds).
-struct SurfaceKey {
-  std::string surface, fibers;
-  bool operator==(const SurfaceKey& o) const { return surface == o.surface && fibers == o.fibers; }
-};
-
-// Builds one case from a complete simulation document, reusing the surface
-// and fibers of an earlier case with the same "surface" and "fibers".
-void build_case(Fields& root, const std::filesystem::path& folder, std::vector<Case>& built,
-                std::vector<SurfaceKey>& keys, std::vector<std::string>* warnings, Case& c) {
-  const SurfaceKey key{root.raw("surface").dump(),
-                       root.has("fibers") ? root.raw("fibers").dump() : std::string()};
-  const auto same = std::find(keys.begin(), keys.end(), key);
-  if (same != keys.end()) {
-    const Case& earlier = built[static_cast<size_t>(same - keys.begin())];
-    c.input_surface = earlier.input_surface;
-    c.model_to_input = earlier.model_to_input;
-    c.model.surface = earlier.model.surface;
-    c.model.fibers = earlier.model.fibers;
-    c.model.connection_count = earlier.model.connection_count;
-    c.fibers = earlier.fibers;
-  } else {
+// Parses one case from a complete simulation document; opens no file.
+CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
+                   std::vector<std::string>* warnings) {
+  CaseSpec c;
+  if (root.has("surface")) {
     Fields surface = root.object("surface");
-    c.input_surface = read_surface_spec(surface, folder, warnings);
+    c.surface = read_surface_spec(surface, folder);
     surface.finish();
-    const geom::CompactSurface compact = geom::remove_unused_vertices(c.input_surface);
-    c.model_to_input = compact.to_input;
-    c.model.surface = compact.surface;
-    read_fibers(root, c);
+  } else {  // the program building the case gives the surface
+    c.surface.field = {root.file(), root.name("surface")};
   }
-  std::vector<int> from_input(static_cast<size_t>(c.input_surface.num_vertices()), -1);
-  for (size_t m = 0; m < c.model_to_input.size(); ++m)
-    from_input[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
-  const int dim = c.model.dim();
-  c.model.material = read_material(root.object("material"), dim);
-  c.model.loads = read_loads(root, c.model.surface, from_input);
-  read_constraints(root, c.model.surface, from_input, c.model);
-  c.model.paddles = read_paddles(root, c.model.surface);
+  c.fibers = read_fibers(root);
+  c.surface_key = (root.has("surface") ? root.raw("surface").dump() : std::string()) + "|" +
+                  (root.has("fibers") ? root.raw("fibers").dump() : std::string());
+  c.material = read_material(root.object("material"));
+  c.loads = read_loads(root);
+  c.constraints = read_constraints(root);
+  c.paddles = read_paddles(root);
+  c.paddles_field = {root.file(), root.name("paddles")};
   c.stepping = root.has("stepping") ? read_stepping(root.object("stepping"), {})
                                     : solve::SteppingOptions{};
-  if (!c.model.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
+  if (!c.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
     root.fail("paddles", "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
                          "an active set inside the equilibrium iterations)");
-  if (!c.model.material.law.is_constant() && c.stepping.scheme == solve::Scheme::Incremental &&
-      !c.stepping.rebuild_matrix && warnings != nullptr)
+  if (!c.material.material.law.is_constant() &&
+      c.stepping.scheme == solve::Scheme::Incremental && !c.stepping.rebuild_matrix &&
+      warnings != nullptr)
     warnings->push_back("material.law: the incremental scheme without stepping.rebuild_matrix "
                         "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
                         "scheme \"newton\" for the strain-dependent law");
   check_tables(root, c);
   root.finish();
-  keys.push_back(key);
+  return c;
 }
 
 // Fields of the experiment that a variant may not patch.
@@ -527,7 +451,7 @@ const char* const kExperimentFields[] = {"name", "description", "kind", "variant
                                          "output"};
 
 void check_variant_name(const Fields& f, const std::string& name,
-                        const std::vector<Case>& earlier) {
+                        const std::vector<CaseSpec>& earlier) {
   const bool safe = !name.empty() && name != "." && name != ".." &&
                     std::all_of(name.begin(), name.end(), [](unsigned char ch) {
                       return std::isalnum(ch) || ch == '_' || ch == '-' || ch == '.';
@@ -535,7 +459,7 @@ void check_variant_name(const Fields& f, const std::string& name,
   if (!safe)
     f.fail("name", "expected a non-empty name of letters, digits, '_', '-' or '.' (it names "
                    "the variant's output folder), got \"" + name + "\"");
-  for (const Case& c : earlier)
+  for (const CaseSpec& c : earlier)
     if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
 }
 
@@ -545,31 +469,29 @@ void read_simulation(Fields& root, const nlohmann::json& document,
                      const std::filesystem::path& folder, Experiment& ex) {
   json base = document;
   for (const char* field : kExperimentFields) base.erase(field);
-  std::vector<SurfaceKey> keys;
   if (!root.has("variants")) {
     Fields f(base, "", root.file());
-    Case c;
-    build_case(f, folder, ex.cases, keys, &ex.warnings, c);
-    ex.cases.push_back(std::move(c));
+    ex.specs.push_back(read_case(f, folder, &ex.warnings));
   } else {
     const json& variants = root.raw("variants");
     if (!variants.is_array() || variants.empty())
       root.fail("variants", "expected a non-empty list of objects");
     for (size_t k = 0; k < variants.size(); ++k) {
       Fields v(variants[k], "variants[" + std::to_string(k) + "]", root.file());
-      Case c;
-      c.variant = v.string("name");
-      check_variant_name(v, c.variant, ex.cases);
-      c.patch = variants[k];
-      c.patch.erase("name");
+      const std::string name = v.string("name");
+      check_variant_name(v, name, ex.specs);
+      json patch = variants[k];
+      patch.erase("name");
       for (const char* field : kExperimentFields)
-        if (c.patch.contains(field))
+        if (patch.contains(field))
           v.fail(field, "belongs to the whole experiment; a variant cannot change it");
       json patched = base;
-      patched.merge_patch(c.patch);
-      Fields f(patched, "", root.file() + " [variant " + c.variant + "]");
-      build_case(f, folder, ex.cases, keys, &ex.warnings, c);
-      ex.cases.push_back(std::move(c));
+      patched.merge_patch(patch);
+      Fields f(patched, "", root.file() + " [variant " + name + "]");
+      CaseSpec c = read_case(f, folder, &ex.warnings);
+      c.variant = name;
+      c.patch = patch;
+      ex.specs.push_back(std::move(c));
     }
   }
   if (root.has("output")) {
@@ -583,32 +505,19 @@ void read_simulation(Fields& root, const nlohmann::json& document,
 
 void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
   for (Fields f : root.objects("surfaces")) {
-    NamedSurface named;
+    NamedSurfaceSpec named;
     named.name = f.string("name");
-    named.surface = read_surface_spec(f, folder, &ex.warnings);
+    named.surface = read_surface_spec(f, folder);
     f.finish();
-    ex.area_surfaces.push_back(named);
+    ex.area_specs.push_back(named);
   }
-  if (ex.area_surfaces.empty()) root.fail("surfaces", "expected at least one surface");
+  if (ex.area_specs.empty()) root.fail("surfaces", "expected at least one surface");
 }
 
 }  // namespace
 
-geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
-                                   std::vector<std::string>* warnings) {
-  geom::ReadResult read = geom::read_surface(path);
-  if (flip) geom::flip_orientation(read.surface);
-  const geom::MeshReport report = geom::inspect(read.surface);
-  geom::require_usable(report, path.string());
-  if (warnings) {
-    warnings->insert(warnings->end(), read.warnings.begin(), read.warnings.end());
-    for (const auto& w : report.warnings) warnings->push_back(path.string() + ": " + w);
-  }
-  return read.surface;
-}
-
-Experiment parse_experiment(const json& document, const std::filesystem::path& folder,
-                            const std::string& label) {
+Experiment read_experiment(const json& document, const std::filesystem::path& folder,
+                           const std::string& label) {
   Fields root(document, "", label);
   Experiment ex;
   ex.name = root.string("name", "experiment");
@@ -623,6 +532,32 @@ Experiment parse_experiment(const json& document, const std::filesystem::path& f
     read_areas(root, folder, ex);
     root.finish();
   }
+  return ex;
+}
+
+void build_experiment(Experiment& ex, const geom::Surface* surface) {
+  ex.cases.clear();
+  ex.area_surfaces.clear();
+  for (const NamedSurfaceSpec& named : ex.area_specs)
+    ex.area_surfaces.push_back({named.name, build_surface(named.surface, &ex.warnings)});
+  for (const CaseSpec& spec : ex.specs) {
+    const auto same = std::find_if(ex.specs.begin(), ex.specs.end(), [&](const CaseSpec& s) {
+      return s.surface_key == spec.surface_key;
+    });
+    const size_t earlier = static_cast<size_t>(same - ex.specs.begin());
+    if (earlier < ex.cases.size())
+      ex.cases.push_back(build_case(spec, ex.cases[earlier]));
+    else if (surface != nullptr)
+      ex.cases.push_back(build_case(spec, *surface, &ex.warnings));
+    else
+      ex.cases.push_back(build_case(spec, &ex.warnings));
+  }
+}
+
+Experiment parse_experiment(const json& document, const std::filesystem::path& folder,
+                            const std::string& label) {
+  Experiment ex = read_experiment(document, folder, label);
+  build_experiment(ex);
   return ex;
 }
 

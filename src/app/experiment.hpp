@@ -7,9 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "app/case_spec.hpp"
 #include "geom/surface.hpp"
-#include "model/model.hpp"
-#include "solve/load_stepper.hpp"
 
 namespace fiberfluid::app {
 
@@ -30,38 +29,15 @@ struct OutputOptions {
   int every = 1;     // write every k-th step's .vtu (the last always)
 };
 
-// What the fiber pruning did (issue 4), for the summary.
-struct FiberReport {
-  bool pruning = true;         // "fibers.pruning": "auto" (prune a concave body) or "off"
-  bool convex = false;         // the fast path: nothing to prune
-  long long pairs = 0;         // fibers in all, N (N-1) / 2
-  long long kept = 0;
-  int min_per_vertex = 0, max_per_vertex = 0;
-  double mean_per_vertex = 0.0;
-  double seconds = 0.0;
-  long long exact_fallbacks = 0;  // pairs decided by exact constructions
-  std::string write = "none";     // "kept" or "pruned": DIR/fibers.vtu
-};
-
 // A named surface for an "areas" experiment (the paper's Table 1).
 struct NamedSurface {
   std::string name;
   geom::Surface surface;
 };
 
-// One simulation, fully resolved: the whole experiment when it does not
-// sweep, or one variant of a sweep (the base document with the variant's
-// JSON merge patch applied).
-struct Case {
-  std::string variant;        // "" unless the experiment sweeps
-  nlohmann::json patch;       // the variant's merge patch (null without a sweep)
-  // The surface as given (input vertex order), the model on its used
-  // vertices, and the map between the two.
-  geom::Surface input_surface;
-  std::vector<int> model_to_input;
-  model::Model model;
-  solve::SteppingOptions stepping;
-  FiberReport fibers;
+struct NamedSurfaceSpec {
+  std::string name;
+  SurfaceSpec surface;
 };
 
 // A parsed and validated experiment file.
@@ -72,22 +48,25 @@ struct Experiment {
   std::string description;
   std::filesystem::path source;  // the JSON file ("" for a document built in a program)
 
-  std::vector<Case> cases;       // Simulate: one, or one per variant
+  // As parsed (read_experiment), and as built (build_experiment):
+  std::vector<CaseSpec> specs;   // Simulate: one, or one per variant
+  std::vector<Case> cases;
   OutputOptions output;
 
   // Areas:
+  std::vector<NamedSurfaceSpec> area_specs;
   std::vector<NamedSurface> area_surfaces;
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader
 
-  bool sweeps() const { return !cases.empty() && !cases.front().variant.empty(); }
+  bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
 };
 
-// Reads and validates an experiment file. Throws InputError naming the file
-// and the field (e.g. "sphere.json: material.Y: expected a positive number")
-// for an unknown field, a wrong type, a missing or bad mesh, a selection that
-// selects nothing; nothing is written.
+// Reads and validates an experiment file, then builds it. Throws InputError
+// naming the file and the field (e.g. "sphere.json: material.Y: expected a
+// positive number") for an unknown field, a wrong type, a missing or bad
+// mesh, a selection that selects nothing; nothing is written.
 Experiment load_experiment(const std::filesystem::path& path);
 
 // The same from a JSON document built in a program (e.g. a Python dict):
@@ -95,9 +74,12 @@ Experiment load_experiment(const std::filesystem::path& path);
 Experiment parse_experiment(const nlohmann::json& document, const std::filesystem::path& folder,
                             const std::string& label);
 
-// Reads a mesh file and checks it (closed, manifold, outward, ...), optionally
-// flipping an inward mesh first. Throws InputError naming the file.
-geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
-                                   std::vector<std::string>* warnings);
+// The two phases of parse_experiment. read_experiment checks every field
+// that needs no mesh and opens no file (the cases stay unbuilt);
+// build_experiment loads the meshes, prunes and builds every case, on
+// `surface` when given (for documents without a "surface": a program's own mesh).
+Experiment read_experiment(const nlohmann::json& document, const std::filesystem::path& folder,
+                           const std::string& label);
+void build_experiment(Experiment& experiment, const geom::Surface* surface = nullptr);
 
 }  // namespace fiberfluid::app

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/case_spec.hpp"
 #include "geom/error.hpp"
 
 namespace fiberfluid::app {
@@ -133,6 +134,8 @@ class Fields {
   }
 
   const std::string& file() const { return file_; }
+  // This object's name, kept with what was read from it for errors found later.
+  FieldName field() const { return {file_, path_}; }
 
  private:
   std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }

@@ -179,12 +179,32 @@ PYBIND11_MODULE(fiberfluid, m) {
                   "file and field on bad input.")
       .def_static(
           "from_dict",
-          [](const py::object& document, const std::filesystem::path& folder) {
-            return ff::app::parse_experiment(to_json(document), folder, "<dict>");
+          [](const py::object& document, const std::filesystem::path& folder,
+             const std::optional<Eigen::MatrixXd>& vertices,
+             const std::optional<Eigen::MatrixXi>& faces) {
+            ff::app::Experiment ex = ff::app::read_experiment(to_json(document), folder, "<dict>");
+            if (vertices.has_value() != faces.has_value())
+              throw ff::InputError("<dict>: give both vertices and faces, or neither");
+            if (!vertices) {
+              ff::app::build_experiment(ex);
+              return ex;
+            }
+            ff::geom::Surface surface;
+            surface.dim = static_cast<int>(vertices->cols());
+            if ((surface.dim != 2 && surface.dim != 3) || faces->cols() != surface.dim)
+              throw ff::InputError("<dict>: vertices must be #V x 3 with faces #F x 3 (or "
+                                   "#V x 2 with segments #F x 2)");
+            surface.V = *vertices;
+            surface.F = *faces;
+            ff::app::build_experiment(ex, &surface);
+            return ex;
           },
           py::arg("document"), py::arg("folder") = std::filesystem::path("."),
+          py::arg("vertices") = py::none(), py::arg("faces") = py::none(),
           "Builds an experiment from a dict with the fields of an experiment file; relative "
-          "mesh paths are taken from `folder`.")
+          "mesh paths are taken from `folder`. A program's own surface may be given as "
+          "`vertices` (#V x 3) and `faces` (#F x 3, from 0) instead of the dict's \"surface\"; "
+          "it is checked like a mesh file.")
       .def_property_readonly("name", [](const ff::app::Experiment& ex) { return ex.name; })
       .def_property_readonly("variants",
                              [](const ff::app::Experiment& ex) {

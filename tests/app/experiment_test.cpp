@@ -9,6 +9,7 @@
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "geom/error.hpp"
+#include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
 
@@ -113,7 +114,7 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
 
   c = base_config();
   c["loads"][0] = {{"type", "point"}, {"vertex", 99}, {"force", {1, 0, 0}}};
-  expect_config_error(dir, c, "loads[0].vertex: expected a whole number from 0 to 41");
+  expect_config_error(dir, c, "loads[0].vertex: vertex 99 does not exist (the mesh has 42");
 
   c = base_config();
   c["loads"][0]["acceleration"] = {0, -9.81};
@@ -328,4 +329,92 @@ TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) 
 }
 
 }  // namespace
+// Parsing opens no file and builds nothing; building loads, prunes and resolves.
+TEST(ExperimentPhases, ReadingOpensNoFileAndBuildingNamesTheField) {
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", "no_such_mesh.obj"}};
+  Experiment ex = read_experiment(c, "/nonexistent_folder", "doc");
+  ASSERT_EQ(ex.specs.size(), 1u);
+  EXPECT_TRUE(ex.cases.empty());
+  EXPECT_EQ(ex.specs[0].surface.file, std::filesystem::path("/nonexistent_folder/no_such_mesh.obj"));
+  try {
+    build_experiment(ex);
+    ADD_FAILURE() << "built a case on a missing mesh";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("doc: surface.file: ", 0), 0u) << e.what();
+  }
+
+  // What only the mesh reveals: a list with one entry per axis of a 2D surface.
+  c = base_config();
+  c["surface"] = {{"generator", "rectangle"}, {"min", {0, 0}}, {"max", {2, 1}}};
+  c["supports"][0]["where"] = "y <= 0";
+  ex = read_experiment(c, ".", "doc");  // 3 numbers are fine before the surface is known
+  try {
+    build_experiment(ex);
+    ADD_FAILURE() << "a 3D acceleration on a 2D surface";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("doc: loads[0].acceleration: expected a list of 2 "
+                                         "numbers"),
+              std::string::npos)
+        << e.what();
+  }
+  c["supports"][0]["where"] = "z <= 0";
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  ex = read_experiment(c, ".", "doc");
+  EXPECT_THROW(build_experiment(ex), InputError);  // no z axis in 2D
+}
+
+// A program builds a model on its own surface, without a mesh file, and gets
+// the very model the file-based experiment builds.
+TEST(ExperimentPhases, AProgramGivesTheSurface) {
+  const nlohmann::json with_generator = base_config();
+  const Experiment from_generator = parse_experiment(with_generator, ".", "doc");
+
+  nlohmann::json without_surface = base_config();
+  without_surface.erase("surface");
+  Experiment ex = read_experiment(without_surface, ".", "doc");
+  const geom::Surface sphere = geom::icosphere(1, 1.0);
+  build_experiment(ex, &sphere);
+  ASSERT_EQ(ex.cases.size(), 1u);
+  const model::Model& a = from_generator.cases[0].model;
+  const model::Model& b = ex.cases[0].model;
+  EXPECT_EQ(b.surface.V, a.surface.V);
+  ASSERT_EQ(b.constraints.size(), a.constraints.size());
+  for (size_t k = 0; k < a.constraints.size(); ++k)
+    EXPECT_EQ(b.constraints[k].vertex, a.constraints[k].vertex);
+  const ExperimentResult ra = run_experiment(from_generator), rb = run_experiment(ex);
+  ASSERT_TRUE(ra.runs_succeeded() && rb.runs_succeeded());
+  EXPECT_EQ(rb.runs[0].summary.unknowns, ra.runs[0].summary.unknowns);
+
+  // One spec builds on any surface: a concave one is pruned on the way.
+  Experiment on_cube = read_experiment(without_surface, ".", "doc");
+  geom::Surface dented = geom::icosphere(2, 1.0);
+  for (int i = 0; i < dented.num_vertices(); ++i)
+    if (dented.V(i, 0) > 0.9) dented.V(i, 0) -= 0.5;  // push a cap inward
+  build_experiment(on_cube, &dented);
+  EXPECT_FALSE(on_cube.cases[0].fibers.convex);
+  EXPECT_LT(on_cube.cases[0].fibers.kept, on_cube.cases[0].fibers.pairs);
+
+  // Neither the document nor the program gives a surface, or both do.
+  Experiment nothing = read_experiment(without_surface, ".", "doc");
+  try {
+    build_experiment(nothing);
+    ADD_FAILURE() << "built without a surface";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("doc: surface: missing", 0), 0u) << e.what();
+  }
+  Experiment both = read_experiment(with_generator, ".", "doc");
+  EXPECT_THROW(build_experiment(both, &sphere), InputError);
+  // A surface the program gives is checked like a mesh file.
+  geom::Surface open = sphere;
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  Experiment on_open = read_experiment(without_surface, ".", "doc");
+  try {
+    build_experiment(on_open, &open);
+    ADD_FAILURE() << "built on an open surface";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the given surface"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace fiberfluid::app

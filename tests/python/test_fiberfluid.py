@@ -109,3 +109,25 @@ def test_the_python_example_runs(tmp_path):
     largest = [float(row[1]) for row in rows]
     assert largest == sorted(largest, reverse=True)
     assert png.stat().st_size > 10000
+
+
+def test_a_program_gives_its_own_surface():
+    """The paper's rectangle as numpy arrays instead of the dict's "surface"."""
+    document = rectangle_dict()
+    from_file = fiberfluid.Experiment.from_dict(document).run()
+    del document["surface"]
+    vertices = np.array([[15.0, 20.0], [15.0, -20.0], [-15.0, -20.0], [-15.0, 20.0]])
+    segments = np.array([[1, 0], [2, 1], [3, 2], [0, 3]])  # counter-clockwise: outward normals
+    with pytest.raises(ValueError, match="the given surface: inverted"):
+        fiberfluid.Experiment.from_dict(document, vertices=vertices, faces=segments[:, ::-1])
+    given = fiberfluid.Experiment.from_dict(document, vertices=vertices, faces=segments)
+    assert given.num_vertices == 4
+    result = given.run()
+    assert result["success"]
+    assert result["runs"][0]["pressure"] == pytest.approx(32.0, abs=1e-10)
+    np.testing.assert_allclose(result["runs"][0]["displacements"],
+                               from_file["runs"][0]["displacements"], atol=1e-12)
+    with pytest.raises(ValueError, match="give both vertices and faces"):
+        fiberfluid.Experiment.from_dict(document, vertices=vertices)
+    with pytest.raises(ValueError, match="surface: missing"):
+        fiberfluid.Experiment.from_dict(document)
