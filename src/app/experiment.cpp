@@ -346,6 +346,7 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
   options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
   options.max_volume_change = f.positive("max_volume_change", options.max_volume_change);
+  options.measure_residual = f.boolean("measure_residual", options.measure_residual);
   options.stop_on_inverted_faces =
       f.boolean("stop_on_inverted_faces", options.stop_on_inverted_faces);
   f.finish();

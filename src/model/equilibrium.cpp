@@ -493,4 +493,25 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
   return D;
 }
 
+double Equilibrium::relative_norm(const Eigen::VectorXd& reduced, double force_scale) const {
+  const Eigen::Index m = reduced.size() - 1;
+  const double force = reduced.head(m).norm() / std::max(force_scale, 1e-300);
+  const double volume = reduced[m] / volume_scale();
+  return std::hypot(force, volume);
+}
+
+std::shared_ptr<const FiberSystem> Equilibrium::linear_system(const Eigen::MatrixXd& X,
+                                                              const DofMap& dofs,
+                                                              BoundaryMethod method,
+                                                              double penalty,
+                                                              bool strained) const {
+  return std::make_shared<const FiberSystem>(model_, X, dofs, method, penalty,
+                                             strained ? &X : nullptr);
+}
+
+Eigen::VectorXd Equilibrium::load_vector(const Eigen::MatrixXd& X,
+                                         const std::vector<double>& factors) const {
+  return right_hand_side(model_, X, factors);
+}
+
 }  // namespace fiberfluid::model

@@ -3,10 +3,13 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
+#include "model/fiber_system.hpp"
 #include "model/model.hpp"
 
 namespace fiberfluid::model {
@@ -77,6 +80,19 @@ class Equilibrium {
   // The same into an existing operator, reusing its arrays (no new pages to fault in).
   void linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
                  TangentOperator& op) const;
+
+  // The size of a residual: the free force rows (reduced) over force_scale
+  // and the volume row over volume_scale(), combined as a Euclidean norm.
+  double relative_norm(const Eigen::VectorXd& reduced_residual, double force_scale) const;
+
+  // The paper's incremental scheme (model.md sections 3-7) linearises at a
+  // geometry X instead: its A with lengths and area vectors from X (and with
+  // `strained`, the secant moduli Y(e) at X's strains), the unknowns `dofs`
+  // holds eliminated or penalised; and its load vector B at X.
+  std::shared_ptr<const FiberSystem> linear_system(const Eigen::MatrixXd& X, const DofMap& dofs,
+                                                   BoundaryMethod method, double penalty,
+                                                   bool strained) const;
+  Eigen::VectorXd load_vector(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
 
   // dR/dtheta, one column per name: a parameter of the law ("Y", "Y0",
   // "beta", "Y_t", "Y_c", "scale"), "gamma", or "factor_x" / "factor_y" /

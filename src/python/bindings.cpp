@@ -38,7 +38,7 @@ py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s)
   const auto n = static_cast<Eigen::Index>(s.steps.size());
   const int dim = c.model.dim();
   Eigen::VectorXi step(n);
-  Eigen::VectorXd pressure(n), volume(n), max_displacement(n), seconds(n);
+  Eigen::VectorXd pressure(n), volume(n), max_displacement(n), residual(n), seconds(n);
   Eigen::MatrixXd applied(n, dim), factors(n, static_cast<Eigen::Index>(c.model.loads.size()));
   const size_t groups = std::max<size_t>(1, c.model.constraint_groups.size());
   std::vector<Eigen::MatrixXd> reactions(groups, Eigen::MatrixXd::Zero(n, dim));
@@ -48,6 +48,7 @@ py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s)
     pressure[k] = r.pressure;
     volume[k] = r.volume;
     max_displacement[k] = r.max_displacement;
+    residual[k] = r.residual;
     seconds[k] = r.seconds;
     applied.row(k) = r.applied_force.head(dim).transpose();
     for (size_t l = 0; l < r.load_factors.size(); ++l)
@@ -60,6 +61,7 @@ py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s)
   out["pressure"] = pressure;
   out["volume"] = volume;
   out["max_displacement"] = max_displacement;
+  out["equilibrium_residual"] = residual;
   out["seconds"] = seconds;
   out["applied_force"] = applied;
   py::dict load_factors;

@@ -9,11 +9,12 @@
 #include <sstream>
 
 #include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "model/loads.hpp"
 #include "geom/error.hpp"
-#include "model/fiber_system.hpp"
 #include "geom/progress.hpp"
+#include "model/assembly.hpp"
+#include "model/equilibrium.hpp"
+#include "model/fiber_system.hpp"
+#include "model/loads.hpp"
 #include "solve/stepping_common.hpp"
 
 namespace fiberfluid::solve {
@@ -176,14 +177,17 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   const double reference_volume = geom::enclosed_volume(reference, model.surface.F);
   const Eigen::MatrixXd reference_face_areas = geom::face_area_vectors(reference, model.surface.F);
   std::optional<Reactions> reactions;
+  std::optional<model::Equilibrium> problem;
   try {
-    reactions.emplace(model);
-  } catch (const InputError& e) {  // one unknown held at two values
+    reactions.emplace(model);  // throws when one unknown is held at two values
+    problem.emplace(model);    // or when two vertices coincide
+  } catch (const InputError& e) {
     return fail(e.what());
   }
   const model::DofMap dofs = model::DofMap::from_constraints(model);
   const int nv = model.num_vertices();
   Eigen::Vector3d applied = Eigen::Vector3d::Zero();  // the loads so far, summed over vertices
+  ResidualGauge residual_gauge;
   std::shared_ptr<const model::FiberSystem> system;  // outlives its factorisation
   std::shared_ptr<LinearSolver> solver;
 
@@ -197,9 +201,9 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
       try {
         // Rebuilt: lengths, area vectors and (for a strain-dependent law) the
         // secant moduli from x_{k-1}, the paper's words (model.md section 7).
-        system = std::make_shared<const model::FiberSystem>(
-            model, options.rebuild_matrix ? X : reference, dofs, options.boundary_method,
-            options.penalty, options.rebuild_matrix ? &X : nullptr);
+        system = problem->linear_system(options.rebuild_matrix ? X : reference, dofs,
+                                        options.boundary_method, options.penalty,
+                                        options.rebuild_matrix);
       } catch (const InputError& e) {  // e.g. two vertices pressed onto each other
         return fail("step " + std::to_string(k) + ": " + e.what());
       }
@@ -227,7 +231,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     std::vector<double> increment(now.size());
     for (size_t l = 0; l < now.size(); ++l) increment[l] = now[l] - before[l];
     const Eigen::VectorXd dB =
-        model::right_hand_side(model, options.update_load_geometry ? X : reference, increment);
+        problem->load_vector(options.update_load_geometry ? X : reference, increment);
     const Eigen::VectorXd dU_c = model::constrained_displacements(model, k, n) -
                                  model::constrained_displacements(model, k - 1, n);
     const Eigen::VectorXd rhs = system->reduce_rhs(dB.head(dB.size() - 1), dU_c);
@@ -258,6 +262,8 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     record.applied_force = applied;
     record.reactions = reactions->per_group();
     record.max_displacement = (X_now - reference).rowwise().norm().maxCoeff();
+    if (options.measure_residual)
+      record.residual = residual_gauge.measure(*problem, dofs, summary.unknowns, now);
     record.seconds = seconds_since(step_start);
     summary.steps.push_back(record);
     report_progress("step", k, n);

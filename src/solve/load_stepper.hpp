@@ -69,6 +69,9 @@ struct SteppingOptions {
   // fraction of the reference volume, or turns a face over, ends the run.
   double max_volume_change = 0.5;
   bool stop_on_inverted_faces = true;
+  // Incremental: measure each step's equilibrium residual (StepRecord::residual),
+  // one O(N^2) pass over the fibers per step.
+  bool measure_residual = true;
   // Newton: keep the tangent solve prepared at the solution in the summary
   // (final_tangent), for sensitivities. It holds O(N^2) memory.
   bool keep_final_tangent = false;
@@ -82,6 +85,11 @@ struct StepRecord {
   double pressure = 0.0;              // P after this step
   double volume = 0.0;                // enclosed volume (area in 2D) after this step
   double max_displacement = 0.0;      // max_i |u_i|
+  // How far the state reached is from equilibrium: the relative |R| of
+  // model.md section 7 (Equilibrium::relative_norm). Newton drives it below
+  // its tolerance; the incremental scheme leaves what its linearisation
+  // misses (with SteppingOptions::measure_residual).
+  double residual = 0.0;
   double seconds = 0.0;               // wall time of this step
   // Force that each constraint group (Model::constraint_groups) exerts on the
   // body, and the sum of the external loads; they sum to zero at equilibrium.

@@ -184,22 +184,13 @@ class NewtonSolver {
     return released;
   }
 
-  // The relative residual: force rows over the force scale, the volume row
-  // over dim C0 V0.
+  // The relative residual (the gauge's force scale: the largest load or reaction seen).
   double measure(const Eigen::VectorXd& reduced) const {
-    const Eigen::Index m = reduced.size() - 1;
-    const double force = reduced.head(m).norm() / std::max(peak_force_, 1e-300);
-    const double volume = reduced[m] / equilibrium_->volume_scale();
-    return std::hypot(force, volume);
+    return equilibrium_->relative_norm(reduced, gauge_.force_scale());
   }
-
-  // The force scale: the largest of the loads and the held rows (reactions) seen.
   void update_force_scale(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
                           const Eigen::VectorXd& R) {
-    const Eigen::VectorXd F = equilibrium_->external_forces(x, at.factors);
-    double held = 0.0;
-    for (int d : dofs.held_dofs()) held += R[d] * R[d];
-    peak_force_ = std::max({peak_force_, F.head(F.size() - 1).norm(), std::sqrt(held)});
+    gauge_.update_scale(*equilibrium_, dofs, x, at.factors, R);
   }
 
   std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
@@ -277,7 +268,8 @@ class NewtonSolver {
   std::vector<int> contact_paddle_;    // per vertex: its paddle, or -1
   Eigen::MatrixXd stuck_;              // sticking contact: displacement at first touch
   Eigen::VectorXd residual_;
-  double diagonal_ = 1.0, peak_force_ = 0.0;
+  double diagonal_ = 1.0;
+  ResidualGauge gauge_;
   std::shared_ptr<TangentSolve> tangent_;
 };
 
@@ -408,6 +400,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     record.volume = volume;
     record.volume_drift = (volume - reference_volume) / reference_volume;
     record.max_displacement = (X - reference).rowwise().norm().maxCoeff();
+    record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
     record.seconds = seconds_since(step_start);
     summary.steps.push_back(record);
     report_progress("step", k, n);

@@ -4,9 +4,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
+#include <vector>
 
+#include "model/dof_map.hpp"
+#include "model/equilibrium.hpp"
 #include "model/model.hpp"
 #include "solve/load_stepper.hpp"
 
@@ -44,5 +49,31 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
                            const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X,
                            double volume, double reference_volume,
                            const Eigen::MatrixXd& reference_face_areas);
+
+// How far a state is from equilibrium, relative (Equilibrium::relative_norm):
+// the free rows of R over the largest force seen so far along the path (the
+// loads, or the held rows: the reactions), the volume row over dim C0 V0.
+class ResidualGauge {
+ public:
+  double measure(const model::Equilibrium& problem, const model::DofMap& dofs,
+                 const Eigen::VectorXd& x, const std::vector<double>& factors) {
+    const Eigen::VectorXd R = problem.residual(x, factors);
+    update_scale(problem, dofs, x, factors, R);
+    return problem.relative_norm(dofs.reduce(R), peak_force_);
+  }
+  // Raises the force scale with the loads and the held rows of R at x.
+  void update_scale(const model::Equilibrium& problem, const model::DofMap& dofs,
+                    const Eigen::VectorXd& x, const std::vector<double>& factors,
+                    const Eigen::VectorXd& R) {
+    const Eigen::VectorXd F = problem.external_forces(x, factors);
+    double held = 0.0;
+    for (int d : dofs.held_dofs()) held += R[d] * R[d];
+    peak_force_ = std::max({peak_force_, F.head(F.size() - 1).norm(), std::sqrt(held)});
+  }
+  double force_scale() const { return peak_force_; }
+
+ private:
+  double peak_force_ = 0.0;
+};
 
 }  // namespace fiberfluid::solve

@@ -139,7 +139,8 @@ TEST(Outputs, CsvTablesOpenAsTables) {
   const std::vector<std::string> header = {
       "step", "load_factor_g", "pressure_Pa", "volume_m3", "max_displacement_m",
       "applied_force_x_N", "applied_force_y_N", "applied_force_z_N",
-      "reaction_top_x_N", "reaction_top_y_N", "reaction_top_z_N", "seconds"};
+      "reaction_top_x_N", "reaction_top_y_N", "reaction_top_z_N", "equilibrium_residual",
+      "seconds"};
   EXPECT_EQ(steps[0], header);
   for (size_t r = 1; r < steps.size(); ++r) {
     ASSERT_EQ(steps[r].size(), header.size());
