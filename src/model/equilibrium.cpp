@@ -493,6 +493,18 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
   return D;
 }
 
+std::vector<std::string> material_parameter_names(const Material& material, int dim) {
+  std::vector<std::string> names = material.law.parameter_names();
+  names.push_back("gamma");
+  for (int a = 0; a < dim; ++a) names.push_back(std::string("factor_") + "xyz"[a]);
+  return names;
+}
+
+bool is_material_parameter(const Material& material, const std::string& name) {
+  const std::vector<std::string> names = material_parameter_names(material, 3);
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
 double Equilibrium::relative_norm(const Eigen::VectorXd& reduced, double force_scale) const {
   const Eigen::Index m = reduced.size() - 1;
   const double force = reduced.head(m).norm() / std::max(force_scale, 1e-300);

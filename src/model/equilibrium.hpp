@@ -16,6 +16,11 @@ namespace fiberfluid::model {
 
 class Equilibrium;
 
+// The names Equilibrium::parameter_derivatives knows for this material: the
+// law's parameters, "gamma", and "factor_x" / "factor_y" / "factor_z".
+std::vector<std::string> material_parameter_names(const Material& material, int dim);
+bool is_material_parameter(const Material& material, const std::string& name);
+
 // The tangent at one state as an operator: the bulk fibers' pair
 // coefficients a Y(e) and a Y'(e) / (r L) stored once (two N x N arrays,
 // bytes_for(N)), so that each product is one pass over memory rather than

@@ -115,6 +115,15 @@ bool SteppingOptions::IsValid(std::string* why) const {
   if (!(pcg.tolerance > 0.0) || pcg.max_iterations < 1)
     return *why = "pcg tolerance must be positive and max_iterations at least 1", false;
   if (!(max_volume_change > 0.0)) return *why = "max_volume_change must be positive", false;
+  if (!sensitivities.parameters.empty()) {
+    if (scheme != Scheme::Newton)
+      return *why = "sensitivities need the Newton scheme (the incremental one has no tangent "
+                    "at equilibrium)", false;
+    for (int k : sensitivities.steps)
+      if (k < 1 || k > steps)
+        return *why = "sensitivities at step " + std::to_string(k) + ": expected 1.." +
+                      std::to_string(steps), false;
+  }
   return scheme != Scheme::Newton || newton.IsValid(why);
 }
 

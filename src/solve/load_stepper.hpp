@@ -75,6 +75,13 @@ struct SteppingOptions {
   // Newton: keep the tangent solve prepared at the solution in the summary
   // (final_tangent), for sensitivities. It holds O(N^2) memory.
   bool keep_final_tangent = false;
+  // Newton: the sensitivities du/dtheta of the solution to material
+  // parameters (named as for model::Equilibrium::parameter_derivatives) at
+  // chosen steps, each one solve with the step's last tangent (calibration).
+  struct Sensitivities {
+    std::vector<std::string> parameters;
+    std::vector<int> steps;  // 1..steps
+  } sensitivities;
 
   bool IsValid(std::string* why) const;
 };
@@ -110,6 +117,9 @@ struct StepRecord {
     int contacts = 0;                   // vertices held on it
   };
   std::vector<PaddleState> paddles;     // one per Model::paddles
+  // At the steps SteppingOptions::sensitivities lists: du/dtheta, full
+  // layout (zero at held unknowns), one column per parameter.
+  Eigen::MatrixXd sensitivities;
 };
 
 struct SteppingSummary {

@@ -99,6 +99,23 @@ class NewtonSolver {
            " active-set rounds (newton.max_contact_rounds)";
   }
 
+  // du/dtheta = -K_T^{-1} dR/dtheta at the solution x, one tangent solve per
+  // parameter, the held set (supports and contacts) fixed. "" or why not.
+  std::string sensitivities(const PathPoint& at, const Eigen::VectorXd& x,
+                            const std::vector<std::string>& names, Eigen::MatrixXd* out) {
+    const std::shared_ptr<TangentSolve> tangent = final_tangent(at, x);
+    if (!tangent) return "the tangent at the solution could not be factored";
+    const Eigen::MatrixXd dR = equilibrium_->parameter_derivatives(x, names);
+    out->resize(x.size(), dR.cols());
+    for (Eigen::Index c = 0; c < dR.cols(); ++c) {
+      Eigen::VectorXd du;
+      const Status status = tangent->solve_full(-dR.col(c), &du);
+      if (!status.ok) return names[static_cast<size_t>(c)] + ": " + status.message;
+      out->col(c) = du;
+    }
+    return {};
+  }
+
   // After a successful solve: the residual at the held unknowns is the force
   // each support or paddle exerts on the body.
   const Eigen::VectorXd& last_residual() const { return residual_; }
@@ -315,6 +332,9 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   if (!why.empty()) return fail(why);
   why = paddle_problem(model, options.steps);
   if (!why.empty()) return fail(why);
+  for (const std::string& name : options.sensitivities.parameters)
+    if (!model::is_material_parameter(model.material, name))
+      return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
   model::DofPartition partition;
   std::unique_ptr<NewtonSolver> solver;
   try {
@@ -401,6 +421,12 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     record.volume_drift = (volume - reference_volume) / reference_volume;
     record.max_displacement = (X - reference).rowwise().norm().maxCoeff();
     record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
+    const std::vector<int>& wanted = options.sensitivities.steps;
+    if (!options.sensitivities.parameters.empty() &&
+        std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
+      why = solver->sensitivities(at, x, options.sensitivities.parameters, &record.sensitivities);
+      if (!why.empty()) return fail("step " + std::to_string(k) + ": sensitivities: " + why);
+    }
     record.seconds = seconds_since(step_start);
     summary.steps.push_back(record);
     report_progress("step", k, n);

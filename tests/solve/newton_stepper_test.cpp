@@ -134,6 +134,60 @@ TEST(Newton, FinalTangentGivesParameterSensitivities) {
   }
 }
 
+// The stepper's own sensitivities at an intermediate step and the last, for
+// every kind of parameter, against central differences of whole runs.
+TEST(Newton, SensitivitiesAtChosenStepsMatchFiniteDifferences) {
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+  const std::vector<std::string> names = {"Y0", "beta", "gamma", "factor_z"};
+  // Central differences of whole runs, at steps 2 and 3, per parameter.
+  std::vector<std::vector<Eigen::VectorXd>> fd(names.size());
+  for (size_t p = 0; p < names.size(); ++p) {
+    auto states_with = [&](double delta) {
+      model::Model changed = m;
+      if (names[p] == "gamma") changed.material.surface_tension += delta;
+      else if (names[p] == "factor_z") changed.material.axis_factors.z() += delta;
+      else changed.material.law.set_parameter(names[p],
+                                              changed.material.law.parameter(names[p]) + delta);
+      SteppingOptions plain = newton(3);
+      plain.newton.residual_tolerance = 1e-13;
+      std::vector<Eigen::VectorXd> states;
+      const SteppingSummary run = solve_load_steps(
+          changed, plain, [&](const StepRecord&, const Eigen::VectorXd& x) { states.push_back(x); });
+      EXPECT_TRUE(run.success) << run.message;
+      return states;
+    };
+    const double h = names[p] == "Y0" || names[p] == "gamma" ? 1.0 : 1e-3;
+    const auto plus = states_with(h), minus = states_with(-h);
+    for (int step : {2, 3}) fd[p].push_back((plus[step - 1] - minus[step - 1]) / (2.0 * h));
+  }
+  for (TangentSolver kind : {TangentSolver::Dense, TangentSolver::Krylov}) {
+    SteppingOptions o = newton(3, kind);
+    o.newton.residual_tolerance = 1e-13;
+    o.sensitivities = {names, {2, 3}};
+    const SteppingSummary s = solve_load_steps(m, o);
+    ASSERT_TRUE(s.success) << s.message;
+    EXPECT_EQ(s.steps[0].sensitivities.size(), 0);
+    for (size_t p = 0; p < names.size(); ++p)
+      for (int step : {2, 3}) {
+        const Eigen::VectorXd& expected = fd[p][static_cast<size_t>(step - 2)];
+        const Eigen::VectorXd du =
+            s.steps[static_cast<size_t>(step - 1)].sensitivities.col(static_cast<Eigen::Index>(p));
+        EXPECT_LT((du - expected).norm(), 1e-6 * expected.norm())
+            << names[p] << " step " << step << " " << to_string(kind);
+      }
+  }
+  // Asked of the incremental scheme, for an unknown name or a step beyond the run: a message.
+  SteppingOptions bad = newton(2);
+  bad.sensitivities = {{"stiffness"}, {2}};
+  EXPECT_NE(solve_load_steps(m, bad).message.find("\"stiffness\" is not a parameter"),
+            std::string::npos);
+  bad.sensitivities = {{"beta"}, {3}};
+  EXPECT_NE(solve_load_steps(m, bad).message.find("expected 1..2"), std::string::npos);
+  bad.scheme = Scheme::Incremental;
+  bad.sensitivities.steps = {2};
+  EXPECT_NE(solve_load_steps(m, bad).message.find("need the Newton scheme"), std::string::npos);
+}
+
 TEST(Newton, CutsAStepThatFailsAndStillSucceeds) {
   // A heavy load in one step: from the start, Newton needs seven iterations;
   // allowed four, the step is cut, and its pieces converge.
