@@ -7,6 +7,7 @@ packages=(
   build-essential cmake
   libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
+  libceres-dev libnlopt-dev                  # calibration (src/fit)
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
   python3-dev pybind11-dev python3-pytest    # the Python module and its tests
 )

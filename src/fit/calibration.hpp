@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// Calibration: the material parameters (and optionally a rigid alignment of
+// the scans) whose simulated deformed surfaces come closest to measured ones.
+// Built on the Newton scheme: the sensitivities du/dtheta = -K_T^{-1}
+// dR/dtheta come from the stepper, one tangent solve per parameter, and are
+// chained through the closest point's direction. The paper's incremental
+// scheme can be fitted too, with finite-difference Jacobians.
+
+#include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fit/parameters.hpp"
+#include "fit/target.hpp"
+#include "model/model.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::fit {
+
+// A measured surface tied to the load step it was measured at.
+struct MeasuredStep {
+  Target target;
+  int step = 0;  // 1..stepping.steps
+};
+
+enum class Method {
+  LevenbergMarquardt,  // Ceres, with Jacobians (analytic for Newton)
+  Bobyqa,              // NLopt, local and derivative-free
+  DirectL,             // NLopt, global within the bounds, then BOBYQA from its best point
+  Crs2,                // NLopt, global (controlled random search), then BOBYQA
+};
+const char* to_string(Method method);
+
+enum class Loss { Squared, Huber, Cauchy };
+const char* to_string(Loss loss);
+
+struct IterationRecord {
+  int iteration = 0;
+  double cost = 0.0;          // 1/2 sum rho(r^2), m^2
+  Eigen::VectorXd values;     // the parameters' values
+  int forward_runs = 0;       // so far
+  double seconds = 0.0;       // since the start
+};
+
+struct FitOptions {
+  Method method = Method::LevenbergMarquardt;
+  // Analytic Jacobians need the Newton scheme; with the incremental scheme
+  // (or when asked) they are central differences of whole runs.
+  bool finite_differences = false;
+  double difference_step = 1e-5;   // in the fitted variable (log or linear)
+  // Also the distances from each target's points to the simulated surface:
+  // catches a simulated surface that covers only part of the target.
+  bool symmetric = false;
+  Loss loss = Loss::Squared;
+  double loss_scale = 1e-3;        // m: where Huber and Cauchy start to discount
+  // The model vertices whose distances count (empty: all), e.g. without the clamped region.
+  std::vector<int> counted_vertices;
+  int max_iterations = 50;         // Levenberg-Marquardt iterations
+  int max_evaluations = 400;       // NLopt objective evaluations (each a forward run)
+  double function_tolerance = 1e-12;  // relative change of the cost that ends the fit
+  double parameter_tolerance = 1e-10; // relative change of the parameters
+  // Called after every iteration (LM) or every improvement (NLopt).
+  std::function<void(const IterationRecord&)> progress;
+};
+
+// The residuals at one point of the parameter space, and their Jacobian.
+struct Evaluation {
+  bool ok = false;
+  std::string message;                 // why the forward run failed
+  Eigen::VectorXd residuals;           // m: the forward distances, then the symmetric ones
+  Eigen::MatrixXd jacobian;            // d residual / d phi (phi: the fitted variables)
+  solve::SteppingSummary summary;
+  std::vector<Eigen::MatrixXd> positions;  // per target: the model's positions at its step
+  int forward_runs = 0;
+  int sensitivity_solves = 0;
+};
+
+struct FitResult {
+  bool success = false;
+  std::string message;
+  Method method = Method::LevenbergMarquardt;
+  bool analytic_jacobian = true;
+  std::vector<std::string> names;
+  Eigen::VectorXd initial, values;
+  // From the covariance at the optimum (Ceres), scaled by the residual
+  // variance 2 cost / (residuals - parameters); intervals are 95%, in log
+  // scale for log-scaled parameters (so they stay positive).
+  bool covariance_ok = false;
+  Eigen::VectorXd standard_errors, lower_95, upper_95;
+  Eigen::MatrixXd correlation;
+  std::vector<IterationRecord> iterations;
+  double initial_cost = 0.0, final_cost = 0.0;
+  int forward_runs = 0, sensitivity_solves = 0;
+  double seconds = 0.0;
+  // At the fitted values: the run, and per target the distance of every
+  // model vertex (NaN where it does not count) and its statistics.
+  solve::SteppingSummary summary;
+  std::vector<Eigen::MatrixXd> positions;
+  std::vector<Eigen::VectorXd> vertex_distances;
+  std::vector<DistanceStatistics> statistics;
+  DistanceStatistics overall;
+};
+
+class Calibration {
+ public:
+  // The model's material holds the values of the parameters that are not
+  // fitted; the parameters' starts replace the fitted ones. Throws InputError
+  // (naming the parameter or the target) for a bad parameter, a target step
+  // outside the run, a counted vertex that does not exist, or a target that
+  // does not overlap the body.
+  Calibration(model::Model model, solve::SteppingOptions stepping,
+              std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
+              FitOptions options = {});
+  ~Calibration();
+
+  const ParameterMap& parameters() const;
+  const model::Model& model() const;
+  bool analytic_jacobian() const;
+  int num_residuals() const;
+  // The body's length the distance shares refer to: its largest extent.
+  double body_length() const;
+
+  // The residuals (and with_jacobian, their Jacobian) at the fitted variables phi.
+  Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian) const;
+  // 1/2 sum rho(r^2) under the chosen loss.
+  double cost(const Eigen::VectorXd& residuals) const;
+
+  FitResult run() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fiberfluid::fit

@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Levenberg-Marquardt (Ceres) and the covariance at the optimum.
+#include <ceres/ceres.h>
+
+#include <chrono>
+#include <memory>
+
+#include "fit/optimizers.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+// One forward run serves every residual at one point: Ceres asks residual
+// by residual (each its own block, so that a robust loss acts on each
+// distance), and the run is kept until the point changes.
+class SharedEvaluation {
+ public:
+  explicit SharedEvaluation(const Calibration& calibration) : calibration_(calibration) {}
+
+  const Evaluation& at(const double* phi, bool with_jacobian) {
+    const int P = calibration_.parameters().size();
+    const Eigen::Map<const Eigen::VectorXd> point(phi, P);
+    if (!valid_ || point != phi_ || (with_jacobian && !has_jacobian_)) {
+      phi_ = point;
+      evaluation_ = calibration_.evaluate(phi_, with_jacobian);
+      valid_ = true;
+      has_jacobian_ = with_jacobian;
+      forward_runs += evaluation_.forward_runs;
+      sensitivity_solves += evaluation_.sensitivity_solves;
+    }
+    return evaluation_;
+  }
+
+  int forward_runs = 0, sensitivity_solves = 0;
+
+ private:
+  const Calibration& calibration_;
+  Eigen::VectorXd phi_;
+  Evaluation evaluation_;
+  bool valid_ = false, has_jacobian_ = false;
+};
+
+class DistanceResidual final : public ceres::CostFunction {
+ public:
+  DistanceResidual(SharedEvaluation* shared, int index, int parameters)
+      : shared_(shared), index_(index) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(parameters);
+  }
+  bool Evaluate(double const* const* phi, double* residuals, double** jacobians) const override {
+    const bool with_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
+    const Evaluation& e = shared_->at(phi[0], with_jacobian);
+    if (!e.ok) return false;  // a failed forward run: Ceres rejects the step
+    residuals[0] = e.residuals[index_];
+    if (with_jacobian)
+      for (Eigen::Index k = 0; k < e.jacobian.cols(); ++k) jacobians[0][k] = e.jacobian(index_, k);
+    return true;
+  }
+
+ private:
+  SharedEvaluation* shared_;
+  int index_;
+};
+
+std::unique_ptr<ceres::LossFunction> make_loss(const FitOptions& options) {
+  switch (options.loss) {
+    case Loss::Huber: return std::make_unique<ceres::HuberLoss>(options.loss_scale);
+    case Loss::Cauchy: return std::make_unique<ceres::CauchyLoss>(options.loss_scale);
+    case Loss::Squared: break;
+  }
+  return nullptr;
+}
+
+// The problem over phi: one residual block per distance, bounds on phi.
+struct CeresProblem {
+  SharedEvaluation shared;
+  std::unique_ptr<ceres::LossFunction> loss;
+  ceres::Problem problem;
+
+  CeresProblem(const Calibration& calibration, const FitOptions& options, Eigen::VectorXd& phi)
+      : shared(calibration), loss(make_loss(options)), problem(problem_options()) {
+    const ParameterMap& map = calibration.parameters();
+    for (int i = 0; i < calibration.num_residuals(); ++i)
+      problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(), phi.data());
+    const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
+    for (int k = 0; k < map.size(); ++k) {
+      if (std::isfinite(lower[k])) problem.SetParameterLowerBound(phi.data(), k, lower[k]);
+      if (std::isfinite(upper[k])) problem.SetParameterUpperBound(phi.data(), k, upper[k]);
+    }
+  }
+  static ceres::Problem::Options problem_options() {
+    ceres::Problem::Options o;
+    o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one loss for every block
+    return o;
+  }
+};
+
+class Recorder final : public ceres::IterationCallback {
+ public:
+  Recorder(const Calibration& calibration, const FitOptions& options, const Eigen::VectorXd& phi,
+           const SharedEvaluation& shared, OptimizerOutcome& outcome)
+      : calibration_(calibration), options_(options), phi_(phi), shared_(shared),
+        outcome_(outcome), start_(std::chrono::steady_clock::now()) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    IterationRecord r;
+    r.iteration = s.iteration;
+    r.cost = s.cost;
+    r.values = calibration_.parameters().values(phi_);  // update_state_every_iteration
+    r.forward_runs = shared_.forward_runs;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    outcome_.iterations.push_back(r);
+    if (options_.progress) options_.progress(r);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const Calibration& calibration_;
+  const FitOptions& options_;
+  const Eigen::VectorXd& phi_;
+  const SharedEvaluation& shared_;
+  OptimizerOutcome& outcome_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const FitOptions& options) {
+  OptimizerOutcome outcome;
+  Eigen::VectorXd phi = calibration.parameters().initial_phi();
+  CeresProblem p(calibration, options, phi);
+  Recorder recorder(calibration, options, phi, p.shared, outcome);
+  ceres::Solver::Options solver;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.gradient_tolerance = 1e-16;
+  solver.num_threads = 1;  // the forward run is threaded itself; the blocks share it
+  solver.logging_type = ceres::SILENT;
+  solver.update_state_every_iteration = true;
+  solver.callbacks.push_back(&recorder);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &p.problem, &summary);
+  outcome.phi = phi;
+  outcome.forward_runs = p.shared.forward_runs;
+  outcome.sensitivity_solves = p.shared.sensitivity_solves;
+  outcome.success = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
+  outcome.message = outcome.success ? "converged: " + summary.message
+                                    : "levenberg-marquardt: " + summary.message;
+  if (summary.termination_type == ceres::NO_CONVERGENCE)
+    outcome.message += " (max_iterations " + std::to_string(options.max_iterations) + ")";
+  return outcome;
+}
+
+bool phi_covariance(const Calibration& calibration, const FitOptions& options,
+                    const Eigen::VectorXd& at, Eigen::MatrixXd* covariance, int* forward_runs) {
+  Eigen::VectorXd phi = at;
+  CeresProblem p(calibration, options, phi);
+  ceres::Covariance::Options o;
+  o.algorithm_type = ceres::DENSE_SVD;  // reports a rank-deficient J instead of failing obscurely
+  o.num_threads = 1;
+  ceres::Covariance c(o);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{phi.data(), phi.data()}};
+  const bool ok = c.Compute(blocks, &p.problem);
+  *forward_runs = p.shared.forward_runs;
+  if (!ok) return false;
+  const int P = calibration.parameters().size();
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(P, P);
+  if (!c.GetCovarianceBlock(phi.data(), phi.data(), C.data())) return false;
+  *covariance = C;
+  return covariance->allFinite();
+}
+
+}  // namespace fiberfluid::fit

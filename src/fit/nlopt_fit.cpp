@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Derivative-free fits (NLopt): BOBYQA locally; DIRECT-L or CRS2 globally
+// within the bounds, then BOBYQA from the best point the global search found.
+#include <nlopt.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "fit/optimizers.hpp"
+#include "geom/error.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+// What a failed forward run costs: far above any real cost, yet finite (the
+// quadratic models of BOBYQA do not survive infinities).
+constexpr double kFailedCost = 1e30;
+
+struct Objective {
+  Objective(const Calibration& c, const FitOptions& o, OptimizerOutcome& out)
+      : calibration(c), options(o), outcome(out) {}
+  const Calibration& calibration;
+  const FitOptions& options;
+  OptimizerOutcome& outcome;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best_phi;
+  int evaluations = 0;
+
+  double operator()(const double* x) {
+    const int P = calibration.parameters().size();
+    const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(x, P);
+    const Evaluation e = calibration.evaluate(phi, false);
+    outcome.forward_runs += e.forward_runs;
+    ++evaluations;
+    const double cost = e.ok ? calibration.cost(e.residuals) : kFailedCost;
+    if (cost < best) {
+      best = cost;
+      best_phi = phi;
+      IterationRecord r;
+      r.iteration = evaluations;
+      r.cost = cost;
+      r.values = calibration.parameters().values(phi);
+      r.forward_runs = outcome.forward_runs;
+      r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      outcome.iterations.push_back(r);
+      if (options.progress) options.progress(r);
+    }
+    return cost;
+  }
+  static double call(unsigned, const double* x, double*, void* data) {
+    return (*static_cast<Objective*>(data))(x);
+  }
+};
+
+std::string describe(nlopt_result r) {
+  switch (r) {
+    case NLOPT_SUCCESS: return "success";
+    case NLOPT_STOPVAL_REACHED: return "the cost reached its target";
+    case NLOPT_FTOL_REACHED: return "converged: the cost changes less than function_tolerance";
+    case NLOPT_XTOL_REACHED: return "converged: the parameters change less than parameter_tolerance";
+    case NLOPT_MAXEVAL_REACHED: return "stopped at max_evaluations";
+    case NLOPT_MAXTIME_REACHED: return "stopped at the time limit";
+    case NLOPT_FAILURE: return "failure";
+    case NLOPT_INVALID_ARGS: return "invalid arguments (bounds?)";
+    case NLOPT_OUT_OF_MEMORY: return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED: return "limited by rounding";
+    case NLOPT_FORCED_STOP: return "stopped";
+    default: break;
+  }
+  return "unknown result";
+}
+
+// One NLopt run of `algorithm` from phi (updated to the best point).
+nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
+                      const FitOptions& options, Objective& objective, Eigen::VectorXd& phi,
+                      int max_evaluations) {
+  const ParameterMap& map = calibration.parameters();
+  const int P = map.size();
+  nlopt_opt opt = nlopt_create(algorithm, static_cast<unsigned>(P));
+  const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
+  nlopt_set_lower_bounds(opt, lower.data());
+  nlopt_set_upper_bounds(opt, upper.data());
+  nlopt_set_min_objective(opt, &Objective::call, &objective);
+  nlopt_set_ftol_rel(opt, options.function_tolerance);
+  nlopt_set_xtol_rel(opt, options.parameter_tolerance);
+  nlopt_set_maxeval(opt, max_evaluations);
+  // First steps: a factor e^0.3 for log-scaled parameters; for linear ones
+  // a tenth of the value (alignment: 0.05 rad, 5% of the body's length).
+  Eigen::VectorXd step(P);
+  for (int k = 0; k < P; ++k) {
+    const Parameter& p = map.parameters()[static_cast<size_t>(k)];
+    step[k] = p.log_scale                          ? 0.3
+              : p.name.rfind("rotation_", 0) == 0    ? 0.05
+              : p.name.rfind("translation_", 0) == 0 ? 0.05 * calibration.body_length()
+                                                     : 0.1 * std::max(std::abs(phi[k]), 1e-3);
+    if (std::isfinite(lower[k]) && std::isfinite(upper[k]))
+      step[k] = std::min(step[k], 0.25 * (upper[k] - lower[k]));
+  }
+  nlopt_set_initial_step(opt, step.data());
+  double value = 0.0;
+  Eigen::VectorXd x = phi;
+  const nlopt_result result = nlopt_optimize(opt, x.data(), &value);
+  nlopt_destroy(opt);
+  if (objective.best_phi.size() == P) phi = objective.best_phi;
+  return result;
+}
+
+}  // namespace
+
+OptimizerOutcome fit_nlopt(const Calibration& calibration, const FitOptions& options) {
+  OptimizerOutcome outcome;
+  const ParameterMap& map = calibration.parameters();
+  Eigen::VectorXd phi = map.initial_phi();
+  Objective objective(calibration, options, outcome);
+  nlopt_result result;
+  if (options.method == Method::Bobyqa) {
+    result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi, options.max_evaluations);
+  } else {
+    const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
+    for (int k = 0; k < map.size(); ++k)
+      if (!std::isfinite(lower[k]) || !std::isfinite(upper[k]))
+        throw InputError("parameter \"" + map.parameters()[static_cast<size_t>(k)].name +
+                         "\": a global search (" + to_string(options.method) +
+                         ") needs finite lower and upper bounds");
+    const int global = options.max_evaluations / 2;
+    minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, calibration,
+             options, objective, phi, global);
+    result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi,
+                      options.max_evaluations - objective.evaluations);
+  }
+  outcome.phi = phi;
+  outcome.success = result > 0 && result != NLOPT_MAXEVAL_REACHED && objective.best < kFailedCost;
+  outcome.message = std::string(to_string(options.method)) + ": " + describe(result) + " after " +
+                    std::to_string(objective.evaluations) + " forward runs";
+  return outcome;
+}
+
+}  // namespace fiberfluid::fit

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fit/parameters.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "geom/error.hpp"
+#include "model/equilibrium.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+const char* const kAlignment[6] = {"rotation_x",    "rotation_y",    "rotation_z",
+                                   "translation_x", "translation_y", "translation_z"};
+
+std::string number(double x) {
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
+}  // namespace
+
+bool is_alignment_parameter(const std::string& name) {
+  return std::find(std::begin(kAlignment), std::end(kAlignment), name) != std::end(kAlignment);
+}
+
+bool log_scale_by_default(const std::string& name) {
+  return !is_alignment_parameter(name) && name != "beta" && name != "transition";
+}
+
+void set_material_parameter(model::Material& material, const std::string& name, double value) {
+  if (name == "gamma") material.surface_tension = value;
+  else if (name.rfind("factor_", 0) == 0 && name.size() == 8) material.axis_factors[name[7] - 'x'] = value;
+  else material.law.set_parameter(name, value);
+}
+
+double material_parameter(const model::Material& material, const std::string& name) {
+  if (name == "gamma") return material.surface_tension;
+  if (name.rfind("factor_", 0) == 0 && name.size() == 8) return material.axis_factors[name[7] - 'x'];
+  return material.law.parameter(name);
+}
+
+ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Material& material,
+                           int dim)
+    : parameters_(std::move(parameters)) {
+  if (parameters_.empty()) throw InputError("nothing to fit: no parameter given");
+  const std::vector<std::string> known = model::material_parameter_names(material, dim);
+  for (size_t k = 0; k < parameters_.size(); ++k) {
+    const Parameter& p = parameters_[k];
+    const std::string who = "parameter \"" + p.name + "\"";
+    for (size_t j = 0; j < k; ++j)
+      if (parameters_[j].name == p.name) throw InputError(who + " is given twice");
+    if (is_alignment_parameter(p.name)) {
+      const int a = static_cast<int>(std::find(std::begin(kAlignment), std::end(kAlignment),
+                                               p.name) - std::begin(kAlignment));
+      alignment_index_[a] = static_cast<int>(k);
+      has_alignment_ = true;
+    } else if (std::find(known.begin(), known.end(), p.name) != known.end()) {
+      material_names_.push_back(p.name);
+      material_indices_.push_back(static_cast<int>(k));
+    } else {
+      std::string list;
+      for (const std::string& n : known) list += (list.empty() ? "" : ", ") + n;
+      throw InputError(who + " is not a parameter of this material or of the alignment "
+                       "(expected one of " + list + ", rotation_x..z, translation_x..z)");
+    }
+    if (!std::isfinite(p.initial)) throw InputError(who + ": the start is not finite");
+    if (!(p.lower <= p.upper)) throw InputError(who + ": the lower bound exceeds the upper");
+    if (p.initial < p.lower || p.initial > p.upper)
+      throw InputError(who + ": the start " + number(p.initial) + " lies outside the bounds [" +
+                       number(p.lower) + ", " + number(p.upper) + "]");
+    if (p.log_scale && !(p.initial > 0.0 && p.lower >= 0.0))
+      throw InputError(who + ": fitted in log scale, so its start must be positive and its lower "
+                       "bound at least 0 (or set log_scale false)");
+  }
+}
+
+std::vector<std::string> ParameterMap::names() const {
+  std::vector<std::string> out;
+  for (const Parameter& p : parameters_) out.push_back(p.name);
+  return out;
+}
+
+Eigen::VectorXd ParameterMap::initial_phi() const {
+  Eigen::VectorXd phi(size());
+  for (int k = 0; k < size(); ++k) {
+    const Parameter& p = parameters_[static_cast<size_t>(k)];
+    phi[k] = p.log_scale ? std::log(p.initial) : p.initial;
+  }
+  return phi;
+}
+
+Eigen::VectorXd ParameterMap::lower_phi() const {
+  Eigen::VectorXd phi(size());
+  for (int k = 0; k < size(); ++k) {
+    const Parameter& p = parameters_[static_cast<size_t>(k)];
+    phi[k] = p.log_scale ? (p.lower > 0.0 ? std::log(p.lower) : -HUGE_VAL) : p.lower;
+  }
+  return phi;
+}
+
+Eigen::VectorXd ParameterMap::upper_phi() const {
+  Eigen::VectorXd phi(size());
+  for (int k = 0; k < size(); ++k) {
+    const Parameter& p = parameters_[static_cast<size_t>(k)];
+    phi[k] = p.log_scale ? std::log(p.upper) : p.upper;
+  }
+  return phi;
+}
+
+Eigen::VectorXd ParameterMap::values(const Eigen::VectorXd& phi) const {
+  Eigen::VectorXd v(size());
+  for (int k = 0; k < size(); ++k)
+    v[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : phi[k];
+  return v;
+}
+
+Eigen::VectorXd ParameterMap::value_derivatives(const Eigen::VectorXd& phi) const {
+  Eigen::VectorXd d(size());
+  for (int k = 0; k < size(); ++k)
+    d[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : 1.0;
+  return d;
+}
+
+model::Material ParameterMap::material(const model::Material& base,
+                                       const Eigen::VectorXd& values) const {
+  model::Material m = base;
+  for (size_t j = 0; j < material_names_.size(); ++j)
+    set_material_parameter(m, material_names_[j], values[material_indices_[j]]);
+  return m;
+}
+
+void ParameterMap::alignment(const Eigen::VectorXd& values, Eigen::Vector3d* rotation,
+                             Eigen::Vector3d* translation) const {
+  for (int a = 0; a < 3; ++a) {
+    (*rotation)[a] = alignment_index_[a] >= 0 ? values[alignment_index_[a]] : 0.0;
+    (*translation)[a] = alignment_index_[3 + a] >= 0 ? values[alignment_index_[3 + a]] : 0.0;
+  }
+}
+
+}  // namespace fiberfluid::fit

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace fiberfluid::fit {
+
+// One fitted parameter: a material parameter by name (the law's: Y, Y0, beta,
+// Y_t, Y_c, scale; "gamma"; "factor_x" / "factor_y" / "factor_z"), or one of
+// the rigid alignment of the targets ("rotation_x/y/z", a rotation vector in
+// radians, and "translation_x/y/z" in m: scans are rarely registered).
+struct Parameter {
+  std::string name;
+  double initial = 0.0;
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  // Fitted as log(value): for positive parameters (moduli, gamma, factors)
+  // whose scale is unknown; the bounds must then be positive too.
+  bool log_scale = false;
+};
+
+bool is_alignment_parameter(const std::string& name);
+// The default for a parameter: log scale for a positive material parameter
+// (a modulus, gamma, a factor); linear for beta, the transition and alignment.
+bool log_scale_by_default(const std::string& name);
+
+// The parameters in the optimiser's variables phi (log or linear) and back.
+class ParameterMap {
+ public:
+  // Throws InputError (naming the parameter) for an unknown name, a name
+  // given twice, bounds that exclude the start, or a log-scaled parameter
+  // that is not positive.
+  ParameterMap(std::vector<Parameter> parameters, const model::Material& material, int dim);
+
+  int size() const { return static_cast<int>(parameters_.size()); }
+  const std::vector<Parameter>& parameters() const { return parameters_; }
+  std::vector<std::string> names() const;
+  // The material parameters' names and their positions among all.
+  const std::vector<std::string>& material_names() const { return material_names_; }
+  const std::vector<int>& material_indices() const { return material_indices_; }
+  bool has_alignment() const { return has_alignment_; }
+
+  Eigen::VectorXd initial_phi() const;
+  Eigen::VectorXd lower_phi() const;
+  Eigen::VectorXd upper_phi() const;
+  Eigen::VectorXd values(const Eigen::VectorXd& phi) const;
+  // d value / d phi, per parameter (value for a log-scaled one, else 1).
+  Eigen::VectorXd value_derivatives(const Eigen::VectorXd& phi) const;
+
+  // The material with the parameters' values set.
+  model::Material material(const model::Material& base, const Eigen::VectorXd& values) const;
+  // The alignment's rotation vector and translation (zero where not fitted).
+  void alignment(const Eigen::VectorXd& values, Eigen::Vector3d* rotation,
+                 Eigen::Vector3d* translation) const;
+  // The position among all parameters of rotation_x.. translation_z, or -1.
+  int alignment_index(int k) const { return alignment_index_[static_cast<size_t>(k)]; }
+
+ private:
+  std::vector<Parameter> parameters_;
+  std::vector<std::string> material_names_;
+  std::vector<int> material_indices_;
+  int alignment_index_[6] = {-1, -1, -1, -1, -1, -1};
+  bool has_alignment_ = false;
+};
+
+// Sets one material parameter by name (as Equilibrium::parameter_derivatives names them).
+void set_material_parameter(model::Material& material, const std::string& name, double value);
+double material_parameter(const model::Material& material, const std::string& name);
+
+}  // namespace fiberfluid::fit
