@@ -218,28 +218,64 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     e.message = "the material at these parameters: " + bad_law;
     return e;
   }
-  const bool analytic = with_jacobian && m.analytic;
+  // Sensitivities du/dtheta of the states at the target steps: from the
+  // Newton stepper, or central differences of whole runs in phi.
+  const bool sensitivities_wanted = with_jacobian && !map.material_names().empty();
   solve::SteppingOptions stepping = m.stepping;
-  if (analytic && !map.material_names().empty())
+  if (sensitivities_wanted && m.analytic)
     stepping.sensitivities = {map.material_names(), m.target_steps};
   std::map<int, Eigen::VectorXd> states;
-  e.summary = solve::solve_load_steps(changed, stepping,
-                                      [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
-                                        if (std::binary_search(m.target_steps.begin(),
-                                                               m.target_steps.end(), r.step))
-                                          states[r.step] = x;
-                                      });
+  auto run = [&](const model::Model& model, const solve::SteppingOptions& options,
+                 std::map<int, Eigen::VectorXd>& at) {
+    return solve::solve_load_steps(model, options,
+                                   [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+                                     if (std::binary_search(m.target_steps.begin(),
+                                                            m.target_steps.end(), r.step))
+                                       at[r.step] = x;
+                                   });
+  };
+  e.summary = run(changed, stepping, states);
   e.forward_runs = 1;
   if (!e.summary.success) {
     e.message = e.summary.message;
     return e;
   }
+  const Eigen::VectorXd dvalue = map.value_derivatives(phi);
+  std::map<int, Eigen::MatrixXd> sensitivity;  // per target step: #unknowns x material parameters
+  if (sensitivities_wanted && m.analytic) {
+    for (int step : m.target_steps) {
+      sensitivity[step] = e.summary.steps[static_cast<size_t>(step - 1)].sensitivities;
+      e.sensitivity_solves += static_cast<int>(sensitivity[step].cols());
+    }
+  } else if (sensitivities_wanted) {
+    const int nm = static_cast<int>(map.material_names().size());
+    for (int step : m.target_steps) sensitivity[step].resize(states.at(step).size(), nm);
+    for (int j = 0; j < nm; ++j) {
+      const int k = map.material_indices()[static_cast<size_t>(j)];
+      const double h = m.options.difference_step * std::max(1.0, std::abs(phi[k]));
+      std::map<int, Eigen::VectorXd> plus, minus;
+      for (double sign : {1.0, -1.0}) {
+        Eigen::VectorXd shifted = phi;
+        shifted[k] += sign * h;
+        model::Model moved = m.model;
+        moved.material = map.material(m.model.material, map.values(shifted));
+        const solve::SteppingSummary s = run(moved, m.stepping, sign > 0 ? plus : minus);
+        ++e.forward_runs;
+        if (!s.success) {
+          e.message = "a finite-difference run failed: " + s.message;
+          return e;
+        }
+      }
+      for (int step : m.target_steps)  // du/dtheta, as the stepper gives it
+        sensitivity[step].col(j) = (plus.at(step) - minus.at(step)) / (2.0 * h * dvalue[k]);
+    }
+  }
+  // The chain through the closest points is the same for both kinds of sensitivity.
   Alignment align;
   map.alignment(values, &align.rotation, &align.translation);
   const Eigen::Matrix3d R_inverse = align.inverse_rotation();
-  const Eigen::VectorXd dvalue = map.value_derivatives(phi);
   e.residuals.resize(m.residuals);
-  if (analytic) e.jacobian = Eigen::MatrixXd::Zero(m.residuals, P);
+  if (with_jacobian) e.jacobian = Eigen::MatrixXd::Zero(m.residuals, P);
 
   // d x_i / d phi_k for the material parameters, 3 x P (zero columns elsewhere).
   auto vertex_sensitivity = [&](const Eigen::MatrixXd& S, int i) {
@@ -265,11 +301,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     const int step = m.targets[t].step;
     const Eigen::MatrixXd X = model::positions(changed, states.at(step));
     e.positions.push_back(X);
-    const Eigen::MatrixXd* S = nullptr;
-    if (analytic && !map.material_names().empty()) {
-      S = &e.summary.steps[static_cast<size_t>(step - 1)].sensitivities;
-      e.sensitivity_solves += static_cast<int>(S->cols());
-    }
+    const Eigen::MatrixXd* S = sensitivity.count(step) ? &sensitivity.at(step) : nullptr;
     const Target& target = m.targets[t].target;
     // Forward: each counted vertex, taken into the target's frame, to the target.
     Eigen::MatrixXd queries(static_cast<Eigen::Index>(m.counted.size()), 3);
@@ -281,7 +313,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     for (size_t c = 0; c < m.counted.size(); ++c, ++row) {
       const Eigen::Vector3d q = queries.row(static_cast<Eigen::Index>(c)).transpose();
       e.residuals[row] = hits[c].distance;
-      if (!analytic) continue;
+      if (!with_jacobian) continue;
       const Eigen::Vector3d n = direction(q, hits[c].point, target, hits[c].primitive);
       if (S) e.jacobian.row(row) += n.transpose() * R_inverse * vertex_sensitivity(*S, m.counted[c]);
       add_alignment(row, n, dq_domega[c], -R_inverse);
@@ -303,7 +335,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     for (Eigen::Index j = 0; j < np; ++j, ++row) {
       const TargetDistance::Closest& hit = back[static_cast<size_t>(j)];
       e.residuals[row] = hit.distance;
-      if (!analytic) continue;
+      if (!with_jacobian) continue;
       const Eigen::Vector3d p = moved.row(j).transpose();
       const Eigen::Vector3d n = direction(p, hit.point, simulated, hit.primitive);
       // make_target keeps every vertex of a closed surface in order, so the
@@ -318,23 +350,6 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     }
   }
 
-  if (with_jacobian && !m.analytic) {
-    // Central differences of whole runs, in the fitted variables.
-    e.jacobian.resize(m.residuals, P);
-    for (int k = 0; k < P; ++k) {
-      const double h = m.options.difference_step * std::max(1.0, std::abs(phi[k]));
-      Eigen::VectorXd plus = phi, minus = phi;
-      plus[k] += h;
-      minus[k] -= h;
-      const Evaluation ep = evaluate(plus, false), em = evaluate(minus, false);
-      e.forward_runs += 2;
-      if (!ep.ok || !em.ok) {
-        e.message = "a finite-difference run failed: " + (ep.ok ? em.message : ep.message);
-        return e;
-      }
-      e.jacobian.col(k) = (ep.residuals - em.residuals) / (2.0 * h);
-    }
-  }
   e.ok = e.residuals.allFinite() && (!with_jacobian || e.jacobian.allFinite());
   if (!e.ok) e.message = "non-finite distances";
   return e;

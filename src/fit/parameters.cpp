@@ -71,7 +71,7 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
     if (p.initial < p.lower || p.initial > p.upper)
       throw InputError(who + ": the start " + number(p.initial) + " lies outside the bounds [" +
                        number(p.lower) + ", " + number(p.upper) + "]");
-    if (p.log_scale && !(p.initial > 0.0 && p.lower >= 0.0))
+    if (p.log_scale && (!(p.initial > 0.0) || (std::isfinite(p.lower) && p.lower < 0.0)))
       throw InputError(who + ": fitted in log scale, so its start must be positive and its lower "
                        "bound at least 0 (or set log_scale false)");
   }

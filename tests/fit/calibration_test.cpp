@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fit/calibration.hpp"
+
+#include <gtest/gtest.h>
+
+#include <ceres/rotation.h>
+
+#include "geom/error.hpp"
+#include "geom/generators.hpp"
+#include "model/assembly.hpp"
+#include "model/boundary_conditions.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+// A small hanging sphere (42 vertices, cap held) with a stiffening law.
+model::Model hanging_sphere() {
+  model::Model m;
+  m.surface = geom::icosphere(1, 1.0);
+  m.material.law = model::FiberLaw::exponential(3000.0, 5.0);
+  m.material.surface_tension = 300.0;
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.5", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  model::Load gravity;
+  gravity.kind = model::Load::Kind::Hydrostatic;
+  gravity.acceleration = {0.0, 0.0, -10.0};
+  gravity.density = 300.0;
+  m.loads = {gravity};
+  return m;
+}
+
+solve::SteppingOptions newton(int steps) {
+  solve::SteppingOptions o;
+  o.scheme = solve::Scheme::Newton;
+  o.steps = steps;
+  o.newton.residual_tolerance = 1e-13;
+  return o;
+}
+
+// The deformed surfaces of a run at every step, as targets on the same mesh.
+std::vector<MeasuredStep> synthetic_targets(const model::Model& m, const solve::SteppingOptions& o,
+                                            const std::vector<int>& steps) {
+  std::vector<MeasuredStep> targets;
+  const solve::SteppingSummary s =
+      solve::solve_load_steps(m, o, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+        if (std::find(steps.begin(), steps.end(), r.step) != steps.end())
+          targets.push_back({make_target("step " + std::to_string(r.step),
+                                         model::positions(m, x), m.surface.F),
+                             r.step});
+      });
+  EXPECT_TRUE(s.success) << s.message;
+  return targets;
+}
+
+Parameter parameter(const std::string& name, double start, bool log = true) {
+  Parameter p;
+  p.name = name;
+  p.initial = start;
+  p.log_scale = log;
+  return p;
+}
+
+// The residuals' Jacobian (Newton sensitivities chained through the closest
+// points, and the alignment) against central differences of whole runs.
+TEST(Calibration, JacobianMatchesFiniteDifferencesForEveryParameterKind) {
+  const model::Model m = hanging_sphere();
+  std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {2});
+  // Move the target: the alignment then has something to do.
+  for (Eigen::Index i = 0; i < targets[0].target.points.rows(); ++i)
+    targets[0].target.points.row(i) += Eigen::RowVector3d(0.01, -0.02, 0.015);
+  FitOptions options;
+  options.symmetric = true;
+  const Calibration c(m, newton(2), targets,
+                      {parameter("Y0", 2500.0), parameter("beta", 4.0, false),
+                       parameter("gamma", 350.0), parameter("factor_x", 1.2),
+                       parameter("rotation_y", 0.02, false), parameter("translation_z", -0.01, false)},
+                      options);
+  EXPECT_TRUE(c.analytic_jacobian());
+  const Eigen::VectorXd phi = c.parameters().initial_phi();
+  const Evaluation e = c.evaluate(phi, true);
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_EQ(e.residuals.size(), 2 * 42);
+  EXPECT_EQ(e.sensitivity_solves, 4);  // one per material parameter
+  for (int k = 0; k < phi.size(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd plus = phi, minus = phi;
+    plus[k] += h;
+    minus[k] -= h;
+    const Eigen::VectorXd fd =
+        (c.evaluate(plus, false).residuals - c.evaluate(minus, false).residuals) / (2.0 * h);
+    EXPECT_LT((e.jacobian.col(k) - fd).norm(), 1e-5 * fd.norm())
+        << c.parameters().parameters()[static_cast<size_t>(k)].name;
+  }
+  // The finite-difference mode differentiates the forward runs, not the
+  // distances (which have a kink at zero), and chains the same way.
+  options.finite_differences = true;
+  const Calibration by_differences(m, newton(2), targets, c.parameters().parameters(), options);
+  EXPECT_FALSE(by_differences.analytic_jacobian());
+  const Evaluation d = by_differences.evaluate(phi, true);
+  ASSERT_TRUE(d.ok) << d.message;
+  EXPECT_EQ(d.forward_runs, 1 + 2 * 4);
+  EXPECT_LT((d.jacobian - e.jacobian).norm(), 1e-6 * e.jacobian.norm());
+}
+
+TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
+  const model::Model m = hanging_sphere();
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {1, 2});
+  // From a start a factor 3 away.
+  const std::vector<Parameter> parameters = {parameter("Y0", 9000.0), parameter("beta", 5.0 / 3.0, false),
+                                             parameter("gamma", 100.0)};
+  const Eigen::Vector3d truth(3000.0, 5.0, 300.0);
+  const FitResult lm = Calibration(m, newton(2), targets, parameters).run();
+  ASSERT_TRUE(lm.success) << lm.message;
+  EXPECT_TRUE(lm.analytic_jacobian);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(lm.values[k] / truth[k], 1.0, 1e-6) << lm.names[k];
+  EXPECT_LT(lm.overall.largest, 1e-8);
+  EXPECT_GT(lm.sensitivity_solves, 0);
+  EXPECT_FALSE(lm.iterations.empty());
+  EXPECT_LT(lm.final_cost, 1e-6 * lm.initial_cost);
+
+  FitOptions bobyqa;
+  bobyqa.method = Method::Bobyqa;
+  bobyqa.max_evaluations = 600;
+  const FitResult b = Calibration(m, newton(2), targets, parameters, bobyqa).run();
+  ASSERT_TRUE(b.success) << b.message;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.values[k] / lm.values[k], 1.0, 1e-4) << b.names[k];
+  EXPECT_EQ(b.sensitivity_solves, 0);
+}
+
+TEST(Calibration, AlignmentRecoversAKnownRigidMotion) {
+  const model::Model m = hanging_sphere();
+  std::vector<MeasuredStep> targets = synthetic_targets(m, newton(1), {1});
+  const double omega[3] = {0.05, -0.03, 0.02};
+  const Eigen::Vector3d shift(0.01, 0.02, -0.01);
+  Eigen::MatrixXd& P = targets[0].target.points;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const double p[3] = {P(i, 0), P(i, 1), P(i, 2)};
+    double q[3];
+    ceres::AngleAxisRotatePoint(omega, p, q);
+    P.row(i) = Eigen::RowVector3d(q[0], q[1], q[2]) + shift.transpose();
+  }
+  std::vector<Parameter> motion;
+  for (const char* name : {"rotation_x", "rotation_y", "rotation_z", "translation_x",
+                           "translation_y", "translation_z"})
+    motion.push_back(parameter(name, 0.0, false));
+  const FitResult r = Calibration(m, newton(1), targets, motion).run();
+  ASSERT_TRUE(r.success) << r.message;
+  // The fitted motion takes the target back onto the body: T(M(p)) = p.
+  const double back[3] = {r.values[0], r.values[1], r.values[2]};
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
+    double moved[3], returned[3];
+    const double pp[3] = {p.x(), p.y(), p.z()};
+    ceres::AngleAxisRotatePoint(omega, pp, moved);
+    for (int a = 0; a < 3; ++a) moved[a] += shift[a];
+    ceres::AngleAxisRotatePoint(back, moved, returned);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(returned[a] + r.values[3 + a], p[a], 1e-7);
+  }
+}
+
+TEST(Calibration, TheIncrementalSchemeIsFittedWithFiniteDifferences) {
+  model::Model m = hanging_sphere();
+  m.material.law = model::FiberLaw::constant(3000.0);
+  solve::SteppingOptions incremental;
+  incremental.steps = 2;
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, incremental, {2});
+  const Calibration c(m, incremental, targets, {parameter("Y", 1000.0), parameter("gamma", 900.0)});
+  EXPECT_FALSE(c.analytic_jacobian());
+  const FitResult r = c.run();
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_FALSE(r.analytic_jacobian);
+  EXPECT_NEAR(r.values[0] / 3000.0, 1.0, 1e-5);
+  EXPECT_NEAR(r.values[1] / 300.0, 1.0, 1e-5);
+}
+
+void expect_input_error(const std::function<void()>& f, const std::string& part) {
+  try {
+    f();
+    ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+TEST(Calibration, BadFitsAreNamed) {
+  const model::Model m = hanging_sphere();
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(1), {1});
+  expect_input_error([&] { Calibration(m, newton(1), targets, {parameter("stiffness", 1.0)}); },
+                     "parameter \"stiffness\" is not a parameter");
+  Parameter bounded = parameter("Y0", 3000.0);
+  bounded.lower = 4000.0;
+  bounded.upper = 8000.0;
+  expect_input_error([&] { Calibration(m, newton(1), targets, {bounded}); },
+                     "the start 3000 lies outside the bounds [4000, 8000]");
+  expect_input_error([&] { Calibration(m, newton(1), targets, {parameter("beta", -1.0)}); },
+                     "log scale");
+  std::vector<MeasuredStep> far = targets;
+  far[0].target.points.col(0).array() += 10.0;
+  expect_input_error([&] { Calibration(m, newton(1), far, {parameter("Y0", 3000.0)}); },
+                     "does not overlap the body");
+  std::vector<MeasuredStep> late = targets;
+  late[0].step = 5;
+  expect_input_error([&] { Calibration(m, newton(1), late, {parameter("Y0", 3000.0)}); },
+                     "tied to load step 5");
+  FitOptions global;
+  global.method = Method::DirectL;
+  expect_input_error([&] { Calibration(m, newton(1), targets, {parameter("Y0", 3000.0)}, global).run(); },
+                     "needs finite lower and upper bounds");
+
+  // A forward run that fails is a result with a message, not a crash.
+  const Calibration soft(m, newton(1), targets, {parameter("Y0", 1e-3)});
+  const Evaluation e = soft.evaluate(soft.parameters().initial_phi(), true);
+  EXPECT_FALSE(e.ok);
+  EXPECT_FALSE(e.message.empty());
+  const FitResult r = soft.run();
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("the forward run at the starting parameters failed"), std::string::npos)
+      << r.message;
+}
+
+}  // namespace
+}  // namespace fiberfluid::fit
