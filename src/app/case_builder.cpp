@@ -174,24 +174,7 @@ class ModelBuilder {
   }
 
   std::vector<int> select(const SelectionSpec& spec) const {
-    const Eigen::MatrixXd& V = c_.model.surface.V;
-    std::vector<int> selected;
-    if (!spec.vertices.empty()) {
-      for (int input : spec.vertices) selected.push_back(model_vertex(spec.field, "vertices", input));
-    } else if (!spec.where.empty()) {
-      try {
-        selected = model::select_half_space(V, model::parse_half_space(spec.where, dim_));
-      } catch (const InputError& e) {
-        spec.field.fail("where", e.what());
-      }
-      if (selected.empty()) spec.field.fail("where", "\"" + spec.where + "\" selects no vertex");
-    } else {
-      require_per_axis(spec.field, "box.min", spec.box_min, dim_);
-      require_per_axis(spec.field, "box.max", spec.box_max, dim_);
-      selected = model::select_box(V, spec.box_min, spec.box_max);
-      if (selected.empty()) spec.field.fail("box", "the box selects no vertex");
-    }
-    return selected;
+    return resolve_selection(spec, c_);
   }
 
   void add_group(const ConstraintSpec& spec) {
@@ -252,6 +235,38 @@ class ModelBuilder {
 };
 
 }  // namespace
+
+std::vector<int> resolve_selection(const SelectionSpec& spec, const Case& c) {
+  const Eigen::MatrixXd& V = c.model.surface.V;
+  const int dim = c.model.dim();
+  std::vector<int> selected;
+  if (!spec.vertices.empty()) {
+    std::vector<int> input_to_model(static_cast<size_t>(c.input_surface.num_vertices()), -1);
+    for (size_t m = 0; m < c.model_to_input.size(); ++m)
+      input_to_model[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
+    for (int input : spec.vertices) {
+      if (input >= static_cast<int>(input_to_model.size()))
+        spec.field.fail("vertices", "vertex " + std::to_string(input) + " does not exist (the mesh has " +
+                                        std::to_string(input_to_model.size()) + " vertices, from 0)");
+      const int m = input_to_model[static_cast<size_t>(input)];
+      if (m < 0) spec.field.fail("vertices", "vertex " + std::to_string(input) + " belongs to no face");
+      selected.push_back(m);
+    }
+  } else if (!spec.where.empty()) {
+    try {
+      selected = model::select_half_space(V, model::parse_half_space(spec.where, dim));
+    } catch (const InputError& e) {
+      spec.field.fail("where", e.what());
+    }
+    if (selected.empty()) spec.field.fail("where", "\"" + spec.where + "\" selects no vertex");
+  } else {
+    require_per_axis(spec.field, "box.min", spec.box_min, dim);
+    require_per_axis(spec.field, "box.max", spec.box_max, dim);
+    selected = model::select_box(V, spec.box_min, spec.box_max);
+    if (selected.empty()) spec.field.fail("box", "the box selects no vertex");
+  }
+  return selected;
+}
 
 Case build_case(const CaseSpec& spec, std::vector<std::string>* warnings) {
   Case c;

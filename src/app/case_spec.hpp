@@ -150,6 +150,10 @@ Case build_case(const CaseSpec& spec, const geom::Surface& surface,
 // from a spec with the same surface_key (a sweep prunes once).
 Case build_case(const CaseSpec& spec, const Case& earlier);
 
+// The model vertices a selection picks on a built case. Throws InputError
+// naming the field when it picks nothing or names a vertex that does not exist.
+std::vector<int> resolve_selection(const SelectionSpec& spec, const Case& c);
+
 // Reads a mesh file and checks it (closed, manifold, outward, ...), optionally
 // flipping an inward mesh first. Throws InputError naming the file.
 geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,

@@ -447,9 +447,68 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
   return c;
 }
 
+// ------------------------------------------------------------ fit
+FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
+  FitSpec spec;
+  spec.field = f.field();
+  for (Fields t : f.objects("targets")) {
+    FitTargetSpec target;
+    target.field = t.field();
+    target.file = t.string("file");
+    if (target.file.is_relative()) target.file = folder / target.file;
+    target.step = t.integer("step", 0, 1, 100000);
+    t.finish();
+    spec.targets.push_back(target);
+  }
+  if (spec.targets.empty()) f.fail("targets", "expected at least one target surface");
+  for (Fields p : f.objects("parameters")) {
+    FitParameterSpec parameter;
+    parameter.field = p.field();
+    parameter.name = p.string("name");
+    for (const FitParameterSpec& other : spec.parameters)
+      if (other.name == parameter.name) p.fail("name", "\"" + parameter.name + "\" is fitted twice");
+    if (p.has("start")) parameter.start = p.number("start");
+    if (p.has("lower")) parameter.lower = p.number("lower");
+    if (p.has("upper")) parameter.upper = p.number("upper");
+    if (p.has("log_scale")) parameter.log_scale = p.boolean("log_scale", false);
+    p.finish();
+    spec.parameters.push_back(parameter);
+  }
+  if (spec.parameters.empty()) f.fail("parameters", "expected at least one parameter to fit");
+  fit::FitOptions& o = spec.options;
+  const std::string method = f.choice("method", "levenberg-marquardt",
+                                      {"levenberg-marquardt", "bobyqa", "direct-l", "crs2"});
+  o.method = method == "bobyqa"     ? fit::Method::Bobyqa
+             : method == "direct-l" ? fit::Method::DirectL
+             : method == "crs2"     ? fit::Method::Crs2
+                                    : fit::Method::LevenbergMarquardt;
+  o.finite_differences =
+      f.choice("jacobian", "analytic", {"analytic", "finite-differences"}) == "finite-differences";
+  o.difference_step = f.positive("difference_step", o.difference_step);
+  if (f.has("objective")) {
+    Fields objective = f.object("objective");
+    o.symmetric = objective.boolean("symmetric", false);
+    const std::string loss = objective.choice("loss", "squared", {"squared", "huber", "cauchy"});
+    o.loss = loss == "huber" ? fit::Loss::Huber : loss == "cauchy" ? fit::Loss::Cauchy : fit::Loss::Squared;
+    o.loss_scale = objective.positive("loss_scale", o.loss_scale);
+    if (objective.has("exclude")) {
+      Fields exclude = objective.object("exclude");
+      spec.exclude = read_selection(exclude);
+      exclude.finish();
+    }
+    objective.finish();
+  }
+  o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
+  o.max_evaluations = f.integer("max_evaluations", o.max_evaluations, 1, 1000000);
+  o.function_tolerance = f.positive("function_tolerance", o.function_tolerance);
+  o.parameter_tolerance = f.positive("parameter_tolerance", o.parameter_tolerance);
+  f.finish();
+  return spec;
+}
+
 // Fields of the experiment that a variant may not patch.
 const char* const kExperimentFields[] = {"name", "description", "kind", "variants", "expected",
-                                         "output"};
+                                         "output", "fit"};
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
@@ -527,6 +586,13 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
                 ? Experiment::Kind::Areas
                 : Experiment::Kind::Simulate;
   ex.expected = read_expected(root);
+  if (root.has("fit")) {
+    if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
+    if (root.has("variants"))
+      root.fail("fit", "a fit calibrates one simulation: remove \"variants\" (fit several loads "
+                       "with several targets, each tied to its step)");
+    ex.fit = read_fit(root.object("fit"), folder);
+  }
   if (ex.kind == Experiment::Kind::Simulate) {
     read_simulation(root, document, folder, ex);  // each case checks its own fields
   } else {

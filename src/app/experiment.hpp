@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "app/case_spec.hpp"
+#include "app/fit_spec.hpp"
 #include "geom/surface.hpp"
 
 namespace fiberfluid::app {
@@ -56,6 +57,8 @@ struct Experiment {
   // Areas:
   std::vector<NamedSurfaceSpec> area_specs;
   std::vector<NamedSurface> area_surfaces;
+
+  std::optional<FitSpec> fit;   // the "fit" section: what `fiberfluid fit` calibrates
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/experiment.hpp"
+#include "app/fitting.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "geom/error.hpp"
@@ -192,6 +193,84 @@ int run_command(const std::string& path, const RunFlags& flags) {
   return kOk;
 }
 
+// Calibrates the material of an experiment to its "fit" targets, then runs
+// it at the fitted values and writes the usual outputs with the fit's files.
+int fit_command(const std::string& path, const RunFlags& flags) {
+  ProgressPrinter printer;
+  if (!flags.quiet)
+    fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
+                                             double done, double total) {
+      printer(label, phase, done, total);
+    });
+  const app::Experiment ex = app::load_experiment(path);  // throws before anything is written
+  printer.close();
+  fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
+  for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
+  const app::FitSetup setup = app::setup_fit(ex, [&](const fiberfluid::fit::IterationRecord& r) {
+    if (flags.quiet) return;
+    std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2;";
+    const auto& names = ex.fit->parameters;
+    for (size_t k = 0; k < names.size(); ++k)
+      std::cerr << (k ? ", " : " ") << names[k].name << " = " << r.values[static_cast<Eigen::Index>(k)];
+    std::cerr << "; " << r.forward_runs << " runs, " << r.seconds << " s\n";
+  });
+  for (const auto& t : setup.targets)
+    std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
+              << "\n";
+  std::cout << "fitting " << setup.calibration->parameters().size() << " parameters to "
+            << setup.calibration->num_residuals() << " distances ("
+            << fiberfluid::fit::to_string(ex.fit->options.method) << ", "
+            << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
+            << ")\n";
+  const fiberfluid::fit::FitResult fitted = setup.calibration->run();
+  if (fitted.values.size() == 0) {  // the start itself failed
+    std::cerr << "error: " << fitted.message << "\n";
+    return kSolverFailed;
+  }
+
+  const app::Experiment at_fit = app::with_fitted_material(ex, *setup.calibration, fitted);
+  const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
+  app::OutputWriter writer(at_fit, output);
+  writer.begin();
+  app::ExperimentResult result = app::run_experiment(
+      at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
+        writer.on_step(run, r, x);
+      });
+  for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
+  result.checks = app::check_expected(at_fit, result);
+  writer.finish(result);
+  if (result.runs_succeeded()) app::write_fit_files(writer.folder(), at_fit, setup, fitted, result);
+
+  std::cout << ex.name << ": " << fitted.message << "; results in " << writer.folder().string() << "\n";
+  for (size_t k = 0; k < fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    std::cout << "  " << fitted.names[k] << " = " << fitted.values[i] << " +- "
+              << fitted.standard_errors[i] << " (95%: " << fitted.lower_95[i] << " .. "
+              << fitted.upper_95[i] << "; start " << fitted.initial[i] << ")\n";
+  }
+  const auto& d = fitted.overall;
+  std::cout << "  distance: mean " << d.mean << ", rms " << d.rms << ", sd " << d.standard_deviation
+            << " (" << 100.0 * d.share(d.standard_deviation) << "% of the body's length "
+            << d.length << "), largest " << d.largest << " m\n";
+  std::cout << "  " << fitted.forward_runs << " forward runs, " << fitted.sensitivity_solves
+            << " sensitivity solves, " << fitted.seconds << " s\n";
+  for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
+  if (!result.runs_succeeded()) {
+    for (const app::RunResult& run : result.runs)
+      if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
+    return kSolverFailed;
+  }
+  if (!fitted.success) {
+    std::cerr << "error: the fit did not converge: " << fitted.message << "\n";
+    return kSolverFailed;
+  }
+  if (flags.check_expected && !result.checks_passed()) {
+    std::cerr << "error: some expected figures were not met (see above)\n";
+    return kChecksFailed;
+  }
+  return kOk;
+}
+
 int check_command(const std::string& path, bool flip) {
   fiberfluid::geom::ReadResult read = fiberfluid::geom::read_surface(path);
   if (flip) fiberfluid::geom::flip_orientation(read.surface);
@@ -225,6 +304,16 @@ int main(int argc, char** argv) {
                   "cores / jobs threads")
       ->check(CLI::Range(0, 256));
 
+  RunFlags fit_flags;
+  CLI::App* fit = cli.add_subcommand(
+      "fit", "Calibrate the material of an experiment to its \"fit\" targets, then run it at the "
+             "fitted values");
+  fit->add_option("experiment", experiment, "Experiment file (JSON) with a \"fit\" section")->required();
+  fit->add_option("-o,--output", fit_flags.output, "Output folder (default: out/<experiment name>)");
+  fit->add_flag("--check", fit_flags.check_expected,
+                "Exit with status 3 when an expected figure of the file is not met");
+  fit->add_flag("-q,--quiet", fit_flags.quiet, "No progress lines");
+
   CLI::App* check = cli.add_subcommand("check", "Check a mesh file and print its report");
   check->add_option("mesh", mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
   check->add_flag("--flip", flip, "Reverse the face orientation before checking");
@@ -240,6 +329,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (run->parsed()) return run_command(experiment, flags);
+    if (fit->parsed()) return fit_command(experiment, fit_flags);
     return check_command(mesh, flip);
   } catch (const fiberfluid::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";

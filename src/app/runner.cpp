@@ -246,9 +246,14 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
           result.figures[prefix + name] = *run_figure(ex.cases[r], run, name);
     }
   }
-  for (const ExpectedFigure& expected : ex.expected)
-    result.checks.push_back(check_figure(ex, result, expected));
+  result.checks = check_expected(ex, result);
   return result;
+}
+
+std::vector<FigureCheck> check_expected(const Experiment& ex, const ExperimentResult& result) {
+  std::vector<FigureCheck> checks;
+  for (const ExpectedFigure& expected : ex.expected) checks.push_back(check_figure(ex, result, expected));
+  return checks;
 }
 
 }  // namespace fiberfluid::app

@@ -40,6 +40,9 @@ struct ExperimentResult {
 using RunObserver =
     std::function<void(size_t run, const solve::StepRecord&, const Eigen::VectorXd&)>;
 
+// Checks the experiment's expected figures against a result's figures and runs.
+std::vector<FigureCheck> check_expected(const Experiment& experiment, const ExperimentResult& result);
+
 struct RunOptions {
   // Cases run at once. Each job's OpenMP loops get cores / jobs threads, so a
   // sweep of small models runs its variants side by side and a single large
