@@ -64,6 +64,24 @@ TEST(Cli, RunWritesItsOutputsAndChecksTheExpectedFigures) {
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "rect" / file)) << file;
 }
 
+TEST(Cli, FitCalibratesThenWritesTheRunAndTheFitFiles) {
+  ScratchDir dir;
+  const Outcome o = run_cli("fit " + testing::experiment_file("fit_sphere.json").string() +
+                            " -o " + (dir.path() / "fit").string() + " --check");
+  EXPECT_EQ(o.status, 0) << o.output;
+  for (const char* part : {"sphere_final.obj (step 10): a triangle soup of 320 triangles",
+                           "finite differences", "fit: iteration 1:", "pass  fit.Y = 3000",
+                           "% of the body's length"})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
+  for (const char* file : {"summary.json", "fit.json", "fit_iterations.csv", "fit_target_0.vtu"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "fit" / file)) << file;
+  // An experiment without a fit section is refused, naming the file.
+  const Outcome none = run_cli("fit " + testing::experiment_file("rectangle.json").string() +
+                               " -o " + (dir.path() / "none").string());
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.output.find("rectangle.json: no \"fit\" section"), std::string::npos) << none.output;
+}
+
 TEST(Cli, BadExperimentWritesNothing) {
   ScratchDir dir;
   const auto config = dir.write("bad.json", R"({"name": "bad",

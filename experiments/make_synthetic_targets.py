@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Makes the synthetic scans of fit_synthetic_liver (data/targets/).
+
+Runs experiments/fit_synthetic_liver_truth.json (known parameters), takes its
+deformed surfaces at load steps 4, 7 and 10, and writes for each:
+  liver_step{K}_exact.obj      the same mesh, exact (17 digits): a same-mesh, noise-free target
+  liver_step{K}_scan.obj       a different mesh with no vertex correspondence: every
+                               triangle split in four at its edge midpoints (so the
+                               surface is the same), the vertices shuffled, and
+                               Gaussian noise of 0.5 mm (standard deviation per
+                               coordinate) added, as a scanner would.
+Usage: /usr/bin/python3 experiments/make_synthetic_targets.py [build-release/src/app/fiberfluid]
+"""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+NOISE = 0.5e-3  # m
+SEED = 20161122
+
+
+def read_vtu(path):
+    """Points (deformed positions) and triangles of a fiberfluid .vtu."""
+    text = open(path).read()
+    arrays = re.findall(r"<DataArray([^>]*)>(.*?)</DataArray>", text, re.S)
+    points = triangles = None
+    for header, body in arrays:
+        values = body.split()
+        if "Name=" not in header and 'NumberOfComponents="3"' in header:
+            points = np.array(values, float).reshape(-1, 3)
+        if 'Name="connectivity"' in header:
+            triangles = np.array(values, int).reshape(-1, 3)
+    return points, triangles
+
+
+def write_obj(path, vertices, faces, comment):
+    with open(path, "w") as f:
+        f.write(f"# {comment}\n")
+        for v in vertices:
+            f.write("v %.17g %.17g %.17g\n" % tuple(v))
+        for t in faces:
+            f.write("f %d %d %d\n" % tuple(t + 1))
+
+
+def subdivide(vertices, faces):
+    """Each triangle into four at its edge midpoints; unused vertices dropped."""
+    used = np.unique(faces)
+    index = {v: k for k, v in enumerate(used)}
+    out = [vertices[v] for v in used]
+    midpoint = {}
+
+    def middle(a, b):
+        key = (min(a, b), max(a, b))
+        if key not in midpoint:
+            midpoint[key] = len(out)
+            out.append(0.5 * (vertices[a] + vertices[b]))
+        return midpoint[key]
+
+    new_faces = []
+    for a, b, c in faces:
+        ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
+        A, B, C = index[a], index[b], index[c]
+        new_faces += [[A, ab, ca], [ab, B, bc], [ca, bc, C], [ab, bc, ca]]
+    return np.array(out), np.array(new_faces)
+
+
+def main():
+    binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build-release/src/app/fiberfluid")
+    truth = os.path.join(ROOT, "experiments/fit_synthetic_liver_truth.json")
+    out_dir = os.path.join(ROOT, "data/targets")
+    os.makedirs(out_dir, exist_ok=True)
+    rng = np.random.default_rng(SEED)
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([binary, "run", truth, "-o", os.path.join(tmp, "truth"), "-q"], check=True,
+                       stdout=subprocess.DEVNULL)
+        for step in (4, 7, 10):
+            points, triangles = read_vtu(os.path.join(tmp, "truth", "vtk", "step_%04d.vtu" % step))
+            if step == 10:  # the .vtu's 12 digits: take the exact final.obj instead
+                final = [l.split()[1:] for l in open(os.path.join(tmp, "truth", "final.obj"))
+                         if l.startswith("v ")]
+                exact = np.array(final, float)
+                assert np.abs(exact - points).max() < 1e-9
+                points = exact
+            write_obj(os.path.join(out_dir, f"liver_step{step}_exact.obj"), points, triangles,
+                      f"fit_synthetic_liver_truth.json at load step {step}: same mesh, exact")
+            fine, fine_faces = subdivide(points, triangles)
+            order = rng.permutation(len(fine))
+            inverse = np.empty_like(order)
+            inverse[order] = np.arange(len(order))
+            scan = fine[order] + rng.normal(0.0, NOISE, fine.shape)
+            write_obj(os.path.join(out_dir, f"liver_step{step}_scan.obj"), scan, inverse[fine_faces],
+                      f"fit_synthetic_liver_truth.json at load step {step}: resampled (midpoint "
+                      f"subdivision, shuffled), Gaussian noise {NOISE * 1e3} mm per coordinate")
+        subprocess.run([binary, "run", os.path.join(ROOT, "experiments/sphere.json"), "-o",
+                        os.path.join(tmp, "sphere"), "-q"], check=True, stdout=subprocess.DEVNULL)
+        with open(os.path.join(tmp, "sphere", "final.obj")) as f:
+            body = f.read()
+        with open(os.path.join(out_dir, "sphere_final.obj"), "w") as f:
+            f.write("# experiments/sphere.json (the paper's sphere) after its 10 steps: exact\n" + body)
+    print("targets in", out_dir)
+
+
+if __name__ == "__main__":
+    main()
