@@ -14,6 +14,8 @@
 #include "app/experiment.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
+#include "fit/calibration.hpp"
+#include "model/equilibrium.hpp"
 #include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
@@ -147,6 +149,103 @@ py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output)
 
 }  // namespace
 
+// A fit of an experiment's material to measured surfaces given as numpy
+// arrays: no JSON needed (fiberfluid.fit).
+py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
+                        const py::list& parameters, const std::string& method,
+                        const std::string& jacobian, bool symmetric, const std::string& loss,
+                        double loss_scale, int max_iterations) {
+  if (ex.cases.size() != 1) throw ff::InputError("fit: the experiment must be one simulation");
+  const ff::app::Case& c = ex.cases.front();
+  std::vector<ff::fit::MeasuredStep> measured;
+  for (size_t k = 0; k < targets.size(); ++k) {
+    const py::dict t = targets[k].cast<py::dict>();
+    const std::string label = "targets[" + std::to_string(k) + "]";
+    const Eigen::MatrixXd V = t["vertices"].cast<Eigen::MatrixXd>();
+    const Eigen::MatrixXi F = t.contains("faces") ? t["faces"].cast<Eigen::MatrixXi>() : Eigen::MatrixXi();
+    const int step = t.contains("step") ? t["step"].cast<int>() : c.stepping.steps;
+    measured.push_back({ff::fit::make_target(label, V, F), step});
+  }
+  std::vector<ff::fit::Parameter> fitted;
+  for (const py::handle& item : parameters) {
+    const py::dict p = item.cast<py::dict>();
+    ff::fit::Parameter q;
+    q.name = p["name"].cast<std::string>();
+    const bool alignment = ff::fit::is_alignment_parameter(q.name);
+    if (!alignment && !ff::model::is_material_parameter(c.model.material, q.name))
+      throw ff::InputError("fit: parameter \"" + q.name + "\" is not a parameter of this material "
+                           "or of the alignment");
+    q.initial = p.contains("start") ? p["start"].cast<double>()
+                : alignment ? 0.0
+                            : ff::fit::material_parameter(c.model.material, q.name);
+    if (p.contains("lower")) q.lower = p["lower"].cast<double>();
+    if (p.contains("upper")) q.upper = p["upper"].cast<double>();
+    q.log_scale = p.contains("log_scale") ? p["log_scale"].cast<bool>()
+                                          : ff::fit::log_scale_by_default(q.name);
+    fitted.push_back(q);
+  }
+  ff::fit::FitOptions options;
+  const std::map<std::string, ff::fit::Method> methods = {
+      {"levenberg-marquardt", ff::fit::Method::LevenbergMarquardt},
+      {"bobyqa", ff::fit::Method::Bobyqa},
+      {"direct-l", ff::fit::Method::DirectL},
+      {"crs2", ff::fit::Method::Crs2}};
+  if (!methods.count(method))
+    throw ff::InputError("fit: method \"" + method + "\": expected levenberg-marquardt, bobyqa, "
+                         "direct-l or crs2");
+  options.method = methods.at(method);
+  if (jacobian != "analytic" && jacobian != "finite-differences")
+    throw ff::InputError("fit: jacobian: expected analytic or finite-differences");
+  options.finite_differences = jacobian == "finite-differences";
+  options.symmetric = symmetric;
+  if (loss != "squared" && loss != "huber" && loss != "cauchy")
+    throw ff::InputError("fit: loss: expected squared, huber or cauchy");
+  options.loss = loss == "huber" ? ff::fit::Loss::Huber
+                 : loss == "cauchy" ? ff::fit::Loss::Cauchy
+                                    : ff::fit::Loss::Squared;
+  options.loss_scale = loss_scale;
+  options.max_iterations = max_iterations;
+  const ff::fit::Calibration calibration(c.model, c.stepping, measured, fitted, options);
+  ff::fit::FitResult r;
+  {
+    py::gil_scoped_release release;
+    r = calibration.run();
+  }
+  py::dict out;
+  out["success"] = r.success;
+  out["message"] = r.message;
+  out["analytic_jacobian"] = r.analytic_jacobian;
+  py::dict values, errors, intervals;
+  for (size_t k = 0; k < r.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (r.values.size() == 0) break;
+    values[py::str(r.names[k])] = r.values[i];
+    errors[py::str(r.names[k])] = r.standard_errors[i];
+    intervals[py::str(r.names[k])] = py::make_tuple(r.lower_95[i], r.upper_95[i]);
+  }
+  out["values"] = values;
+  out["standard_errors"] = errors;
+  out["interval_95"] = intervals;
+  out["correlation"] = r.correlation;
+  py::list costs;
+  for (const auto& it : r.iterations) costs.append(it.cost);
+  out["cost_per_iteration"] = costs;
+  py::dict distance;
+  distance["mean"] = r.overall.mean;
+  distance["rms"] = r.overall.rms;
+  distance["standard_deviation"] = r.overall.standard_deviation;
+  distance["largest"] = r.overall.largest;
+  distance["share_of_length"] = r.overall.share(r.overall.standard_deviation);
+  out["distance"] = distance;
+  out["forward_runs"] = r.forward_runs;
+  out["sensitivity_solves"] = r.sensitivity_solves;
+  out["seconds"] = r.seconds;
+  py::list positions;
+  for (const Eigen::MatrixXd& X : r.positions) positions.append(X);
+  out["positions"] = positions;
+  return out;
+}
+
 PYBIND11_MODULE(fiberfluid, m) {
   m.doc() = "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
             "SI units throughout: m, N, Pa.";
@@ -224,6 +323,18 @@ PYBIND11_MODULE(fiberfluid, m) {
            "result folder as `fiberfluid run -o` does. Returns a dict with success, runs (each "
            "with positions, displacements, pressure, steps as numpy arrays, figures), figures "
            "and checks.");
+
+  m.def("fit", &fit_experiment, py::arg("experiment"), py::arg("targets"), py::arg("parameters"),
+        py::arg("method") = "levenberg-marquardt", py::arg("jacobian") = "analytic",
+        py::arg("symmetric") = false, py::arg("loss") = "squared", py::arg("loss_scale") = 1e-3,
+        py::arg("max_iterations") = 50,
+        "Fits the material (and optionally a rigid alignment) of a one-run experiment to measured "
+        "surfaces. targets: a list of dicts with vertices (#P x 3), faces (#T x 3, omit for a point "
+        "cloud) and step (default: the last); parameters: dicts with name (Y0, beta, gamma, "
+        "factor_x, rotation_y, ...), and optionally start, lower, upper, log_scale. Returns a dict: "
+        "success, message, values, standard_errors, interval_95, correlation, cost_per_iteration, "
+        "distance (mean, rms, standard_deviation, largest, share_of_length), forward_runs, "
+        "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
 
   m.def(
       "summary",

@@ -131,3 +131,24 @@ def test_a_program_gives_its_own_surface():
         fiberfluid.Experiment.from_dict(document, vertices=vertices)
     with pytest.raises(ValueError, match="surface: missing"):
         fiberfluid.Experiment.from_dict(document)
+
+
+def test_a_fit_without_json():
+    """The paper's sphere: its deformed surface as numpy arrays, Y and gamma from a factor 3 away."""
+    with open(os.path.join(EXPERIMENTS, "sphere.json")) as f:
+        document = json.load(f)
+    document["expected"] = []
+    truth = fiberfluid.Experiment.from_dict(document).run()["runs"][0]
+    mesh = fiberfluid.read_mesh(os.path.join(SOURCE, "data", "targets", "sphere_final.obj"))
+    np.testing.assert_allclose(mesh["vertices"], truth["positions"], atol=1e-12)
+    document["material"] = {"Y": 1000, "gamma": 9000}
+    start = fiberfluid.Experiment.from_dict(document)
+    result = fiberfluid.fit(start, targets=[{"vertices": truth["positions"], "faces": mesh["faces"]}],
+                            parameters=[{"name": "Y"}, {"name": "gamma"}])
+    assert result["success"], result["message"]
+    assert not result["analytic_jacobian"]  # the paper's incremental scheme
+    assert result["values"]["Y"] == pytest.approx(3000.0, rel=1e-6)
+    assert result["values"]["gamma"] == pytest.approx(3000.0, rel=1e-6)
+    assert result["distance"]["largest"] < 1e-8
+    with pytest.raises(ValueError, match="not a parameter"):
+        fiberfluid.fit(start, targets=[{"vertices": truth["positions"]}], parameters=[{"name": "E"}])
