@@ -5,10 +5,7 @@
 #   scripts/fit.sh [experiments/NAME.json]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
-cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DFIBERFLUID_BUILD_TESTS=OFF \
-      -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build-release -j"$(nproc)"
+scripts/build-release.sh
 
 experiment="${1:-experiments/fit_synthetic_liver.json}"
 name="$(basename "$experiment" .json)"

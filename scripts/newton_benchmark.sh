@@ -7,10 +7,7 @@
 #   scripts/newton_benchmark.sh [--max-subdivisions 5]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
-cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DFIBERFLUID_BUILD_TESTS=OFF \
-      -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build-release -j"$(nproc)"
+scripts/build-release.sh
 max=5
 if [[ "${1:-}" == "--max-subdivisions" ]]; then max="$2"; fi
 printf '| vertices | steps | newton iterations / step | gmres iterations / solve | preconditioner factorizations | s / step | whole run s | peak MiB |\n'

@@ -4,10 +4,7 @@
 #   scripts/run.sh [experiments/NAME.json]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
-cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DFIBERFLUID_BUILD_TESTS=OFF \
-      -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null  # Debian's, with the numpy it installs
-cmake --build build-release -j"$(nproc)"
+scripts/build-release.sh
 
 experiment="${1:-experiments/sphere.json}"
 name="$(basename "$experiment" .json)"

@@ -140,16 +140,23 @@ struct RunFlags {
   int jobs = 0;
 };
 
-int run_command(const std::string& path, const RunFlags& flags) {
-  ProgressPrinter printer;
-  if (!flags.quiet)
+// Loads an experiment (throwing before anything is written), drawing the
+// progress of long phases such as pruning unless quiet; the sink stays set.
+app::Experiment load_showing_progress(const std::string& path, bool quiet, ProgressPrinter& printer) {
+  if (!quiet)
     fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
                                              double done, double total) {
       printer(label, phase, done, total);
     });
-  const app::Experiment ex = app::load_experiment(path);  // throws before anything is written
+  app::Experiment ex = app::load_experiment(path);
   printer.close();
   for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
+  return ex;
+}
+
+int run_command(const std::string& path, const RunFlags& flags) {
+  ProgressPrinter printer;
+  const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
 
   app::OutputWriter writer(ex, output);
@@ -197,15 +204,8 @@ int run_command(const std::string& path, const RunFlags& flags) {
 // it at the fitted values and writes the usual outputs with the fit's files.
 int fit_command(const std::string& path, const RunFlags& flags) {
   ProgressPrinter printer;
-  if (!flags.quiet)
-    fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
-                                             double done, double total) {
-      printer(label, phase, done, total);
-    });
-  const app::Experiment ex = app::load_experiment(path);  // throws before anything is written
-  printer.close();
+  const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
-  for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
   const app::FitSetup setup = app::setup_fit(ex, [&](const fiberfluid::fit::IterationRecord& r) {
     if (flags.quiet) return;
     std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2;";
