@@ -97,6 +97,21 @@ def main():
             write_obj(os.path.join(out_dir, f"liver_step{step}_scan.obj"), scan, inverse[fine_faces],
                       f"fit_synthetic_liver_truth.json at load step {step}: resampled (midpoint "
                       f"subdivision, shuffled), Gaussian noise {NOISE * 1e3} mm per coordinate")
+        # The same liver on a finer mesh, and its own deformed surfaces.
+        lines = open(os.path.join(ROOT, "data/meshes/liver.obj")).read().split("\n")
+        rest = np.array([l.split()[1:4] for l in lines if l.startswith("v ")], float)
+        faces = np.array([[int(w.split("/")[0]) - 1 for w in l.split()[1:4]]
+                          for l in lines if l.startswith("f ")])
+        fine, fine_faces = subdivide(rest, faces)
+        write_obj(os.path.join(out_dir, "liver_fine.obj"), fine, fine_faces,
+                  "data/meshes/liver.obj (SOFA, LGPL-2.1-or-later) with every triangle split in four")
+        fine_truth = os.path.join(ROOT, "experiments/fit_remeshed_liver_truth.json")
+        subprocess.run([binary, "run", fine_truth, "-o", os.path.join(tmp, "fine"), "-q"], check=True,
+                       stdout=subprocess.DEVNULL)
+        for step in (4, 7, 10):
+            points, triangles = read_vtu(os.path.join(tmp, "fine", "vtk", "step_%04d.vtu" % step))
+            write_obj(os.path.join(out_dir, f"liver_fine_step{step}.obj"), points, triangles,
+                      f"fit_remeshed_liver_truth.json at load step {step} (the finer liver): exact")
         subprocess.run([binary, "run", os.path.join(ROOT, "experiments/sphere.json"), "-o",
                         os.path.join(tmp, "sphere"), "-q"], check=True, stdout=subprocess.DEVNULL)
         with open(os.path.join(tmp, "sphere", "final.obj")) as f:
