@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   std::printf("%s: %d vertices, %lld of %lld fibers kept, %d Newton steps; loaded and pruned in %.1f s\n",
               ex.name.c_str(), c.model.num_vertices(), c.fibers.kept, c.fibers.pairs,
               c.stepping.steps, load_seconds);
+  std::fflush(stdout);
 
   // The truth and its deformed surface at the last step: the target.
   const auto truth_start = std::chrono::steady_clock::now();
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
   const double run_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - truth_start).count();
   std::printf("one forward run: %.2f s, %d Newton iterations\n", run_seconds, truth.newton_iterations);
+  std::fflush(stdout);
   const std::vector<ff::fit::MeasuredStep> targets = {
       {ff::fit::make_target("truth", ff::model::positions(c.model, truth.unknowns), c.model.surface.F),
        c.stepping.steps}};
@@ -65,6 +67,10 @@ int main(int argc, char** argv) {
     if (differences && skip_differences) break;
     ff::fit::FitOptions options;
     options.finite_differences = differences;
+    options.progress = [](const ff::fit::IterationRecord& r) {  // stderr: unbuffered
+      std::fprintf(stderr, "  iteration %d: cost %.6g, %d forward runs, %.1f s\n", r.iteration,
+                   r.cost, r.forward_runs, r.seconds);
+    };
     const ff::fit::Calibration calibration(c.model, c.stepping, targets, parameters, options);
     const ff::fit::FitResult r = calibration.run();
     std::printf("| %s | %zu | %d | %d | %.1f | %.6g | %.6g | %.6g |%s\n",
