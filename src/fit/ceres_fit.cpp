@@ -18,6 +18,10 @@ class SharedEvaluation {
   explicit SharedEvaluation(const Calibration& calibration) : calibration_(calibration) {}
 
   const Evaluation& at(const double* phi, bool with_jacobian) {
+    // Analytic sensitivities cost a few tangent solves next to a whole
+    // forward run: take them always, so that an accepted trial point needs
+    // no second run when Ceres asks for its Jacobian.
+    with_jacobian = with_jacobian || calibration_.analytic_jacobian();
     const int P = calibration_.parameters().size();
     const Eigen::Map<const Eigen::VectorXd> point(phi, P);
     if (!valid_ || point != phi_ || (with_jacobian && !has_jacobian_)) {
