@@ -171,6 +171,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
           {"iterations", iterations},
           {"forward_runs", r.forward_runs},
           {"sensitivity_solves", r.sensitivity_solves},
+          {"failed_runs", r.failed_runs},
           {"seconds", r.seconds},
           {"body_length", c.body_length()},
           {"body_length_is", "the largest extent of the rest surface's bounding box"},

@@ -252,8 +252,9 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   std::cout << "  distance: mean " << d.mean << ", rms " << d.rms << ", sd " << d.standard_deviation
             << " (" << 100.0 * d.share(d.standard_deviation) << "% of the body's length "
             << d.length << "), largest " << d.largest << " m\n";
-  std::cout << "  " << fitted.forward_runs << " forward runs, " << fitted.sensitivity_solves
-            << " sensitivity solves, " << fitted.seconds << " s\n";
+  std::cout << "  " << fitted.forward_runs << " forward runs";
+  if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed: rejected steps)";
+  std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds << " s\n";
   for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
   if (!result.runs_succeeded()) {
     for (const app::RunResult& run : result.runs)

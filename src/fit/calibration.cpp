@@ -378,6 +378,7 @@ FitResult Calibration::run() const {
   result.iterations = outcome.iterations;
   result.forward_runs = 1 + outcome.forward_runs;
   result.sensitivity_solves = outcome.sensitivity_solves;
+  result.failed_runs = outcome.failed_runs;
   result.values = m.map.values(outcome.phi);
 
   // At the optimum: the run, the distances, and the covariance.

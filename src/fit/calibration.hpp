@@ -95,6 +95,7 @@ struct FitResult {
   std::vector<IterationRecord> iterations;
   double initial_cost = 0.0, final_cost = 0.0;
   int forward_runs = 0, sensitivity_solves = 0;
+  int failed_runs = 0;  // trial points whose forward run failed: rejected steps
   double seconds = 0.0;
   // At the fitted values: the run, and per target the distance of every
   // model vertex (NaN where it does not count) and its statistics.

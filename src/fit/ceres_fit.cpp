@@ -31,11 +31,12 @@ class SharedEvaluation {
       has_jacobian_ = with_jacobian;
       forward_runs += evaluation_.forward_runs;
       sensitivity_solves += evaluation_.sensitivity_solves;
+      if (!evaluation_.ok) ++failed_runs;
     }
     return evaluation_;
   }
 
-  int forward_runs = 0, sensitivity_solves = 0;
+  int forward_runs = 0, sensitivity_solves = 0, failed_runs = 0;
 
  private:
   const Calibration& calibration_;
@@ -150,6 +151,7 @@ OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const F
   outcome.phi = phi;
   outcome.forward_runs = p.shared.forward_runs;
   outcome.sensitivity_solves = p.shared.sensitivity_solves;
+  outcome.failed_runs = p.shared.failed_runs;
   outcome.success = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   outcome.message = outcome.success ? "converged: " + summary.message
                                     : "levenberg-marquardt: " + summary.message;

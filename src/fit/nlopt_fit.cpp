@@ -34,6 +34,7 @@ struct Objective {
     const Evaluation e = calibration.evaluate(phi, false);
     outcome.forward_runs += e.forward_runs;
     ++evaluations;
+    if (!e.ok) ++outcome.failed_runs;
     const double cost = e.ok ? calibration.cost(e.residuals) : kFailedCost;
     if (cost < best) {
       best = cost;

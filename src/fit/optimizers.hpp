@@ -17,6 +17,7 @@ struct OptimizerOutcome {
   Eigen::VectorXd phi;                    // the best point found
   std::vector<IterationRecord> iterations;
   int forward_runs = 0, sensitivity_solves = 0;
+  int failed_runs = 0;  // trial points whose forward run failed (rejected, not fatal)
 };
 
 OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const FitOptions& options);

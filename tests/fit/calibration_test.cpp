@@ -210,6 +210,37 @@ TEST(Calibration, ARobustLossResistsOutliers) {
   EXPECT_LT(cauchy, 0.01 * squared);
 }
 
+// A trial point whose forward run fails (a material so soft that the body
+// runs away) is a rejected step: the fit goes on and still recovers the truth.
+TEST(Calibration, AForwardRunThatFailsInsideTheFitIsARejectedStep) {
+  const model::Model m = hanging_sphere();
+  std::vector<MeasuredStep> probe = synthetic_targets(m, newton(2), {2});
+  // The softest Y0 that still runs, by bisection in log scale.
+  double ok = 3000.0, fails = 1e-3;
+  for (int k = 0; k < 40; ++k) {
+    const double mid = std::sqrt(ok * fails);
+    const Calibration c(m, newton(2), probe, {parameter("Y0", mid)});
+    (c.evaluate(c.parameters().initial_phi(), false).ok ? ok : fails) = mid;
+  }
+  ASSERT_LT(ok, 2000.0) << "no failing region below the truth";
+  // The truth just above it; BOBYQA starts where its first steps (a factor
+  // e^0.3 down) fail.
+  model::Model soft = m;
+  soft.material.law.set_parameter("Y0", 1.3 * ok);
+  const std::vector<MeasuredStep> targets = synthetic_targets(soft, newton(2), {2});
+  FitOptions bobyqa;
+  bobyqa.method = Method::Bobyqa;
+  const FitResult b =
+      Calibration(soft, newton(2), targets, {parameter("Y0", 1.2 * ok)}, bobyqa).run();
+  EXPECT_GT(b.failed_runs, 0);
+  ASSERT_TRUE(b.success) << b.message;
+  EXPECT_NEAR(b.values[0] / (1.3 * ok), 1.0, 1e-5);
+  // Levenberg-Marquardt from a factor 3 above: whatever its trial points, it recovers.
+  const FitResult lm = Calibration(soft, newton(2), targets, {parameter("Y0", 3.9 * ok)}).run();
+  ASSERT_TRUE(lm.success) << lm.message;
+  EXPECT_NEAR(lm.values[0] / (1.3 * ok), 1.0, 1e-6);
+}
+
 void expect_input_error(const std::function<void()>& f, const std::string& part) {
   try {
     f();
