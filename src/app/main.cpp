@@ -157,6 +157,9 @@ app::Experiment load_showing_progress(const std::string& path, bool quiet, Progr
 int run_command(const std::string& path, const RunFlags& flags) {
   ProgressPrinter printer;
   const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
+  if (ex.fit)
+    std::cerr << "note: " << path << " has a \"fit\" section: `run` simulates at the starting "
+              << "values; `fiberfluid fit` calibrates\n";
   const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
 
   app::OutputWriter writer(ex, output);
