@@ -318,6 +318,7 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
   o.krylov_max_iterations = f.integer("krylov_max_iterations", o.krylov_max_iterations, 1, 100000);
   o.max_contact_rounds = f.integer("max_contact_rounds", o.max_contact_rounds, 1, 1000);
+  o.predictor = f.boolean("predictor", o.predictor);
   f.finish();
   return o;
 }
@@ -502,6 +503,8 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   o.max_evaluations = f.integer("max_evaluations", o.max_evaluations, 1, 1000000);
   o.function_tolerance = f.positive("function_tolerance", o.function_tolerance);
   o.parameter_tolerance = f.positive("parameter_tolerance", o.parameter_tolerance);
+  o.initial_trust_region_radius =
+      f.positive("initial_trust_region_radius", o.initial_trust_region_radius);
   f.finish();
   return spec;
 }

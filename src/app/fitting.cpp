@@ -140,8 +140,10 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
   for (const fit::IterationRecord& it : r.iterations) {
     json values = json::object();
     for (size_t k = 0; k < r.names.size(); ++k) values[r.names[k]] = it.values[static_cast<Eigen::Index>(k)];
-    iterations.push_back({{"iteration", it.iteration}, {"cost", it.cost}, {"values", values},
-                          {"forward_runs", it.forward_runs}, {"seconds", it.seconds}});
+    iterations.push_back({{"iteration", it.iteration}, {"cost", it.cost},
+                          {"accepted", it.accepted}, {"trial_cost", it.trial_cost},
+                          {"values", values}, {"forward_runs", it.forward_runs},
+                          {"seconds", it.seconds}});
   }
   json targets = json::array();
   for (size_t t = 0; t < setup.targets.size(); ++t)
@@ -184,12 +186,13 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
                      const FitSetup& setup, const fit::FitResult& r, const ExperimentResult& run) {
   geom::write_text_file(folder / "fit.json", fit_json(ex, setup, r, run).dump(2) + "\n");
   std::ostringstream iterations;
-  iterations << "iteration,cost_m2,forward_runs,seconds";
+  iterations << "iteration,cost_m2,accepted,trial_cost_m2,forward_runs,seconds";
   for (const std::string& name : r.names) iterations << "," << name;
   iterations << "\n";
   iterations.precision(12);
   for (const fit::IterationRecord& it : r.iterations) {
-    iterations << it.iteration << "," << it.cost << "," << it.forward_runs << "," << it.seconds;
+    iterations << it.iteration << "," << it.cost << "," << (it.accepted ? 1 : 0) << ","
+               << it.trial_cost << "," << it.forward_runs << "," << it.seconds;
     for (Eigen::Index k = 0; k < it.values.size(); ++k) iterations << "," << it.values[k];
     iterations << "\n";
   }

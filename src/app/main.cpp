@@ -211,7 +211,9 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
   const app::FitSetup setup = app::setup_fit(ex, [&](const fiberfluid::fit::IterationRecord& r) {
     if (flags.quiet) return;
-    std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2;";
+    std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2";
+    if (!r.accepted) std::cerr << " (step rejected: it cost " << r.trial_cost << ")";
+    std::cerr << ";";
     const auto& names = ex.fit->parameters;
     for (size_t k = 0; k < names.size(); ++k)
       std::cerr << (k ? ", " : " ") << names[k].name << " = " << r.values[static_cast<Eigen::Index>(k)];

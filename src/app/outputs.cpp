@@ -42,7 +42,8 @@ json newton_options_json(const solve::NewtonOptions& n) {
           {"krylov_tolerance", n.krylov_tolerance},
           {"krylov_restart", n.krylov_restart},
           {"krylov_max_iterations", n.krylov_max_iterations},
-          {"max_contact_rounds", n.max_contact_rounds}};
+          {"max_contact_rounds", n.max_contact_rounds},
+          {"predictor", n.predictor}};
 }
 
 json stepping_json(const solve::SteppingOptions& s) {

@@ -355,6 +355,22 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   return e;
 }
 
+const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jacobian) {
+  for (auto entry = kept_.begin(); entry != kept_.end(); ++entry)
+    if (entry->phi.size() == phi.size() && entry->phi == phi &&
+        (entry->has_jacobian || !with_jacobian)) {
+      if (entry != kept_.begin()) std::rotate(kept_.begin(), entry, std::next(entry));
+      return kept_.front().evaluation;
+    }
+  Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian)};
+  forward_runs += entry.evaluation.forward_runs;
+  sensitivity_solves += entry.evaluation.sensitivity_solves;
+  if (!entry.evaluation.ok) ++failed_runs;
+  kept_.push_front(std::move(entry));
+  if (kept_.size() > kKept) kept_.pop_back();
+  return kept_.front().evaluation;
+}
+
 FitResult Calibration::run() const {
   const Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
@@ -363,27 +379,34 @@ FitResult Calibration::run() const {
   result.analytic_jacobian = m.analytic;
   result.names = m.map.names();
   result.initial = m.map.values(m.map.initial_phi());
-  const Evaluation first = evaluate(m.map.initial_phi(), false);
+  EvaluationCache evaluations(*this);
+  auto count_runs = [&] {
+    result.forward_runs = evaluations.forward_runs;
+    result.sensitivity_solves = evaluations.sensitivity_solves;
+    result.failed_runs = evaluations.failed_runs;
+  };
+  // The start, as Levenberg-Marquardt will ask for it (with analytic
+  // sensitivities): a failure here is the user's to fix, not a rejected step.
+  const bool levenberg_marquardt = m.options.method == Method::LevenbergMarquardt;
+  const Evaluation& first = evaluations.at(m.map.initial_phi(), levenberg_marquardt && m.analytic);
   if (!first.ok) {
+    count_runs();
     result.message = "the forward run at the starting parameters failed: " + first.message;
     return result;
   }
   result.initial_cost = cost(first.residuals);
 
-  const OptimizerOutcome outcome = m.options.method == Method::LevenbergMarquardt
-                                       ? fit_levenberg_marquardt(*this, m.options)
-                                       : fit_nlopt(*this, m.options);
+  const OptimizerOutcome outcome = levenberg_marquardt ? fit_levenberg_marquardt(evaluations, m.options)
+                                                       : fit_nlopt(evaluations, m.options);
   result.success = outcome.success;
   result.message = outcome.message;
   result.iterations = outcome.iterations;
-  result.forward_runs = 1 + outcome.forward_runs;
-  result.sensitivity_solves = outcome.sensitivity_solves;
-  result.failed_runs = outcome.failed_runs;
   result.values = m.map.values(outcome.phi);
 
-  // At the optimum: the run, the distances, and the covariance.
-  const Evaluation best = evaluate(outcome.phi, false);
-  ++result.forward_runs;
+  // At the optimum (usually kept from the optimiser): the run, the distances,
+  // and the covariance. A copy: the cache's entries move.
+  const Evaluation best = evaluations.at(outcome.phi, false);
+  count_runs();
   if (!best.ok) {
     result.success = false;
     result.message = "the forward run at the fitted parameters failed: " + best.message;
@@ -410,9 +433,8 @@ FitResult Calibration::run() const {
   result.overall = distance_statistics(Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())), m.length);
 
   Eigen::MatrixXd covariance;
-  int covariance_runs = 0;
-  result.covariance_ok = phi_covariance(*this, m.options, outcome.phi, &covariance, &covariance_runs);
-  result.forward_runs += covariance_runs;
+  result.covariance_ok = phi_covariance(evaluations, m.options, outcome.phi, &covariance);
+  count_runs();
   const int P = m.map.size();
   result.standard_errors = result.lower_95 = result.upper_95 =
       Eigen::VectorXd::Constant(P, std::numeric_limits<double>::quiet_NaN());

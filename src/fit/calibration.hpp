@@ -40,8 +40,12 @@ const char* to_string(Loss loss);
 
 struct IterationRecord {
   int iteration = 0;
-  double cost = 0.0;          // 1/2 sum rho(r^2), m^2
-  Eigen::VectorXd values;     // the parameters' values
+  double cost = 0.0;          // 1/2 sum rho(r^2), m^2, at the current point
+  // Levenberg-Marquardt: whether this iteration's trial point was accepted,
+  // and its cost (a rejected one costs more than `cost`).
+  bool accepted = true;
+  double trial_cost = 0.0;
+  Eigen::VectorXd values;     // the parameters' values at the current point
   int forward_runs = 0;       // so far
   double seconds = 0.0;       // since the start
 };
@@ -62,7 +66,13 @@ struct FitOptions {
   int max_iterations = 50;         // Levenberg-Marquardt iterations
   int max_evaluations = 400;       // NLopt objective evaluations (each a forward run)
   double function_tolerance = 1e-12;  // relative change of the cost that ends the fit
-  double parameter_tolerance = 1e-10; // relative change of the parameters
+  double parameter_tolerance = 1e-8;  // relative change of the parameters
+  // Levenberg-Marquardt's first trust region (Ceres' radius: the damping
+  // starts at the scaled diagonal over it). The default (Ceres') starts with
+  // nearly Gauss-Newton steps; about 10 damps the first steps, which pays
+  // when a far start makes the full steps overshoot (each rejected step
+  // costs a forward run and only halves the region).
+  double initial_trust_region_radius = 1e4;
   // Called after every iteration (LM) or every improvement (NLopt).
   std::function<void(const IterationRecord&)> progress;
 };

@@ -12,37 +12,23 @@ namespace {
 
 // One forward run serves every residual at one point: Ceres asks residual
 // by residual (each its own block, so that a robust loss acts on each
-// distance), and the run is kept until the point changes.
+// distance), and the cache keeps the run.
 class SharedEvaluation {
  public:
-  explicit SharedEvaluation(const Calibration& calibration) : calibration_(calibration) {}
+  explicit SharedEvaluation(EvaluationCache& cache) : cache_(cache) {}
 
   const Evaluation& at(const double* phi, bool with_jacobian) {
     // Analytic sensitivities cost a few tangent solves next to a whole
     // forward run: take them always, so that an accepted trial point needs
     // no second run when Ceres asks for its Jacobian.
-    with_jacobian = with_jacobian || calibration_.analytic_jacobian();
-    const int P = calibration_.parameters().size();
-    const Eigen::Map<const Eigen::VectorXd> point(phi, P);
-    if (!valid_ || point != phi_ || (with_jacobian && !has_jacobian_)) {
-      phi_ = point;
-      evaluation_ = calibration_.evaluate(phi_, with_jacobian);
-      valid_ = true;
-      has_jacobian_ = with_jacobian;
-      forward_runs += evaluation_.forward_runs;
-      sensitivity_solves += evaluation_.sensitivity_solves;
-      if (!evaluation_.ok) ++failed_runs;
-    }
-    return evaluation_;
+    with_jacobian = with_jacobian || cache_.calibration().analytic_jacobian();
+    const int P = cache_.calibration().parameters().size();
+    return cache_.at(Eigen::Map<const Eigen::VectorXd>(phi, P), with_jacobian);
   }
-
-  int forward_runs = 0, sensitivity_solves = 0, failed_runs = 0;
+  const EvaluationCache& cache() const { return cache_; }
 
  private:
-  const Calibration& calibration_;
-  Eigen::VectorXd phi_;
-  Evaluation evaluation_;
-  bool valid_ = false, has_jacobian_ = false;
+  EvaluationCache& cache_;
 };
 
 class DistanceResidual final : public ceres::CostFunction {
@@ -82,8 +68,9 @@ struct CeresProblem {
   std::unique_ptr<ceres::LossFunction> loss;
   ceres::Problem problem;
 
-  CeresProblem(const Calibration& calibration, const FitOptions& options, Eigen::VectorXd& phi)
-      : shared(calibration), loss(make_loss(options)), problem(problem_options()) {
+  CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi)
+      : shared(cache), loss(make_loss(options)), problem(problem_options()) {
+    const Calibration& calibration = cache.calibration();
     const ParameterMap& map = calibration.parameters();
     for (int i = 0; i < calibration.num_residuals(); ++i)
       problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(), phi.data());
@@ -109,9 +96,13 @@ class Recorder final : public ceres::IterationCallback {
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     IterationRecord r;
     r.iteration = s.iteration;
-    r.cost = s.cost;
+    // Ceres reports a rejected step's cost as the iteration's cost; the
+    // current point's is the last accepted one.
+    r.accepted = s.iteration == 0 || s.step_is_successful;
+    r.trial_cost = s.cost;
+    r.cost = r.accepted || outcome_.iterations.empty() ? s.cost : outcome_.iterations.back().cost;
     r.values = calibration_.parameters().values(phi_);  // update_state_every_iteration
-    r.forward_runs = shared_.forward_runs;
+    r.forward_runs = shared_.cache().forward_runs;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     outcome_.iterations.push_back(r);
     if (options_.progress) options_.progress(r);
@@ -129,15 +120,17 @@ class Recorder final : public ceres::IterationCallback {
 
 }  // namespace
 
-OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const FitOptions& options) {
+OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options) {
+  const Calibration& calibration = evaluations.calibration();
   OptimizerOutcome outcome;
   Eigen::VectorXd phi = calibration.parameters().initial_phi();
-  CeresProblem p(calibration, options, phi);
+  CeresProblem p(evaluations, options, phi);
   Recorder recorder(calibration, options, phi, p.shared, outcome);
   ceres::Solver::Options solver;
   solver.minimizer_type = ceres::TRUST_REGION;
   solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   solver.linear_solver_type = ceres::DENSE_QR;
+  solver.initial_trust_region_radius = options.initial_trust_region_radius;
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
   solver.parameter_tolerance = options.parameter_tolerance;
@@ -149,9 +142,6 @@ OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const F
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &p.problem, &summary);
   outcome.phi = phi;
-  outcome.forward_runs = p.shared.forward_runs;
-  outcome.sensitivity_solves = p.shared.sensitivity_solves;
-  outcome.failed_runs = p.shared.failed_runs;
   outcome.success = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
   outcome.message = outcome.success ? "converged: " + summary.message
                                     : "levenberg-marquardt: " + summary.message;
@@ -160,19 +150,18 @@ OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const F
   return outcome;
 }
 
-bool phi_covariance(const Calibration& calibration, const FitOptions& options,
-                    const Eigen::VectorXd& at, Eigen::MatrixXd* covariance, int* forward_runs) {
+bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
+                    const Eigen::VectorXd& at, Eigen::MatrixXd* covariance) {
   Eigen::VectorXd phi = at;
-  CeresProblem p(calibration, options, phi);
+  CeresProblem p(evaluations, options, phi);
   ceres::Covariance::Options o;
   o.algorithm_type = ceres::DENSE_SVD;  // reports a rank-deficient J instead of failing obscurely
   o.num_threads = 1;
   ceres::Covariance c(o);
   const std::vector<std::pair<const double*, const double*>> blocks = {{phi.data(), phi.data()}};
   const bool ok = c.Compute(blocks, &p.problem);
-  *forward_runs = p.shared.forward_runs;
   if (!ok) return false;
-  const int P = calibration.parameters().size();
+  const int P = evaluations.calibration().parameters().size();
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(P, P);
   if (!c.GetCovarianceBlock(phi.data(), phi.data(), C.data())) return false;
   *covariance = C;

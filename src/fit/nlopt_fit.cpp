@@ -18,32 +18,31 @@ namespace {
 constexpr double kFailedCost = 1e30;
 
 struct Objective {
-  Objective(const Calibration& c, const FitOptions& o, OptimizerOutcome& out)
-      : calibration(c), options(o), outcome(out) {}
+  Objective(EvaluationCache& e, const FitOptions& o, OptimizerOutcome& out)
+      : evaluations(e), calibration(e.calibration()), options(o), outcome(out) {}
+  EvaluationCache& evaluations;
   const Calibration& calibration;
   const FitOptions& options;
   OptimizerOutcome& outcome;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_phi;
-  int evaluations = 0;
+  int calls = 0;
 
   double operator()(const double* x) {
     const int P = calibration.parameters().size();
     const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(x, P);
-    const Evaluation e = calibration.evaluate(phi, false);
-    outcome.forward_runs += e.forward_runs;
-    ++evaluations;
-    if (!e.ok) ++outcome.failed_runs;
+    const Evaluation& e = evaluations.at(phi, false);
+    ++calls;
     const double cost = e.ok ? calibration.cost(e.residuals) : kFailedCost;
     if (cost < best) {
       best = cost;
       best_phi = phi;
       IterationRecord r;
-      r.iteration = evaluations;
-      r.cost = cost;
+      r.iteration = calls;
+      r.cost = r.trial_cost = cost;
       r.values = calibration.parameters().values(phi);
-      r.forward_runs = outcome.forward_runs;
+      r.forward_runs = evaluations.forward_runs;
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       outcome.iterations.push_back(r);
       if (options.progress) options.progress(r);
@@ -110,11 +109,12 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
 
 }  // namespace
 
-OptimizerOutcome fit_nlopt(const Calibration& calibration, const FitOptions& options) {
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options) {
+  const Calibration& calibration = evaluations.calibration();
   OptimizerOutcome outcome;
   const ParameterMap& map = calibration.parameters();
   Eigen::VectorXd phi = map.initial_phi();
-  Objective objective(calibration, options, outcome);
+  Objective objective(evaluations, options, outcome);
   nlopt_result result;
   if (options.method == Method::Bobyqa) {
     result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi, options.max_evaluations);
@@ -129,12 +129,12 @@ OptimizerOutcome fit_nlopt(const Calibration& calibration, const FitOptions& opt
     minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, calibration,
              options, objective, phi, global);
     result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi,
-                      options.max_evaluations - objective.evaluations);
+                      options.max_evaluations - objective.calls);
   }
   outcome.phi = phi;
   outcome.success = result > 0 && result != NLOPT_MAXEVAL_REACHED && objective.best < kFailedCost;
   outcome.message = std::string(to_string(options.method)) + ": " + describe(result) + " after " +
-                    std::to_string(objective.evaluations) + " forward runs";
+                    std::to_string(objective.calls) + " evaluations";
   return outcome;
 }
 

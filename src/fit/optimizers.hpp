@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -11,22 +12,45 @@
 
 namespace fiberfluid::fit {
 
+// The forward runs of one fit, shared by the start's check, the optimiser,
+// the covariance and the report: the last few points are kept, so that a
+// point asked for twice (the start, the optimum) costs one run. Counts runs.
+class EvaluationCache {
+ public:
+  explicit EvaluationCache(const Calibration& calibration) : calibration_(calibration) {}
+  const Calibration& calibration() const { return calibration_; }
+  // The evaluation at phi, with the Jacobian when asked (a kept one without
+  // it is evaluated again). The reference stays valid until the next call.
+  const Evaluation& at(const Eigen::VectorXd& phi, bool with_jacobian);
+
+  int forward_runs = 0, sensitivity_solves = 0;
+  int failed_runs = 0;  // points whose forward run failed (rejected, not fatal)
+
+ private:
+  static constexpr size_t kKept = 8;  // a few trial points past the optimum
+  struct Entry {
+    Eigen::VectorXd phi;
+    bool has_jacobian = false;
+    Evaluation evaluation;
+  };
+  const Calibration& calibration_;
+  std::deque<Entry> kept_;  // newest first
+};
+
 struct OptimizerOutcome {
   bool success = false;
   std::string message;
   Eigen::VectorXd phi;                    // the best point found
   std::vector<IterationRecord> iterations;
-  int forward_runs = 0, sensitivity_solves = 0;
-  int failed_runs = 0;  // trial points whose forward run failed (rejected, not fatal)
 };
 
-OptimizerOutcome fit_levenberg_marquardt(const Calibration& calibration, const FitOptions& options);
-OptimizerOutcome fit_nlopt(const Calibration& calibration, const FitOptions& options);
+OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options);
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options);
 
 // The covariance of the fitted variables phi at the optimum (Ceres
 // Covariance, unscaled: (J^T J)^-1 of the robustified residuals), or false
-// when J is rank deficient. Counts its forward runs.
-bool phi_covariance(const Calibration& calibration, const FitOptions& options,
-                    const Eigen::VectorXd& phi, Eigen::MatrixXd* covariance, int* forward_runs);
+// when J is rank deficient.
+bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
+                    const Eigen::VectorXd& phi, Eigen::MatrixXd* covariance);
 
 }  // namespace fiberfluid::fit

@@ -51,6 +51,10 @@ struct NewtonOptions {
   int krylov_restart = 50;
   int krylov_max_iterations = 500;
   int max_contact_rounds = 30;  // active-set updates per step
+  // Start each step from the solution extrapolated along the load path
+  // (quadratic in the last three converged points) rather than from the last
+  // solution: fewer iterations on a smooth path.
+  bool predictor = true;
 
   bool IsValid(std::string* why) const;
 };

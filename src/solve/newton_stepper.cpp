@@ -78,7 +78,7 @@ class NewtonSolver {
   const model::Equilibrium& equilibrium() const { return *equilibrium_; }
   // The tangent solve prepared at x (the solution), for the summary.
   std::shared_ptr<TangentSolve> final_tangent(const PathPoint& at, const Eigen::VectorXd& x) {
-    if (!tangent_->prepare(x, at.factors, held_map()).ok) return nullptr;
+    if (!tangent_->prepare(x, at.factors, held_map(), &supports_).ok) return nullptr;
     return tangent_;
   }
 
@@ -89,11 +89,12 @@ class NewtonSolver {
     for (int round = 0; round < newton_.max_contact_rounds; ++round) {
       const DofMap dofs = held_map();
       apply_held_values(at, dofs, x);
-      const std::string why = newton(at, dofs, x, record);
+      bool converged = false;
+      const std::string why = newton(at, dofs, x, record, &converged);
       if (!why.empty()) return why;
       const bool released = release_pulling();
       const bool added = add_penetrating(at, x);
-      if (!released && !added) return {};
+      if (converged && !released && !added) return {};
     }
     return "the paddle contact did not settle in " + std::to_string(newton_.max_contact_rounds) +
            " active-set rounds (newton.max_contact_rounds)";
@@ -164,9 +165,9 @@ class NewtonSolver {
     }
   }
 
-  // Vertices past a paddle join its contact set; true when any did.
-  bool add_penetrating(const PathPoint& at, const Eigen::VectorXd& x) {
-    const Eigen::MatrixXd X = model::positions(model_, x);
+  // Vertices past a paddle join its contact set; true when any did (with
+  // `apply` false, only whether any would).
+  bool add_penetrating(const PathPoint& at, const Eigen::VectorXd& x, bool apply = true) {
     const int n = model_.num_vertices();
     bool added = false;
     for (size_t p = 0; p < model_.paddles.size(); ++p) {
@@ -174,7 +175,9 @@ class NewtonSolver {
       for (int v = 0; v < n; ++v) {
         if (contact_paddle_[static_cast<size_t>(v)] >= 0 || supports_.held(paddle.axis * n + v))
           continue;
-        if (paddle.penetration(X(v, paddle.axis), at.planes[p]) > 1e-12 * diagonal_) {
+        const double coordinate = model_.surface.V(v, paddle.axis) + x[paddle.axis * n + v];
+        if (paddle.penetration(coordinate, at.planes[p]) > 1e-12 * diagonal_) {
+          if (!apply) return true;
           contact_paddle_[static_cast<size_t>(v)] = static_cast<int>(p);
           for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
           added = true;
@@ -184,21 +187,29 @@ class NewtonSolver {
     return added;
   }
 
-  // Contact vertices whose paddle would have to pull them leave the set.
-  bool release_pulling() {
+  // Contact vertices whose paddle would have to pull them (the force on the
+  // body in `R` at their held unknown) leave the set; true when any did.
+  bool release_pulling(const Eigen::VectorXd& R, bool apply = true) {
     const int n = model_.num_vertices();
     bool released = false;
     for (int v = 0; v < n; ++v) {
       const int p = contact_paddle_[static_cast<size_t>(v)];
       if (p < 0) continue;
       const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
-      const double force = residual_[paddle.axis * n + v];  // on the body, along the axis
+      const double force = R[paddle.axis * n + v];  // on the body, along the axis
       if (paddle.above ? force > 0.0 : force < 0.0) {
+        if (!apply) return true;
         contact_paddle_[static_cast<size_t>(v)] = -1;
         released = true;
       }
     }
     return released;
+  }
+  bool release_pulling() { return release_pulling(residual_); }
+  bool contact_would_change(const PathPoint& at, const Eigen::VectorXd& x,
+                            const Eigen::VectorXd& R) {
+    return !model_.paddles.empty() &&
+           (release_pulling(R, false) || add_penetrating(at, x, false));
   }
 
   // The relative residual (the gauge's force scale: the largest load or reaction seen).
@@ -210,8 +221,13 @@ class NewtonSolver {
     gauge_.update_scale(*equilibrium_, dofs, x, at.factors, R);
   }
 
+  // Newton iterations with the held set `dofs`, until converged (*converged
+  // true) or, after an iteration, until the paddles' active set would change:
+  // the set is updated as the iterates go (a semi-smooth Newton), rather than
+  // after a full solve with each set. "" or why it failed.
   std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
-                     StepRecord& record) {
+                     StepRecord& record, bool* converged) {
+    *converged = false;
     Eigen::VectorXd R = equilibrium_->residual(x, at.factors);
     update_force_scale(at, dofs, x, R);
     double last_move = std::numeric_limits<double>::infinity();
@@ -226,6 +242,11 @@ class NewtonSolver {
       if (norm <= newton_.residual_tolerance ||
           (small_move && norm <= 1e3 * newton_.residual_tolerance)) {
         residual_ = R;
+        *converged = true;
+        return {};
+      }
+      if (it > 0 && contact_would_change(at, x, R)) {
+        residual_ = R;
         return {};
       }
       if (it == newton_.max_iterations) {
@@ -238,7 +259,7 @@ class NewtonSolver {
       // Inexact Newton: a Krylov solve only as accurate as the residual it
       // corrects (relative to it), which keeps the convergence quadratic.
       const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
-      Status status = tangent_->prepare(x, at.factors, dofs);
+      Status status = tangent_->prepare(x, at.factors, dofs, &supports_);
       if (status.ok) {
         int iterations = 0;
         status = tangent_->solve(-r, forcing, &dx, &iterations);
@@ -288,6 +309,39 @@ class NewtonSolver {
   double diagonal_ = 1.0;
   ResidualGauge gauge_;
   std::shared_ptr<TangentSolve> tangent_;
+};
+
+// Extrapolates the solution along the load path from the last converged
+// points (Lagrange, up to quadratic): each step's starting guess. On a smooth
+// path it leaves Newton little to do, and it shows the paddles' new contacts
+// before the first iteration.
+class PathPredictor {
+ public:
+  explicit PathPredictor(int order) : order_(order) {}
+  void add(double t, const Eigen::VectorXd& x) {
+    points_.push_back({t, x});
+    if (static_cast<int>(points_.size()) > order_ + 1) points_.erase(points_.begin());
+  }
+  bool extrapolates() const { return points_.size() > 1; }
+  // The guess at t; the last point when there is nothing to extrapolate from.
+  Eigen::VectorXd predict(double t) const {
+    Eigen::VectorXd guess = Eigen::VectorXd::Zero(points_.back().x.size());
+    for (size_t i = 0; i < points_.size(); ++i) {
+      double weight = 1.0;
+      for (size_t j = 0; j < points_.size(); ++j)
+        if (j != i) weight *= (t - points_[j].t) / (points_[i].t - points_[j].t);
+      guess += weight * points_[i].x;
+    }
+    return guess;
+  }
+
+ private:
+  struct Point {
+    double t;
+    Eigen::VectorXd x;
+  };
+  int order_;
+  std::vector<Point> points_;
 };
 
 bool partition_holds(const model::DofPartition& partition, int dof) {
@@ -351,25 +405,37 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   const size_t groups = std::max<size_t>(1, model.constraint_groups.size());
   Eigen::VectorXd& x = summary.unknowns;
 
+  PathPredictor predictor(options.newton.predictor ? 2 : 0);
+  predictor.add(0.0, x);
   report_progress("step", 0, n);
   for (int k = 1; k <= n; ++k) {
     const Clock::time_point step_start = Clock::now();
     StepRecord record;
     record.step = k;
-    // Pieces of the step: the whole step, halved on failure.
+    // Pieces of the step: the whole step, halved on failure. A piece that
+    // fails from the predicted guess is first tried again from the last
+    // solution.
     double reached = k - 1, piece = 1.0;
+    bool predict = options.newton.predictor;
     while (reached < k) {
       const double target = std::min<double>(k, reached + piece);
       const PathPoint at = path_point(model, target, n);
       const Eigen::VectorXd saved = x;
       const auto contact = solver->contact_state();
+      if (predict) x = predictor.predict(target);
       why = solver->solve(at, x, record);
       if (why.empty()) {
         reached = target;
+        predictor.add(reached, x);
+        predict = options.newton.predictor;
         continue;
       }
       x = saved;
       solver->restore(contact);
+      if (predict && predictor.extrapolates()) {
+        predict = false;
+        continue;
+      }
       if (record.step_cuts == options.newton.max_step_cuts)
         return fail("step " + std::to_string(k) + ": " + why + "; the step was halved " +
                     std::to_string(record.step_cuts) +

@@ -22,10 +22,11 @@ TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium
 }
 
 Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
-                             const model::DofMap& dofs) {
+                             const model::DofMap& dofs, const model::DofMap* preconditioner_dofs) {
   x_ = x;
   factors_ = factors;
   dofs_ = dofs;
+  preconditioner_dofs_ = preconditioner_dofs ? *preconditioner_dofs : dofs;
   ready_ = false;
   if (kind_ == TangentSolver::Dense) {
     lu_ = std::make_unique<DenseLU>();
@@ -33,7 +34,8 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   } else {
     if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
-    const bool same_set = preconditioner_ && dofs_.held_flags() == preconditioned_held_;
+    const bool same_set =
+        preconditioner_ && preconditioner_dofs_.held_flags() == preconditioned_held_;
     if (!same_set || refactor_) {
       const Status status = factor_preconditioner();
       if (!status.ok) return status;
@@ -49,6 +51,25 @@ Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
   return dofs_.reduce(store_ ? stored_.apply(w) : equilibrium_->tangent_product(x_, factors_, w));
 }
 
+// The preconditioner's solve, through its own layout when it holds fewer
+// unknowns: the tangent's held unknowns enter as zeros and leave unread.
+Eigen::VectorXd TangentSolve::precondition(const Eigen::VectorXd& reduced) const {
+  const bool same_layout = preconditioner_dofs_.num_reduced() == dofs_.num_reduced();
+  Eigen::VectorXd in = reduced;
+  if (!same_layout) {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
+    dofs_.scatter(reduced, full);
+    in = preconditioner_dofs_.reduce(full);
+  }
+  Eigen::VectorXd out;
+  if (!preconditioner_->solve(in, &out).ok)
+    return Eigen::VectorXd::Constant(reduced.size(), NAN);
+  if (same_layout) return out;
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
+  preconditioner_dofs_.scatter(out, full);
+  return dofs_.reduce(full);
+}
+
 Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::VectorXd* y,
                            int* iterations) {
   if (!ready_) return Status::failure("newton: the tangent was not prepared");
@@ -58,9 +79,7 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   }
   const LinearOperator apply_tangent = [this](const Eigen::VectorXd& v) { return apply(v); };
   const LinearOperator precondition = [this](const Eigen::VectorXd& v) {
-    Eigen::VectorXd out;
-    const Status status = preconditioner_->solve(v, &out);
-    return status.ok ? out : Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), NAN));
+    return this->precondition(v);
   };
   GmresOptions gmres_options;
   gmres_options.tolerance = tolerance;
@@ -98,10 +117,10 @@ Status TangentSolve::solve_full(const Eigen::VectorXd& b, Eigen::VectorXd* y, do
 Status TangentSolve::factor_preconditioner() {
   const model::Model& model = equilibrium_->model();
   const Eigen::MatrixXd X = model::positions(model, x_);
-  secant_ = std::make_unique<model::FiberSystem>(model, model.surface.V, dofs_,
+  secant_ = std::make_unique<model::FiberSystem>(model, model.surface.V, preconditioner_dofs_,
                                                  model::BoundaryMethod::Elimination,
                                                  options_.penalty, &X);
-  if (!preconditioner_ || !(dofs_.held_flags() == preconditioned_held_)) {
+  if (!preconditioner_ || !(preconditioner_dofs_.held_flags() == preconditioned_held_)) {
     // By size as for the linear scheme, but never the dense LU of the whole
     // bordered system: block Cholesky does the same job in a fraction of the flops.
     SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
@@ -116,7 +135,7 @@ Status TangentSolve::factor_preconditioner() {
   const Status status = preconditioner_->factorize(*secant_);
   if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
   ++factorizations_;
-  preconditioned_held_ = dofs_.held_flags();
+  preconditioned_held_ = preconditioner_dofs_.held_flags();
   baseline_rate_ = -1.0;
   refactor_ = false;
   just_factored_ = true;

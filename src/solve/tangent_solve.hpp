@@ -20,8 +20,12 @@ namespace fiberfluid::solve {
 // tangent as an operator (its pair coefficients stored), right-preconditioned
 // by the structured secant solve (the reference bordered system with each
 // bulk weight times Y(e_ij)). The preconditioner is kept between states and
-// refactored when the held set changes or GMRES needs clearly more
-// iterations per decade than just after its last factorisation.
+// refactored when its own held set changes or GMRES needs clearly more
+// iterations per decade than just after its last factorisation. Its held set
+// may be a subset of the tangent's (the supports without the paddle
+// contacts, which come and go): it then stands in for the tangent's
+// preconditioner, costing GMRES an iteration or so per extra held unknown
+// instead of a factorisation per change.
 //
 // The Newton stepper prepares one per iteration. With
 // SteppingOptions::keep_final_tangent the summary keeps it prepared at the
@@ -39,9 +43,11 @@ class TangentSolve {
   const model::DofMap& dofs() const { return dofs_; }
   const Eigen::VectorXd& state() const { return x_; }
 
-  // Makes the tangent at x (loads `factors`, held set `dofs`) ready to solve.
+  // Makes the tangent at x (loads `factors`, held set `dofs`) ready to solve;
+  // the preconditioner holds `preconditioner_dofs` (a subset of `dofs`;
+  // nullptr: the same set).
   Status prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
-                 const model::DofMap& dofs);
+                 const model::DofMap& dofs, const model::DofMap* preconditioner_dofs = nullptr);
   // J_ff y = b over the reduced unknowns (DofMap layout); krylov stops at the
   // relative residual `tolerance`. iterations (krylov) is added to.
   Status solve(const Eigen::VectorXd& b, double tolerance, Eigen::VectorXd* y,
@@ -54,6 +60,7 @@ class TangentSolve {
  private:
   Status factor_preconditioner();
   Eigen::VectorXd apply(const Eigen::VectorXd& reduced) const;
+  Eigen::VectorXd precondition(const Eigen::VectorXd& reduced) const;
 
   std::shared_ptr<const model::Equilibrium> equilibrium_;
   SteppingOptions options_;
@@ -61,6 +68,7 @@ class TangentSolve {
   Eigen::VectorXd x_;
   std::vector<double> factors_;
   model::DofMap dofs_;
+  model::DofMap preconditioner_dofs_;
   bool ready_ = false;
   // Dense.
   std::unique_ptr<DenseLU> lu_;

@@ -81,6 +81,9 @@ TEST(FitConfig, BadFitSectionsAreNamed) {
   d["fit"]["colour"] = "green";
   expect_fit_error(d, "fit.colour: unknown field");
   d = sphere_fit_document();
+  d["fit"]["initial_trust_region_radius"] = 0;
+  expect_fit_error(d, "fit.initial_trust_region_radius");
+  d = sphere_fit_document();
   d["variants"] = {{{"name", "a"}}};
   expect_fit_error(d, "a fit calibrates one simulation");
 }

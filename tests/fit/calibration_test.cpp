@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fit/optimizers.hpp"
+
 #include <ceres/rotation.h>
 
 #include "geom/error.hpp"
@@ -117,6 +119,18 @@ TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   EXPECT_GT(lm.sensitivity_solves, 0);
   EXPECT_FALSE(lm.iterations.empty());
   EXPECT_LT(lm.final_cost, 1e-6 * lm.initial_cost);
+  // The cost reported per iteration is the current point's: it never rises;
+  // a rejected trial point costs more.
+  for (size_t k = 1; k < lm.iterations.size(); ++k) {
+    EXPECT_LE(lm.iterations[k].cost, lm.iterations[k - 1].cost) << k;
+    if (!lm.iterations[k].accepted) {
+      EXPECT_GT(lm.iterations[k].trial_cost, lm.iterations[k].cost);
+    }
+  }
+  // One forward run per trial point: the start, the optimum and the
+  // covariance reuse the optimiser's runs (at most one last trial point is
+  // evaluated without an iteration of its own).
+  EXPECT_LE(lm.forward_runs, static_cast<int>(lm.iterations.size()) + 1);
 
   FitOptions bobyqa;
   bobyqa.method = Method::Bobyqa;
@@ -124,7 +138,34 @@ TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   const FitResult b = Calibration(m, newton(2), targets, parameters, bobyqa).run();
   ASSERT_TRUE(b.success) << b.message;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.values[k] / lm.values[k], 1.0, 1e-4) << b.names[k];
-  EXPECT_EQ(b.sensitivity_solves, 0);
+  // No sensitivities for the search; the covariance's Jacobian at the
+  // optimum takes one solve per material parameter and target step.
+  EXPECT_EQ(b.sensitivity_solves, 3 * 2);
+}
+
+// A point asked for twice costs one forward run; with the Jacobian after
+// without it, a second.
+TEST(Calibration, EvaluationsAreKeptAndCounted) {
+  const model::Model m = hanging_sphere();
+  const Calibration c(m, newton(2), synthetic_targets(m, newton(2), {2}),
+                      {parameter("Y0", 2000.0), parameter("gamma", 200.0)});
+  EvaluationCache cache(c);
+  const Eigen::VectorXd phi = c.parameters().initial_phi();
+  const double cost = c.cost(cache.at(phi, false).residuals);
+  EXPECT_EQ(cache.forward_runs, 1);
+  EXPECT_EQ(c.cost(cache.at(phi, false).residuals), cost);
+  EXPECT_EQ(cache.forward_runs, 1);
+  EXPECT_EQ(cache.at(phi, true).jacobian.cols(), 2);
+  EXPECT_EQ(cache.forward_runs, 2);
+  EXPECT_EQ(cache.sensitivity_solves, 2);  // one tangent solve per material parameter
+  EXPECT_EQ(cache.at(phi, false).jacobian.cols(), 2);  // the kept one, Jacobian and all
+  EXPECT_EQ(cache.forward_runs, 2);
+  Eigen::VectorXd moved = phi;
+  moved[0] += 0.1;
+  EXPECT_GT(c.cost(cache.at(moved, false).residuals), 0.0);
+  EXPECT_EQ(cache.forward_runs, 3);
+  cache.at(phi, false);  // still kept
+  EXPECT_EQ(cache.forward_runs, 3);
 }
 
 TEST(Calibration, AlignmentRecoversAKnownRigidMotion) {

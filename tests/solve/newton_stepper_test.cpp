@@ -260,6 +260,26 @@ TEST(Newton, PaddleContactPushesHoldsAndBalances) {
   }
 }
 
+// The predictor (the path extrapolated to each step's guess) and the active
+// set updated within Newton's iterations change the work, not the answer.
+TEST(Newton, ThePredictorSavesIterationsAndKeepsTheAnswer) {
+  const std::vector<std::pair<const char*, model::Model>> cases = {
+      {"hanging", hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0))},
+      {"pressed", pressed_sphere(false)}};
+  for (const auto& [name, m] : cases) {
+    SteppingOptions with = newton(8), without = newton(8);
+    without.newton.predictor = false;
+    const SteppingSummary a = solve_load_steps(m, with), b = solve_load_steps(m, without);
+    ASSERT_TRUE(a.success && b.success) << a.message << b.message;
+    EXPECT_LT(displacement_norm(m, a.unknowns - b.unknowns), 1e-9 * displacement_norm(m, b.unknowns))
+        << name;
+    EXPECT_LT(a.newton_iterations, b.newton_iterations) << name;
+    if (!m.paddles.empty()) {
+      EXPECT_EQ(a.steps.back().paddles[0].contacts, b.steps.back().paddles[0].contacts);
+    }
+  }
+}
+
 TEST(Newton, BadPaddlesAreRejected) {
   model::Model inside = pressed_sphere(false);
   inside.paddles[0].position = 0.5;

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// The accuracy metrics of Alterovitz and Goldberg (the benchmarks paper,
+// docs: benchmarks.md) between a reference deformed mesh M, an approximation
+// M' and the undeformed mesh M0: the relative energy norm E_n, the surface
+// error E_s (exact, CGAL Booleans) and the interior error E_i.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "geom/surface.hpp"
+
+namespace fiberfluid::metrics {
+
+// E_n = |u' - u| / |u|: plain Euclidean norms of the stacked nodal
+// displacements (the paper calls it an energy norm and writes no matrix).
+// Both #nodes by dim; throws InputError on a size mismatch or u = 0.
+double relative_energy_norm(const Eigen::MatrixXd& u_reference, const Eigen::MatrixXd& u);
+
+// The measure enclosed by a closed surface: the area inside a 2D polygon,
+// the volume inside a 3D triangle mesh (signed: positive when outward).
+double enclosed_measure(const geom::Surface& surface);
+
+// |Int(A) xor Int(B)|, exactly: CGAL's 2D Boolean operations on polygons, or
+// its 3D corefinement (|A| + |B| - 2 |A and B|) on closed triangle meshes.
+// Throws InputError naming `what_a` / `what_b` when a surface does not bound
+// a solid (open, self-intersecting, a polygon that is not simple).
+double symmetric_difference_measure(const geom::Surface& a, const geom::Surface& b,
+                                    const std::string& what_a = "A",
+                                    const std::string& what_b = "B");
+
+// E_s = |Int(M) xor Int(M')| / |Int(M)|.
+double surface_error(const geom::Surface& reference, const geom::Surface& approximation);
+
+// Each node's share of the body's measure for E_i. For a surface-only model
+// (no interior nodes) the share of the boundary: a third of the area of the
+// triangles around a vertex (3D), half the length of the edges at a vertex
+// (2D): |S_i| of benchmarks.md.
+Eigen::VectorXd boundary_node_measures(const geom::Surface& surface);
+
+// E_i = sum_i w_i |p_i - p'_i| / |Int(M0)|^(1/d): the integral over M0 of the
+// displacement error, lumped onto nodes with weights w (#nodes).
+double interior_error(const Eigen::MatrixXd& reference, const Eigen::MatrixXd& approximation,
+                      const Eigen::VectorXd& weights, double undeformed_measure, int dim);
+
+}  // namespace fiberfluid::metrics

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// E_s's symmetric difference, exactly (CGAL, kept inside this file: its
+// headers compile slowly). |A xor B| = |A| + |B| - 2 |A and B| with exact
+// arithmetic for the intersection: 2D Boolean operations on polygons, 3D
+// corefinement of closed triangle meshes.
+#include <CGAL/Boolean_set_operations_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Polygon_2.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_with_holes_2.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <cmath>
+#include <iterator>
+#include <vector>
+
+#include "geom/error.hpp"
+#include "metrics/metrics.hpp"
+
+namespace fiberfluid::metrics {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
+using Polygon = CGAL::Polygon_2<Kernel>;
+using PolygonWithHoles = CGAL::Polygon_with_holes_2<Kernel>;
+using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+void require_finite(const geom::Surface& s, const std::string& what) {
+  if (!s.V.allFinite()) throw InputError(what + ": a vertex coordinate is not finite");
+}
+
+// The 2D surface's segments as one closed loop, counterclockwise.
+Polygon polygon(const geom::Surface& s, const std::string& what) {
+  require_finite(s, what);
+  const int n = s.num_vertices();
+  std::vector<int> next(static_cast<size_t>(n), -1);
+  for (int f = 0; f < s.num_faces(); ++f) {
+    const int a = s.F(f, 0), b = s.F(f, 1);
+    if (a < 0 || a >= n || b < 0 || b >= n || next[static_cast<size_t>(a)] >= 0)
+      throw InputError(what + ": its segments do not form one closed polygon (segment " +
+                       std::to_string(f) + ")");
+    next[static_cast<size_t>(a)] = b;
+  }
+  Polygon p;
+  int v = s.num_faces() > 0 ? s.F(0, 0) : -1;
+  for (int k = 0; k < s.num_faces(); ++k) {
+    if (v < 0) break;
+    p.push_back(Kernel::Point_2(s.V(v, 0), s.V(v, 1)));
+    v = next[static_cast<size_t>(v)];
+  }
+  if (s.num_faces() < 3 || v != s.F(0, 0) || static_cast<int>(p.size()) != s.num_faces())
+    throw InputError(what + ": its segments do not form one closed polygon");
+  if (!p.is_simple())
+    throw InputError(what + ": the polygon crosses itself, so it bounds no region");
+  if (p.orientation() == CGAL::CLOCKWISE) p.reverse_orientation();
+  return p;
+}
+
+double area(const PolygonWithHoles& p) {
+  Kernel::FT a = p.outer_boundary().area();
+  for (auto h = p.holes_begin(); h != p.holes_end(); ++h) a += h->area();  // holes are clockwise
+  return CGAL::to_double(a);
+}
+
+double symmetric_difference_2d(const geom::Surface& a, const geom::Surface& b,
+                               const std::string& what_a, const std::string& what_b) {
+  const Polygon p = polygon(a, what_a), q = polygon(b, what_b);
+  std::vector<PolygonWithHoles> both;
+  CGAL::intersection(p, q, std::back_inserter(both));
+  double common = 0.0;
+  for (const PolygonWithHoles& piece : both) common += area(piece);
+  return CGAL::to_double(p.area()) + CGAL::to_double(q.area()) - 2.0 * common;
+}
+
+// A closed, outward, self-intersection-free triangle mesh.
+Mesh solid(const geom::Surface& s, const std::string& what) {
+  require_finite(s, what);
+  Mesh mesh;
+  std::vector<Mesh::Vertex_index> vertices;
+  for (int v = 0; v < s.num_vertices(); ++v)
+    vertices.push_back(mesh.add_vertex(Kernel::Point_3(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
+  for (int f = 0; f < s.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k)
+      if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices())
+        throw InputError(what + ": face " + std::to_string(f) + " refers to a missing vertex");
+    if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))], vertices[static_cast<size_t>(s.F(f, 1))],
+                      vertices[static_cast<size_t>(s.F(f, 2))]) == Mesh::null_face())
+      throw InputError(what + ": face " + std::to_string(f) + " makes the mesh non-manifold");
+  }
+  if (mesh.is_empty() || !CGAL::is_closed(mesh))
+    throw InputError(what + ": the mesh is not closed, so it bounds no solid");
+  if (PMP::does_self_intersect(mesh))
+    throw InputError(what + ": the mesh intersects itself (an inverted or overlapping part)");
+  if (!PMP::is_outward_oriented(mesh)) PMP::reverse_face_orientations(mesh);
+  return mesh;
+}
+
+double symmetric_difference_3d(const geom::Surface& a, const geom::Surface& b,
+                               const std::string& what_a, const std::string& what_b) {
+  Mesh p = solid(a, what_a), q = solid(b, what_b);
+  const double volume_p = CGAL::to_double(PMP::volume(p)), volume_q = CGAL::to_double(PMP::volume(q));
+  Mesh common;
+  if (!PMP::corefine_and_compute_intersection(p, q, common))
+    throw InputError("the intersection of " + what_a + " and " + what_b +
+                     " is not a closed solid (CGAL corefinement)");
+  return volume_p + volume_q - 2.0 * CGAL::to_double(PMP::volume(common));
+}
+
+}  // namespace
+
+double symmetric_difference_measure(const geom::Surface& a, const geom::Surface& b,
+                                    const std::string& what_a, const std::string& what_b) {
+  if (a.dim != b.dim)
+    throw InputError(what_a + " is " + std::to_string(a.dim) + "D and " + what_b + " " +
+                     std::to_string(b.dim) + "D");
+  return a.dim == 2 ? symmetric_difference_2d(a, b, what_a, what_b)
+                    : symmetric_difference_3d(a, b, what_a, what_b);
+}
+
+}  // namespace fiberfluid::metrics

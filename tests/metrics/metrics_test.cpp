@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The benchmarks paper's metrics on cases with known answers.
+#include "metrics/metrics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "geom/error.hpp"
+#include "geom/generators.hpp"
+
+namespace fiberfluid::metrics {
+namespace {
+
+geom::Surface translated(geom::Surface s, const Eigen::RowVectorXd& by) {
+  s.V.rowwise() += by;
+  return s;
+}
+
+TEST(SurfaceError, TwoUnitSquaresOffsetByATenth) {
+  const geom::Surface square = geom::rectangle({0.0, 0.0}, {1.0, 1.0}, 3, 2);
+  const geom::Surface moved = translated(square, Eigen::RowVector2d(0.1, 0.0));
+  EXPECT_NEAR(symmetric_difference_measure(square, moved), 0.2, 1e-15);
+  EXPECT_NEAR(surface_error(square, moved), 0.2, 1e-15);
+  // Diagonally: the overlap is 0.9 x 0.8.
+  const geom::Surface diagonal = translated(square, Eigen::RowVector2d(0.1, 0.2));
+  EXPECT_NEAR(surface_error(square, diagonal), 2.0 - 2.0 * 0.72, 1e-15);
+  EXPECT_EQ(surface_error(square, square), 0.0);
+}
+
+TEST(SurfaceError, CubesAgainstThemselvesAndTranslated) {
+  const geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {2, 3, 1});
+  EXPECT_EQ(surface_error(cube, cube), 0.0);
+  EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(0.1, 0.0, 0.0))), 0.2, 1e-14);
+  // Overlap 0.9 x 0.8 x 0.7 = 0.504: |xor| = 2 - 1.008.
+  EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(0.1, -0.2, 0.3))), 0.992,
+              1e-14);
+  // Apart: everything differs.
+  EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(2.0, 0.0, 0.0))), 2.0, 1e-14);
+}
+
+TEST(SurfaceError, NestedPolyhedraDifferByTheirVolumes) {
+  // A sphere and the same mesh scaled by 0.9 about its centre: nested, so
+  // |xor| = |big| - |small| = (1 - 0.729) |big|.
+  const geom::Surface big = geom::icosphere(2, 1.0);
+  geom::Surface small = big;
+  small.V *= 0.9;
+  EXPECT_NEAR(surface_error(big, small), 1.0 - 0.729, 1e-12);
+  // And the 2D analogue with a rotated square inside a square.
+  Eigen::MatrixXd diamond(4, 2);
+  diamond << 0.5, 0.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.5;
+  EXPECT_NEAR(surface_error(geom::rectangle({0, 0}, {1, 1}), geom::polygon(diamond)), 0.5, 1e-15);
+}
+
+TEST(SurfaceError, SurfacesThatBoundNoSolidAreNamed) {
+  geom::Surface open = geom::cube();
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  try {
+    symmetric_difference_measure(geom::cube(), open, "reference.obj", "scan.obj");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scan.obj: the mesh is not closed"), std::string::npos)
+        << e.what();
+  }
+  Eigen::MatrixXd bow(4, 2);  // a bow tie crosses itself
+  bow << 0, 0, 1, 1, 1, 0, 0, 1;
+  geom::Surface tie;
+  tie.dim = 2;
+  tie.V = bow;
+  tie.F.resize(4, 2);
+  tie.F << 0, 1, 1, 2, 2, 3, 3, 0;
+  EXPECT_THROW(symmetric_difference_measure(geom::rectangle({0, 0}, {1, 1}), tie), InputError);
+  geom::Surface nan = geom::cube();
+  nan.V(0, 0) = NAN;
+  EXPECT_THROW(surface_error(geom::cube(), nan), InputError);
+  EXPECT_THROW(symmetric_difference_measure(geom::cube(), geom::rectangle({0, 0}, {1, 1})),
+               InputError);
+}
+
+TEST(EnergyNorm, HandMadeCases) {
+  Eigen::MatrixXd u(2, 2), v(2, 2);
+  u << 1, 0, 0, 1;
+  v << 1, 0, 0, 0;
+  EXPECT_NEAR(relative_energy_norm(u, v), 1.0 / std::sqrt(2.0), 1e-15);
+  EXPECT_EQ(relative_energy_norm(u, u), 0.0);
+  EXPECT_NEAR(relative_energy_norm(u, 2.0 * u), 1.0, 1e-15);
+  EXPECT_THROW(relative_energy_norm(Eigen::MatrixXd::Zero(2, 2), v), InputError);
+  EXPECT_THROW(relative_energy_norm(u, Eigen::MatrixXd::Zero(3, 2)), InputError);
+}
+
+TEST(InteriorError, WeightedDisplacementErrorOverTheBodysScale) {
+  // Two nodes weighted 0.25 and 0.75 of a unit square's area; errors 1 and 2.
+  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(2, 2), q(2, 2);
+  q << 1, 0, 0, 2;
+  EXPECT_NEAR(interior_error(p, q, Eigen::Vector2d(0.25, 0.75), 1.0, 2), 1.75, 1e-15);
+  // A body of volume 8 in 3D: divided by 8^(1/3) = 2.
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(1, 3), s(1, 3);
+  s << 3, 4, 0;
+  EXPECT_NEAR(interior_error(r, s, Eigen::VectorXd::Constant(1, 8.0), 8.0, 3), 20.0, 1e-14);
+  // A rigid translation by t of a surface-only model: E_i = t sum|S_i| / V^(1/3).
+  const geom::Surface cube = geom::box({0, 0, 0}, {2, 2, 2}, {2, 2, 2});
+  const Eigen::VectorXd w = boundary_node_measures(cube);
+  ASSERT_EQ(w.size(), cube.num_vertices());
+  EXPECT_GT(w.minCoeff(), 0.0);
+  const Eigen::MatrixXd moved = translated(cube, Eigen::RowVector3d(0.0, 0.0, 0.1)).V;
+  EXPECT_NEAR(interior_error(cube.V, moved, w, 8.0, 3), 0.1 * w.sum() / 2.0, 1e-14);
+  EXPECT_THROW(interior_error(p, q, Eigen::Vector3d(1, 1, 1), 1.0, 2), InputError);
+}
+
+}  // namespace
+}  // namespace fiberfluid::metrics
