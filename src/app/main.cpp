@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <thread>
 
+#include "app/compare.hpp"
 #include "app/experiment.hpp"
 #include "app/fitting.hpp"
 #include "app/outputs.hpp"
@@ -277,6 +279,16 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   return kOk;
 }
 
+int compare_command(const std::string& reference, const std::string& approximation,
+                    const std::string& undeformed, bool as_json) {
+  const app::Comparison c = app::compare_files(
+      reference, approximation,
+      undeformed.empty() ? std::nullopt : std::optional<std::filesystem::path>(undeformed));
+  if (as_json) std::cout << app::comparison_json(c).dump(2) << "\n";
+  else std::cout << app::comparison_text(c);
+  return kOk;
+}
+
 int check_command(const std::string& path, bool flip) {
   fiberfluid::geom::ReadResult read = fiberfluid::geom::read_surface(path);
   if (flip) fiberfluid::geom::flip_orientation(read.surface);
@@ -324,6 +336,17 @@ int main(int argc, char** argv) {
   check->add_option("mesh", mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
   check->add_flag("--flip", flip, "Reverse the face orientation before checking");
 
+  std::string compared_reference, compared, undeformed;
+  bool as_json = false;
+  CLI::App* compare = cli.add_subcommand(
+      "compare", "The benchmarks paper's metrics (E_s; E_n and E_i with --reference) and the "
+                 "surface distances between a reference deformed surface M and another M'");
+  compare->add_option("M", compared_reference, "The reference deformed surface")->required();
+  compare->add_option("M_prime", compared, "The deformed surface to compare with it")->required();
+  compare->add_option("--reference", undeformed,
+                      "The undeformed surface M0 (same vertices as both): adds E_n and E_i");
+  compare->add_flag("--json", as_json, "Print JSON instead of text");
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -336,6 +359,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(experiment, flags);
     if (fit->parsed()) return fit_command(experiment, fit_flags);
+    if (compare->parsed()) return compare_command(compared_reference, compared, undeformed, as_json);
     return check_command(mesh, flip);
   } catch (const fiberfluid::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <chrono>
 #include <fstream>
@@ -12,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "geom/generators.hpp"
+#include "geom/mesh_io.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {
@@ -241,6 +244,40 @@ TEST(Cli, UsageErrors) {
     EXPECT_NE(o.output.find(c.message), std::string::npos) << c.arguments << "\n" << o.output;
   }
   EXPECT_EQ(run_cli("--help").status, 0);
+}
+
+// The benchmarks paper's metrics between two files: a unit cube and the same
+// cube moved 0.1 along x (E_s = 0.2 exactly), with the undeformed cube as M0.
+TEST(Cli, CompareGivesTheMetricsAsTextAndJson) {
+  ScratchDir dir;
+  geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  const std::filesystem::path m = dir.path() / "m.obj", moved = dir.path() / "moved.obj",
+                              m0 = dir.path() / "m0.obj";
+  geom::write_obj(m0, cube);
+  cube.V.col(2) *= 0.8;  // the reference: squashed to 80% height
+  geom::write_obj(m, cube);
+  cube.V.col(0).array() += 0.1;
+  geom::write_obj(moved, cube);
+  const Outcome text = run_cli("compare " + m.string() + " " + moved.string());
+  EXPECT_EQ(text.status, 0) << text.output;
+  for (const char* part : {"E_s = 0.2 ", "need the undeformed mesh", "distance from M' to M"})
+    EXPECT_NE(text.output.find(part), std::string::npos) << part << "\n" << text.output;
+  const Outcome json = run_cli("compare " + m.string() + " " + moved.string() + " --reference " +
+                               m0.string() + " --json");
+  ASSERT_EQ(json.status, 0) << json.output;
+  const nlohmann::json j = nlohmann::json::parse(json.output.substr(json.output.find('{')));
+  EXPECT_NEAR(j["E_s"].get<double>(), 0.2, 1e-14);
+  // u = (0, 0, -0.2 z), u' = u + (0.1, 0, 0) at every node.
+  double u2 = 0.0;
+  for (Eigen::Index v = 0; v < cube.V.rows(); ++v) u2 += std::pow(0.2 * cube.V(v, 2) / 0.8, 2);
+  EXPECT_NEAR(j["E_n"].get<double>(), 0.1 * std::sqrt(static_cast<double>(cube.V.rows()) / u2), 1e-12);
+  EXPECT_GT(j["E_i"].get<double>(), 0.0);
+  EXPECT_NEAR(j["distance"]["largest"].get<double>(), 0.1, 1e-12);
+  // An open mesh bounds no solid: the file is named.
+  std::ofstream(dir.path() / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\n";
+  const Outcome bad = run_cli("compare " + m.string() + " " + (dir.path() / "open.obj").string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.output.find("open.obj: the mesh is not closed"), std::string::npos) << bad.output;
 }
 
 }  // namespace
