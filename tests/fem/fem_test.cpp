@@ -3,10 +3,14 @@
 // test, the mass, and a cantilever against beam theory under refinement.
 #include "fem/fem.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+
+#include "fem/dynamics.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -140,6 +144,129 @@ TEST(Fem, TooFewSupportsIsAStatus) {
                                        Eigen::VectorXd::Ones(mesh.num_dofs()), Constraints{}, &u);
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("too few supports"), std::string::npos) << s.message;
+}
+
+// A small 2D cantilever (clamped at x = 0) as a dynamic system.
+struct Cantilever {
+  Mesh mesh;
+  Dynamics d;
+  std::vector<int> free;
+};
+Cantilever cantilever_2d(double alpha = 0.0, double beta = 0.0) {
+  Cantilever c;
+  c.mesh = structured_grid(Eigen::Vector2d(1.0, 0.2), Eigen::Vector2i(8, 2));
+  Material m;
+  m.young = 7000.0;
+  m.poisson = 0.2;
+  m.density = 1000.0;
+  c.d.K = stiffness_matrix(c.mesh, m);
+  c.d.M = mass_matrix(c.mesh, m);
+  c.d.lumped = lumped_mass(c.mesh, m);
+  c.d.alpha = alpha;
+  c.d.beta = beta;
+  for (int v = 0; v < c.mesh.num_nodes(); ++v)
+    for (int a = 0; a < 2; ++a)
+      (c.mesh.nodes(v, 0) < 1e-12 ? c.d.held : c.free).push_back(2 * v + a);
+  return c;
+}
+
+Eigen::MatrixXd block(const Eigen::SparseMatrix<double>& A, const std::vector<int>& idx) {
+  const Eigen::MatrixXd dense(A);
+  Eigen::MatrixXd out(idx.size(), idx.size());
+  for (size_t i = 0; i < idx.size(); ++i)
+    for (size_t j = 0; j < idx.size(); ++j) out(i, j) = dense(idx[i], idx[j]);
+  return out;
+}
+
+// Undamped Newmark (average acceleration) under a constant load: the total
+// energy 1/2 v'Mv + 1/2 u'Ku - f'u is conserved; loaded along the first mode,
+// the body swings at that mode's frequency (computed separately, a dense
+// generalised eigenproblem), with Newmark's known period elongation.
+TEST(FemDynamics, NewmarkConservesEnergyAndSwingsAtTheLowestFrequency) {
+  Cantilever c = cantilever_2d();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> modes(block(c.d.K, c.free),
+                                                                       block(c.d.M, c.free));
+  const double omega = std::sqrt(modes.eigenvalues()[0]);
+  const Eigen::VectorXd phi = modes.eigenvectors().col(0);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(c.mesh.num_dofs()), phi_full = f;
+  for (size_t i = 0; i < c.free.size(); ++i) phi_full[c.free[i]] = phi[static_cast<Eigen::Index>(i)];
+  f = 0.01 * (c.d.M * phi_full);
+  for (int dof : c.d.held) f[dof] = 0.0;
+  c.d.force = [f](double) { return f; };
+  const double period = 2.0 * M_PI / omega, h = period / 100.0;
+  const Trajectory t = integrate(c.d, Integrator::ImplicitNewmark, h, 400);
+  ASSERT_TRUE(t.ok) << t.message;
+  double lowest = 1e300, highest = -1e300;
+  for (size_t k = 1; k < t.u.size(); ++k) {
+    const double e = mechanical_energy(c.d, t.u[k], t.v[k]) - f.dot(t.u[k]);
+    lowest = std::min(lowest, e);
+    highest = std::max(highest, e);
+  }
+  const double scale = std::abs(f.dot(t.u[50]));  // the swing's energy
+  EXPECT_LT(highest - lowest, 1e-10 * scale);
+  // The modal coordinate q = phi' M u swings as (1 - cos w t) q_static: its
+  // upward crossings of q_static are one period apart.
+  const double q_static = 0.01 / (omega * omega);
+  std::vector<double> crossings;
+  for (size_t k = 1; k < t.u.size(); ++k) {
+    const double a = phi_full.dot(c.d.M * t.u[k - 1]) - q_static,
+                 b = phi_full.dot(c.d.M * t.u[k]) - q_static;
+    if (a < 0.0 && b >= 0.0) crossings.push_back(t.times[k - 1] + h * a / (a - b));
+  }
+  ASSERT_GE(crossings.size(), 3u);
+  const double measured = (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  const double newmark = 2.0 * M_PI * h / (2.0 * std::atan(omega * h / 2.0));  // period elongation
+  EXPECT_NEAR(measured / newmark, 1.0, 1e-4);
+  EXPECT_NEAR(measured / period, 1.0, 5e-4);  // (pi h / T)^2 / 3 = 3.3e-4
+}
+
+// The benchmarks paper's MP2 finding: a stiff, nearly incompressible block
+// with Rayleigh damping, pushed by a needle at h = 1/30 s: explicit
+// integration diverges; the implicit and quasi-static ones reach the same
+// static state.
+TEST(FemDynamics, ExplicitDivergesOnTheStiffBlockWhereImplicitSettles) {
+  const Mesh mesh = structured_grid(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2i(6, 6));
+  Material m;
+  m.young = 60000.0;
+  m.poisson = 0.495;
+  m.density = 1140.0;
+  Dynamics d;
+  d.K = stiffness_matrix(mesh, m);
+  d.M = mass_matrix(mesh, m);
+  d.lumped = lumped_mass(mesh, m);
+  d.alpha = 1.0;
+  d.beta = 0.1;
+  d.divergence_scale = 10.0;  // ten times the block
+  int needle = -1;
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    const double x = mesh.nodes(v, 0), y = mesh.nodes(v, 1);
+    if (x < 1e-12 || y < 1e-12 || y > 1.0 - 1e-12)
+      for (int a = 0; a < 2; ++a) d.held.push_back(2 * v + a);
+    if (x > 1.0 - 1e-12 && std::abs(y - 0.5) < 1e-12) needle = v;
+  }
+  ASSERT_GE(needle, 0);
+  d.held.push_back(2 * needle);
+  const size_t supports = d.held.size() - 1;
+  d.held_values = [supports](double t) {
+    Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(supports + 1));
+    values[static_cast<Eigen::Index>(supports)] = -0.08 * std::min(t, 2.0);
+    return values;
+  };
+  const double h = 1.0 / 30.0;
+  for (Integrator explicit_kind : {Integrator::ExplicitConsistent, Integrator::ExplicitLumped}) {
+    const Trajectory t = integrate(d, explicit_kind, h, 300);
+    EXPECT_FALSE(t.ok) << to_string(explicit_kind);
+    EXPECT_NE(t.message.find("diverged"), std::string::npos) << t.message;
+  }
+  const Trajectory reference = integrate(d, Integrator::ImplicitNewmark, h, 600);
+  ASSERT_TRUE(reference.ok) << reference.message;
+  for (Integrator kind : {Integrator::ImplicitLumped, Integrator::QuasiStatic}) {
+    const Trajectory t = integrate(d, kind, h, 600);
+    ASSERT_TRUE(t.ok) << t.message;
+    EXPECT_LT((t.u.back() - reference.u.back()).norm(), 1e-3 * reference.u.back().norm())
+        << to_string(kind);
+  }
+  EXPECT_NEAR(reference.u.back()[2 * needle], -0.16, 1e-12);  // the needle stopped at 16 cm
 }
 
 }  // namespace
