@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fem/free_unknowns.hpp"
 #include "solve/sparse_cholesky.hpp"
 
 namespace fiberfluid::fem {
@@ -18,42 +19,10 @@ Sparse diagonal(const Eigen::VectorXd& d) {
   return D;
 }
 
-// The free unknowns' block of a matrix, and the free/held split of vectors.
-struct Split {
-  std::vector<int> index;  // per unknown: its place among the free ones, or -1
-  int free = 0;
-  Split(int n, const std::vector<int>& held) : index(static_cast<size_t>(n), 0) {
-    for (int d : held) index[static_cast<size_t>(d)] = -1;
-    for (int d = 0; d < n; ++d)
-      if (index[static_cast<size_t>(d)] >= 0) index[static_cast<size_t>(d)] = free++;
-  }
-  Sparse free_block(const Sparse& A) const {
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int c = 0; c < A.outerSize(); ++c)
-      for (Sparse::InnerIterator it(A, c); it; ++it) {
-        const int r = index[static_cast<size_t>(it.row())], k = index[static_cast<size_t>(it.col())];
-        if (r >= 0 && k >= 0) entries.emplace_back(r, k, it.value());
-      }
-    Sparse B(free, free);
-    B.setFromTriplets(entries.begin(), entries.end());
-    return B;
-  }
-  Eigen::VectorXd restrict(const Eigen::VectorXd& x) const {
-    Eigen::VectorXd out(free);
-    for (size_t d = 0; d < index.size(); ++d)
-      if (index[d] >= 0) out[index[d]] = x[static_cast<Eigen::Index>(d)];
-    return out;
-  }
-  void scatter(const Eigen::VectorXd& free_values, Eigen::VectorXd& x) const {
-    for (size_t d = 0; d < index.size(); ++d)
-      if (index[d] >= 0) x[static_cast<Eigen::Index>(d)] = free_values[index[d]];
-  }
-};
-
 // Solves A_ff x_f = r_f: a division for a diagonal A, CHOLMOD otherwise.
 class FreeSolve {
  public:
-  FreeSolve(const Sparse& A, const Split& split, bool is_diagonal) {
+  FreeSolve(const Sparse& A, const FreeUnknowns& split, bool is_diagonal) {
     if (is_diagonal) {
       diagonal_ = split.restrict(A.diagonal());
       ok_ = (diagonal_.array() > 0.0).all();
@@ -95,7 +64,13 @@ double mechanical_energy(const Dynamics& d, const Eigen::VectorXd& u, const Eige
 Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps) {
   const int n = static_cast<int>(d.K.rows());
   Trajectory out;
-  const Split split(n, d.held);
+  for (int dof : d.held)
+    if (dof < 0 || dof >= n) {
+      out.ok = false;
+      out.message = "fem: a held unknown is out of range";
+      return out;
+    }
+  const FreeUnknowns split(n, d.held);
   auto force = [&](double t) { return d.force ? d.force(t) : Eigen::VectorXd(Eigen::VectorXd::Zero(n)); };
   auto held_at = [&](double t) {
     Eigen::VectorXd values = d.held_values ? d.held_values(t)

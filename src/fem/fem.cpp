@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "fem/free_unknowns.hpp"
 #include "geom/error.hpp"
 #include "solve/sparse_cholesky.hpp"
 
@@ -223,40 +224,24 @@ Eigen::VectorXd body_forces(const Mesh& mesh, const Material& m, const Eigen::Ve
 solve::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
                            const Constraints& held, Eigen::VectorXd* u) {
   const int n = static_cast<int>(K.rows());
-  std::vector<int> index(static_cast<size_t>(n), 0);  // free: its place; held: -1
   Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
   for (size_t c = 0; c < held.dofs.size(); ++c) {
     const int d = held.dofs[c];
     if (d < 0 || d >= n) return solve::Status::failure("fem: a held unknown is out of range");
-    index[static_cast<size_t>(d)] = -1;
     fixed[d] = held.values[c];
   }
-  int free = 0;
-  for (int d = 0; d < n; ++d)
-    if (index[static_cast<size_t>(d)] >= 0) index[static_cast<size_t>(d)] = free++;
   // K_ff u_f = f_f - K_fh u_h.
-  const Eigen::VectorXd coupling = K * fixed;
-  std::vector<Eigen::Triplet<double>> entries;
-  Eigen::VectorXd rhs(free);
-  for (int d = 0; d < n; ++d)
-    if (index[static_cast<size_t>(d)] >= 0) rhs[index[static_cast<size_t>(d)]] = f[d] - coupling[d];
-  for (int col = 0; col < K.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) {
-      const int r = index[static_cast<size_t>(it.row())], c = index[static_cast<size_t>(it.col())];
-      if (r >= 0 && c >= 0) entries.emplace_back(r, c, it.value());
-    }
-  Eigen::SparseMatrix<double> Kff(free, free);
-  Kff.setFromTriplets(entries.begin(), entries.end());
+  const FreeUnknowns split(n, held.dofs);
+  const Eigen::SparseMatrix<double> Kff = split.free_block(K);
+  const Eigen::VectorXd rhs = split.restrict(f - K * fixed);
   solve::SparseCholesky cholesky;
   cholesky.analyze_pattern(Kff);
   const solve::Status status = cholesky.factorize(Kff);
   if (!status.ok)
     return solve::Status::failure("fem: the stiffness is singular on the free unknowns (too few "
                                   "supports?): " + status.message);
-  const Eigen::VectorXd uf = cholesky.solve(rhs);
   *u = fixed;
-  for (int d = 0; d < n; ++d)
-    if (index[static_cast<size_t>(d)] >= 0) (*u)[d] = uf[index[static_cast<size_t>(d)]];
+  split.scatter(cholesky.solve(rhs), *u);
   return {};
 }
 

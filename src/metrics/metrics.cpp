@@ -23,13 +23,15 @@ double enclosed_measure(const geom::Surface& surface) {
   return geom::enclosed_volume(surface.V, surface.F);
 }
 
-double surface_error(const geom::Surface& reference, const geom::Surface& approximation) {
+double surface_error(const geom::Surface& reference, const geom::Surface& approximation,
+                     const std::string& what_reference, const std::string& what_approximation) {
   const double measure = enclosed_measure(reference);
   if (!(measure > 0.0))
-    throw InputError("E_s: the reference encloses no positive " +
+    throw InputError(what_reference + ": encloses no positive " +
                      std::string(reference.dim == 2 ? "area" : "volume") +
                      " (is it closed and outward?)");
-  return symmetric_difference_measure(reference, approximation, "the reference", "the approximation") /
+  return symmetric_difference_measure(reference, approximation, what_reference,
+                                      what_approximation) /
          measure;
 }
 

@@ -30,8 +30,10 @@ double symmetric_difference_measure(const geom::Surface& a, const geom::Surface&
                                     const std::string& what_a = "A",
                                     const std::string& what_b = "B");
 
-// E_s = |Int(M) xor Int(M')| / |Int(M)|.
-double surface_error(const geom::Surface& reference, const geom::Surface& approximation);
+// E_s = |Int(M) xor Int(M')| / |Int(M)|; the labels name the surfaces in errors.
+double surface_error(const geom::Surface& reference, const geom::Surface& approximation,
+                     const std::string& what_reference = "the reference",
+                     const std::string& what_approximation = "the approximation");
 
 // Each node's share of the body's measure for E_i. For a surface-only model
 // (no interior nodes) the share of the boundary: a third of the area of the
