@@ -57,6 +57,16 @@ const char* to_string(Integrator integrator) {
   return "?";
 }
 
+Dynamics make_dynamics(const Mesh& mesh, const Material& material, double alpha, double beta) {
+  Dynamics d;
+  d.K = stiffness_matrix(mesh, material);
+  d.M = mass_matrix(mesh, material);
+  d.lumped = d.M * Eigen::VectorXd::Ones(d.M.cols());  // lumped_mass without a second assembly
+  d.alpha = alpha;
+  d.beta = beta;
+  return d;
+}
+
 double mechanical_energy(const Dynamics& d, const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
   return 0.5 * v.dot(d.M * v) + 0.5 * u.dot(d.K * u);
 }

@@ -48,6 +48,10 @@ struct Trajectory {
   std::vector<Eigen::VectorXd> u, v;  // per time
 };
 
+// The matrices of a mesh and material with Rayleigh damping; no loads, no
+// held unknowns yet.
+Dynamics make_dynamics(const Mesh& mesh, const Material& material, double alpha, double beta);
+
 // From rest (u = v = 0, a from the equation at t = 0), `steps` steps of h.
 // Stops with ok = false, naming the time, when the state stops being finite
 // or a displacement exceeds divergence_scale (diverged).

@@ -160,11 +160,7 @@ Cantilever cantilever_2d(double alpha = 0.0, double beta = 0.0) {
   m.young = 7000.0;
   m.poisson = 0.2;
   m.density = 1000.0;
-  c.d.K = stiffness_matrix(c.mesh, m);
-  c.d.M = mass_matrix(c.mesh, m);
-  c.d.lumped = lumped_mass(c.mesh, m);
-  c.d.alpha = alpha;
-  c.d.beta = beta;
+  c.d = make_dynamics(c.mesh, m, alpha, beta);
   for (int v = 0; v < c.mesh.num_nodes(); ++v)
     for (int a = 0; a < 2; ++a)
       (c.mesh.nodes(v, 0) < 1e-12 ? c.d.held : c.free).push_back(2 * v + a);
@@ -221,38 +217,46 @@ TEST(FemDynamics, NewmarkConservesEnergyAndSwingsAtTheLowestFrequency) {
   EXPECT_NEAR(measured / period, 1.0, 5e-4);  // (pi h / T)^2 / 3 = 3.3e-4
 }
 
+// The benchmarks paper's block and needle: a unit square of cells x cells
+// Q1 elements, top, bottom and left held, the needle (the middle of the
+// right side) moving left at 0.08 m/s for 2 s, Rayleigh 1.0 and 0.1.
+struct NeedleBlock {
+  Dynamics d;
+  int needle = -1;
+};
+NeedleBlock needle_block(double young, double poisson, double density, int cells) {
+  Material m;
+  m.young = young;
+  m.poisson = poisson;
+  m.density = density;
+  const Mesh mesh = structured_grid(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2i(cells, cells));
+  NeedleBlock b{make_dynamics(mesh, m, 1.0, 0.1)};
+  b.d.divergence_scale = 10.0;  // ten times the block
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    const double x = mesh.nodes(v, 0), y = mesh.nodes(v, 1);
+    if (x < 1e-12 || y < 1e-12 || y > 1.0 - 1e-12)
+      for (int a = 0; a < 2; ++a) b.d.held.push_back(2 * v + a);
+    if (x > 1.0 - 1e-12 && std::abs(y - 0.5) < 1e-12) b.needle = v;
+  }
+  if (b.needle >= 0) b.d.held.push_back(2 * b.needle);
+  const size_t supports = b.d.held.size() - 1;
+  b.d.held_values = [supports](double t) {
+    Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(supports + 1));
+    values[static_cast<Eigen::Index>(supports)] = -0.08 * std::min(t, 2.0);
+    return values;
+  };
+  return b;
+}
+
 // The benchmarks paper's MP2 finding: a stiff, nearly incompressible block
 // with Rayleigh damping, pushed by a needle at h = 1/30 s: explicit
 // integration diverges; the implicit and quasi-static ones reach the same
 // static state.
 TEST(FemDynamics, ExplicitDivergesOnTheStiffBlockWhereImplicitSettles) {
-  const Mesh mesh = structured_grid(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2i(6, 6));
-  Material m;
-  m.young = 60000.0;
-  m.poisson = 0.495;
-  m.density = 1140.0;
-  Dynamics d;
-  d.K = stiffness_matrix(mesh, m);
-  d.M = mass_matrix(mesh, m);
-  d.lumped = lumped_mass(mesh, m);
-  d.alpha = 1.0;
-  d.beta = 0.1;
-  d.divergence_scale = 10.0;  // ten times the block
-  int needle = -1;
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    const double x = mesh.nodes(v, 0), y = mesh.nodes(v, 1);
-    if (x < 1e-12 || y < 1e-12 || y > 1.0 - 1e-12)
-      for (int a = 0; a < 2; ++a) d.held.push_back(2 * v + a);
-    if (x > 1.0 - 1e-12 && std::abs(y - 0.5) < 1e-12) needle = v;
-  }
+  const NeedleBlock block = needle_block(60000.0, 0.495, 1140.0, 6);
+  const Dynamics& d = block.d;
+  const int needle = block.needle;
   ASSERT_GE(needle, 0);
-  d.held.push_back(2 * needle);
-  const size_t supports = d.held.size() - 1;
-  d.held_values = [supports](double t) {
-    Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(supports + 1));
-    values[static_cast<Eigen::Index>(supports)] = -0.08 * std::min(t, 2.0);
-    return values;
-  };
   const double h = 1.0 / 30.0;
   for (Integrator explicit_kind : {Integrator::ExplicitConsistent, Integrator::ExplicitLumped}) {
     const Trajectory t = integrate(d, explicit_kind, h, 300);
@@ -280,12 +284,7 @@ TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
   m.young = 7000.0;
   m.poisson = 0.2;
   m.density = 10000.0;
-  Dynamics d;
-  d.K = stiffness_matrix(mesh, m);
-  d.M = mass_matrix(mesh, m);
-  d.lumped = lumped_mass(mesh, m);
-  d.alpha = 1.0;
-  d.beta = 0.1;
+  Dynamics d = make_dynamics(mesh, m, 1.0, 0.1);
   const Eigen::VectorXd gravity = body_forces(mesh, m, Eigen::Vector3d(0.05, 0.0, 0.0));
   d.force = [gravity](double) { return gravity; };
   Constraints clamp;
@@ -335,32 +334,9 @@ TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
 // lumped methods next, quasi-static worst while the needle moves; all reach
 // the same static state.
 TEST(FemDynamics, MP1OrdersTheSolversAsThePaperFound) {
-  const Mesh mesh = structured_grid(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2i(8, 8));
-  Material m;
-  m.young = 200.0;
-  m.poisson = 0.47;
-  m.density = 2000.0;
-  Dynamics d;
-  d.K = stiffness_matrix(mesh, m);
-  d.M = mass_matrix(mesh, m);
-  d.lumped = lumped_mass(mesh, m);
-  d.alpha = 1.0;
-  d.beta = 0.1;
-  d.divergence_scale = 10.0;
-  int needle = -1;
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    const double x = mesh.nodes(v, 0), y = mesh.nodes(v, 1);
-    if (x < 1e-12 || y < 1e-12 || y > 1.0 - 1e-12)
-      for (int a = 0; a < 2; ++a) d.held.push_back(2 * v + a);
-    if (x > 1.0 - 1e-12 && std::abs(y - 0.5) < 1e-12) needle = v;
-  }
-  d.held.push_back(2 * needle);
-  const size_t supports = d.held.size() - 1;
-  d.held_values = [supports](double t) {
-    Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(supports + 1));
-    values[static_cast<Eigen::Index>(supports)] = -0.08 * std::min(t, 2.0);
-    return values;
-  };
+  const NeedleBlock block = needle_block(200.0, 0.47, 2000.0, 8);
+  const Dynamics& d = block.d;
+  ASSERT_GE(block.needle, 0);
   const double h = 1.0 / 30.0;
   const int steps = 900;  // 30 s
   const Trajectory reference = integrate(d, Integrator::ImplicitNewmark, h, steps);
