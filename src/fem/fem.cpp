@@ -84,14 +84,27 @@ Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& dN, int dim) {
   return B;
 }
 
-void check_corners(const Eigen::MatrixXd& corners) {
+// Quadrilaterals and hexahedra have 2^dim corners, triangles and tetrahedra dim + 1.
+bool is_simplex(const Eigen::MatrixXd& corners) {
   const int dim = static_cast<int>(corners.cols());
-  if ((dim != 2 && dim != 3) || corners.rows() != (1 << dim))
-    throw InputError("fem: an element needs 4 corners in 2D or 8 in 3D");
+  if ((dim != 2 && dim != 3) || (corners.rows() != (1 << dim) && corners.rows() != dim + 1))
+    throw InputError("fem: an element needs 4 corners (a quadrilateral) or 3 (a triangle) in "
+                     "2D, 8 (a hexahedron) or 4 (a tetrahedron) in 3D");
+  return corners.rows() == dim + 1;
+}
+
+// A linear simplex: constant shape derivatives (#nodes x dim) and its measure.
+double simplex_derivatives(const Eigen::MatrixXd& corners, Eigen::MatrixXd* dN_dx) {
+  const int dim = static_cast<int>(corners.cols());
+  Eigen::MatrixXd dN_dxi = Eigen::MatrixXd::Zero(dim + 1, dim);  // N0 = 1 - sum xi, Ni = xi_i
+  dN_dxi.row(0).setConstant(-1.0);
+  dN_dxi.bottomRows(dim).setIdentity();
+  const double det = physical_derivatives(corners, dN_dxi, dN_dx);
+  return det / (dim == 2 ? 2.0 : 6.0);
 }
 
 Eigen::SparseMatrix<double> assemble(const Mesh& mesh, const Material& m, bool stiffness) {
-  const int dim = mesh.dim, per = 1 << dim;
+  const int dim = mesh.dim, per = static_cast<int>(mesh.elements.cols());
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(static_cast<size_t>(mesh.elements.rows()) * (dim * per) * (dim * per));
   Eigen::MatrixXd corners(per, dim);
@@ -170,9 +183,15 @@ Eigen::MatrixXd elasticity_matrix(const Material& m, int dim) {
 }
 
 Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material& m) {
-  check_corners(corners);
+  const bool simplex = is_simplex(corners);
   const int dim = static_cast<int>(corners.cols());
   const Eigen::MatrixXd D = elasticity_matrix(m, dim);
+  if (simplex) {  // constant strain: one point is exact
+    Eigen::MatrixXd dN_dx;
+    const double measure = simplex_derivatives(corners, &dN_dx);
+    const Eigen::MatrixXd B = strain_matrix(dN_dx, dim);
+    return measure * B.transpose() * D * B;
+  }
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(dim * corners.rows(), dim * corners.rows());
   Eigen::VectorXd N;
   Eigen::MatrixXd dN_dxi, dN_dx;
@@ -186,15 +205,21 @@ Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material
 }
 
 Eigen::MatrixXd element_mass(const Eigen::MatrixXd& corners, const Material& m) {
-  check_corners(corners);
+  const bool simplex = is_simplex(corners);
   const int dim = static_cast<int>(corners.cols()), n = static_cast<int>(corners.rows());
   Eigen::MatrixXd scalar = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd N;
   Eigen::MatrixXd dN_dxi, dN_dx;
-  for (const Eigen::VectorXd& xi : gauss_points(dim)) {
-    shape(xi, dim, &N, &dN_dxi);
-    const double det = physical_derivatives(corners, dN_dxi, &dN_dx);
-    scalar += m.density * det * N * N.transpose();
+  if (simplex) {  // the exact integral of N_a N_b: |T| (1 + delta_ab) / ((d + 1)(d + 2))
+    const double measure = simplex_derivatives(corners, &dN_dx);
+    scalar.setConstant(m.density * measure / ((dim + 1) * (dim + 2)));
+    scalar.diagonal() *= 2.0;
+  } else {
+    for (const Eigen::VectorXd& xi : gauss_points(dim)) {
+      shape(xi, dim, &N, &dN_dxi);
+      const double det = physical_derivatives(corners, dN_dxi, &dN_dx);
+      scalar += m.density * det * N * N.transpose();
+    }
   }
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(dim * n, dim * n);
   for (int a = 0; a < n; ++a)

@@ -3,7 +3,9 @@
 
 // Linear-elastic finite elements for the accuracy benchmarks (Alterovitz and
 // Goldberg; docs: benchmarks.md): bilinear quadrilaterals (Q1, 2D) and
-// trilinear hexahedra (3D), 2 x 2 (x 2) Gauss quadrature, small strains.
+// trilinear hexahedra (3D) with 2 x 2 (x 2) Gauss quadrature, linear
+// triangles and tetrahedra (P1, for organ shapes) exact with one point;
+// small strains.
 // Unknowns are ordered node by node: u = (u0x, u0y[, u0z], u1x, ...).
 
 #include <Eigen/Core>
@@ -14,13 +16,14 @@
 
 namespace fiberfluid::fem {
 
-// A mesh of Q1 quadrilaterals (dim 2, 4 nodes counterclockwise) or
-// hexahedra (dim 3, 8 nodes: the bottom face counterclockwise seen from
-// above, then the top face above it).
+// A mesh of one element kind, told by the nodes per element: Q1
+// quadrilaterals (dim 2, 4 nodes counterclockwise), hexahedra (dim 3, 8
+// nodes: the bottom face counterclockwise seen from above, then the top face
+// above it), or positively oriented simplices (dim + 1 nodes).
 struct Mesh {
   int dim = 2;
   Eigen::MatrixXd nodes;     // #nodes x dim
-  Eigen::MatrixXi elements;  // #elements x 4 (2D) or 8 (3D)
+  Eigen::MatrixXi elements;  // #elements x nodes per element
   int num_nodes() const { return static_cast<int>(nodes.rows()); }
   int num_dofs() const { return dim * num_nodes(); }
 };

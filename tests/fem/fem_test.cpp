@@ -12,6 +12,9 @@
 #include <map>
 
 #include "fem/dynamics.hpp"
+#include "fem/mesh_tools.hpp"
+#include "geom/error.hpp"
+#include "metrics/metrics.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -33,11 +36,14 @@ bool on_boundary(const Eigen::RowVectorXd& p) {
 
 // Any linear displacement field is reproduced exactly: the boundary nodes
 // held at it, the inner ones must follow with no force.
+// Quadrilaterals and hexahedra, and the same grids split into triangles and
+// tetrahedra.
 TEST(Fem, PassesThePatchTest) {
   for (int dim : {2, 3}) {
-    for (PlaneModel plane : {PlaneModel::Strain, PlaneModel::Stress}) {
+    for (PlaneModel plane : {PlaneModel::Strain, PlaneModel::Stress})
+    for (bool simplices : {false, true}) {
       if (dim == 3 && plane == PlaneModel::Stress) continue;
-      const Mesh mesh = distorted_grid(dim);
+      const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
       Material m;
       m.young = 5000.0;
       m.poisson = 0.45;
@@ -57,7 +63,7 @@ TEST(Fem, PassesThePatchTest) {
       const solve::Status s =
           solve_static(stiffness_matrix(mesh, m), Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u);
       ASSERT_TRUE(s.ok) << s.message;
-      EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-14) << dim << "D";
+      EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-14) << dim << "D, simplices " << simplices;
       // A rigid motion costs no energy: K annihilates it.
       Eigen::VectorXd shift(mesh.num_dofs());
       for (int v = 0; v < mesh.num_nodes(); ++v) shift.segment(dim * v, dim) = c;
@@ -67,8 +73,10 @@ TEST(Fem, PassesThePatchTest) {
 }
 
 TEST(Fem, MassMatricesSumToTheTotalMass) {
-  for (int dim : {2, 3}) {
-    const Mesh mesh = distorted_grid(dim);  // a unit square or cube, inner nodes moved
+  for (int dim : {2, 3})
+  for (bool simplices : {false, true}) {
+    // A unit square or cube, inner nodes moved.
+    const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
     Material m;
     m.density = 1140.0;
     const Eigen::SparseMatrix<double> M = mass_matrix(mesh, m);
@@ -84,7 +92,54 @@ TEST(Fem, MassMatricesSumToTheTotalMass) {
     double weight = 0.0;
     for (int v = 0; v < mesh.num_nodes(); ++v) weight += f[dim * v + dim - 1];
     EXPECT_NEAR(weight, -9.81 * 1140.0, 1e-8);
+    EXPECT_NEAR(node_measures(mesh).sum(), 1.0, 1e-12);
   }
+}
+
+// The exact consistent mass of a tetrahedron: rho |T| (1 + delta_ab) / 20
+// per component; its stiffness annihilates the six rigid motions.
+TEST(Fem, TetrahedronMatricesAreExact) {
+  Eigen::MatrixXd corners(4, 3);
+  corners << 0.1, 0.0, 0.0, 1.0, 0.2, 0.0, 0.3, 0.9, 0.1, 0.2, 0.3, 0.8;
+  Material m;
+  m.density = 3.0;
+  const double volume = (Eigen::Matrix3d() << (corners.row(1) - corners.row(0)),
+                         (corners.row(2) - corners.row(0)), (corners.row(3) - corners.row(0)))
+                            .finished()
+                            .determinant() / 6.0;
+  const Eigen::MatrixXd M = element_mass(corners, m);
+  EXPECT_NEAR(M(0, 0), 3.0 * volume / 10.0, 1e-15);
+  EXPECT_NEAR(M(0, 3), 3.0 * volume / 20.0, 1e-15);
+  EXPECT_EQ(M(0, 1), 0.0);
+  const Eigen::MatrixXd K = element_stiffness(corners, m);
+  for (int axis = 0; axis < 3; ++axis) {  // translations and small rotations
+    Eigen::VectorXd shift = Eigen::VectorXd::Zero(12), turn = shift;
+    for (int a = 0; a < 4; ++a) {
+      shift[3 * a + axis] = 1.0;
+      const Eigen::Vector3d p = corners.row(a).transpose();
+      turn.segment(3 * a, 3) = Eigen::Vector3d::Unit(axis).cross(p);
+    }
+    EXPECT_LT((K * shift).norm(), 1e-12);
+    EXPECT_LT((K * turn).norm(), 1e-12);
+  }
+  corners.row(1).swap(corners.row(2));  // inverted
+  EXPECT_THROW(element_stiffness(corners, m), InputError);
+}
+
+// The boundary of a grid, and of the same grid in simplices, encloses the
+// body: area 1 (2D, one polygon) or volume 0.125 (3D), outward.
+TEST(Fem, BoundaryEnclosesTheBody) {
+  for (int dim : {2, 3})
+    for (bool simplices : {false, true}) {
+      const Mesh grid = structured_grid(Eigen::VectorXd::Constant(dim, dim == 2 ? 1.0 : 0.5),
+                                        Eigen::VectorXi::Constant(dim, 3));
+      const Mesh mesh = simplices ? to_simplices(grid) : grid;
+      const Boundary b = boundary(mesh);
+      EXPECT_NEAR(metrics::enclosed_measure(b.surface), dim == 2 ? 1.0 : 0.125, 1e-14);
+      // Every node of the boundary of a 4 x 4 (x 4) node grid but the inner ones.
+      EXPECT_EQ(static_cast<int>(b.nodes.size()), dim == 2 ? 12 : 64 - 8);
+      EXPECT_EQ(b.surface.num_faces(), dim == 2 ? 12 : 6 * 9 * 2);
+    }
 }
 
 // Tip deflection of a cantilever (clamped at x = 0, a shear load P on its
