@@ -19,32 +19,79 @@ Sparse diagonal(const Eigen::VectorXd& d) {
   return D;
 }
 
-// Solves A_ff x_f = r_f: a division for a diagonal A, CHOLMOD otherwise.
+// Gauss-Seidel sweeps on a symmetric positive definite matrix (stored by
+// rows), from x, until |b - A x| <= tolerance |b|. Returns the sweeps taken,
+// or -1 when max_sweeps were not enough.
+int gauss_seidel(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const Eigen::VectorXd& b,
+                 const IntegrationOptions& options, Eigen::VectorXd& x) {
+  const double target = options.tolerance * b.norm();
+  for (int sweep = 0; sweep <= options.max_sweeps; ++sweep) {
+    if ((b - A * x).norm() <= target) return sweep;
+    for (Eigen::Index r = 0; r < A.outerSize(); ++r) {
+      double sum = b[r], diagonal = 0.0;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(A, r); it; ++it) {
+        if (it.col() == r) diagonal = it.value();
+        else sum -= it.value() * x[it.col()];
+      }
+      x[r] = sum / diagonal;
+    }
+  }
+  return -1;
+}
+
+// Solves A_ff x_f = r_f: a division for a diagonal A, else CHOLMOD or
+// Gauss-Seidel (warm-started from the last solution).
 class FreeSolve {
  public:
-  FreeSolve(const Sparse& A, const FreeUnknowns& split, bool is_diagonal) {
+  FreeSolve(const Sparse& A, const FreeUnknowns& split, bool is_diagonal,
+            const IntegrationOptions& options)
+      : options_(options) {
     if (is_diagonal) {
       diagonal_ = split.restrict(A.diagonal());
       ok_ = (diagonal_.array() > 0.0).all();
       return;
     }
     const Sparse block = split.free_block(A);
+    if (options.linear == LinearMethod::GaussSeidel) {
+      by_rows_ = block;
+      ok_ = (block.diagonal().array() > 0.0).all();
+      last_ = Eigen::VectorXd::Zero(block.rows());
+      return;
+    }
     cholesky_.analyze_pattern(block);
     ok_ = cholesky_.factorize(block).ok;
   }
   bool ok() const { return ok_; }
-  Eigen::VectorXd solve(const Eigen::VectorXd& rhs_free) const {
-    return diagonal_.size() > 0 ? Eigen::VectorXd(rhs_free.cwiseQuotient(diagonal_))
-                                : cholesky_.solve(rhs_free);
+  long long sweeps() const { return sweeps_; }
+  // False when Gauss-Seidel did not converge.
+  bool solve(const Eigen::VectorXd& rhs_free, Eigen::VectorXd* x) {
+    if (diagonal_.size() > 0) {
+      *x = rhs_free.cwiseQuotient(diagonal_);
+    } else if (by_rows_.rows() > 0) {
+      const int taken = gauss_seidel(by_rows_, rhs_free, options_, last_);
+      if (taken < 0) return false;
+      sweeps_ += taken;
+      *x = last_;
+    } else {
+      *x = cholesky_.solve(rhs_free);
+    }
+    return true;
   }
 
  private:
-  Eigen::VectorXd diagonal_;
+  IntegrationOptions options_;
+  Eigen::VectorXd diagonal_, last_;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> by_rows_;
   solve::SparseCholesky cholesky_;
   bool ok_ = false;
+  long long sweeps_ = 0;
 };
 
 }  // namespace
+
+const char* to_string(LinearMethod method) {
+  return method == LinearMethod::GaussSeidel ? "gauss-seidel" : "cholesky";
+}
 
 const char* to_string(Integrator integrator) {
   switch (integrator) {
@@ -71,7 +118,8 @@ double mechanical_energy(const Dynamics& d, const Eigen::VectorXd& u, const Eige
   return 0.5 * v.dot(d.M * v) + 0.5 * u.dot(d.K * u);
 }
 
-Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps) {
+Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps,
+                     const IntegrationOptions& options) {
   const int n = static_cast<int>(d.K.rows());
   Trajectory out;
   for (int dof : d.held)
@@ -99,20 +147,27 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
   out.u.push_back(u);
   out.v.push_back(v);
 
-  if (integrator == Integrator::QuasiStatic) {
-    Constraints held;
+  const std::string no_convergence =
+      "Gauss-Seidel did not converge in " + std::to_string(options.max_sweeps) + " sweeps";
+  if (integrator == Integrator::QuasiStatic) {  // K_ff u_f = f_f - K_fh u_h
+    FreeSolve stiffness_solve(d.K, split, false, options);
+    if (!stiffness_solve.ok())
+      return fail(0.0, "the stiffness is singular on the free unknowns (too few supports?)");
+    Eigen::VectorXd free_u;
     for (int s = 1; s <= steps; ++s) {
       const double t = s * h;
-      held.dofs = d.held;
-      const Eigen::VectorXd values = held_at(t);
-      held.values.assign(values.data(), values.data() + values.size());
-      const Eigen::VectorXd previous = u;
-      const solve::Status status = solve_static(d.K, force(t), held, &u);
-      if (!status.ok) return fail(t, status.message);
+      const Eigen::VectorXd previous = u, target = held_at(t);
+      Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
+      for (size_t k = 0; k < d.held.size(); ++k) fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
+      if (!stiffness_solve.solve(split.restrict(force(t) - d.K * fixed), &free_u))
+        return fail(t, no_convergence);
+      u = fixed;
+      split.scatter(free_u, u);
       out.times.push_back(t);
       out.u.push_back(u);
       out.v.push_back((u - previous) / h);
     }
+    out.sweeps = stiffness_solve.sweeps();
     return out;
   }
 
@@ -125,13 +180,14 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
                        ? diagonal(d.alpha * d.lumped + d.beta * Eigen::VectorXd(d.K.diagonal()))
                        : Sparse(d.alpha * M + d.beta * d.K);
   const Sparse A = M + (g * h) * C + (b * h * h / 2.0) * d.K;
-  const FreeSolve step_solve(A, split, integrator == Integrator::ExplicitLumped);
-  const FreeSolve mass_solve(M, split, lumped);
+  FreeSolve step_solve(A, split, integrator == Integrator::ExplicitLumped, options);
+  FreeSolve mass_solve(M, split, lumped, options);
   if (!step_solve.ok() || !mass_solve.ok()) return fail(0.0, "the step matrix is not positive definite");
 
   // a at rest: M a = f(0) on the free unknowns; the held ones start at rest.
-  Eigen::VectorXd a = Eigen::VectorXd::Zero(n);
-  split.scatter(mass_solve.solve(split.restrict(force(0.0))), a);
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(n), free_a;
+  if (!mass_solve.solve(split.restrict(force(0.0)), &free_a)) return fail(0.0, no_convergence);
+  split.scatter(free_a, a);
 
   for (int s = 1; s <= steps; ++s) {
     const double t = s * h;
@@ -146,7 +202,8 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
                             : 2.0 * (target[static_cast<Eigen::Index>(k)] - u[dof] - h * v[dof]) / (h * h);
     }
     const Eigen::VectorXd rhs = force(t) - C * v_pred - d.K * u_pred - A * a_next;
-    split.scatter(step_solve.solve(split.restrict(rhs)), a_next);
+    if (!step_solve.solve(split.restrict(rhs), &free_a)) return fail(t, no_convergence);
+    split.scatter(free_a, a_next);
     a = a_next;
     u = u_pred + (b * h * h / 2.0) * a;
     v = v_pred + (g * h) * a;
@@ -158,6 +215,7 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
     out.u.push_back(u);
     out.v.push_back(v);
   }
+  out.sweeps = step_solve.sweeps() + mass_solve.sweeps();
   return out;
 }
 

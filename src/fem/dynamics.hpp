@@ -41,11 +41,25 @@ struct Dynamics {
   double divergence_scale = std::numeric_limits<double>::infinity();
 };
 
+// How the integrators solve their linear systems: a sparse Cholesky
+// factorisation once (CHOLMOD), or the paper's Gauss-Seidel sweeps every
+// step, warm-started from the last solution, until the residual falls below
+// `tolerance` relative to the right-hand side (to show what it costs).
+enum class LinearMethod { Cholesky, GaussSeidel };
+const char* to_string(LinearMethod method);
+
+struct IntegrationOptions {
+  LinearMethod linear = LinearMethod::Cholesky;
+  double tolerance = 1e-10;
+  int max_sweeps = 100000;  // per solve; more is a failure
+};
+
 struct Trajectory {
   bool ok = true;
   std::string message;          // why it stopped (diverged, singular)
   std::vector<double> times;    // 0, h, 2h, ...
   std::vector<Eigen::VectorXd> u, v;  // per time
+  long long sweeps = 0;         // Gauss-Seidel sweeps in all (0 with Cholesky)
 };
 
 // The matrices of a mesh and material with Rayleigh damping; no loads, no
@@ -55,7 +69,9 @@ Dynamics make_dynamics(const Mesh& mesh, const Material& material, double alpha,
 // From rest (u = v = 0, a from the equation at t = 0), `steps` steps of h.
 // Stops with ok = false, naming the time, when the state stops being finite
 // or a displacement exceeds divergence_scale (diverged).
-Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps);
+// Stops, naming the time, when Gauss-Seidel does not reach its tolerance.
+Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps,
+                     const IntegrationOptions& options = {});
 
 // Total mechanical energy 1/2 v^T M v + 1/2 u^T K u (consistent mass).
 double mechanical_energy(const Dynamics& d, const Eigen::VectorXd& u, const Eigen::VectorXd& v);
