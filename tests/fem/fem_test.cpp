@@ -13,6 +13,7 @@
 
 #include "fem/dynamics.hpp"
 #include "fem/mesh_tools.hpp"
+#include "fem/scenes.hpp"
 #include "geom/error.hpp"
 #include "metrics/metrics.hpp"
 
@@ -272,35 +273,13 @@ TEST(FemDynamics, NewmarkConservesEnergyAndSwingsAtTheLowestFrequency) {
   EXPECT_NEAR(measured / period, 1.0, 5e-4);  // (pi h / T)^2 / 3 = 3.3e-4
 }
 
-// The benchmarks paper's block and needle: a unit square of cells x cells
-// Q1 elements, top, bottom and left held, the needle (the middle of the
-// right side) moving left at 0.08 m/s for 2 s, Rayleigh 1.0 and 0.1.
-struct NeedleBlock {
-  Dynamics d;
-  int needle = -1;
-};
-NeedleBlock needle_block(double young, double poisson, double density, int cells) {
-  Material m;
-  m.young = young;
-  m.poisson = poisson;
-  m.density = density;
-  const Mesh mesh = structured_grid(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2i(cells, cells));
-  NeedleBlock b{make_dynamics(mesh, m, 1.0, 0.1)};
-  b.d.divergence_scale = 10.0;  // ten times the block
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    const double x = mesh.nodes(v, 0), y = mesh.nodes(v, 1);
-    if (x < 1e-12 || y < 1e-12 || y > 1.0 - 1e-12)
-      for (int a = 0; a < 2; ++a) b.d.held.push_back(2 * v + a);
-    if (x > 1.0 - 1e-12 && std::abs(y - 0.5) < 1e-12) b.needle = v;
-  }
-  if (b.needle >= 0) b.d.held.push_back(2 * b.needle);
-  const size_t supports = b.d.held.size() - 1;
-  b.d.held_values = [supports](double t) {
-    Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(supports + 1));
-    values[static_cast<Eigen::Index>(supports)] = -0.08 * std::min(t, 2.0);
-    return values;
-  };
-  return b;
+// The benchmarks paper's block and needle (fem::needle_block) with a
+// material preset, on cells x cells quadrilaterals.
+Scene block_with(const std::string& preset, int cells) {
+  BlockOptions options;
+  options.material = material_preset(preset);
+  options.cells = Eigen::Vector2i(cells, cells);
+  return needle_block(options);
 }
 
 // The benchmarks paper's MP2 finding: a stiff, nearly incompressible block
@@ -308,8 +287,8 @@ NeedleBlock needle_block(double young, double poisson, double density, int cells
 // integration diverges; the implicit and quasi-static ones reach the same
 // static state.
 TEST(FemDynamics, ExplicitDivergesOnTheStiffBlockWhereImplicitSettles) {
-  const NeedleBlock block = needle_block(60000.0, 0.495, 1140.0, 6);
-  const Dynamics& d = block.d;
+  const Scene block = block_with("MP2", 6);
+  const Dynamics& d = block.dynamics;
   const int needle = block.needle;
   ASSERT_GE(needle, 0);
   const double h = 1.0 / 30.0;
@@ -329,44 +308,37 @@ TEST(FemDynamics, ExplicitDivergesOnTheStiffBlockWhereImplicitSettles) {
   EXPECT_NEAR(reference.u.back()[2 * needle], -0.16, 1e-12);  // the needle stopped at 16 cm
 }
 
-// The bending rod of the benchmarks paper (0.25 x 0.25 x 0.5 m, clamped at
-// z = 0, MP3, gravity 0.05 m/s^2 switched on at t = 0, h = 1/30 s): the
-// damped dynamic response reaches its static shape, overshoots it, swings
-// back below it, and settles on it.
+// The bending rod of the benchmarks paper (fem::bending_rod: 0.5 m along x,
+// 0.25 x 0.25 m across, clamped at x = 0, MP3, gravity 0.05 m/s^2 along -z
+// switched on at t = 0, h = 1/30 s): the damped dynamic response reaches its
+// static shape, overshoots it, swings back below it, and settles on it.
 TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
-  const Mesh mesh = structured_grid(Eigen::Vector3d(0.25, 0.25, 0.5), Eigen::Vector3i(2, 2, 4));
-  Material m;
-  m.young = 7000.0;
-  m.poisson = 0.2;
-  m.density = 10000.0;
-  Dynamics d = make_dynamics(mesh, m, 1.0, 0.1);
-  const Eigen::VectorXd gravity = body_forces(mesh, m, Eigen::Vector3d(0.05, 0.0, 0.0));
-  d.force = [gravity](double) { return gravity; };
-  Constraints clamp;
-  int tip = -1;
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    if (mesh.nodes(v, 2) < 1e-12)
-      for (int a = 0; a < 3; ++a) clamp.hold(3 * v + a, 0.0);
-    if (mesh.nodes(v, 2) > 0.5 - 1e-12 && std::abs(mesh.nodes(v, 0) - 0.125) < 1e-12 &&
-        std::abs(mesh.nodes(v, 1) - 0.125) < 1e-12)
+  const Scene rod = bending_rod(RodOptions{});
+  const Dynamics& d = rod.dynamics;
+  int tip = -1;  // the middle of the free end
+  for (int v = 0; v < rod.mesh.num_nodes(); ++v)
+    if (rod.mesh.nodes(v, 0) > 0.5 - 1e-12 && std::abs(rod.mesh.nodes(v, 1) - 0.125) < 1e-12 &&
+        std::abs(rod.mesh.nodes(v, 2) - 0.125) < 1e-12)
       tip = v;
-  }
-  d.held = clamp.dofs;
+  ASSERT_GE(tip, 0);
+  Constraints clamp;
+  for (int dof : d.held) clamp.hold(dof, 0.0);
   Eigen::VectorXd rest;
-  ASSERT_TRUE(solve_static(d.K, gravity, clamp, &rest).ok);
-  const double statics = rest[3 * tip];
+  ASSERT_TRUE(solve_static(d.K, d.force(0.0), clamp, &rest).ok);
+  const int down = 3 * tip + 2;  // the sag is -u_z
+  const double statics = -rest[down];
   ASSERT_GT(statics, 0.0);
   const Trajectory t = integrate(d, Integrator::ImplicitNewmark, 1.0 / 30.0, 600);  // 20 s
   ASSERT_TRUE(t.ok) << t.message;
   double peak = 0.0, peak_time = 0.0, cross_time = -1.0, reach_time = -1.0;
   for (size_t k = 1; k < t.u.size(); ++k) {
-    const double x = t.u[k][3 * tip];
+    const double x = -t.u[k][down];
     if (reach_time < 0.0 && x >= statics) reach_time = t.times[k];
     if (x > peak) {
       peak = x;
       peak_time = t.times[k];
     }
-    if (cross_time < 0.0 && peak > statics && t.u[k - 1][3 * tip] >= statics && x < statics)
+    if (cross_time < 0.0 && peak > statics && -t.u[k - 1][down] >= statics && x < statics)
       cross_time = t.times[k];
   }
   std::printf("rod: static tip %.4e m, reached at %.2f s, peak %.4e m at %.2f s (overshoot "
@@ -377,10 +349,10 @@ TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
   EXPECT_NEAR(reach_time, 4.2, 0.5);
   EXPECT_GT(peak, 1.03 * statics);  // overshoot
   EXPECT_GT(cross_time, peak_time);  // and swings back below the static shape
-  EXPECT_NEAR(t.u.back()[3 * tip] / statics, 1.0, 1e-3);  // settled
+  EXPECT_NEAR(-t.u.back()[down] / statics, 1.0, 1e-3);  // settled
   // The quasi-static solver is at the static shape from the first step.
   const Trajectory q = integrate(d, Integrator::QuasiStatic, 1.0 / 30.0, 2);
-  EXPECT_NEAR(q.u.back()[3 * tip] / statics, 1.0, 1e-12);
+  EXPECT_NEAR(-q.u.back()[down] / statics, 1.0, 1e-12);
 }
 
 // The block and needle with MP1 (soft: E = 200 Pa, nu = 0.47), h = 1/30 s:
@@ -389,8 +361,8 @@ TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
 // lumped methods next, quasi-static worst while the needle moves; all reach
 // the same static state.
 TEST(FemDynamics, MP1OrdersTheSolversAsThePaperFound) {
-  const NeedleBlock block = needle_block(200.0, 0.47, 2000.0, 8);
-  const Dynamics& d = block.d;
+  const Scene block = block_with("MP1", 8);
+  const Dynamics& d = block.dynamics;
   ASSERT_GE(block.needle, 0);
   const double h = 1.0 / 30.0;
   const int steps = 900;  // 30 s
@@ -421,14 +393,14 @@ TEST(FemDynamics, MP1OrdersTheSolversAsThePaperFound) {
 // factorisation, to the sweeps' tolerance, at the cost of sweeps every step;
 // too few sweeps is a status naming the time.
 TEST(FemDynamics, GaussSeidelGivesTheFactorisationsTrajectories) {
-  const NeedleBlock block = needle_block(200.0, 0.47, 2000.0, 4);
+  const Scene block = block_with("MP1", 4);
   IntegrationOptions sweeps;
   sweeps.linear = LinearMethod::GaussSeidel;
   sweeps.tolerance = 1e-12;
   for (Integrator kind : {Integrator::ImplicitNewmark, Integrator::ExplicitConsistent,
                           Integrator::QuasiStatic}) {
-    const Trajectory direct = integrate(block.d, kind, 1.0 / 30.0, 90);
-    const Trajectory iterated = integrate(block.d, kind, 1.0 / 30.0, 90, sweeps);
+    const Trajectory direct = integrate(block.dynamics, kind, 1.0 / 30.0, 90);
+    const Trajectory iterated = integrate(block.dynamics, kind, 1.0 / 30.0, 90, sweeps);
     ASSERT_TRUE(direct.ok && iterated.ok) << iterated.message;
     EXPECT_EQ(direct.sweeps, 0);
     EXPECT_GT(iterated.sweeps, 90) << to_string(kind);  // at least one a step
@@ -436,7 +408,7 @@ TEST(FemDynamics, GaussSeidelGivesTheFactorisationsTrajectories) {
         << to_string(kind);
   }
   sweeps.max_sweeps = 2;
-  const Trajectory starved = integrate(block.d, Integrator::QuasiStatic, 1.0 / 30.0, 10, sweeps);
+  const Trajectory starved = integrate(block.dynamics, Integrator::QuasiStatic, 1.0 / 30.0, 10, sweeps);
   EXPECT_FALSE(starved.ok);
   EXPECT_NE(starved.message.find("Gauss-Seidel did not converge"), std::string::npos);
   EXPECT_NE(starved.message.find("t = 0.0333"), std::string::npos) << starved.message;
