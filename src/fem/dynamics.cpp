@@ -175,11 +175,13 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
   const bool implicit = integrator == Integrator::ImplicitNewmark || integrator == Integrator::ImplicitLumped;
   const double b = implicit ? 0.5 : 0.0, g = 0.5;  // the paper's Newmark parameters
   const Sparse M = lumped ? diagonal(d.lumped) : d.M;
-  // Explicit-lumped damps with a diagonal too, so that nothing needs a solve.
-  const Sparse C = integrator == Integrator::ExplicitLumped
-                       ? diagonal(d.alpha * d.lumped + d.beta * Eigen::VectorXd(d.K.diagonal()))
-                       : Sparse(d.alpha * M + d.beta * d.K);
-  const Sparse A = M + (g * h) * C + (b * h * h / 2.0) * d.K;
+  const Sparse C = d.alpha * M + d.beta * d.K;
+  // M a+ + C (v_pred + g h a+) + K (u_pred + b h^2/2 a+) = f+. Explicit-lumped
+  // needs no solve: its stiffness-proportional damping acts at the predicted
+  // velocity (explicitly), its mass-proportional part at the new one.
+  const Sparse A = integrator == Integrator::ExplicitLumped
+                       ? diagonal((1.0 + g * h * d.alpha) * d.lumped)
+                       : Sparse(M + (g * h) * C + (b * h * h / 2.0) * d.K);
   FreeSolve step_solve(A, split, integrator == Integrator::ExplicitLumped, options);
   FreeSolve mass_solve(M, split, lumped, options);
   if (!step_solve.ok() || !mass_solve.ok()) return fail(0.0, "the step matrix is not positive definite");
