@@ -585,9 +585,10 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   Experiment ex;
   ex.name = root.string("name", "experiment");
   ex.description = root.string("description", "");
-  ex.kind = root.choice("kind", "simulate", {"simulate", "areas"}) == "areas"
-                ? Experiment::Kind::Areas
-                : Experiment::Kind::Simulate;
+  const std::string kind = root.choice("kind", "simulate", {"simulate", "areas", "benchmark"});
+  ex.kind = kind == "areas"       ? Experiment::Kind::Areas
+            : kind == "benchmark" ? Experiment::Kind::Benchmark
+                                  : Experiment::Kind::Simulate;
   ex.expected = read_expected(root);
   if (root.has("fit")) {
     if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
@@ -598,6 +599,9 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   }
   if (ex.kind == Experiment::Kind::Simulate) {
     read_simulation(root, document, folder, ex);  // each case checks its own fields
+  } else if (ex.kind == Experiment::Kind::Benchmark) {
+    ex.benchmark = read_benchmark(root);
+    root.finish();
   } else {
     read_areas(root, folder, ex);
     root.finish();

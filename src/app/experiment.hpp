@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "app/benchmark.hpp"
 #include "app/case_spec.hpp"
 #include "app/fit_spec.hpp"
 #include "geom/surface.hpp"
@@ -43,7 +44,7 @@ struct NamedSurfaceSpec {
 
 // A parsed and validated experiment file.
 struct Experiment {
-  enum class Kind { Simulate, Areas };
+  enum class Kind { Simulate, Areas, Benchmark };
   Kind kind = Kind::Simulate;
   std::string name;
   std::string description;
@@ -57,6 +58,8 @@ struct Experiment {
   // Areas:
   std::vector<NamedSurfaceSpec> area_specs;
   std::vector<NamedSurface> area_surfaces;
+
+  std::optional<BenchmarkSpec> benchmark;  // Benchmark: the scene, solvers and comparisons
 
   std::optional<FitSpec> fit;   // the "fit" section: what `fiberfluid fit` calibrates
 

@@ -228,7 +228,10 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   doc["description"] = ex.description;
   doc["source"] = ex.source.string();
   doc["fiberfluid_version"] = FIBERFLUID_VERSION;
-  doc["kind"] = ex.kind == Experiment::Kind::Areas ? "areas" : "simulate";
+  doc["kind"] = ex.kind == Experiment::Kind::Areas       ? "areas"
+                : ex.kind == Experiment::Kind::Benchmark ? "benchmark"
+                                                         : "simulate";
+  if (!result.failure.empty()) doc["failure"] = result.failure;
   doc["units"] = {{"length", "m"},        {"displacement", "m"}, {"force", "N"},
                   {"pressure", "Pa"},     {"volume", "m^3 (m^2 in 2D)"},
                   {"Y", "Pa"},            {"gamma", "N/m"},      {"time", "s"}};
@@ -528,6 +531,15 @@ void OutputWriter::finish(const ExperimentResult& result) {
   }
   if (experiment_.sweeps())
     geom::write_text_file(staging_ / "comparison.csv", comparison_csv(experiment_, result));
+  if (result.benchmark) {
+    const BenchmarkResult& b = *result.benchmark;
+    geom::write_text_file(staging_ / "metrics.csv", benchmark_csv(b));
+    geom::write_text_file(staging_ / "benchmark.json", benchmark_json(*experiment_.benchmark, b));
+    if (b.reference_final.num_vertices() > 0)
+      geom::write_obj(staging_ / "reference_final.obj", b.reference_final);
+    if (b.fiber_final.num_vertices() > 0)
+      geom::write_obj(staging_ / "fiber_model_final.obj", b.fiber_final);
+  }
   geom::write_text_file(staging_ / "summary.json",
                         summary_json(experiment_, result).dump(2) + "\n");
 
@@ -537,7 +549,7 @@ void OutputWriter::finish(const ExperimentResult& result) {
     result_folder_ = target_;
     return;
   }
-  std::string why;
+  std::string why = result.failure.empty() ? "" : result.failure + "\n";
   for (const RunResult& run : result.runs)
     if (!run.summary.success)
       why += (run.variant.empty() ? "" : run.variant + ": ") + run.summary.message + "\n";

@@ -40,7 +40,8 @@ std::string comparison_csv(const Experiment& experiment, const ExperimentResult&
 // sweeps): final.obj, steps.csv, vertices.csv, series.pvd and
 // vtk/step_NNNN.vtu (point data displacement, displacement_magnitude,
 // area_vector); at the top: summary.json, comparison.csv for a sweep,
-// fibers.vtu when asked.
+// fibers.vtu when asked. A benchmark writes metrics.csv, benchmark.json and
+// the final deformed boundaries (reference_final.obj, fiber_model_final.obj).
 class OutputWriter {
  public:
   // Throws InputError when DIR exists and is not a fiberfluid output folder

@@ -119,6 +119,7 @@ std::string FigureCheck::Describe() const {
 }
 
 bool ExperimentResult::runs_succeeded() const {
+  if (!failure.empty()) return false;
   for (const RunResult& run : runs)
     if (!run.summary.success) return false;
   return true;
@@ -201,6 +202,12 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
   ExperimentResult result;
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
+  } else if (ex.kind == Experiment::Kind::Benchmark) {
+    auto benchmark = std::make_shared<BenchmarkResult>(run_benchmark(
+        *ex.benchmark, [](int done, int total) { report_progress("benchmark runs", done, total); }));
+    result.figures = benchmark->figures;
+    if (!benchmark->ok) result.failure = benchmark->message;
+    result.benchmark = benchmark;
   } else {
     result.runs.resize(ex.cases.size());
     std::atomic<size_t> finished{0};

@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,8 @@ struct ExperimentResult {
   std::map<std::string, double> figures;  // headline figures, "variant.figure" for sweeps,
                                           // and fibers.in_all / kept / pruned
   std::vector<FigureCheck> checks;
+  std::shared_ptr<const BenchmarkResult> benchmark;  // a benchmark's series
+  std::string failure;  // what failed besides the runs (a benchmark's reference)
   bool runs_succeeded() const;
   bool checks_passed() const;
 };
