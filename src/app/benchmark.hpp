@@ -94,6 +94,10 @@ struct BenchmarkResult {
 BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
                               const std::function<void(int done, int total)>& progress = {});
 
+// One line per series: its E_n, E_s, E_i at 1 s, 2 s, 5 s and the end, or
+// where it diverged, and its time (for the command's report).
+std::string benchmark_report(const BenchmarkResult& result);
+
 // metrics.csv: time_s, series, E_n, E_s, E_i (one row per series and time).
 std::string benchmark_csv(const BenchmarkResult& result);
 // benchmark.json: the scene, the solvers, times and the fiber model's choice.

@@ -189,10 +189,18 @@ int run_command(const std::string& path, const RunFlags& flags) {
   for (const app::RunResult& run : result.runs)
     std::cout << "  " << (run.variant.empty() ? "run" : run.variant) << ": "
               << run.summary.BriefReport() << "\n";
-  for (const auto& [name, value] : result.figures)
-    std::cout << "  " << name << " = " << value << "\n";
+  if (result.benchmark) {  // its many figures are in summary.json
+    std::cout << app::benchmark_report(*result.benchmark);
+  } else {
+    for (const auto& [name, value] : result.figures)
+      std::cout << "  " << name << " = " << value << "\n";
+  }
   for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
 
+  if (!result.failure.empty()) {
+    std::cerr << "error: " << result.failure << "\n";
+    return kSolverFailed;
+  }
   if (!result.runs_succeeded()) {
     for (const app::RunResult& run : result.runs)
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";

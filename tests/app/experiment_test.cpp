@@ -34,7 +34,8 @@ INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                                            "round_trip.json", "liver_gravity.json",
                                            "bunny_gravity.json", "liver_sweep.json",
                                            "nonlinear_round_trip.json", "liver_paddles.json",
-                                           "stress_strain.json"));
+                                           "stress_strain.json", "benchmark_block_mp1.json",
+                                           "benchmark_block_mp2.json", "benchmark_rod.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
