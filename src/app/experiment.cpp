@@ -511,7 +511,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
 
 // Fields of the experiment that a variant may not patch.
 const char* const kExperimentFields[] = {"name", "description", "kind", "variants", "expected",
-                                         "output", "fit"};
+                                         "output", "fit", "fem_reference"};
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
@@ -596,6 +596,14 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
       root.fail("fit", "a fit calibrates one simulation: remove \"variants\" (fit several loads "
                        "with several targets, each tied to its step)");
     ex.fit = read_fit(root.object("fit"), folder);
+  }
+  if (root.has("fem_reference")) {
+    if (ex.kind != Experiment::Kind::Simulate)
+      root.fail("fem_reference", "only a simulation has a FEM reference");
+    if (root.has("variants"))
+      root.fail("fem_reference", "a FEM reference solves one simulation: remove \"variants\"");
+    Fields f = root.object("fem_reference");
+    ex.fem_reference = read_fem_reference(f);
   }
   if (ex.kind == Experiment::Kind::Simulate) {
     read_simulation(root, document, folder, ex);  // each case checks its own fields

@@ -9,6 +9,7 @@
 
 #include "app/benchmark.hpp"
 #include "app/case_spec.hpp"
+#include "app/fem_reference.hpp"
 #include "app/fit_spec.hpp"
 #include "geom/surface.hpp"
 
@@ -61,7 +62,10 @@ struct Experiment {
 
   std::optional<BenchmarkSpec> benchmark;  // Benchmark: the scene, solvers and comparisons
 
-  std::optional<FitSpec> fit;   // the "fit" section: what `fiberfluid fit` calibrates
+  std::optional<FitSpec> fit;
+  // "fem_reference": also solve the simulation by linear FEM on tetrahedra
+  // and write its deformed boundary (fem_reference.obj) as a target.
+  std::optional<FemReferenceSpec> fem_reference;   // the "fit" section: what `fiberfluid fit` calibrates
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader

@@ -531,6 +531,13 @@ void OutputWriter::finish(const ExperimentResult& result) {
   }
   if (experiment_.sweeps())
     geom::write_text_file(staging_ / "comparison.csv", comparison_csv(experiment_, result));
+  if (result.fem_reference) {  // the target for a fit, and the same with its displacement
+    const FemReferenceResult& f = *result.fem_reference;
+    geom::write_obj(staging_ / "fem_reference.obj", f.deformed_boundary);
+    Eigen::MatrixXd U = f.deformed_boundary.V - f.rest_boundary.V;
+    geom::write_vtu(staging_ / "fem_reference.vtu", f.deformed_boundary,
+                    {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}});
+  }
   if (result.benchmark) {
     const BenchmarkResult& b = *result.benchmark;
     geom::write_text_file(staging_ / "metrics.csv", benchmark_csv(b));

@@ -42,6 +42,8 @@ std::string comparison_csv(const Experiment& experiment, const ExperimentResult&
 // area_vector); at the top: summary.json, comparison.csv for a sweep,
 // fibers.vtu when asked. A benchmark writes metrics.csv, benchmark.json and
 // the final deformed boundaries (reference_final.obj, fiber_model_final.obj).
+// A "fem_reference" adds fem_reference.obj (the FEM's deformed boundary, a
+// target for `fiberfluid fit`) and fem_reference.vtu.
 class OutputWriter {
  public:
   // Throws InputError when DIR exists and is not a fiberfluid output folder

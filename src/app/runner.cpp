@@ -241,6 +241,14 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
         });
       for (std::thread& worker : workers) worker.join();
     }
+    if (ex.fem_reference && !ex.cases.empty()) {
+      report_progress("FEM reference", 0.0, 1.0);
+      auto reference = std::make_shared<FemReferenceResult>(
+          solve_fem_reference(ex.cases.front(), result.runs.front(), *ex.fem_reference));
+      report_progress("FEM reference", 1.0, 1.0);
+      for (const auto& [name, value] : reference->figures) result.figures[name] = value;
+      result.fem_reference = reference;
+    }
     const FiberReport& fibers = ex.cases.front().fibers;
     result.figures["fibers.in_all"] = static_cast<double>(fibers.pairs);
     result.figures["fibers.kept"] = static_cast<double>(fibers.kept);

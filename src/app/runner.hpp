@@ -33,6 +33,7 @@ struct ExperimentResult {
                                           // and fibers.in_all / kept / pruned
   std::vector<FigureCheck> checks;
   std::shared_ptr<const BenchmarkResult> benchmark;  // a benchmark's series
+  std::shared_ptr<const FemReferenceResult> fem_reference;  // when the experiment asks for one
   std::string failure;  // what failed besides the runs (a benchmark's reference)
   bool runs_succeeded() const;
   bool checks_passed() const;
