@@ -54,9 +54,12 @@ Mesh tetrahedralize(const geom::Surface& s, const TetMeshOptions& options) {
   const Criteria criteria(p::edge_size = size, p::facet_angle = 25, p::facet_size = size,
                           p::facet_distance = distance, p::cell_radius_edge_ratio = 3,
                           p::cell_size = size);
-  // No perturbation or exudation: they only polish slivers and cost time;
-  // the default random seed keeps the result deterministic.
-  const Complex c3t3 = CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::no_exude());
+  // A manifold boundary (thin parts otherwise meet at an edge or a vertex,
+  // and a surface like that bounds no solid for the metrics). No
+  // perturbation or exudation: they only polish slivers and cost time. The
+  // default random seed keeps the result deterministic.
+  const Complex c3t3 =
+      CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::no_exude(), p::manifold());
 
   std::map<Triangulation::Vertex_handle, int> index;
   Mesh out;

@@ -5,14 +5,15 @@
 // corefinement of closed triangle meshes.
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
-#include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_with_holes_2.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <iterator>
 #include <vector>
@@ -27,6 +28,10 @@ using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
 using Polygon = CGAL::Polygon_2<Kernel>;
 using PolygonWithHoles = CGAL::Polygon_with_holes_2<Kernel>;
 using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
+// The checks need exact predicates only: filtered doubles are many times
+// faster than exact constructions on meshes of thousands of triangles.
+using CheckKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CheckMesh = CGAL::Surface_mesh<CheckKernel::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
 void require_finite(const geom::Surface& s, const std::string& what) {
@@ -76,38 +81,65 @@ double symmetric_difference_2d(const geom::Surface& a, const geom::Surface& b,
   return CGAL::to_double(p.area()) + CGAL::to_double(q.area()) - 2.0 * common;
 }
 
-// A closed, outward, self-intersection-free triangle mesh.
-Mesh solid(const geom::Surface& s, const std::string& what) {
-  require_finite(s, what);
-  Mesh mesh;
-  std::vector<Mesh::Vertex_index> vertices;
+// The surface as a CGAL mesh of kernel K; throws unless every face makes a manifold.
+template <class MeshType>
+MeshType build_mesh(const geom::Surface& s, const std::string& what) {
+  using Point = typename MeshType::Point;
+  MeshType mesh;
+  std::vector<typename MeshType::Vertex_index> vertices;
   for (int v = 0; v < s.num_vertices(); ++v)
-    vertices.push_back(mesh.add_vertex(Kernel::Point_3(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
+    vertices.push_back(mesh.add_vertex(Point(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
   for (int f = 0; f < s.num_faces(); ++f) {
     for (int k = 0; k < 3; ++k)
       if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices())
         throw InputError(what + ": face " + std::to_string(f) + " refers to a missing vertex");
     if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))], vertices[static_cast<size_t>(s.F(f, 1))],
-                      vertices[static_cast<size_t>(s.F(f, 2))]) == Mesh::null_face())
+                      vertices[static_cast<size_t>(s.F(f, 2))]) == MeshType::null_face())
       throw InputError(what + ": face " + std::to_string(f) + " makes the mesh non-manifold");
   }
-  if (mesh.is_empty() || !CGAL::is_closed(mesh))
-    throw InputError(what + ": the mesh is not closed, so it bounds no solid");
-  if (PMP::does_self_intersect(mesh))
-    throw InputError(what + ": the mesh intersects itself (an inverted or overlapping part)");
-  if (!PMP::is_outward_oriented(mesh)) PMP::reverse_face_orientations(mesh);
   return mesh;
+}
+
+// A closed, outward, self-intersection-free triangle mesh (checked with
+// filtered predicates, built again with exact constructions).
+Mesh solid(const geom::Surface& s, const std::string& what) {
+  require_finite(s, what);
+  const CheckMesh check = build_mesh<CheckMesh>(s, what);
+  if (check.is_empty() || !CGAL::is_closed(check))
+    throw InputError(what + ": the mesh is not closed, so it bounds no solid");
+  if (PMP::does_self_intersect(check))
+    throw InputError(what + ": the mesh intersects itself (an inverted or overlapping part)");
+  Mesh mesh = build_mesh<Mesh>(s, what);
+  if (!PMP::is_outward_oriented(check)) PMP::reverse_face_orientations(mesh);
+  return mesh;
+}
+
+// The enclosed volume, summed in doubles from the exactly placed vertices:
+// an exact sum of thousands of rational tetrahedra (PMP::volume on this
+// kernel) spends seconds on gcds for digits a double result drops anyway.
+double volume(const Mesh& mesh) {
+  double sum = 0.0;
+  for (const auto f : mesh.faces()) {
+    Eigen::Vector3d corner[3];
+    int k = 0;
+    for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+      const Kernel::Point_3& point = mesh.point(v);
+      corner[k++] = {CGAL::to_double(point.x()), CGAL::to_double(point.y()), CGAL::to_double(point.z())};
+    }
+    sum += corner[0].dot(corner[1].cross(corner[2]));
+  }
+  return sum / 6.0;
 }
 
 double symmetric_difference_3d(const geom::Surface& a, const geom::Surface& b,
                                const std::string& what_a, const std::string& what_b) {
   Mesh p = solid(a, what_a), q = solid(b, what_b);
-  const double volume_p = CGAL::to_double(PMP::volume(p)), volume_q = CGAL::to_double(PMP::volume(q));
+  const double volume_p = volume(p), volume_q = volume(q);
   Mesh common;
   if (!PMP::corefine_and_compute_intersection(p, q, common))
     throw InputError("the intersection of " + what_a + " and " + what_b +
                      " is not a closed solid (CGAL corefinement)");
-  return volume_p + volume_q - 2.0 * CGAL::to_double(PMP::volume(common));
+  return volume_p + volume_q - 2.0 * volume(common);
 }
 
 }  // namespace

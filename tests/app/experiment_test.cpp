@@ -35,7 +35,8 @@ INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                                            "bunny_gravity.json", "liver_sweep.json",
                                            "nonlinear_round_trip.json", "liver_paddles.json",
                                            "stress_strain.json", "benchmark_block_mp1.json",
-                                           "benchmark_block_mp2.json", "benchmark_rod.json"));
+                                           "benchmark_block_mp2.json", "benchmark_rod.json",
+                                           "liver_fem_reference.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
