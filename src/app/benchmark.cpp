@@ -205,31 +205,60 @@ geom::Surface deformed_boundary(const ReferenceFrames& frames, const Eigen::Matr
   return s;
 }
 
+// Appends one time step's E_n, E_s and E_i: the reference and the
+// approximation as positions of the same nodes (#nodes x dim) with their
+// rest positions, E_i's weights and measure, and the boundaries for E_s
+// (only on metrics steps: NaN between them, and where a diverging boundary
+// crosses itself and bounds no solid).
+struct Frame {
+  const Eigen::MatrixXd* rest = nullptr;
+  const Eigen::VectorXd* weights = nullptr;
+  double measure = 0.0;
+};
+void append_metrics(MetricSeries& s, double t, const Frame& frame, const Eigen::MatrixXd& reference,
+                    const Eigen::MatrixXd& approximation, const geom::Surface* reference_boundary,
+                    const geom::Surface* approximation_boundary) {
+  const Eigen::MatrixXd U = reference - *frame.rest, V = approximation - *frame.rest;
+  const int dim = static_cast<int>(U.cols());
+  s.times.push_back(t);
+  s.energy_norm.push_back(U.norm() > 0.0 ? metrics::relative_energy_norm(U, V)
+                                         : std::numeric_limits<double>::quiet_NaN());
+  double es = std::numeric_limits<double>::quiet_NaN();
+  if (reference_boundary != nullptr) {
+    try {
+      es = metrics::surface_error(*reference_boundary, *approximation_boundary, "the reference",
+                                  s.label);
+    } catch (const InputError&) {
+    }
+  }
+  s.surface.push_back(es);
+  s.interior.push_back(metrics::interior_error(reference, approximation, *frame.weights, frame.measure, dim));
+}
+
+bool metrics_step(size_t k, size_t count, int every) {
+  return k % static_cast<size_t>(every) == 0 || k + 1 == count;
+}
+
 // E_n, E_s, E_i of a FEM trajectory against the reference, step by step.
 MetricSeries compare_fem(const ReferenceFrames& frames, const fem::Trajectory& reference,
-                         const fem::Trajectory& run, int metrics_every) {
+                         const fem::Trajectory& run, const std::string& label, int metrics_every) {
   MetricSeries out;
+  out.label = label;
   out.interior_weights = "volume";
   const int dim = frames.scene->mesh.dim;
   const Eigen::MatrixXd& X0 = frames.scene->mesh.nodes;
+  const Frame frame{&X0, &frames.volume_weights, frames.measure};
   const size_t count = std::min(reference.u.size(), run.u.size());
   for (size_t k = 1; k < count; ++k) {
-    const Eigen::MatrixXd U = fem::displacement_rows(reference.u[k], dim),
-                          V = fem::displacement_rows(run.u[k], dim);
-    out.times.push_back(run.times[k]);
-    out.energy_norm.push_back(U.norm() > 0.0 ? metrics::relative_energy_norm(U, V)
-                                             : std::numeric_limits<double>::quiet_NaN());
-    const bool surface_step = k % static_cast<size_t>(metrics_every) == 0 || k + 1 == count;
-    double es = std::numeric_limits<double>::quiet_NaN();
-    if (surface_step) {
-      try {
-        es = metrics::surface_error(deformed_boundary(frames, X0 + U), deformed_boundary(frames, X0 + V));
-      } catch (const InputError&) {  // a diverging run's boundary may cross itself
-      }
+    const Eigen::MatrixXd R = X0 + fem::displacement_rows(reference.u[k], dim),
+                          A = X0 + fem::displacement_rows(run.u[k], dim);
+    if (metrics_step(k, count, metrics_every)) {
+      const geom::Surface reference_boundary = deformed_boundary(frames, R),
+                          run_boundary = deformed_boundary(frames, A);
+      append_metrics(out, run.times[k], frame, R, A, &reference_boundary, &run_boundary);
+    } else {
+      append_metrics(out, run.times[k], frame, R, A, nullptr, nullptr);
     }
-    out.surface.push_back(es);
-    out.interior.push_back(
-        metrics::interior_error(X0 + U, X0 + V, frames.volume_weights, frames.measure, dim));
   }
   return out;
 }
@@ -272,12 +301,18 @@ struct FiberRun {
   double seconds = 0.0;
 };
 
-FiberRun run_fiber_model(const fem::Scene& scene, const fem::Boundary& rest, double Y,
-                         double gamma, int steps, bool newton, Experiment* built = nullptr) {
-  const auto start = std::chrono::steady_clock::now();
+Experiment fiber_experiment(const fem::Scene& scene, const fem::Boundary& rest, double Y,
+                            double gamma, int steps, bool newton) {
   Experiment ex = read_experiment(fiber_document(scene, rest, Y, gamma, steps, newton), ".",
                                   "the fiber model of the benchmark");
   build_experiment(ex, &rest.surface);
+  return ex;
+}
+
+FiberRun run_fiber_model(const fem::Scene& scene, const fem::Boundary& rest, double Y,
+                         double gamma, int steps, bool newton) {
+  const auto start = std::chrono::steady_clock::now();
+  const Experiment ex = fiber_experiment(scene, rest, Y, gamma, steps, newton);
   FiberRun out;
   out.positions.assign(static_cast<size_t>(steps) + 1, rest.surface.V);
   const Case& c = ex.cases.front();
@@ -288,7 +323,6 @@ FiberRun run_fiber_model(const fem::Scene& scene, const fem::Boundary& rest, dou
   out.ok = r.runs_succeeded();
   out.message = r.runs.front().summary.message;
   out.seconds = seconds_since(start);
-  if (built != nullptr) *built = std::move(ex);
   return out;
 }
 
@@ -358,9 +392,7 @@ FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Sce
     report.how = how.str();
     return report;
   }
-  Experiment built;
-  const FiberRun start = run_fiber_model(scene, rest, E, 0.01 * E, steps, spec.fiber.newton, &built);
-  if (!start.ok) throw InputError("benchmark: the fiber model fails at the fit's start: " + start.message);
+  const Experiment built = fiber_experiment(scene, rest, E, 0.01 * E, steps, spec.fiber.newton);
   const Case& c = built.cases.front();
   std::vector<fit::MeasuredStep> measured = {
       {fit::make_target("the FEM's static boundary", target, rest.surface.F), steps}};
@@ -481,27 +513,28 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
   result.figures["reference.seconds"] = result.reference_seconds;
   result.reference_final = deformed_boundary(frames, scene.mesh.nodes + fem::displacement_rows(reference.u.back(), dim));
 
-  auto run_one = [&](const fem::Scene& on, Integrator kind, const std::string& label) {
+  // One solver on a scene (this one, or another material's) whose static state is given.
+  auto run_one = [&](const fem::Scene& on, const Eigen::VectorXd& on_statics, Integrator kind,
+                     const std::string& label) {
     tell(label);
     const auto t0 = std::chrono::steady_clock::now();
     const fem::Trajectory run = fem::integrate(on.dynamics, kind, spec.step, steps, spec.linear);
     const double seconds = seconds_since(t0);
-    MetricSeries s = compare_fem(frames, reference, run, spec.metrics_every);
-    s.label = label;
+    MetricSeries s = compare_fem(frames, reference, run, label, spec.metrics_every);
     s.ok = run.ok;
     s.message = run.message;
     s.seconds = seconds;
     s.sweeps = run.sweeps;
-    if (run.ok) {
-      const Eigen::VectorXd own_statics = &on == &scene ? statics : static_state(on);
-      result.figures[label + ".static_gap"] = (run.u.back() - own_statics).norm() / own_statics.norm();
-    }
+    if (run.ok)
+      result.figures[label + ".static_gap"] = (run.u.back() - on_statics).norm() / on_statics.norm();
     result.series.push_back(std::move(s));
   };
-  for (Integrator kind : spec.solvers) run_one(scene, kind, fem::to_string(kind));
+  for (Integrator kind : spec.solvers) run_one(scene, statics, kind, fem::to_string(kind));
   for (const BenchmarkSpec::OtherMaterial& other : spec.other_materials) {
     const fem::Scene on = scene_with(other.material);
-    for (Integrator kind : other.solvers) run_one(on, kind, other.label + "/" + fem::to_string(kind));
+    const Eigen::VectorXd on_statics = static_state(on);
+    for (Integrator kind : other.solvers)
+      run_one(on, on_statics, kind, other.label + "/" + fem::to_string(kind));
   }
 
   if (spec.fiber.enabled) {
@@ -531,26 +564,16 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
     report.vertices = frames.rest.surface.num_vertices();
     if (run.ok) {
       const Eigen::VectorXd weights = metrics::boundary_node_measures(frames.rest.surface);
-      const double measure = metrics::enclosed_measure(frames.rest.surface);
       const Eigen::MatrixXd& rest = frames.rest.surface.V;
+      const Frame frame{&rest, &weights, metrics::enclosed_measure(frames.rest.surface)};
+      geom::Surface reference_boundary = frames.rest.surface, fiber_boundary = frames.rest.surface;
       for (size_t k = 1; k < reference.u.size(); ++k) {
         const double t = reference.times[k];
-        const Eigen::MatrixXd R = boundary_rows(frames.rest, X0 + fem::displacement_rows(reference.u[k], dim));
-        const Eigen::MatrixXd& P = run.positions[fiber_step(scene, t, fiber_steps)];
-        s.times.push_back(t);
-        s.energy_norm.push_back(metrics::relative_energy_norm(R - rest, P - rest));
-        double es = std::numeric_limits<double>::quiet_NaN();
-        if (k % static_cast<size_t>(spec.metrics_every) == 0 || k + 1 == reference.u.size()) {
-          geom::Surface a = frames.rest.surface, b = frames.rest.surface;
-          a.V = R;
-          b.V = P;
-          try {
-            es = metrics::surface_error(a, b, "the reference", "the fiber model");
-          } catch (const InputError&) {
-          }
-        }
-        s.surface.push_back(es);
-        s.interior.push_back(metrics::interior_error(R, P, weights, measure, dim));
+        reference_boundary.V = boundary_rows(frames.rest, X0 + fem::displacement_rows(reference.u[k], dim));
+        fiber_boundary.V = run.positions[fiber_step(scene, t, fiber_steps)];
+        const bool surface_step = metrics_step(k, reference.u.size(), spec.metrics_every);
+        append_metrics(s, t, frame, reference_boundary.V, fiber_boundary.V,
+                       surface_step ? &reference_boundary : nullptr, &fiber_boundary);
       }
       report.static_energy_norm = metrics::relative_energy_norm(target - rest, run.positions.back() - rest);
       result.fiber_final = frames.rest.surface;

@@ -92,6 +92,7 @@ Boundary boundary(const Mesh& mesh, const Eigen::MatrixXd& positions) {
       kept.push_back(face);
     }
   }
+  if (kept.empty()) throw InputError("fem: the mesh has no boundary (no elements)");
   Boundary b;
   std::map<int, int> vertex_of;
   if (mesh.dim == 2) {  // chain the segments: each node starts exactly one
