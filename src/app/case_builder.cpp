@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Building a parsed case on its surface: what needs the mesh (case_spec.hpp).
 #include <algorithm>
+#include <sstream>
 #include <string>
 
 #include "app/case_spec.hpp"
@@ -49,6 +50,13 @@ geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* w
                                      "generator");
   }
   surface.V *= spec.scale;
+  // The checks above saw the unscaled mesh: a scale can still push coordinates
+  // past what squares and cross products of them can hold (or to nothing).
+  const double size = geom::bounding_box_diagonal(surface.V);
+  if (!(size > 1e-100 && size < 1e100))
+    spec.field.fail("scale", (std::ostringstream() << "scaled by " << spec.scale << " the surface is "
+                                                    << size << " m across; expected a size from "
+                                                    "1e-100 to 1e100 m").str());
   return surface;
 }
 

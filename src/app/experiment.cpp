@@ -43,10 +43,8 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   if (kind == "box") {
     const Eigen::Vector3d min = f.vector("min", 3), max = f.vector("max", 3);
     Eigen::Vector3i segments = Eigen::Vector3i::Ones();
-    if (f.has("segments")) segments = f.vector("segments", 3).cast<int>();
+    if (f.has("segments")) segments = f.counts("segments", 3, 1, 200);
     if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on every axis");
-    if ((segments.array() < 1).any() || (segments.array() > 200).any())
-      f.fail("segments", "expected 3 whole numbers from 1 to 200");
     return [=] { return geom::box(min, max, segments); };
   }
   if (kind == "dome") {
@@ -57,9 +55,8 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   if (kind == "rectangle") {
     const Eigen::Vector2d min = f.vector("min", 2), max = f.vector("max", 2);
     Eigen::Vector2i segments = Eigen::Vector2i::Ones();
-    if (f.has("segments")) segments = f.vector("segments", 2).cast<int>();
+    if (f.has("segments")) segments = f.counts("segments", 2, 1, 1000);
     if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on both axes");
-    if ((segments.array() < 1).any()) f.fail("segments", "expected 2 whole numbers from 1");
     return [=] { return geom::rectangle(min, max, segments.x(), segments.y()); };
   }
   // polygon
@@ -227,6 +224,7 @@ std::vector<LoadSpec> read_loads(Fields& root) {
       load.density = f.positive("density", 1000.0);
     } else {
       load.kind = model::Load::Kind::Point;
+      if (!f.has("vertex")) f.fail("vertex", "missing (required): the vertex the force acts on");
       spec.input_vertex = f.integer("vertex", 0, 0, std::numeric_limits<int>::max());
       spec.vector = per_axis_vector(f, "force");
     }
@@ -649,7 +647,7 @@ Experiment load_experiment(const std::filesystem::path& path) {
   json document;
   try {
     document = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
     throw InputError(path.string() + ": not valid JSON: " + e.what());
   }
   if (document.is_object() && !document.contains("name")) document["name"] = path.stem().string();

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -62,12 +63,9 @@ class Fields {
   int integer(const std::string& key, int fallback, int min, int max) {
     if (!has(key)) return seen_.insert(key), fallback;
     const nlohmann::json& v = raw(key);
-    if (!v.is_number_integer()) fail(key, "expected a whole number, got " + v.dump());
-    const long long x = v.get<long long>();
-    if (x < min || x > max)
-      fail(key, "expected a whole number from " + std::to_string(min) + " to " +
-                    std::to_string(max) + ", got " + std::to_string(x));
-    return static_cast<int>(x);
+    const std::string range = "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
+    if (!v.is_number_integer() || !fits(v, min, max)) fail(key, "expected " + range + ", got " + v.dump());
+    return static_cast<int>(v.get<long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
     if (!has(key)) return seen_.insert(key), fallback;
@@ -105,13 +103,28 @@ class Fields {
     }
     return out;
   }
+  // A list of `size` whole numbers from min to max (counts such as segments).
+  Eigen::VectorXi counts(const std::string& key, int size, int min, int max) {
+    const nlohmann::json& v = raw(key);
+    const std::string want = "a list of " + std::to_string(size) + " whole numbers from " +
+                             std::to_string(min) + " to " + std::to_string(max);
+    if (!v.is_array() || static_cast<int>(v.size()) != size) fail(key, "expected " + want + ", got " + v.dump());
+    Eigen::VectorXi out(size);
+    for (int k = 0; k < size; ++k) {
+      const nlohmann::json& item = v[static_cast<size_t>(k)];
+      if (!item.is_number_integer() || !fits(item, min, max)) fail(key, "expected " + want + ", got " + v.dump());
+      out[k] = static_cast<int>(item.get<long long>());
+    }
+    return out;
+  }
   std::vector<int> indices(const std::string& key) {
     const nlohmann::json& v = raw(key);
     if (!v.is_array() || v.empty()) fail(key, "expected a non-empty list of vertex indices");
     std::vector<int> out;
     for (const nlohmann::json& item : v) {
-      if (!item.is_number_integer() || item.get<long long>() < 0)
-        fail(key, "expected vertex indices (whole numbers from 0), got " + item.dump());
+      if (!item.is_number_integer() || !fits(item, 0, std::numeric_limits<int>::max()))
+        fail(key, "expected vertex indices (whole numbers from 0 to " +
+                      std::to_string(std::numeric_limits<int>::max()) + "), got " + item.dump());
       out.push_back(static_cast<int>(item.get<long long>()));
     }
     return out;
@@ -138,6 +151,16 @@ class Fields {
   FieldName field() const { return {file_, path_}; }
 
  private:
+  // Whether a JSON integer lies in [min, max] (an unsigned one may exceed long long).
+  static bool fits(const nlohmann::json& v, long long min, long long max) {
+    if (v.is_number_unsigned()) {
+      const unsigned long long u = v.get<unsigned long long>();
+      return (min <= 0 || u >= static_cast<unsigned long long>(min)) && max >= 0 &&
+             u <= static_cast<unsigned long long>(max);
+    }
+    const long long x = v.get<long long>();
+    return x >= min && x <= max;
+  }
   std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }
   static std::string join(const std::vector<std::string>& words) {
     std::string out;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "geom/mesh_check.hpp"
+#include "geom/self_intersection.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -218,6 +219,13 @@ MeshReport inspect(const Surface& s) {
   r.euler_characteristic = s.dim == 3 ? r.used_vertices - r.edges + r.faces : 0;
   if (s.dim == 3 && r.closed && r.components == 1) r.genus = (2 - r.euler_characteristic) / 2;
   r.outward = r.volume > 0.0;
+  // A surface that crosses itself bounds no solid: its enclosed volume (the
+  // fluid's) and the exact pruning's inside test mean nothing there.
+  if (r.ok())
+    if (const auto crossing = find_self_intersection(s))
+      r.problems.push_back("the surface intersects itself: " + std::string(s.dim == 3 ? "triangles " : "segments ") +
+                           std::to_string(crossing->first) + " and " + std::to_string(crossing->second) +
+                           " cross (it bounds no solid, so its volume and the fiber pruning are meaningless)");
   if (r.ok() && !r.outward)
     r.problems.push_back(std::string("inverted: the faces point inward (enclosed ") +
                          (s.dim == 3 ? "volume " : "area ") + std::to_string(r.volume) +

@@ -2,6 +2,7 @@
 #include "geom/mesh_io.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cctype>
 #include <cstdint>
@@ -32,6 +33,10 @@ struct MeshBuilder {
   }
 
   ReadResult finish(const std::string& name) const {
+    for (size_t i = 0; i < vertices.size(); ++i)
+      if (!vertices[i].allFinite())
+        throw InputError(name + ": vertex " + std::to_string(i) +
+                         " has a coordinate that is not a finite number");
     ReadResult out;
     if (split_polygons > 0)
       out.warnings.push_back(name + ": " + std::to_string(split_polygons) +
@@ -58,6 +63,14 @@ struct MeshBuilder {
     return out;
   }
 };
+
+// A count or an index read as a double: the whole number from 0 to `limit`,
+// or -1 (converting a double outside int's range to int is undefined, and a
+// count larger than the file could hold would only exhaust memory).
+long long whole_number(double value, double limit) {
+  if (!(value >= 0.0 && value <= limit) || value != std::floor(value)) return -1;
+  return static_cast<long long>(value);
+}
 
 // "file:line: ", or "file: " where the line is unknown (line 0: binary or
 // whitespace-separated data such as a PLY body).
@@ -156,11 +169,15 @@ ReadResult read_off(std::istream& in, const std::filesystem::path& path) {
       throw InputError(path.string() + ": the file ends early, expected " + what);
     return tokens[at++];
   };
+  // No count can exceed the tokens the file holds.
+  const double most = static_cast<double>(tokens.size());
   auto next_count = [&](const char* what) {
     const auto& [token, l] = next(what);
-    const double value = parse_number(token, path, l, what);
-    if (value < 0 || value != static_cast<int>(value))
-      throw InputError(where(path, l) + "expected a count for " + what + ", got '" + token + "'");
+    const long long value = whole_number(parse_number(token, path, l, what), most);
+    if (value < 0)
+      throw InputError(where(path, l) + "expected a count for " + what + " (a whole number no "
+                       "larger than the file's " + std::to_string(tokens.size()) + " values), got '" +
+                       token + "'");
     return static_cast<int>(value);
   };
   if (tokens.empty() || tokens[0].first != "OFF")
@@ -183,8 +200,8 @@ ReadResult read_off(std::istream& in, const std::filesystem::path& path) {
     std::vector<int> face;
     for (int k = 0; k < corners; ++k) {
       const auto& [token, l] = next("a face index");
-      const double index = parse_number(token, path, l, "a face index");
-      if (index < 0 || index >= nv || index != static_cast<int>(index))
+      const long long index = whole_number(parse_number(token, path, l, "a face index"), nv - 1.0);
+      if (index < 0)
         throw InputError(where(path, l) + "face index " + token + " is out of range 0.." +
                          std::to_string(nv - 1));
       face.push_back(static_cast<int>(index));
@@ -201,10 +218,15 @@ ReadResult read_off(std::istream& in, const std::filesystem::path& path) {
 
 // ---------------------------------------------------------------- STL
 // Welds corners with bit-identical coordinates: STL repeats them per face.
+// A NaN cannot be ordered (the map's keys), so it is refused here.
 struct Welder {
   std::map<std::array<double, 3>, int> index_of;
   MeshBuilder mesh;
+  std::string name;
   int add(const std::array<double, 3>& p) {
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw InputError(name + ": facet " + std::to_string(mesh.triangles.size() + 1) +
+                       " has a corner with a coordinate that is not a finite number");
     auto [it, inserted] = index_of.emplace(p, static_cast<int>(mesh.vertices.size()));
     if (inserted) mesh.vertices.emplace_back(p[0], p[1], p[2]);
     return it->second;
@@ -213,6 +235,7 @@ struct Welder {
 
 ReadResult read_stl_ascii(std::istream& in, const std::filesystem::path& path) {
   Welder welder;
+  welder.name = path.string();
   std::string text;
   int line = 0;
   std::vector<int> corners;
@@ -252,6 +275,7 @@ ReadResult read_stl_binary(const std::string& bytes, const std::filesystem::path
                      std::to_string(count) + " triangles (" + std::to_string(needed) +
                      " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
   Welder welder;
+  welder.name = path.string();
   for (uint32_t t = 0; t < count; ++t) {
     const char* record = bytes.data() + 84 + 50ull * t + 12;  // skip the normal
     std::vector<int> corners;
@@ -374,7 +398,12 @@ ReadResult read_ply(const std::string& bytes, const std::filesystem::path& path)
       PlyElement element;
       std::string count;
       tokens >> element.name >> count;
-      element.count = static_cast<long>(parse_number(count, path, line, "an element count"));
+      // Each item takes at least a byte: no count can exceed the file's size.
+      element.count = static_cast<long>(whole_number(parse_number(count, path, line, "an element count"),
+                                                     static_cast<double>(bytes.size())));
+      if (element.count < 0)
+        throw InputError(where(path, line) + "expected an element count no larger than the "
+                         "file's " + std::to_string(bytes.size()) + " bytes, got '" + count + "'");
       elements.push_back(element);
     } else if (keyword == "property") {
       if (elements.empty()) throw InputError(where(path, line) + "property before any element");
@@ -403,16 +432,24 @@ ReadResult read_ply(const std::string& bytes, const std::filesystem::path& path)
             position[p.name[0] - 'x'] = value;
           continue;
         }
-        const int n = static_cast<int>(reader.read(p.count_type));
-        for (int k = 0; k < n; ++k) corners.push_back(static_cast<int>(reader.read(p.type)));
+        const long long n = whole_number(reader.read(p.count_type), static_cast<double>(bytes.size()));
+        if (n < 0)
+          throw InputError(path.string() + ": " + element.name + " " + std::to_string(item) +
+                           ": a list length that is not a count the file could hold");
+        for (long long k = 0; k < n; ++k) {
+          // An index beyond int's range is out of range whatever it is.
+          const long long c = whole_number(reader.read(p.type), 2147483647.0);
+          corners.push_back(c < 0 ? -1 : static_cast<int>(c));
+        }
       }
       if (element.name == "vertex") mesh.vertices.push_back(position);
       if (element.name == "face") {
         for (int c : corners)
           if (c < 0 || c >= static_cast<int>(mesh.vertices.size()))
-            throw InputError(path.string() + ": face " + std::to_string(item) +
-                             " refers to vertex " + std::to_string(c) + ", outside 0.." +
-                             std::to_string(mesh.vertices.size() - 1));
+            throw InputError(path.string() + ": face " + std::to_string(item) + " refers to " +
+                             (c < 0 ? std::string("an index that is no vertex number")
+                                    : "vertex " + std::to_string(c)) +
+                             ", outside 0.." + std::to_string(mesh.vertices.size() - 1));
         if (corners.size() < 3)
           throw InputError(path.string() + ": face " + std::to_string(item) +
                            " has fewer than 3 corners");

@@ -2,6 +2,8 @@
 #include "model/boundary_conditions.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <regex>
@@ -28,7 +30,10 @@ HalfSpace parse_half_space(const std::string& text, int dim) {
   const std::string op = match[2].str();
   h.greater = op[0] == '>';
   h.inclusive = op.size() == 2;
-  h.threshold = std::stod(match[3].str());
+  // strtod, not stod: a threshold beyond a double (1e999) is an input error, not an exception.
+  h.threshold = std::strtod(match[3].str().c_str(), nullptr);
+  if (!std::isfinite(h.threshold))
+    throw InputError("'" + text + "': the threshold " + match[3].str() + " is beyond a double's range");
   return h;
 }
 

@@ -106,6 +106,45 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   c["supports"][0]["where"] = "z >= 5";
   expect_config_error(dir, c, "supports[0].where: \"z >= 5\" selects no vertex");
 
+  // Found from outside (issue 11): each aborted, read out of bounds, or
+  // silently did something else.
+  c = base_config();
+  c["supports"][0]["where"] = "z >= 1e999";
+  expect_config_error(dir, c, "supports[0].where: 'z >= 1e999': the threshold 1e999 is beyond a double's range");
+  c = base_config();
+  c["supports"][0] = {{"vertices", {2147483648LL}}};
+  expect_config_error(dir, c, "supports[0].vertices: expected vertex indices (whole numbers from 0 to 2147483647)");
+  c = base_config();
+  c["supports"][0] = {{"vertices", {4294967296ULL}}};
+  expect_config_error(dir, c, "supports[0].vertices: expected vertex indices");
+  c = base_config();
+  c["loads"] = {{{"type", "point"}, {"force", {0, 0, -1}}}};
+  expect_config_error(dir, c, "loads[0].vertex: missing (required)");
+  c = base_config();
+  c["surface"] = {{"generator", "box"}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"segments", {1.9, 2, 2}}};
+  expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers from 1 to 200");
+  c["surface"]["segments"] = {1e300, 2, 2};
+  expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers");
+  c = base_config();
+  c["surface"]["scale"] = 1e308;
+  expect_config_error(dir, c, "surface.scale: scaled by 1e+308 the surface is inf m across");
+  c["surface"]["scale"] = 1e-300;
+  expect_config_error(dir, c, "surface.scale: scaled by 1e-300");
+  c = base_config();
+  c["stepping"]["steps"] = 0;  // unsigned in JSON: still below the range
+  expect_config_error(dir, c, "stepping.steps: expected a whole number from 1");
+  c["stepping"]["steps"] = 18446744073709551615ULL;
+  expect_config_error(dir, c, "stepping.steps: expected a whole number from 1");
+  // A number a double cannot hold, anywhere in the file: not a crash.
+  const auto overflow = dir.write("overflow.json", R"({"name": "x", "material": {"Y": 1e999}})");
+  try {
+    load_experiment(overflow);
+    ADD_FAILURE() << "no error for 1e999";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow.json: not valid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e999"), std::string::npos) << e.what();
+  }
+
   c = base_config();
   c["supports"][0]["where"] = "height > 1";
   expect_config_error(dir, c, "is not a half-space");

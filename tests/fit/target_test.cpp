@@ -98,7 +98,7 @@ TEST(Targets, ReadSoupsAndCloudsAndSayWhatWasRead) {
     read_target(dir.write("nan.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
     ADD_FAILURE() << "read a NaN";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("nan.obj: point 0 has a non-finite coordinate"),
+    EXPECT_NE(std::string(e.what()).find("nan.obj: vertex 0 has a coordinate that is not a finite number"),
               std::string::npos) << e.what();
   }
   EXPECT_THROW(read_target(dir.path() / "missing.obj"), InputError);

@@ -42,6 +42,21 @@ TEST(MeshCheck, GoodMeshes) {
 TEST(MeshCheck, EachBadMeshHasItsOwnMessage) {
   expect_problem(drop_last_face(cube()), "not closed");
 
+  // Closed, manifold, consistently oriented and outward, but one vertex
+  // pushed through the far side: its triangles cross others (found from
+  // outside, issue 11: it passed the check).
+  Surface through = icosphere(1);
+  through.V.row(0) *= -1.6;
+  expect_problem(through, "the surface intersects itself: triangles");
+  // A bow tie: the polygon's segments cross.
+  Surface bow_tie;
+  bow_tie.dim = 2;
+  bow_tie.V.resize(4, 2);
+  bow_tie.V << 0, 0, 2, 0, 0, 1, 2, 1;
+  bow_tie.F.resize(4, 2);
+  bow_tie.F << 0, 1, 1, 2, 2, 3, 3, 0;
+  expect_problem(bow_tie, "the surface intersects itself: segments");
+
   Surface fin = cube();  // a third face on an existing edge
   fin.V.conservativeResize(9, 3);
   fin.V.row(8) << 0, 0, 3;

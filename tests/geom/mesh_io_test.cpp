@@ -291,5 +291,41 @@ TEST(MeshIO, BadFilesAreRejectedWithTheirOwnMessage) {
                     "word.ply: expected a number for a PLY value, got 'zero'");
 }
 
+// Found by fuzzing from outside (issue 11): a NaN the welding map cannot
+// order, and counts and indices whose conversion to int was undefined or
+// whose size would exhaust memory before the file ran out.
+TEST(MeshIO, NonFiniteCoordinatesAndHugeCountsAreErrors) {
+  ScratchDir dir;
+  expect_read_error(dir.write("nan.stl", "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\n"
+                                         "vertex 1 0 nan\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n"),
+                    "nan.stl: facet 1 has a corner with a coordinate that is not a finite number");
+  const Surface ico = icosahedron();
+  std::string binary = binary_stl(ico, ico.num_faces());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&binary[84 + 12], &nan, 4);  // the first corner's x
+  expect_read_error(dir.write("nan_binary.stl", binary), "not a finite number");
+  expect_read_error(dir.write("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n"),
+                    "nan.obj: vertex 1 has a coordinate that is not a finite number");
+  expect_read_error(dir.write("inf.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"),
+                    "vertex 1 has a coordinate that is not a finite number");
+  expect_read_error(dir.write("big.off", "OFF\n3 1e300 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                    "big.off:2: expected a count for the number of faces");
+  expect_read_error(dir.write("many.off", "OFF\n2147483648 1 0\n0 0 0\n"),
+                    "expected a count for the number of vertices");
+  expect_read_error(dir.write("nan_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 nan\n"),
+                    "face index nan is out of range 0..2");
+  expect_read_error(dir.write("half_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"),
+                    "face index 1.5 is out of range 0..2");
+  const std::string ply_header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                 "property float y\nproperty float z\nelement face 1\n"
+                                 "property list uchar int vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  expect_read_error(dir.write("big_index.ply", ply_header + "3 0 1 1e300\n"),
+                    "face 0 refers to an index that is no vertex number");
+  expect_read_error(dir.write("big_list.ply", ply_header + "1e300 0 1 2\n"), "a list length that is not a count");
+  expect_read_error(dir.write("big_count.ply", "ply\nformat ascii 1.0\nelement vertex 1e300\nproperty float x\n"
+                                               "end_header\n0\n"),
+                    "big_count.ply:3: expected an element count no larger than the file's");
+}
+
 }  // namespace
 }  // namespace fiberfluid::geom
