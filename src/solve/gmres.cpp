@@ -2,6 +2,7 @@
 #include "solve/gmres.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -17,6 +18,7 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
     return result;
   }
   const int m = std::max(1, options.restart);
+  double previous = std::numeric_limits<double>::infinity();  // the last restart's residual
   while (true) {
     Eigen::VectorXd r = b - A(x);
     double beta = r.norm();
@@ -27,6 +29,17 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
     }
     if (result.relative_residual <= options.tolerance) return result;
     if (result.iterations >= options.max_iterations) break;
+    // A whole restart cycle that did not lower the residual will not on the
+    // next one either (the same Krylov space): stagnation, not slow progress.
+    if (!(beta < previous * (1.0 - 1e-12))) {
+      std::ostringstream out;
+      out << "gmres: stagnation: a restart cycle of " << m << " iterations left the relative "
+          << "residual at " << result.relative_residual << " (tolerance " << options.tolerance
+          << "); a larger restart or a better preconditioner may help";
+      result.status = Status::failure(out.str());
+      return result;
+    }
+    previous = beta;
     // Arnoldi with modified Gram-Schmidt; Givens rotations keep the small
     // least-squares problem triangular.
     std::vector<Eigen::VectorXd> V{r / beta}, Z;
