@@ -10,6 +10,7 @@ packages=(
   libceres-dev libnlopt-dev                  # calibration (src/fit)
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
   python3-dev pybind11-dev python3-pytest    # the Python module and its tests
+  clang libclang-rt-14-dev libomp-dev        # the libFuzzer targets (scripts/fuzz.sh)
 )
 
 missing=()

@@ -9,6 +9,8 @@
 #include "geom/fiber_pruning.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
+#include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 #include "model/boundary_conditions.hpp"
 
 namespace fiberfluid::app {
@@ -73,8 +75,12 @@ void require_per_axis(const FieldName& field, const std::string& key, const Eige
 }
 
 // ------------------------------------------------------------ fibers
+// Bodies beyond this are not pruned: N^2 pair tests (5,000 vertices: about 2
+// minutes here) and an N^2 byte table.
+constexpr int kLargestPruned = 10000;
+
 // Prunes the fibers that leave a concave body and reports what it did.
-FiberReport prune(const FiberSpec& spec, model::Model& m) {
+FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
   FiberReport report;
   report.pruning = spec.pruning;
   report.write = spec.write;
@@ -85,15 +91,9 @@ FiberReport prune(const FiberSpec& spec, model::Model& m) {
   report.min_per_vertex = report.max_per_vertex = n - 1;
   report.mean_per_vertex = n - 1;
   if (!report.pruning) return report;
-  report.convex = geom::is_convex(m.surface);
+  report.convex = !concave;
   if (report.convex) return report;
-  // N^2 pair tests (5,000 vertices: about 2 minutes here) and an N^2 byte table.
-  constexpr int kLargestPruned = 10000;
-  if (n > kLargestPruned)
-    spec.field.fail("pruning", "a concave body of " + std::to_string(n) +
-                                   " vertices is beyond exact pruning (at most " +
-                                   std::to_string(kLargestPruned) + "); set \"off\"");
-  geom::PruningResult pruned = geom::prune_fibers(m.surface);
+  geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
   report.seconds = pruned.seconds;
   report.exact_fallbacks = pruned.exact_fallbacks;
   report.kept = pruned.mask.num_kept();
@@ -111,13 +111,28 @@ FiberReport prune(const FiberSpec& spec, model::Model& m) {
   return report;
 }
 
-// The surface as given, its used vertices as the model's, and the fibers.
+// The surface as given, its used vertices as the model's, and the fibers:
+// the case's cost is estimated (and refused beyond the memory or time
+// budget) before the convexity check and again, once it has said whether the
+// body is pruned, before pruning.
 void build_geometry(const CaseSpec& spec, geom::Surface input, Case& c) {
   c.input_surface = std::move(input);
   const geom::CompactSurface compact = geom::remove_unused_vertices(c.input_surface);
   c.model_to_input = compact.to_input;
   c.model.surface = compact.surface;
-  c.fibers = prune(spec.fibers, c.model);
+  const int n = c.model.num_vertices();
+  // First as if convex (the convexity check is N x F itself), then as it is.
+  require_within_budget(estimate_resources(spec, c.model.surface, false), spec);
+  const bool concave = spec.fibers.pruning && !geom::is_convex(c.model.surface);
+  if (concave && n > kLargestPruned)
+    spec.fibers.field.fail("pruning", "a concave body of " + std::to_string(n) +
+                                          " vertices is beyond exact pruning (at most " +
+                                          std::to_string(kLargestPruned) + "); set \"off\"");
+  c.estimate = estimate_resources(spec, c.model.surface, concave);
+  require_within_budget(c.estimate, spec);
+  if (c.estimate.seconds >= 10.0 || c.estimate.peak_bytes >= 0.25 * memory_budget_bytes())
+    report_note("estimate for a long run: " + c.estimate.describe());
+  c.fibers = prune(spec.fibers, concave, c.model);
 }
 
 // ------------------------------------------------------------ model parts
@@ -307,6 +322,8 @@ Case build_case(const CaseSpec& spec, const Case& earlier) {
   c.model.fibers = earlier.model.fibers;
   c.model.connection_count = earlier.model.connection_count;
   c.fibers = earlier.fibers;
+  c.estimate = estimate_resources(spec, c.model.surface, c.fibers.pruning && !c.fibers.convex);
+  require_within_budget(c.estimate, spec);
   ModelBuilder(spec, c).build();
   return c;
 }

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "app/resources.hpp"
 #include "geom/surface.hpp"
 #include "model/model.hpp"
 #include "solve/load_stepper.hpp"
@@ -132,6 +133,7 @@ struct Case {
   model::Model model;
   solve::SteppingOptions stepping;
   FiberReport fibers;
+  ResourceEstimate estimate;  // memory and time, estimated before pruning
 };
 
 // Loads or generates the spec's surface and checks it (closed, manifold,

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // fiberfluid: command-line tool. It only parses, loads and dispatches.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <unistd.h>
 
 #include <chrono>
@@ -21,12 +22,32 @@
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 
 namespace {
 
 namespace app = fiberfluid::app;
 
-enum ExitCode { kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3, kUsage = 64 };
+enum ExitCode {
+  kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3, kUsage = 64,
+  kInterrupted = 130,  // 128 + SIGINT, as a shell reports a process ended by Ctrl-C
+};
+
+// The first Ctrl-C asks the run to stop at its next check (a load step, a
+// pruning row, a solver iteration) and clean up; a second one ends the
+// process at once (the handler is reset after the first).
+void stop_on_interrupt() {
+  struct sigaction action {};
+  action.sa_handler = [](int) { fiberfluid::request_cancel(); };
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+// Throws Interrupted after a phase that returned early because of Ctrl-C,
+// before its partial results are written anywhere.
+void stop_if_interrupted(const std::string& phase) { fiberfluid::throw_if_cancelled(phase); }
 
 // Draws the library's progress reports on stderr, for phases that run longer
 // than a moment: one line redrawn in place on a terminal; plain lines (every
@@ -140,23 +161,34 @@ struct RunFlags {
   bool check_expected = false;
   bool quiet = false;
   int jobs = 0;
+  double max_memory = 0.0;  // bytes; 0: 80% of the machine's memory
+  double max_time = 0.0;    // seconds of estimated time; 0: no limit
 };
 
 // Loads an experiment (throwing before anything is written), drawing the
 // progress of long phases such as pruning unless quiet; the sink stays set.
+// Estimates of long runs are printed before they start (as notes).
 app::Experiment load_showing_progress(const std::string& path, bool quiet, ProgressPrinter& printer) {
-  if (!quiet)
+  if (!quiet) {
     fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
                                              double done, double total) {
       printer(label, phase, done, total);
     });
+    fiberfluid::set_note_sink([&printer](const std::string& label, const std::string& text) {
+      printer.close();
+      std::cerr << "note: " << (label.empty() ? "" : "[" + label + "] ") << text << "\n";
+    });
+  }
   app::Experiment ex = app::load_experiment(path);
   printer.close();
+  fiberfluid::set_note_sink({});
   for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
   return ex;
 }
 
 int run_command(const std::string& path, const RunFlags& flags) {
+  fiberfluid::set_memory_budget(flags.max_memory);
+  fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
   const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   if (ex.fit)
@@ -176,6 +208,7 @@ int run_command(const std::string& path, const RunFlags& flags) {
       options);
   printer.close();
   fiberfluid::set_progress_sink({});
+  stop_if_interrupted("the run");  // the writer's staging folder goes with it
   writer.finish(result);
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
@@ -216,6 +249,8 @@ int run_command(const std::string& path, const RunFlags& flags) {
 // Calibrates the material of an experiment to its "fit" targets, then runs
 // it at the fitted values and writes the usual outputs with the fit's files.
 int fit_command(const std::string& path, const RunFlags& flags) {
+  fiberfluid::set_memory_budget(flags.max_memory);
+  fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
   const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
@@ -238,6 +273,7 @@ int fit_command(const std::string& path, const RunFlags& flags) {
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
             << ")\n";
   const fiberfluid::fit::FitResult fitted = setup.calibration->run();
+  stop_if_interrupted("the fit");
   if (fitted.values.size() == 0) {  // the start itself failed
     std::cerr << "error: " << fitted.message << "\n";
     return kSolverFailed;
@@ -251,6 +287,7 @@ int fit_command(const std::string& path, const RunFlags& flags) {
       at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
         writer.on_step(run, r, x);
       });
+  stop_if_interrupted("the run at the fitted values");
   for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
   result.checks = app::check_expected(at_fit, result);
   writer.finish(result);
@@ -310,6 +347,29 @@ int check_command(const std::string& path, bool flip) {
   return kOk;
 }
 
+// --max-memory SIZE: the memory budget that every case's estimate and every
+// dense factor is checked against before it is allocated; --max-time: the
+// longest estimate that may start.
+void add_resource_limits(CLI::App* command, RunFlags& flags) {
+  command->add_option("--max-time", flags.max_time,
+                      "Refuse a case whose estimated time exceeds this many seconds")
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option_function<std::string>(
+          "--max-memory",
+          [&flags](const std::string& text) { fiberfluid::parse_bytes(text, &flags.max_memory); },
+          "Memory a run may plan for, e.g. 8G or 512M (default: 80% of this machine's); a case "
+          "estimated beyond it is refused before it starts")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            double bytes = 0.0;
+            return fiberfluid::parse_bytes(text, &bytes)
+                       ? ""
+                       : "expected a size such as 8G, 512M or 2e9 (bytes), got '" + text + "'";
+          },
+          "SIZE"));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -325,6 +385,7 @@ int main(int argc, char** argv) {
   run->add_flag("--check", flags.check_expected,
                 "Exit with status 3 when an expected figure of the file is not met");
   run->add_flag("-q,--quiet", flags.quiet, "No progress lines");
+  add_resource_limits(run, flags);
   run->add_option("-j,--jobs", flags.jobs,
                   "Variants of a sweep run at once (default: one per core); each gets "
                   "cores / jobs threads")
@@ -339,6 +400,7 @@ int main(int argc, char** argv) {
   fit->add_flag("--check", fit_flags.check_expected,
                 "Exit with status 3 when an expected figure of the file is not met");
   fit->add_flag("-q,--quiet", fit_flags.quiet, "No progress lines");
+  add_resource_limits(fit, fit_flags);
 
   CLI::App* check = cli.add_subcommand("check", "Check a mesh file and print its report");
   check->add_option("mesh", mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
@@ -364,11 +426,16 @@ int main(int argc, char** argv) {
     cli.exit(e);
     return kUsage;
   }
+  stop_on_interrupt();
   try {
     if (run->parsed()) return run_command(experiment, flags);
     if (fit->parsed()) return fit_command(experiment, fit_flags);
     if (compare->parsed()) return compare_command(compared_reference, compared, undeformed, as_json);
     return check_command(mesh, flip);
+  } catch (const fiberfluid::Interrupted& e) {
+    std::cerr << "\nerror: " << e.what() << " (Ctrl-C): nothing was written; an earlier "
+              << "result in the output folder is kept as it was\n";
+    return kInterrupted;
   } catch (const fiberfluid::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kBadInput;

@@ -103,6 +103,15 @@ json reactions_json(const model::Model& m, const solve::StepRecord& r) {
   return out;
 }
 
+// What the case was expected to cost before it ran (app/resources.hpp).
+json estimate_json(const ResourceEstimate& e) {
+  json parts = json::array();
+  for (const ResourcePart& p : e.parts)
+    parts.push_back({{"name", p.name}, {"bytes", p.bytes}, {"seconds", p.seconds}});
+  return {{"peak_bytes", e.peak_bytes}, {"seconds", e.seconds}, {"solver", e.solver},
+          {"parts", parts}};
+}
+
 json run_json(const Case& c, const ExperimentResult& result, const RunResult& run) {
   const model::Model& m = c.model;
   json steps = json::array();
@@ -144,6 +153,7 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
                        {"factorize", run.summary.factorize_seconds},
                        {"solve", run.summary.solve_seconds},
                        {"total", run.summary.total_seconds}}},
+          {"estimate", estimate_json(c.estimate)},
           {"steps", steps},
           {"final", final_figures}};
 }
@@ -258,6 +268,7 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
                       {"note", c.expected.note}});
   doc["checks"] = checks;
   doc["warnings"] = ex.warnings;
+  doc["peak_resident_bytes"] = peak_resident_bytes();  // of the whole process so far
   return doc;
 }
 
@@ -445,6 +456,13 @@ OutputWriter::OutputWriter(const Experiment& experiment, fs::path folder)
   staging_ = target_;
   staging_ += ".running-" + std::to_string(getpid());
   result_folder_ = target_;
+}
+
+OutputWriter::~OutputWriter() { abandon(); }
+
+void OutputWriter::abandon() noexcept {
+  std::error_code ignored;  // finish() moved it away already, or begin() never made it
+  fs::remove_all(staging_, ignored);
 }
 
 fs::path OutputWriter::run_folder(size_t run) const {

@@ -49,6 +49,11 @@ class OutputWriter {
   // Throws InputError when DIR exists and is not a fiberfluid output folder
   // (it holds files but no summary.json): it is never replaced.
   OutputWriter(const Experiment& experiment, std::filesystem::path folder);
+  // A writer dropped before finish() (an interruption, an exception) removes
+  // its staging folder: DIR keeps its last complete result.
+  ~OutputWriter();
+  OutputWriter(const OutputWriter&) = delete;
+  OutputWriter& operator=(const OutputWriter&) = delete;
 
   // Creates the staging folder and writes step 0 (the reference) of each run.
   void begin();
@@ -56,6 +61,8 @@ class OutputWriter {
   void on_step(size_t run, const solve::StepRecord& record, const Eigen::VectorXd& unknowns);
   // Writes the summaries and moves the staging folder into place.
   void finish(const ExperimentResult& result);
+  // Removes the staging folder and everything written so far.
+  void abandon() noexcept;
 
   // Where the results are: DIR after a success, DIR.failed after a failure.
   const std::filesystem::path& folder() const { return result_folder_; }

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "fem/free_unknowns.hpp"
+#include "geom/run_control.hpp"
 #include "solve/sparse_cholesky.hpp"
 
 namespace fiberfluid::fem {
@@ -156,6 +157,7 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
     Eigen::VectorXd free_u;
     for (int s = 1; s <= steps; ++s) {
       const double t = s * h;
+      if (cancel_requested()) return fail(t, "interrupted");
       const Eigen::VectorXd previous = u, target = held_at(t);
       Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
       for (size_t k = 0; k < d.held.size(); ++k) fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
@@ -193,6 +195,7 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
 
   for (int s = 1; s <= steps; ++s) {
     const double t = s * h;
+    if (cancel_requested()) return fail(t, "interrupted");
     const Eigen::VectorXd u_pred = u + h * v + ((1.0 - b) * h * h / 2.0) * a;
     const Eigen::VectorXd v_pred = v + ((1.0 - g) * h) * a;
     // The held unknowns' accelerations: those that reach their path at t.

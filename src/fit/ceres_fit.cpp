@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "fit/optimizers.hpp"
+#include "geom/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -106,7 +107,7 @@ class Recorder final : public ceres::IterationCallback {
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     outcome_.iterations.push_back(r);
     if (options_.progress) options_.progress(r);
-    return ceres::SOLVER_CONTINUE;
+    return cancel_requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
   }
 
  private:

@@ -9,6 +9,7 @@
 
 #include "fit/optimizers.hpp"
 #include "geom/error.hpp"
+#include "geom/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -28,6 +29,7 @@ struct Objective {
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_phi;
   int calls = 0;
+  nlopt_opt running = nullptr;  // the optimiser calling, stopped on a requested interruption
 
   double operator()(const double* x) {
     const int P = calibration.parameters().size();
@@ -35,6 +37,7 @@ struct Objective {
     const Evaluation& e = evaluations.at(phi, false);
     ++calls;
     const double cost = e.ok ? calibration.cost(e.residuals) : kFailedCost;
+    if (cancel_requested() && running) nlopt_force_stop(running);
     if (cost < best) {
       best = cost;
       best_phi = phi;
@@ -83,6 +86,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
   nlopt_set_lower_bounds(opt, lower.data());
   nlopt_set_upper_bounds(opt, upper.data());
   nlopt_set_min_objective(opt, &Objective::call, &objective);
+  objective.running = opt;
   nlopt_set_ftol_rel(opt, options.function_tolerance);
   nlopt_set_xtol_rel(opt, options.parameter_tolerance);
   nlopt_set_maxeval(opt, max_evaluations);
@@ -102,6 +106,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
   double value = 0.0;
   Eigen::VectorXd x = phi;
   const nlopt_result result = nlopt_optimize(opt, x.data(), &value);
+  objective.running = nullptr;
   nlopt_destroy(opt);
   if (objective.best_phi.size() == P) phi = objective.best_phi;
   return result;

@@ -8,6 +8,7 @@
 #include <atomic>
 
 #include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -241,6 +242,7 @@ PruningResult prune_3d(const Surface& s) {
     std::vector<int> faces;
 #pragma omp for schedule(dynamic, 4)
     for (int i = 0; i < n; ++i) {
+      if (cancel_requested()) continue;  // no break out of an OpenMP loop: the rest is skipped
       for (int j = i + 1; j < n; ++j)
         if (!keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks))
           result.mask.prune(i, j);
@@ -248,6 +250,7 @@ PruningResult prune_3d(const Surface& s) {
       if (omp_get_thread_num() == 0) report_progress("pruning", static_cast<double>(done), pairs);
     }
   }
+  throw_if_cancelled("the fiber pruning");
   report_progress("pruning", pairs, pairs);
   result.exact_fallbacks = fallbacks;
   return result;
@@ -283,6 +286,7 @@ PruningResult prune_2d(const Surface& s) {
   };
   long long fallbacks = 0;
   for (int i = 0; i < n; ++i) {
+    throw_if_cancelled("the fiber pruning");
     for (int j = i + 1; j < n; ++j) {
       const Epick::Point_2 &p = point[static_cast<size_t>(i)], &q = point[static_cast<size_t>(j)];
       bool degenerate = false, crossed = false;
@@ -352,7 +356,10 @@ bool is_convex(const Surface& s) {
   // N x F orientation tests: minutes on a 160,000-vertex mesh, so it reports.
   const double faces = s.num_faces();
   for (int f = 0; f < s.num_faces(); ++f) {
-    if (f % 1024 == 0) report_progress("convexity check", f, faces);
+    if (f % 1024 == 0) {
+      throw_if_cancelled("the convexity check");
+      report_progress("convexity check", f, faces);
+    }
     for (int v = 0; v < s.num_vertices(); ++v) {
       if (s.dim == 3) {
         const CGAL::Orientation o = CGAL::orientation(

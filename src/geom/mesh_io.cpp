@@ -460,31 +460,42 @@ ReadResult read_ply(const std::string& bytes, const std::filesystem::path& path)
   return mesh.finish(path.string());
 }
 
-std::string lower_extension(const std::filesystem::path& path) {
+}  // namespace
+
+std::optional<MeshFormat> mesh_format_of(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
+  if (ext == ".obj") return MeshFormat::Obj;
+  if (ext == ".off") return MeshFormat::Off;
+  if (ext == ".stl") return MeshFormat::Stl;
+  if (ext == ".ply") return MeshFormat::Ply;
+  return std::nullopt;
 }
 
-}  // namespace
+ReadResult read_surface_bytes(const std::string& bytes, MeshFormat format, const std::string& name) {
+  if (bytes.empty()) throw InputError(name + ": the file is empty");
+  const std::filesystem::path path = name;
+  switch (format) {
+    case MeshFormat::Stl: return read_stl(bytes, path);
+    case MeshFormat::Ply: return read_ply(bytes, path);
+    case MeshFormat::Obj:
+    case MeshFormat::Off: break;
+  }
+  std::istringstream in(bytes);
+  return format == MeshFormat::Obj ? read_obj(in, path) : read_off(in, path);
+}
 
 ReadResult read_surface(const std::filesystem::path& path) {
-  const std::string ext = lower_extension(path);
-  if (ext != ".obj" && ext != ".off" && ext != ".stl" && ext != ".ply")
-    throw InputError(path.string() + ": unknown mesh format '" + ext +
+  const std::optional<MeshFormat> format = mesh_format_of(path);
+  if (!format)
+    throw InputError(path.string() + ": unknown mesh format '" + path.extension().string() +
                      "' (expected .obj, .off, .stl or .ply)");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path.string() + ": cannot open the file");
   std::ostringstream buffer;
   buffer << file.rdbuf();
-  const std::string bytes = buffer.str();
-  if (bytes.empty()) throw InputError(path.string() + ": the file is empty");
-
-  if (ext == ".stl") return read_stl(bytes, path);
-  if (ext == ".ply") return read_ply(bytes, path);
-  std::istringstream in(bytes);
-  return ext == ".obj" ? read_obj(in, path) : read_off(in, path);
+  return read_surface_bytes(buffer.str(), *format, path.string());
 }
 
 void write_text_file(const std::filesystem::path& path, const std::string& content) {

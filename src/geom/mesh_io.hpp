@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,15 @@ struct ReadResult {
 // (and line where there is one) on anything it cannot read. The result is
 // not checked for being closed or manifold: see inspect().
 ReadResult read_surface(const std::filesystem::path& path);
+
+enum class MeshFormat { Obj, Off, Stl, Ply };
+
+// The format named by a path's extension (any case), or nothing.
+std::optional<MeshFormat> mesh_format_of(const std::filesystem::path& path);
+
+// Reads a surface held in memory (a file's bytes), as read_surface does;
+// errors name `name`.
+ReadResult read_surface_bytes(const std::string& bytes, MeshFormat format, const std::string& name);
 
 // Writes an OBJ: triangles as `f`; a 2D polygon as `v x y 0` and `l` lines.
 // Written to a temporary file first and renamed, so no half-written file

@@ -21,6 +21,12 @@ using ProgressSink = std::function<void(const std::string& label, const char* ph
 void set_progress_sink(ProgressSink sink);
 void report_progress(const char* phase, double done, double total);
 
+// Notes for the user (an estimate before a long run): (label, text). Same
+// rules as the progress sink; without one a note is dropped.
+using NoteSink = std::function<void(const std::string& label, const std::string& text)>;
+void set_note_sink(NoteSink sink);
+void report_note(const std::string& text);
+
 // Names the run that this thread's reports belong to, for its lifetime.
 class ProgressLabel {
  public:

@@ -2,6 +2,7 @@
 #include "solve/dense_lu.hpp"
 
 #include <cstddef>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -35,9 +36,12 @@ Status DenseLU::factorize(const Eigen::MatrixXd& A) {
     return Status::failure("the system matrix is singular (zero pivot at unknown " +
                            std::to_string(info - 1) + ")");
   dgecon_(&norm, &n, lu_.data(), &n, &anorm, &rcond_, work.data(), iwork.data(), &info, 1);
-  if (!(rcond_ >= 10 * std::numeric_limits<double>::epsilon()))
-    return Status::failure("the system matrix is numerically singular (reciprocal condition " +
-                           std::to_string(rcond_) + ")");
+  if (!(rcond_ >= 10 * std::numeric_limits<double>::epsilon())) {
+    char rcond[32];
+    std::snprintf(rcond, sizeof rcond, "%.3g", rcond_);
+    return Status::failure(std::string("the system matrix is numerically singular (reciprocal "
+                                       "condition ") + rcond + ")");
+  }
   factored_ = true;
   return {};
 }

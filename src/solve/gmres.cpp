@@ -6,6 +6,8 @@
 #include <sstream>
 #include <vector>
 
+#include "geom/run_control.hpp"
+
 namespace fiberfluid::solve {
 
 GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
@@ -29,6 +31,11 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
     }
     if (result.relative_residual <= options.tolerance) return result;
     if (result.iterations >= options.max_iterations) break;
+    if (cancel_requested()) {
+      result.status = Status::failure("gmres: interrupted after " +
+                                      std::to_string(result.iterations) + " iterations");
+      return result;
+    }
     // A whole restart cycle that did not lower the residual will not on the
     // next one either (the same Krylov space): stagnation, not slow progress.
     if (!(beta < previous * (1.0 - 1e-12))) {

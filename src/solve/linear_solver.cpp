@@ -2,8 +2,8 @@
 #include "solve/linear_solver.hpp"
 
 #include <sstream>
-#include <unistd.h>
 
+#include "geom/run_control.hpp"
 #include "solve/backends.hpp"
 
 namespace fiberfluid::solve {
@@ -37,29 +37,27 @@ std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptio
   return nullptr;
 }
 
-SolverKind choose_solver(const model::BorderedSystem& system, double memory_bytes) {
+SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes) {
   const double n = system.largest_block();
   if (n <= 600) return SolverKind::DenseLU;  // the paper's method, well within a second
   const int factors = system.blocks_equal() ? 1 : system.num_blocks();
-  if (8.0 * n * n * (factors + 1) < 0.3 * memory_bytes) return SolverKind::BlockCholesky;
+  if (8.0 * n * n * (factors + 1) < 0.375 * budget_bytes) return SolverKind::BlockCholesky;
   return SolverKind::PCG;
 }
 
 SolverKind choose_solver(const model::BorderedSystem& system) {
-  return choose_solver(system, physical_memory_bytes());
-}
-
-double physical_memory_bytes() {
-  return static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  return choose_solver(system, memory_budget_bytes());
 }
 
 Status require_memory(double bytes, const std::string& what) {
-  const double physical = physical_memory_bytes();
-  if (physical <= 0.0 || bytes < 0.8 * physical) return {};
+  const double budget = memory_budget_bytes();
+  if (bytes <= budget) return {};
   std::ostringstream out;
-  out.precision(3);
-  out << what << " needs about " << bytes / (1u << 30) << " GiB, more than this machine's "
-      << physical / (1u << 30) << " GiB; use the pcg solver or a coarser mesh";
+  out << what << " needs about " << format_bytes(bytes) << ", more than the memory budget of "
+      << format_bytes(budget)
+      << (memory_budget_is_set() ? " (--max-memory)" : " (80% of this machine's memory)")
+      << "; use the pcg solver or a coarser mesh"
+      << (memory_budget_is_set() ? ", or raise --max-memory" : "");
   return Status::failure(out.str());
 }
 

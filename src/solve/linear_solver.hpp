@@ -57,14 +57,14 @@ class LinearSolver {
 std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptions& pcg = {});
 
 // The default by size: the paper's dense LU for small systems, block
-// Cholesky while its dense N x N blocks fit in 30% of `memory_bytes`, pcg beyond.
-SolverKind choose_solver(const model::BorderedSystem& system, double memory_bytes);
-// The same for this machine's physical memory.
+// Cholesky while its dense N x N blocks take at most 3/8 of `budget_bytes`
+// (30% of the memory under the default budget of 80%), pcg beyond.
+SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes);
+// The same for the process's memory budget (memory_budget_bytes()).
 SolverKind choose_solver(const model::BorderedSystem& system);
 
-// Physical memory of this machine in bytes.
-double physical_memory_bytes();
-// A failure when `bytes` would not fit in 80% of the physical memory.
+// A failure when `bytes` would not fit in the memory budget; the message says
+// what lifts it (--max-memory, another solver, a coarser mesh).
 Status require_memory(double bytes, const std::string& what);
 
 }  // namespace fiberfluid::solve

@@ -11,6 +11,7 @@
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
 #include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 #include "model/equilibrium.hpp"
 #include "model/fiber_system.hpp"
@@ -202,6 +203,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
 
   report_progress("step", 0, n);
   for (int k = 1; k <= n; ++k) {
+    if (cancel_requested()) return fail("step " + std::to_string(k) + ": interrupted");
     const Clock::time_point step_start = Clock::now();
     const Eigen::MatrixXd X = model::positions(model, summary.unknowns);
 

@@ -12,6 +12,7 @@
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
 #include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 #include "model/dof_map.hpp"
 #include "model/equilibrium.hpp"
@@ -232,6 +233,7 @@ class NewtonSolver {
     update_force_scale(at, dofs, x, R);
     double last_move = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
+      if (cancel_requested()) return "interrupted";
       const Eigen::VectorXd r = dofs.reduce(R);
       const double norm = measure(r);
       record.residual_norms.push_back(norm);
@@ -418,6 +420,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     double reached = k - 1, piece = 1.0;
     bool predict = options.newton.predictor;
     while (reached < k) {
+      if (cancel_requested()) return fail("step " + std::to_string(k) + ": interrupted");
       const double target = std::min<double>(k, reached + piece);
       const PathPoint at = path_point(model, target, n);
       const Eigen::VectorXd saved = x;

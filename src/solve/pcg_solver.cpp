@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "geom/progress.hpp"
+#include "geom/run_control.hpp"
 #include "solve/backends.hpp"
 #include "solve/schur_solver.hpp"
 #include "solve/sparse_cholesky.hpp"
@@ -59,7 +60,12 @@ class PcgSolver final : public SchurSolver {
       r -= alpha * q;
       ++statistics_.iterations;
       report_progress("pcg iteration", it, 0.0);
-      if (r.norm() <= options_.tolerance * norm_f) return {};
+      const double residual = r.norm();
+      if (residual <= options_.tolerance * norm_f) return {};
+      if (!std::isfinite(residual))
+        return Status::failure("pcg: the residual is not finite at iteration " + std::to_string(it));
+      if (cancel_requested())
+        return Status::failure("pcg: interrupted at iteration " + std::to_string(it));
       z = precondition(r);
       const double rz_next = r.dot(z);
       p = z + (rz_next / rz) * p;

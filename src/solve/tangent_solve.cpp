@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 #include "solve/dense_lu.hpp"
 #include "solve/gmres.hpp"
@@ -14,10 +15,10 @@ TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium
                            const SteppingOptions& options, TangentSolver kind)
     : equilibrium_(std::move(equilibrium)), options_(options), kind_(kind) {
   const model::Model& model = equilibrium_->model();
-  // The pair coefficients are stored when two N x N arrays fit in a quarter
-  // of the memory; else each product recomputes them.
+  // The pair coefficients are stored when two N x N arrays fit in a
+  // quarter of the memory budget; else each product recomputes them.
   store_ = model::TangentOperator::bytes_for(model.num_vertices()) <
-           0.25 * physical_memory_bytes();
+           0.25 * memory_budget_bytes();
   preconditioner_kind_ = kind_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
 }
 

@@ -209,6 +209,94 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
             summary);
 }
 
+// Waits for a background run; its exit status, or -1 when it was killed by a signal.
+int wait_for(pid_t pid, double* seconds = nullptr) {
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
+  ScratchDir dir;
+  const std::filesystem::path out = dir.path() / "out";
+  nlohmann::json config = nlohmann::json::parse(R"({"name": "long",
+    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
+    "material": {"Y": 20000, "gamma": 1},
+    "supports": [{"where": "z >= 0.04"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 3, "rebuild_matrix": true, "solver": "block-cholesky"}})");
+  ASSERT_EQ(run_cli("run " + dir.write("short.json", config.dump()).string() + " -q -o " +
+                    out.string()).status, 0);
+  const std::string earlier = read_file(out / "summary.json");
+
+  config["stepping"]["steps"] = 4000;
+  const pid_t pid = start_cli({"run", dir.write("long.json", config.dump()).string(), "-o",
+                               out.string()}, dir.path() / "run.log");
+  std::filesystem::path staging = out;
+  staging += ".running-" + std::to_string(pid);
+  for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_GE(count_files(staging / "vtk"), 5) << "the run did not get going";
+  kill(pid, SIGINT);
+  double seconds = 0.0;
+  EXPECT_EQ(wait_for(pid, &seconds), 130) << read_file(dir.path() / "run.log");
+  EXPECT_LT(seconds, 10.0);  // at the next load step
+  EXPECT_NE(read_file(dir.path() / "run.log").find("interrupted during the run (Ctrl-C): nothing was written"),
+            std::string::npos) << read_file(dir.path() / "run.log");
+  EXPECT_FALSE(std::filesystem::exists(staging));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out.failed"));
+  EXPECT_EQ(read_file(out / "summary.json"), earlier);
+}
+
+TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
+  ScratchDir dir;
+  // The bunny's 930,000 fiber pairs take seconds to prune (minutes under ASan).
+  const pid_t pid = start_cli({"run", testing::experiment_file("bunny_gravity.json").string(),
+                               "-o", (dir.path() / "out").string()},
+                              dir.path() / "run.log");
+  // Progress lines start after 2 s: "pruning 1234/930,000 (...)".
+  auto pruning = [&] { return ("\n" + read_file(dir.path() / "run.log")).find("\npruning ") != std::string::npos; };
+  for (int wait = 0; wait < 1200 && !pruning(); ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  kill(pid, SIGINT);
+  double seconds = 0.0;
+  EXPECT_EQ(wait_for(pid, &seconds), 130) << read_file(dir.path() / "run.log");
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_NE(read_file(dir.path() / "run.log").find("interrupted during the fiber pruning"),
+            std::string::npos) << read_file(dir.path() / "run.log");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator()), 1);  // the log alone
+}
+
+TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {
+  ScratchDir dir;
+  const auto config = dir.write("dense.json", R"({"name": "dense",
+    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
+    "material": {"Y": 20000, "gamma": 1},
+    "supports": [{"where": "z >= 0.04"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"solver": "dense-lu"}})");
+  const std::filesystem::path out = dir.path() / "out";
+  Outcome o = run_cli("run " + config.string() + " --max-memory 20M -o " + out.string());
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("dense.json: this case needs about 59"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("more than the memory budget of 20 MiB set by --max-memory; raise "
+                          "--max-memory"), std::string::npos) << o.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  o = run_cli("run " + config.string() + " --max-memory 100M -q -o " + out.string());
+  EXPECT_EQ(o.status, 0) << o.output;
+  o = run_cli("run " + config.string() + " --max-memory lots");
+  EXPECT_EQ(o.status, 64) << o.output;
+  EXPECT_NE(o.output.find("expected a size such as 8G"), std::string::npos) << o.output;
+}
+
 TEST(Cli, LongPhasesShowProgressUnlessQuiet) {
   ScratchDir dir;
   // About 4 s of load steps (642 vertices, A rebuilt every step, 10 ms each).

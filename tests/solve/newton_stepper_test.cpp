@@ -211,6 +211,29 @@ TEST(Newton, CutsAStepThatFailsAndStillSucceeds) {
   EXPECT_NE(failed.message.find("newton.max_step_cuts"), std::string::npos);
 }
 
+TEST(Newton, ADivergingStepIsAStatusNamingTheStepWithFiniteUnknowns) {
+  // Gravity a million times too strong for a stiffening law: the Newton
+  // iterates leave every basin, with or without the line search, and every
+  // cut piece fails too. The run stops at step 1 with the cause; the state it
+  // returns is the last one reached (the start), never NaN.
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0), 1e9);
+  for (bool line_search : {true, false}) {
+    SteppingOptions o = newton(2);
+    o.newton.line_search = line_search;
+    o.newton.max_step_cuts = 2;
+    const SteppingSummary s = solve_load_steps(m, o);
+    ASSERT_FALSE(s.success) << line_search;
+    EXPECT_EQ(s.message.rfind("step 1: ", 0), 0u) << s.message;
+    EXPECT_NE(s.message.find("the step was halved 2 times"), std::string::npos) << s.message;
+    EXPECT_TRUE(s.unknowns.allFinite());
+    EXPECT_TRUE(s.steps.empty());
+    // Far from equilibrium the tangent itself becomes singular: named, with its condition.
+    EXPECT_NE(s.message.find("newton: the tangent: the system matrix is numerically singular "
+                             "(reciprocal condition "),
+              std::string::npos) << s.message;
+  }
+}
+
 // A sphere resting on supports at its bottom, pressed by a paddle from above.
 model::Model pressed_sphere(bool sticking) {
   model::Model m = testing::paper_sphere_model();

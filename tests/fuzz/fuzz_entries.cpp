@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fuzz_entries.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "app/experiment.hpp"
+#include "app/runner.hpp"
+#include "geom/area_vectors.hpp"
+#include "geom/error.hpp"
+#include "geom/mesh_check.hpp"
+#include "geom/mesh_io.hpp"
+#include "geom/run_control.hpp"
+
+namespace fiberfluid::fuzz {
+namespace {
+
+// A broken invariant: abort, which libFuzzer and the replay test report.
+void require(bool holds, const char* what) {
+  if (holds) return;
+  std::fprintf(stderr, "fuzz invariant broken: %s\n", what);
+  std::abort();
+}
+
+// ---------------------------------------------------------------- meshes
+void read_mesh(geom::MeshFormat format, const char* name, const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  geom::ReadResult read;
+  try {
+    read = geom::read_surface_bytes(bytes, format, name);
+  } catch (const InputError&) {
+    return;
+  }
+  const geom::Surface& s = read.surface;
+  require(s.dim == 2 || s.dim == 3, "the dimension is 2 or 3");
+  require(s.V.cols() == s.dim && s.F.cols() == s.dim, "V and F have dim columns");
+  require(s.V.allFinite(), "a read surface has finite coordinates");
+  require(s.F.size() == 0 || (s.F.minCoeff() >= 0 && s.F.maxCoeff() < s.num_vertices()),
+          "face indices refer to vertices");
+  const geom::MeshReport report = geom::inspect(s);
+  if (!report.ok()) {
+    require(!report.problems.front().empty(), "a rejected surface says why");
+    return;
+  }
+  const double volume = geom::enclosed_volume(s.V, s.F);
+  require(std::isfinite(volume) && volume > 0.0, "a usable surface encloses a positive volume");
+  const geom::VertexAreaVectors areas = geom::vertex_area_vectors(s.V, s.F);
+  require(areas.S.allFinite(), "area vectors are finite");
+}
+
+// ---------------------------------------------------------------- experiments
+std::optional<nlohmann::json> parse_json(const uint8_t* data, size_t size) {
+  try {
+    return nlohmann::json::parse(data, data + size);
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
+}
+
+const std::filesystem::path kExperiments = FIBERFLUID_EXPERIMENTS;
+
+void read_experiment(const uint8_t* data, size_t size) {
+  const std::optional<nlohmann::json> document = parse_json(data, size);
+  if (!document) return;
+  try {
+    const app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    for (const app::CaseSpec& spec : ex.specs) {
+      std::string why;
+      require(spec.stepping.IsValid(&why), "parsed stepping options are valid");
+    }
+  } catch (const InputError&) {
+  }
+}
+
+// A model is built and run only when its estimate is small: the fuzzer looks
+// for wrong answers and crashes, not for long runs (which the estimate refuses).
+void build_and_run(const uint8_t* data, size_t size) {
+  const std::optional<nlohmann::json> document = parse_json(data, size);
+  if (!document) return;
+  struct Budgets {  // small while this input runs (the replay test shares the process)
+    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.2); }
+    ~Budgets() { set_memory_budget(0.0), set_time_budget(0.0); }
+  } budgets;  // the estimate refuses longer cases before pruning
+  try {
+    app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    if (ex.kind != app::Experiment::Kind::Simulate || ex.specs.size() > 4) return;
+    app::build_experiment(ex);
+    ex.fem_reference.reset();  // tetrahedral meshing: seconds per input
+    app::RunOptions options;
+    options.jobs = 1;
+    const app::ExperimentResult result = app::run_experiment(ex, {}, options);
+    for (const app::RunResult& run : result.runs) {
+      if (!run.summary.success) {
+        require(!run.summary.message.empty(), "a failed run says why");
+        continue;
+      }
+      require(run.summary.unknowns.allFinite(), "a successful run's unknowns are finite");
+      for (const solve::StepRecord& r : run.summary.steps)
+        require(std::isfinite(r.pressure) && std::isfinite(r.volume) &&
+                    std::isfinite(r.max_displacement),
+                "a successful run's step records are finite");
+    }
+  } catch (const InputError&) {
+  }
+}
+
+}  // namespace
+
+const std::vector<Target>& targets() {
+  using geom::MeshFormat;
+  static const std::vector<Target> all = {
+      {"obj", ".obj", [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Obj, "fuzz.obj", d, n); }},
+      {"off", ".off", [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Off, "fuzz.off", d, n); }},
+      {"stl_ascii", ".stl",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Stl, "fuzz.stl", d, n); }},
+      {"stl_binary", ".stl",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Stl, "fuzz.stl", d, n); }},
+      {"ply_ascii", ".ply",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Ply, "fuzz.ply", d, n); }},
+      {"ply_binary", ".ply",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Ply, "fuzz.ply", d, n); }},
+      {"experiment", ".json", read_experiment},
+      {"model_setup", ".json", build_and_run},
+  };
+  return all;
+}
+
+const Target* find_target(const std::string& name) {
+  for (const Target& t : targets())
+    if (name == t.name) return &t;
+  return nullptr;
+}
+
+}  // namespace fiberfluid::fuzz

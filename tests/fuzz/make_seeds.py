@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Writes the fuzz targets' small seed inputs into tests/fuzz/seeds/TARGET/.
+
+The repository's meshes (data/meshes) and experiments (experiments/) are
+seeds too; scripts/fuzz.sh adds them. These cover what those do not: every
+format variant (OFF, STL ASCII and binary, PLY ASCII and both binary byte
+orders, OBJ index forms and 2D outlines) and small experiments of each kind.
+"""
+import json
+import pathlib
+import struct
+
+HERE = pathlib.Path(__file__).resolve().parent / "seeds"
+
+# A tetrahedron with outward faces, and a cube with outward quads.
+TET_V = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+TET_F = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+CUBE_V = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+CUBE_F = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+
+
+def write(target, name, data):
+    folder = HERE / target
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / name).write_bytes(data if isinstance(data, bytes) else data.encode())
+
+
+def obj(V, F, form="{}"):
+    lines = [f"v {x} {y} {z}" for x, y, z in V]
+    lines += ["f " + " ".join(form.format(i + 1) for i in f) for f in F]
+    return "\n".join(lines) + "\n"
+
+
+def off(V, F):
+    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [f"{x} {y} {z}" for x, y, z in V]
+    lines += [f"{len(f)} " + " ".join(map(str, f)) for f in F]
+    return "\n".join(lines) + "\n"
+
+
+def triangles(V, F):
+    for f in F:
+        for k in range(1, len(f) - 1):
+            yield V[f[0]], V[f[k]], V[f[k + 1]]
+
+
+def stl_ascii(V, F):
+    out = ["solid seed"]
+    for a, b, c in triangles(V, F):
+        out += ["facet normal 0 0 0", "outer loop"]
+        out += [f"vertex {p[0]} {p[1]} {p[2]}" for p in (a, b, c)]
+        out += ["endloop", "endfacet"]
+    return "\n".join(out + ["endsolid seed"]) + "\n"
+
+
+def stl_binary(V, F):
+    tris = list(triangles(V, F))
+    data = b"binary seed".ljust(80, b" ") + struct.pack("<I", len(tris))
+    for t in tris:
+        data += struct.pack("<3f", 0, 0, 0)
+        for p in t:
+            data += struct.pack("<3f", *p)
+        data += b"\0\0"
+    return data
+
+
+def ply(V, F, fmt):
+    header = (f"ply\nformat {fmt} 1.0\ncomment seed\nelement vertex {len(V)}\n"
+              "property float x\nproperty float y\nproperty float z\n"
+              f"element face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
+    if fmt == "ascii":
+        body = "".join(f"{x} {y} {z}\n" for x, y, z in V)
+        body += "".join(f"{len(f)} " + " ".join(map(str, f)) + "\n" for f in F)
+        return (header + body).encode()
+    e = "<" if fmt == "binary_little_endian" else ">"
+    body = b"".join(struct.pack(e + "3f", *v) for v in V)
+    body += b"".join(struct.pack(e + "B" + "i" * len(f), len(f), *f) for f in F)
+    return header.encode() + body
+
+
+def main():
+    write("obj", "tetrahedron.obj", obj(TET_V, TET_F))
+    write("obj", "cube_quads_texture_normal.obj", obj(CUBE_V, CUBE_F, "{0}/{0}/{0}"))
+    write("obj", "tetrahedron_negative.obj",
+          obj(TET_V, []) + "".join(f"f {a - 4} {b - 4} {c - 4}\n" for a, b, c in TET_F))
+    write("obj", "square_2d.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 4\nl 4 1\n")
+    write("off", "tetrahedron.off", off(TET_V, TET_F))
+    write("off", "cube_quads.off", off(CUBE_V, CUBE_F))
+    write("stl_ascii", "tetrahedron.stl", stl_ascii(TET_V, TET_F))
+    write("stl_ascii", "cube.stl", stl_ascii(CUBE_V, CUBE_F))
+    write("stl_binary", "tetrahedron.stl", stl_binary(TET_V, TET_F))
+    write("stl_binary", "cube.stl", stl_binary(CUBE_V, CUBE_F))
+    write("ply_ascii", "tetrahedron.ply", ply(TET_V, TET_F, "ascii"))
+    write("ply_ascii", "cube_quads.ply", ply(CUBE_V, CUBE_F, "ascii"))
+    for order in ("binary_little_endian", "binary_big_endian"):
+        write("ply_binary", f"tetrahedron_{order}.ply", ply(TET_V, TET_F, order))
+        write("ply_binary", f"cube_{order}.ply", ply(CUBE_V, CUBE_F, order))
+
+    sphere = {"generator": "icosphere", "subdivisions": 1, "radius": 0.05}
+    experiments = {
+        "sphere_gravity": {"surface": sphere, "material": {"Y": 5000, "gamma": 1},
+                           "supports": [{"where": "z <= -0.04"}],
+                           "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81],
+                                      "density": 1000}],
+                           "stepping": {"steps": 3}},
+        "cube_newton_paddles": {
+            "surface": {"generator": "box", "min": [0, 0, 0], "max": [1, 1, 1],
+                        "segments": [2, 2, 2]},
+            "material": {"law": {"type": "exponential", "Y0": 1000, "beta": 2}, "gamma": 5},
+            "paddles": [{"label": "top", "axis": "z", "side": "above", "compression": 0.2},
+                        {"label": "bottom", "axis": "z", "side": "below", "travel": 0}],
+            "supports": [{"where": "z <= 0.01", "axes": "xy"}],
+            "stepping": {"steps": 2, "scheme": "newton"}},
+        "rectangle_sweep": {
+            "surface": {"generator": "rectangle", "min": [0, 0], "max": [2, 1],
+                        "segments": [4, 2]},
+            "material": {"Y": 100, "gamma": 0.5},
+            "supports": [{"box": {"min": [-0.1, -0.1], "max": [0.1, 1.1]}}],
+            "prescribed": [{"where": "x >= 1.9", "displacement": [0.1, 0]}],
+            "stepping": {"steps": 2, "solver": "pcg"},
+            "variants": [{"name": "soft"}, {"name": "stiff", "material": {"Y": 1000}}]},
+        "liver_point_load": {
+            "surface": {"file": "../data/meshes/liver.obj", "scale": 0.04},
+            "material": {"Y": 20000, "gamma": 50},
+            "supports": [{"where": "y <= 0.015"}],
+            "loads": [{"type": "point", "vertex": 10, "force": [0, -1, 0]}],
+            "stepping": {"steps": 2, "solver": "cholmod"}},
+    }
+    for name, document in experiments.items():
+        text = json.dumps(dict(name=name, **document), indent=1)
+        write("experiment", name + ".json", text)
+        write("model_setup", name + ".json", text)
+
+
+if __name__ == "__main__":
+    main()
