@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz (clang, with ASan and UBSan, in
 # build-fuzz/) and runs each for SECONDS (default 60), as many at once as
-# there are cores. Each starts from its corpus: the seeds in tests/fuzz/seeds,
+# there are cores (or FUZZ_JOBS). Each starts from its corpus: the seeds in tests/fuzz/seeds,
 # the repository's meshes or experiments, and what earlier runs here added
 # (build-fuzz/corpus). A crash, a hang past 25 s, a leak or a broken invariant
 # stops that target: its input is copied to tests/fuzz/regressions/TARGET/,
@@ -64,7 +64,7 @@ running=0
 for target in "${targets[@]}"; do
   fuzz_one "$target" &
   running=$((running + 1))
-  if [ "$running" -ge "$(nproc)" ]; then
+  if [ "$running" -ge "${FUZZ_JOBS:-$(nproc)}" ]; then
     wait -n || failed=1
     running=$((running - 1))
   fi

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds fiberfluid with its tests (RelWithDebInfo) and runs them all; then
 # builds the suite again with AddressSanitizer and UndefinedBehaviorSanitizer
-# (build-sanitize/) and runs it there too.
+# (build-sanitize/) and runs it there too; then runs each fuzz target for 30 s.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -26,3 +26,8 @@ start=$(date +%s)
 ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" \
       -E 'install\.|bunny_gravity\.json|benchmark_rod\.json'
 echo "sanitized tests (ASan + UBSan): passed in $(( $(date +%s) - start )) s"
+
+# The libFuzzer targets (clang, ASan + UBSan, build-fuzz/), each for 30 s from
+# its seeds: a crash, hang, leak or broken invariant fails the run and leaves
+# its input in tests/fuzz/regressions/ (scripts/fuzz.sh).
+scripts/fuzz.sh 30

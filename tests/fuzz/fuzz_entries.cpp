@@ -74,13 +74,15 @@ void read_experiment(const uint8_t* data, size_t size) {
   }
 }
 
-// A model is built and run only when its estimate is small: the fuzzer looks
-// for wrong answers and crashes, not for long runs (which the estimate refuses).
+// A model is built and run only when its estimate is small (0.02 s in Release,
+// a second or so in this instrumented build): the fuzzer looks for wrong
+// answers and crashes, not for long runs, which the estimate refuses before
+// pruning.
 void build_and_run(const uint8_t* data, size_t size) {
   const std::optional<nlohmann::json> document = parse_json(data, size);
   if (!document) return;
   struct Budgets {  // small while this input runs (the replay test shares the process)
-    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.2); }
+    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.02); }
     ~Budgets() { set_memory_budget(0.0), set_time_budget(0.0); }
   } budgets;  // the estimate refuses longer cases before pruning
   try {

@@ -20,6 +20,14 @@ CUBE_V = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
 CUBE_F = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
 
 
+# An L-shaped prism: concave, so a model on it prunes fibers (in milliseconds).
+L_XY = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+L_V = [(x, y, 0) for x, y in L_XY] + [(x, y, 1) for x, y in L_XY]
+L_CAP = [(3, 4, 5), (3, 5, 0), (3, 0, 1), (3, 1, 2)]  # a fan from the reflex corner, counter-clockwise
+L_F = ([(a, c, b) for a, b, c in L_CAP] + [(a + 6, b + 6, c + 6) for a, b, c in L_CAP] +
+       [(k, (k + 1) % 6, (k + 1) % 6 + 6, k + 6) for k in range(6)])
+
+
 def write(target, name, data):
     folder = HERE / target
     folder.mkdir(parents=True, exist_ok=True)
@@ -83,6 +91,7 @@ def main():
     write("obj", "cube_quads_texture_normal.obj", obj(CUBE_V, CUBE_F, "{0}/{0}/{0}"))
     write("obj", "tetrahedron_negative.obj",
           obj(TET_V, []) + "".join(f"f {a - 4} {b - 4} {c - 4}\n" for a, b, c in TET_F))
+    write("obj", "l_prism_concave.obj", obj(L_V, L_F))
     write("obj", "square_2d.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 4\nl 4 1\n")
     write("off", "tetrahedron.off", off(TET_V, TET_F))
     write("off", "cube_quads.off", off(CUBE_V, CUBE_F))
@@ -119,6 +128,17 @@ def main():
             "prescribed": [{"where": "x >= 1.9", "displacement": [0.1, 0]}],
             "stepping": {"steps": 2, "solver": "pcg"},
             "variants": [{"name": "soft"}, {"name": "stiff", "material": {"Y": 1000}}]},
+        "l_prism_pruned": {
+            "surface": {"file": "../tests/fuzz/seeds/obj/l_prism_concave.obj", "scale": 0.1},
+            "material": {"Y": 1000, "gamma": 1}, "fibers": {"write": "pruned"},
+            "supports": [{"where": "z <= 0.01"}],
+            "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+            "stepping": {"steps": 2, "scheme": "newton"}},
+        "concave_polygon_2d": {
+            "surface": {"generator": "polygon",
+                        "points": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]},
+            "material": {"Y": 100}, "supports": [{"where": "y <= 0.1"}],
+            "loads": [{"type": "point", "vertex": 4, "force": [0.5, 0]}]},
         "liver_point_load": {
             "surface": {"file": "../data/meshes/liver.obj", "scale": 0.04},
             "material": {"Y": 20000, "gamma": 50},
