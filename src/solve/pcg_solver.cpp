@@ -44,14 +44,18 @@ class PcgSolver final : public SchurSolver {
   }
 
   Status solve_K(const Eigen::VectorXd& f, Eigen::VectorXd* w) override {
-    const double norm_f = f.norm();
     *w = Eigen::VectorXd::Zero(f.size());
+    if (!f.allFinite()) return Status::failure("pcg: the right-hand side is not finite");
+    const double norm_f = f.stableNorm();  // no overflow of the squares
     if (norm_f == 0.0) return {};
     Eigen::VectorXd r = f, z = precondition(r), p = z;
     double rz = r.dot(z);
     for (int it = 1; it <= options_.max_iterations; ++it) {
       const Eigen::VectorXd q = system_->apply_K(p);
       const double pq = p.dot(q);
+      if (!std::isfinite(pq))
+        return Status::failure("pcg: a product with the matrix is not finite at iteration " +
+                               std::to_string(it));
       if (!(pq > 0.0))
         return Status::failure("pcg: the system is not positive definite (p.Kp = " +
                                std::to_string(pq) + ")");
@@ -60,7 +64,7 @@ class PcgSolver final : public SchurSolver {
       r -= alpha * q;
       ++statistics_.iterations;
       report_progress("pcg iteration", it, 0.0);
-      const double residual = r.norm();
+      const double residual = r.stableNorm();
       if (residual <= options_.tolerance * norm_f) return {};
       if (!std::isfinite(residual))
         return Status::failure("pcg: the residual is not finite at iteration " + std::to_string(it));

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
+#include <cmath>
 
 #include "geom/fiber_pruning.hpp"
 #include "geom/mesh_io.hpp"
@@ -185,6 +186,29 @@ TEST(BackendFailures, PcgWithoutConvergence) {
   tight.tolerance = 1e-15;
   tight.max_iterations = 1;
   expect_failure(run(testing::paper_sphere_model(), SolverKind::PCG, tight), "no convergence in 1");
+}
+
+TEST(BackendFailures, PcgNamesNonFiniteValues) {
+  const Eigen::MatrixXd K = 4.0 * Eigen::MatrixXd::Identity(20, 20) +
+                            Eigen::MatrixXd::Constant(20, 20, 0.1);
+  PcgOptions pcg;
+  auto solve_with = [&](const Eigen::MatrixXd& block, const Eigen::VectorXd& rhs) {
+    const model::DenseBorderedSystem system({block}, Eigen::VectorXd::Ones(20));
+    const auto solver = make_linear_solver(SolverKind::PCG, pcg);
+    EXPECT_TRUE(solver->analyze_pattern(system).ok);
+    Status status = solver->factorize(system);
+    Eigen::VectorXd x;
+    if (status.ok) status = solver->solve(rhs, &x);
+    EXPECT_FALSE(status.ok);
+    return status.message;
+  };
+  Eigen::VectorXd rhs = Eigen::VectorXd::Ones(21);
+  rhs[3] = std::nan("");
+  EXPECT_NE(solve_with(K, rhs).find("pcg: the right-hand side is not finite"), std::string::npos);
+  // A right-hand side near the largest double: its inner products overflow.
+  const std::string message = solve_with(K, 1e300 * Eigen::VectorXd::Ones(21));
+  EXPECT_NE(message.find("pcg: a product with the matrix is not finite at iteration 1"),
+            std::string::npos) << message;
 }
 
 TEST(BackendFailures, SingularSetupForEveryBackend) {
