@@ -156,16 +156,23 @@ int count_files(const std::filesystem::path& folder) {
   return n;
 }
 
-TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
-  ScratchDir dir;
-  const std::filesystem::path out = dir.path() / "out";
-  // Long enough to be killed part way: 642 vertices, 400 steps, a .vtu per step.
+// A run long enough to be stopped part way: 642 vertices, A rebuilt every
+// step (about 10 ms each), a .vtu per step.
+nlohmann::json many_steps(int steps) {
   nlohmann::json config = nlohmann::json::parse(R"({"name": "long",
     "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
     "material": {"Y": 20000, "gamma": 1},
     "supports": [{"where": "z >= 0.04"}],
     "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
-    "stepping": {"steps": 400, "rebuild_matrix": true, "solver": "block-cholesky"}})");
+    "stepping": {"rebuild_matrix": true, "solver": "block-cholesky"}})");
+  config["stepping"]["steps"] = steps;
+  return config;
+}
+
+TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
+  ScratchDir dir;
+  const std::filesystem::path out = dir.path() / "out";
+  nlohmann::json config = many_steps(400);
   const auto long_run = dir.write("long.json", config.dump());
   config["stepping"]["steps"] = 3;
   const auto short_run = dir.write("short.json", config.dump());
@@ -226,12 +233,7 @@ std::string read_file(const std::filesystem::path& file) {
 TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
   ScratchDir dir;
   const std::filesystem::path out = dir.path() / "out";
-  nlohmann::json config = nlohmann::json::parse(R"({"name": "long",
-    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
-    "material": {"Y": 20000, "gamma": 1},
-    "supports": [{"where": "z >= 0.04"}],
-    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
-    "stepping": {"steps": 3, "rebuild_matrix": true, "solver": "block-cholesky"}})");
+  nlohmann::json config = many_steps(3);
   ASSERT_EQ(run_cli("run " + dir.write("short.json", config.dump()).string() + " -q -o " +
                     out.string()).status, 0);
   const std::string earlier = read_file(out / "summary.json");
@@ -277,12 +279,9 @@ TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
 
 TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {
   ScratchDir dir;
-  const auto config = dir.write("dense.json", R"({"name": "dense",
-    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
-    "material": {"Y": 20000, "gamma": 1},
-    "supports": [{"where": "z >= 0.04"}],
-    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
-    "stepping": {"solver": "dense-lu"}})");
+  nlohmann::json dense = many_steps(1);
+  dense["stepping"] = {{"solver", "dense-lu"}};
+  const auto config = dir.write("dense.json", dense.dump());
   const std::filesystem::path out = dir.path() / "out";
   Outcome o = run_cli("run " + config.string() + " --max-memory 20M -o " + out.string());
   EXPECT_EQ(o.status, 1) << o.output;
@@ -299,14 +298,10 @@ TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {
 
 TEST(Cli, LongPhasesShowProgressUnlessQuiet) {
   ScratchDir dir;
-  // About 4 s of load steps (642 vertices, A rebuilt every step, 10 ms each).
-  const auto config = dir.write("steps.json", R"({"name": "steps",
-    "surface": {"generator": "icosphere", "subdivisions": 3, "radius": 0.05},
-    "material": {"Y": 20000, "gamma": 1},
-    "supports": [{"where": "z >= 0.04"}],
-    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
-    "stepping": {"steps": 400, "rebuild_matrix": true, "solver": "block-cholesky"},
-    "output": {"vtk": false}})");
+  // About 4 s of load steps.
+  nlohmann::json steps = many_steps(400);
+  steps["output"] = {{"vtk", false}};
+  const auto config = dir.write("steps.json", steps.dump());
   Outcome o = run_cli("run " + config.string() + " -o " + (dir.path() / "a").string());
   ASSERT_EQ(o.status, 0) << o.output;
   // Not a terminal: plain lines with the elapsed time and an estimate of what is left.
