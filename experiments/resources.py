@@ -36,12 +36,8 @@ CASES = [
     ("sphere 2562, dense-lu", sphere(4, "dense-lu", steps=3)),
     ("sphere 10242, pcg", sphere(5, "pcg", steps=3)),
     ("sphere 642, newton", sphere(3, scheme="newton", steps=5)),
-    ("liver 139, pruned", {"name": "liver", "surface": {"file": "LIVER", "scale": 0.04},
-                            "material": {"Y": 20000, "gamma": 50},
-                            "supports": [{"where": "y <= 0.015"}],
-                            "loads": [{"type": "gravity", "acceleration": [0, -9.81, 0]}],
-                            "stepping": {"steps": 10}, "output": {"vtk": False}}),
-    ("bunny 1366, pruned", "BUNNY"),
+    ("liver 139, pruned", "liver_gravity"),
+    ("bunny 1366, pruned", "bunny_gravity"),
 ]
 
 
@@ -57,12 +53,11 @@ def main():
     print(f"{'case':24} {'solver':15} {'est. memory':>12} {'peak RSS':>10} {'ratio':>6}"
           f" {'est. time':>10} {'wall time':>10} {'ratio':>6}")
     for label, config in CASES:
-        if config == "BUNNY":
-            path = root / "experiments" / "bunny_gravity.json"
+        if isinstance(config, str):  # an experiment of the repository
+            path = root / "experiments" / (config + ".json")
         else:
-            text = json.dumps(config).replace("LIVER", str(root / "data" / "meshes" / "liver.obj"))
             path = out / (config["name"] + ".json")
-            path.write_text(text)
+            path.write_text(json.dumps(config))
         folder = out / path.stem
         start = time.monotonic()
         done = subprocess.run([str(binary), "run", str(path), "-q", "-o", str(folder)],

@@ -111,25 +111,32 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
   return report;
 }
 
-// The surface as given, its used vertices as the model's, and the fibers:
-// the case's cost is estimated (and refused beyond the memory or time
-// budget) before the convexity check and again, once it has said whether the
-// body is pruned, before pruning.
-void build_geometry(const CaseSpec& spec, geom::Surface input, Case& c) {
+// The surface as given and its used vertices as the model's.
+void set_surface(geom::Surface input, Case& c) {
   c.input_surface = std::move(input);
   const geom::CompactSurface compact = geom::remove_unused_vertices(c.input_surface);
   c.model_to_input = compact.to_input;
   c.model.surface = compact.surface;
+}
+
+// Refuses a case whose estimate exceeds the budgets; notes a long one.
+void estimate(const CaseSpec& spec, PruningWork pruning, Case& c) {
+  c.estimate = estimate_resources(c.model, c.stepping, pruning);
+  require_within_budget(c.estimate, spec);
+}
+
+// The fibers of a case whose model parts are built: its cost is estimated
+// (and refused beyond the memory or time budget) before the convexity check,
+// and again before pruning once the check has said whether it prunes.
+void add_fibers(const CaseSpec& spec, Case& c) {
   const int n = c.model.num_vertices();
-  // First as if convex (the convexity check is N x F itself), then as it is.
-  require_within_budget(estimate_resources(spec, c.model.surface, false), spec);
+  estimate(spec, spec.fibers.pruning ? PruningWork::ConvexityCheck : PruningWork::None, c);
   const bool concave = spec.fibers.pruning && !geom::is_convex(c.model.surface);
   if (concave && n > kLargestPruned)
     spec.fibers.field.fail("pruning", "a concave body of " + std::to_string(n) +
                                           " vertices is beyond exact pruning (at most " +
                                           std::to_string(kLargestPruned) + "); set \"off\"");
-  c.estimate = estimate_resources(spec, c.model.surface, concave);
-  require_within_budget(c.estimate, spec);
+  if (concave) estimate(spec, PruningWork::Prune, c);
   if (c.estimate.seconds >= 10.0 || c.estimate.peak_bytes >= 0.25 * memory_budget_bytes())
     report_note("estimate for a long run: " + c.estimate.describe());
   c.fibers = prune(spec.fibers, concave, c.model);
@@ -293,8 +300,9 @@ std::vector<int> resolve_selection(const SelectionSpec& spec, const Case& c) {
 
 Case build_case(const CaseSpec& spec, std::vector<std::string>* warnings) {
   Case c;
-  build_geometry(spec, build_surface(spec.surface, warnings), c);
+  set_surface(build_surface(spec.surface, warnings), c);
   ModelBuilder(spec, c).build();
+  add_fibers(spec, c);
   return c;
 }
 
@@ -309,8 +317,9 @@ Case build_case(const CaseSpec& spec, const geom::Surface& surface,
   if (warnings)
     for (const auto& w : report.warnings) warnings->push_back(label + ": " + w);
   Case c;
-  build_geometry(spec, surface, c);
+  set_surface(surface, c);
   ModelBuilder(spec, c).build();
+  add_fibers(spec, c);
   return c;
 }
 
@@ -322,9 +331,8 @@ Case build_case(const CaseSpec& spec, const Case& earlier) {
   c.model.fibers = earlier.model.fibers;
   c.model.connection_count = earlier.model.connection_count;
   c.fibers = earlier.fibers;
-  c.estimate = estimate_resources(spec, c.model.surface, c.fibers.pruning && !c.fibers.convex);
-  require_within_budget(c.estimate, spec);
   ModelBuilder(spec, c).build();
+  estimate(spec, PruningWork::None, c);  // pruned once, for the earlier case
   return c;
 }
 

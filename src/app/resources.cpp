@@ -14,29 +14,47 @@
 namespace fiberfluid::app {
 namespace {
 
-// Typical counts where the work depends on the data (from the scaling and
-// Newton benchmarks): PCG iterations per solve, Newton iterations per load
-// step, GMRES products per Newton iteration.
-constexpr double kPcgIterations = 60.0;
-constexpr double kNewtonIterations = 4.0;
-constexpr double kKrylovProducts = 20.0;
-// Per vertex: the surface, area vectors, unknowns, residuals, outputs.
-constexpr double kBytesPerVertex = 4096.0;
+// Typical counts where the work depends on the data (scripts/resources.sh:
+// the sphere's load steps and Newton steps): PCG iterations per solve, Newton
+// iterations per load step, GMRES products per Newton iteration.
+constexpr double kPcgIterations = 15.0;
+constexpr double kNewtonIterations = 2.5;
+constexpr double kKrylovProducts = 6.0;
+// The process itself (libraries, CGAL, OpenMP pools) and each vertex's
+// surface, area vectors, unknowns, outputs.
+constexpr double kProcessBytes = 20.0 * 1024 * 1024;
+constexpr double kBytesPerVertex = 1024.0;
 
-// The three axis blocks share one factor when every axis is held alike and
-// the material is isotropic (FiberSystem::blocks_equal).
-bool blocks_may_be_equal(const CaseSpec& spec) {
-  const Eigen::VectorXd& f = spec.material.per_axis;
-  if (f.size() > 0 && (f.array() != f[0]).any()) return false;
-  for (const ConstraintSpec& c : spec.constraints)
-    if (!c.prescribed && !c.axes.empty() && c.axes.size() < 2) return false;
-  return true;
+// The axis blocks of the structured system as the solvers see them
+// (FiberSystem): per axis the vertices not held by a support, or all of them
+// with the penalty method; equal when every axis holds the same vertices
+// with the same axis factor, so one factor serves all.
+struct Blocks {
+  double largest = 0.0;
+  int factors = 1;
+};
+
+Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
+  const int n = m.num_vertices(), dim = m.dim();
+  std::vector<std::vector<bool>> held(static_cast<size_t>(dim), std::vector<bool>(static_cast<size_t>(n)));
+  if (o.boundary_method == model::BoundaryMethod::Elimination)
+    for (const model::Constraint& c : m.constraints)
+      held[static_cast<size_t>(c.axis)][static_cast<size_t>(c.vertex)] = true;
+  Blocks b;
+  bool equal = true;
+  for (int a = 0; a < dim; ++a) {
+    const auto& h = held[static_cast<size_t>(a)];
+    b.largest = std::max(b.largest, static_cast<double>(std::count(h.begin(), h.end(), false)));
+    equal = equal && h == held[0] && m.material.axis_factors[a] == m.material.axis_factors[0];
+  }
+  b.factors = equal ? 1 : dim;
+  return b;
 }
 
-solve::SolverKind choose(const CaseSpec& spec, double n, int factors) {
-  if (spec.stepping.solver != solve::SolverKind::Auto) return spec.stepping.solver;
-  if (n <= 600) return solve::SolverKind::DenseLU;  // as solve::choose_solver
-  if (8.0 * n * n * (factors + 1) < 0.375 * memory_budget_bytes())
+solve::SolverKind choose(const solve::SteppingOptions& o, const Blocks& b) {
+  if (o.solver != solve::SolverKind::Auto) return o.solver;
+  if (b.largest <= 600) return solve::SolverKind::DenseLU;  // as solve::choose_solver
+  if (8.0 * b.largest * b.largest * (b.factors + 1) < 0.375 * memory_budget_bytes())
     return solve::SolverKind::BlockCholesky;
   return solve::SolverKind::PCG;
 }
@@ -66,82 +84,88 @@ std::string ResourceEstimate::describe() const {
   return out.str();
 }
 
-ResourceEstimate estimate_resources(const CaseSpec& spec, const geom::Surface& surface,
-                                    bool concave, const KernelSpeed& speed) {
+ResourceEstimate estimate_resources(const model::Model& model,
+                                    const solve::SteppingOptions& o, PruningWork pruning,
+                                    const KernelSpeed& speed) {
   ResourceEstimate e;
+  const geom::Surface& surface = model.surface;
   const double N = surface.num_vertices(), d = surface.dim;
-  const double pairs = 0.5 * N * (N - 1.0), n_unknowns = d * N + 1.0;
-  const solve::SteppingOptions& o = spec.stepping;
+  const double pairs = 0.5 * N * (N - 1.0), unknowns = d * N + 1.0;
   const double steps = o.steps;
 
-  e.parts.push_back({"model", kBytesPerVertex * N, 0.0, true});
-  if (spec.fibers.pruning)  // N x F orientation tests when convex; a concave body stops early
+  e.parts.push_back({"model", kProcessBytes + kBytesPerVertex * N, 0.0, true});
+  if (pruning != PruningWork::None)  // N x F tests when convex; a concave body stops early
     e.parts.push_back({"convexity check", 0.0,
                        N * surface.num_faces() / speed.orientation_tests_per_second});
-  if (concave)  // an N x N byte table, kept for the solvers; an AABB tree per thread
-    e.parts.push_back({"pruning", N * N + 400.0 * surface.num_faces(),
+  // An N x N byte table, kept for the solvers, and per thread an AABB tree and
+  // the exact solid (about 12 kB a face in all: the bunny's peak).
+  if (pruning == PruningWork::Prune)
+    e.parts.push_back({"pruning", N * N + 12000.0 * surface.num_faces(),
                        pairs / speed.prune_pairs_per_second, true});
 
-  const int factors = blocks_may_be_equal(spec) ? 1 : static_cast<int>(d);
-  const double product = d * pairs / speed.pair_updates_per_second;  // K (or R) once
+  const Blocks blocks = axis_blocks(model, o);
+  const double n = blocks.largest, factors = blocks.factors;
+  const double product = d * pairs / speed.pair_updates_per_second;  // K v, every axis block
+  const double residual = 2.0 * pairs / speed.residual_pairs_per_second;
   const bool newton = o.scheme == solve::Scheme::Newton;
   const bool dense_tangent =
       newton && (o.newton.tangent == solve::TangentSolver::Dense ||
-                 (o.newton.tangent == solve::TangentSolver::Auto && n_unknowns <= 600));
-  const solve::SolverKind kind =
-      dense_tangent ? solve::SolverKind::DenseLU : choose(spec, N, factors);
+                 (o.newton.tangent == solve::TangentSolver::Auto && unknowns <= 600));
+  const solve::SolverKind kind = dense_tangent ? solve::SolverKind::DenseLU : choose(o, blocks);
   e.solver = solve::to_string(kind);
 
-  // One factorisation of the structured system (or the Newton preconditioner).
+  // One factorisation of the structured system (or the Newton preconditioner)
+  // and one solve with it.
   ResourcePart factor{"factorisation", 0.0, 0.0};
+  double solve_seconds = 0.0;
+  const double m = d * n + 1.0;  // the reduced unknowns
   switch (kind) {
-    case solve::SolverKind::DenseLU:
-      factor.bytes = 2.0 * 8.0 * n_unknowns * n_unknowns;  // the matrix and its LU
-      factor.seconds = 2.0 / 3.0 * n_unknowns * n_unknowns * n_unknowns /
-                           speed.dense_flops_per_second + d * d * product;
+    case solve::SolverKind::DenseLU:  // the assembled matrix, factored in a copy
+      factor.bytes = 1.2 * 8.0 * m * m;
+      factor.seconds = 2.0 / 3.0 * m * m * m / speed.factor_flops_per_second + product;
+      solve_seconds = 2.0 * m * m / speed.triangular_flops_per_second;
       break;
     case solve::SolverKind::BlockCholesky:
-      factor.bytes = 8.0 * N * N * (factors + 1);
-      factor.seconds = factors * N * N * N / 3.0 / speed.dense_flops_per_second + product;
+      factor.bytes = 8.0 * n * n * factors;
+      factor.seconds = factors * n * n * n / 3.0 / speed.factor_flops_per_second + product;
+      // The Schur complement's solves and each step's: forward and back per axis.
+      solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;
       break;
     case solve::SolverKind::Cholmod:  // dense bulk blocks: every pair a nonzero
-      factor.bytes = d * (12.0 * N * N + 4.0 * N * N);
-      factor.seconds = d * N * N * N / 3.0 / speed.sparse_flops_per_second + product;
+      factor.bytes = factors * (12.0 * n * n + 4.0 * n * n);
+      factor.seconds = factors * n * n * n / 3.0 / speed.sparse_flops_per_second + product;
+      solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;
       break;
-    case solve::SolverKind::PCG:  // the surface-tension Laplacian's sparse factor
+    case solve::SolverKind::PCG:  // the bulk diagonal and the surface Laplacian's sparse factor
     case solve::SolverKind::Auto:
-      factor.bytes = 64.0 * 40.0 * N;
-      factor.seconds = 1e-6 * N;
+      factor.bytes = 500.0 * N;
+      factor.seconds = product;
+      solve_seconds = (kPcgIterations + 1.0) * product;
       break;
   }
-  const double solve_seconds = kind == solve::SolverKind::PCG
-                                   ? kPcgIterations * product
-                                   : d * 8.0 * N * N / speed.dense_flops_per_second;
 
   if (newton) {
     const double iterations = steps * kNewtonIterations;
-    ResourcePart tangent{"newton iterations", 0.0, 0.0};
+    ResourcePart tangent{std::to_string(o.steps) + " Newton steps", factor.bytes, 0.0};
     if (dense_tangent) {
-      tangent.bytes = factor.bytes;
-      tangent.seconds = iterations * factor.seconds;
+      tangent.seconds = iterations * (factor.seconds + residual);
     } else {
       // The stored pair coefficients (when they fit a quarter of the
-      // budget), the preconditioner refactored per step, GMRES products.
+      // budget), the preconditioner once per step, GMRES products.
       const double stored = 2.0 * 8.0 * N * N;
-      tangent.bytes = factor.bytes + (stored < 0.25 * memory_budget_bytes() ? stored : 0.0) +
-                      8.0 * n_unknowns * (o.newton.krylov_restart + 2);
+      tangent.bytes += (stored < 0.25 * memory_budget_bytes() ? stored : 0.0) +
+                       8.0 * unknowns * (o.newton.krylov_restart + 2);
       tangent.seconds = steps * factor.seconds +
-                        iterations * (kKrylovProducts * 3.0 * product + solve_seconds);
+                        iterations * (residual + kKrylovProducts * (3.0 * product + solve_seconds));
     }
-    tangent.name = std::to_string(o.steps) + " Newton steps";
     e.parts.push_back(tangent);
   } else {
     const double factorizations = o.rebuild_matrix ? steps : 1.0;
     factor.seconds *= factorizations;
     if (o.rebuild_matrix) factor.name = std::to_string(o.steps) + " factorisations";
     e.parts.push_back(factor);
-    const double per_step = solve_seconds + (o.measure_residual ? product : 0.0);
-    e.parts.push_back({std::to_string(o.steps) + " load steps", 8.0 * n_unknowns * 8.0,
+    const double per_step = solve_seconds + (o.measure_residual ? residual : 0.0);
+    e.parts.push_back({std::to_string(o.steps) + " load steps", 8.0 * unknowns * 8.0,
                        steps * per_step});
   }
 

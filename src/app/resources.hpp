@@ -8,28 +8,31 @@
 #include <string>
 #include <vector>
 
-#include "geom/surface.hpp"
+#include "model/model.hpp"
+#include "solve/load_stepper.hpp"
 
 namespace fiberfluid::app {
 
 struct CaseSpec;  // case_spec.hpp, which keeps an estimate in each Case
 
 // This machine's speed for the kernels the estimate counts (Release build,
-// all cores). Measured here with experiments/resources (scripts/resources.sh):
-// rerun it and put the figures here on another machine.
+// both cores), from scripts/resources.sh on this 2-core machine: rerun it
+// and put the figures here on another machine.
 struct KernelSpeed {
-  double prune_pairs_per_second = 1.1e5;        // exact pruning, pair tests (concave bodies)
-  double orientation_tests_per_second = 3e8;    // the convexity check: N x F orientation tests
-  double dense_flops_per_second = 3e10;         // LAPACK dgetrf / dpotrf on large matrices
-  double pair_updates_per_second = 4e8;         // one fiber pair in a product or an assembly
-  double sparse_flops_per_second = 3e9;         // CHOLMOD on pruned or surface-tension blocks
+  double prune_pairs_per_second = 1.1e5;       // exact pruning: bunny, 930k pairs in 8.5 s
+  double orientation_tests_per_second = 3e8;   // the convexity check: N x F orientation tests
+  double factor_flops_per_second = 6.5e10;     // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
+  double triangular_flops_per_second = 1e10;   // solves with a dense factor (memory-bound)
+  double pair_updates_per_second = 9e8;        // one fiber pair in one axis block's product
+  double residual_pairs_per_second = 2.6e8;    // one ordered pair of the Newton residual
+  double sparse_flops_per_second = 3e9;        // CHOLMOD on dense bulk blocks
 };
 
 struct ResourcePart {
-  std::string name;     // "pruning", "factorisation", "load steps" ...
+  std::string name;     // "pruning", "factorisation", "10 load steps" ...
   double bytes = 0.0;   // held while this part runs (and after, for the kept parts)
   double seconds = 0.0;
-  bool kept = false;    // still held by the later parts (the fiber table)
+  bool kept = false;    // still held by the later parts (the model, the fiber table)
 };
 
 struct ResourceEstimate {
@@ -37,15 +40,21 @@ struct ResourceEstimate {
   std::string solver;        // the backend assumed ("block-cholesky", ...)
   double peak_bytes = 0.0;   // the largest part plus what the kept parts hold
   double seconds = 0.0;      // all parts
-  // "about 1.2 GiB and 40 s (pruning 30 s, factorisation 8 s, 10 load steps 2 s)".
+  // "about 1.2 GiB and 40 s (pruning 30 s, factorisation 8 s / 1.1 GiB, ...; block-cholesky)".
   std::string describe() const;
 };
 
-// The estimate for a case on its model surface (every vertex used), with
-// `concave`: its fibers will be pruned exactly. With pruning on, the
-// convexity check that decides it is counted too (its worst case).
-ResourceEstimate estimate_resources(const CaseSpec& spec, const geom::Surface& model_surface,
-                                    bool concave, const KernelSpeed& speed = {});
+// What the fibers cost before the solve: nothing (pruning off), the
+// convexity check (a convex body, or before the check has said), or the
+// check and the exact pruning of a concave body.
+enum class PruningWork { None, ConvexityCheck, Prune };
+
+// The estimate for a model whose supports are set (the backend and its
+// block sizes follow from them, as solve::choose_solver does) with the
+// stepping options it will run with.
+ResourceEstimate estimate_resources(const model::Model& model,
+                                    const solve::SteppingOptions& stepping, PruningWork pruning,
+                                    const KernelSpeed& speed = {});
 
 // Throws InputError naming the spec's file when the estimate exceeds the
 // memory budget (fiberfluid::memory_budget_bytes()) or the time budget:

@@ -3,6 +3,7 @@
 // and interruption (Ctrl-C) of pruning and of every solver loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -61,57 +62,69 @@ const ResourcePart* part(const ResourceEstimate& e, const std::string& name) {
   return nullptr;
 }
 
+Case built(const json& doc) { return build_case(read(doc).specs[0]); }
+
 TEST_F(ResourceGuards, TheEstimateCountsTheBackendsDenseBlocks) {
-  const Experiment ex = read(sphere(3, "block-cholesky"));  // 642 vertices
-  const geom::Surface s = build_surface(ex.specs[0].surface, nullptr);
-  const ResourceEstimate e = estimate_resources(ex.specs[0], s, false);
-  const double n = 642;
+  const Case c = built(sphere(3, "block-cholesky"));  // 642 vertices, 61 held (z >= 0.04)
+  const double n = 642 - 61;
+  ASSERT_EQ(c.model.constraints.size(), 3u * 61u);
+  const ResourceEstimate e = estimate_resources(c.model, c.stepping, PruningWork::ConvexityCheck);
   EXPECT_EQ(e.solver, "block-cholesky") << e.describe();
-  // Every axis held alike: one factor and its copy, 8 n^2 bytes each.
+  // Every axis held alike: one factor of the free vertices, 8 n^2 bytes.
   ASSERT_NE(part(e, "factorisation"), nullptr);
-  EXPECT_DOUBLE_EQ(part(e, "factorisation")->bytes, 2 * 8 * n * n);
-  EXPECT_GE(e.peak_bytes, 2 * 8 * n * n);
-  EXPECT_LT(e.peak_bytes, 2 * 8 * n * n + 8192 * n);
+  EXPECT_DOUBLE_EQ(part(e, "factorisation")->bytes, 8 * n * n);
+  EXPECT_DOUBLE_EQ(e.peak_bytes, part(e, "model")->bytes + 8 * n * n);
   ASSERT_NE(part(e, "3 load steps"), nullptr);
-  EXPECT_GT(e.seconds, 0.0);
-  EXPECT_EQ(part(e, "pruning"), nullptr);  // convex
-  // dense-lu: the whole (3N+1)-square system and its LU.
-  const ResourceEstimate lu = estimate_resources(read(sphere(3, "dense-lu")).specs[0], s, false);
-  EXPECT_DOUBLE_EQ(part(lu, "factorisation")->bytes, 2 * 8 * (3 * n + 1) * (3 * n + 1));
-  // 2/3 (3n)^3 against n^3 / 3 flops (54 times), with the same assembly added to each.
+  ASSERT_NE(part(e, "convexity check"), nullptr);
+  EXPECT_EQ(part(e, "pruning"), nullptr);
+  // Held on x alone: three distinct blocks, three factors.
+  Case one_axis = c;
+  one_axis.model.constraints.erase(
+      std::remove_if(one_axis.model.constraints.begin(), one_axis.model.constraints.end(),
+                     [](const model::Constraint& k) { return k.axis != 0; }),
+      one_axis.model.constraints.end());
+  const ResourceEstimate three =
+      estimate_resources(one_axis.model, c.stepping, PruningWork::ConvexityCheck);
+  EXPECT_DOUBLE_EQ(part(three, "factorisation")->bytes, 3 * 8 * 642.0 * 642.0);
+  // dense-lu: the whole (3n+1)-square system; 2/3 (3n)^3 flops against n^3 / 3 (54 times).
+  solve::SteppingOptions lu_options = c.stepping;
+  lu_options.solver = solve::SolverKind::DenseLU;
+  const ResourceEstimate lu = estimate_resources(c.model, lu_options, PruningWork::ConvexityCheck);
+  EXPECT_DOUBLE_EQ(part(lu, "factorisation")->bytes, 1.2 * 8 * (3 * n + 1) * (3 * n + 1));
   EXPECT_GT(part(lu, "factorisation")->seconds, 30 * part(e, "factorisation")->seconds)
-      << lu.describe() << "\n" << e.describe();  // 2/3 (3n)^3 against n^3 / 3 flops: 54 times
+      << lu.describe() << "\n" << e.describe();
   // A concave body adds its N x N table of kept fibers and the pair tests.
-  const ResourceEstimate pruned = estimate_resources(ex.specs[0], s, true);
+  const ResourceEstimate pruned = estimate_resources(c.model, c.stepping, PruningWork::Prune);
   ASSERT_NE(part(pruned, "pruning"), nullptr);
-  EXPECT_GE(part(pruned, "pruning")->bytes, n * n);
+  EXPECT_GE(part(pruned, "pruning")->bytes, 642.0 * 642.0);
   EXPECT_NEAR(pruned.peak_bytes - e.peak_bytes, part(pruned, "pruning")->bytes, 1.0);
+  EXPECT_GT(pruned.seconds, e.seconds);
 }
 
 TEST_F(ResourceGuards, AutoTakesPcgWhenTheDenseBlocksWouldNotFitTheBudget) {
-  const Experiment ex = read(sphere(4));  // 2562 vertices: one 52 MB block and its copy
-  const geom::Surface s = build_surface(ex.specs[0].surface, nullptr);
-  EXPECT_EQ(estimate_resources(ex.specs[0], s, false).solver, "block-cholesky");
-  set_memory_budget(200e6);  // 3/8 of it is 75 MB < 105 MB
-  EXPECT_EQ(estimate_resources(ex.specs[0], s, false).solver, "pcg");
+  const Case c = built(sphere(4));  // 2562 vertices: a 48 MB block and its copy
+  EXPECT_EQ(estimate_resources(c.model, c.stepping, PruningWork::None).solver, "block-cholesky");
+  set_memory_budget(200e6);  // 3/8 of it is 75 MB < 96 MB
+  EXPECT_EQ(estimate_resources(c.model, c.stepping, PruningWork::None).solver, "pcg");
   // The solver that runs is the one estimated.
-  Experiment built = read(sphere(4));
-  build_experiment(built);
-  const ExperimentResult r = run_experiment(built);
+  Experiment ex = read(sphere(4));
+  build_experiment(ex);
+  const ExperimentResult r = run_experiment(ex);
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
   EXPECT_EQ(r.runs[0].summary.solver, solve::SolverKind::PCG);
+  EXPECT_EQ(ex.cases[0].estimate.solver, "pcg");
 }
 
 TEST_F(ResourceGuards, ACaseBeyondTheMemoryBudgetIsRefusedBeforeItStarts) {
-  set_memory_budget(8e6);
-  Experiment ex = read(sphere(3, "dense-lu"));  // 59 MB of dense LU; pcg needs about 4 MB
+  set_memory_budget(40.0 * 1024 * 1024);
+  Experiment ex = read(sphere(3, "dense-lu"));  // 28 MiB of dense LU beside the process's 21
   try {
     build_experiment(ex);
     FAIL() << "expected a refusal";
   } catch (const InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("test.json: this case needs about"), std::string::npos) << what;
-    EXPECT_NE(what.find("more than the memory budget of 7.63 MiB set by --max-memory"),
+    EXPECT_NE(what.find("more than the memory budget of 40 MiB set by --max-memory"),
               std::string::npos) << what;
     EXPECT_NE(what.find("raise --max-memory"), std::string::npos) << what;
     EXPECT_NE(what.find("\"solver\": \"pcg\""), std::string::npos) << what;
