@@ -2,6 +2,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Writes the fuzz targets' small seed inputs into tests/fuzz/seeds/TARGET/.
 
+(The seeds of bad input, such as experiment/unsafe_variant_name.json, were
+written by hand from what was found from outside in issue 11.)
+
 The repository's meshes (data/meshes) and experiments (experiments/) are
 seeds too; scripts/fuzz.sh adds them. These cover what those do not: every
 format variant (OFF, STL ASCII and binary, PLY ASCII and both binary byte
