@@ -18,11 +18,7 @@
 
 #include "app/experiment.hpp"
 #include "app/runner.hpp"
-
-extern "C" void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k,
-                       const double* alpha, const double* a, const int* lda, const double* b,
-                       const int* ldb, const double* beta, double* c, const int* ldc,
-                       std::size_t, std::size_t);
+#include "gemm_peak.hpp"
 
 namespace {
 
@@ -30,22 +26,6 @@ double peak_memory_mib() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // kilobytes on Linux
-}
-
-// The best of three n x n dgemm runs, in GFLOP/s: the machine's dense peak.
-double gemm_gflops(int n) {
-  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n), b = Eigen::MatrixXd::Random(n, n);
-  Eigen::MatrixXd c(n, n);
-  const double one = 1.0, zero = 0.0;
-  double best = 0.0;
-  for (int trial = 0; trial < 3; ++trial) {
-    const auto start = std::chrono::steady_clock::now();
-    dgemm_("N", "N", &n, &n, &n, &one, a.data(), &n, b.data(), &n, &zero, c.data(), &n, 1, 1);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    best = std::max(best, 2.0 * n * n * n / seconds / 1e9);
-  }
-  return best;
 }
 
 }  // namespace
