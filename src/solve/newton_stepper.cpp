@@ -58,7 +58,6 @@ class NewtonSolver {
  public:
   NewtonSolver(const Model& model, const SteppingOptions& options, SteppingSummary& summary)
       : model_(model),
-        options_(options),
         newton_(options.newton),
         summary_(summary),
         equilibrium_(std::make_shared<const model::Equilibrium>(model)),
@@ -300,7 +299,6 @@ class NewtonSolver {
   }
 
   const Model& model_;
-  const SteppingOptions& options_;
   const NewtonOptions& newton_;
   SteppingSummary& summary_;
   std::shared_ptr<const model::Equilibrium> equilibrium_;
