@@ -6,7 +6,8 @@
 //
 // Flops are counted per pair visit as the kernels do the arithmetic (a square
 // root or a division counts one): bulk product with 3 columns 21 per ordered
-// pair, bulk diagonal 13 per ordered pair, dense block 13 per unordered pair,
+// pair, bulk diagonal 13 per ordered pair, dense block 13 per unordered pair
+// (useful work: it computes both triangles, each pair twice),
 // Newton tangent product (constant law, recomputed) 50 per ordered pair,
 // stored tangent product 27 per ordered pair.
 #include <CLI/CLI.hpp>
