@@ -32,20 +32,26 @@ constexpr double kBytesPerVertex = 1024.0;
 struct Blocks {
   double largest = 0.0;
   int factors = 1;
+  int newton_unknowns = 1;  // the supports eliminated (as Newton always does), then P
 };
 
 Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
   const int n = m.num_vertices(), dim = m.dim();
-  std::vector<std::vector<bool>> held(static_cast<size_t>(dim), std::vector<bool>(static_cast<size_t>(n)));
-  if (o.boundary_method == model::BoundaryMethod::Elimination)
-    for (const model::Constraint& c : m.constraints)
-      held[static_cast<size_t>(c.axis)][static_cast<size_t>(c.vertex)] = true;
+  std::vector<std::vector<bool>> supported(static_cast<size_t>(dim),
+                                           std::vector<bool>(static_cast<size_t>(n)));
+  for (const model::Constraint& c : m.constraints)
+    supported[static_cast<size_t>(c.axis)][static_cast<size_t>(c.vertex)] = true;
+  // The penalty method keeps the supported vertices in the blocks.
+  const bool eliminated = o.boundary_method == model::BoundaryMethod::Elimination;
   Blocks b;
   bool equal = true;
   for (int a = 0; a < dim; ++a) {
-    const auto& h = held[static_cast<size_t>(a)];
-    b.largest = std::max(b.largest, static_cast<double>(std::count(h.begin(), h.end(), false)));
-    equal = equal && h == held[0] && m.material.axis_factors[a] == m.material.axis_factors[0];
+    const auto& s = supported[static_cast<size_t>(a)];
+    const int free = static_cast<int>(std::count(s.begin(), s.end(), false));
+    b.newton_unknowns += free;
+    b.largest = std::max(b.largest, static_cast<double>(eliminated ? free : n));
+    // As FiberSystem::blocks_equal: the same supports (eliminated or penalised) and factor.
+    equal = equal && s == supported[0] && m.material.axis_factors[a] == m.material.axis_factors[0];
   }
   b.factors = equal ? 1 : dim;
   return b;
@@ -53,10 +59,7 @@ Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
 
 solve::SolverKind choose(const solve::SteppingOptions& o, const Blocks& b) {
   if (o.solver != solve::SolverKind::Auto) return o.solver;
-  if (b.largest <= 600) return solve::SolverKind::DenseLU;  // as solve::choose_solver
-  if (8.0 * b.largest * b.largest * (b.factors + 1) < 0.375 * memory_budget_bytes())
-    return solve::SolverKind::BlockCholesky;
-  return solve::SolverKind::PCG;
+  return solve::choose_solver(b.largest, b.factors, memory_budget_bytes());
 }
 
 std::string seconds_text(double s) {
@@ -109,8 +112,8 @@ ResourceEstimate estimate_resources(const model::Model& model,
   const double residual = 2.0 * pairs / speed.residual_pairs_per_second;
   const bool newton = o.scheme == solve::Scheme::Newton;
   const bool dense_tangent =
-      newton && (o.newton.tangent == solve::TangentSolver::Dense ||
-                 (o.newton.tangent == solve::TangentSolver::Auto && unknowns <= 600));
+      newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns) ==
+                    solve::TangentSolver::Dense;
   const solve::SolverKind kind = dense_tangent ? solve::SolverKind::DenseLU : choose(o, blocks);
   e.solver = solve::to_string(kind);
 

@@ -37,12 +37,16 @@ std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptio
   return nullptr;
 }
 
-SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes) {
-  const double n = system.largest_block();
+SolverKind choose_solver(double largest_block, int factors, double budget_bytes) {
+  const double n = largest_block;
   if (n <= 600) return SolverKind::DenseLU;  // the paper's method, well within a second
-  const int factors = system.blocks_equal() ? 1 : system.num_blocks();
   if (8.0 * n * n * (factors + 1) < 0.375 * budget_bytes) return SolverKind::BlockCholesky;
   return SolverKind::PCG;
+}
+
+SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes) {
+  return choose_solver(system.largest_block(), system.blocks_equal() ? 1 : system.num_blocks(),
+                       budget_bytes);
 }
 
 SolverKind choose_solver(const model::BorderedSystem& system) {

@@ -60,6 +60,9 @@ std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptio
 // Cholesky while its dense N x N blocks take at most 3/8 of `budget_bytes`
 // (30% of the memory under the default budget of 80%), pcg beyond.
 SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes);
+// The same rule from the sizes alone: the largest axis block and the number
+// of distinct block factors (1 when every axis block is equal).
+SolverKind choose_solver(double largest_block, int factors, double budget_bytes);
 // The same for the process's memory budget (memory_budget_bytes()).
 SolverKind choose_solver(const model::BorderedSystem& system);
 

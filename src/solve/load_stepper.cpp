@@ -150,6 +150,11 @@ const char* to_string(TangentSolver solver) {
   return "?";
 }
 
+TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns) {
+  if (requested != TangentSolver::Auto) return requested;
+  return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
+}
+
 std::string SteppingSummary::BriefReport() const {
   std::ostringstream out;
   out << (success ? "success" : "failure") << ": ";

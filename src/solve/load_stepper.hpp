@@ -32,6 +32,9 @@ enum class TangentSolver {
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
 };
 const char* to_string(TangentSolver solver);
+// What `requested` means for a Newton run with `reduced_unknowns` (the
+// unknowns left after the supports): Auto is dense up to 600, Krylov above.
+TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns);
 
 struct NewtonOptions {
   // Converged when the relative residual (force rows over the largest of the

@@ -66,10 +66,7 @@ class NewtonSolver {
         stuck_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
     const Eigen::MatrixXd& V = model.surface.V;
     diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
-    const int reduced = supports_.num_reduced();
-    const TangentSolver kind = newton_.tangent != TangentSolver::Auto ? newton_.tangent
-                               : reduced <= 600                      ? TangentSolver::Dense
-                                                                     : TangentSolver::Krylov;
+    const TangentSolver kind = choose_tangent(newton_.tangent, supports_.num_reduced());
     tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
     summary_.tangent = kind;
     summary_.solver = tangent_->preconditioner_kind();
