@@ -44,6 +44,11 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
   global_ = n_ > 0 ? sum / n_ : 0.0;
 }
 
+std::vector<double> PairFactors::vertex_counts() const {
+  if (fibers_ != nullptr && count_ == ConnectionCount::Symmetric) return kept_;
+  return std::vector<double>(static_cast<size_t>(n_), global_);
+}
+
 void PairFactors::row(int i, double* row) const {
   if (fibers_ == nullptr) {
     std::fill(row, row + n_, 0.5 / global_);

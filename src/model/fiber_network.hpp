@@ -25,6 +25,11 @@ class PairFactors {
   PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices);
   // Fills row (length N) with h_ij for j = 0..N-1.
   void row(int i, double* row) const;
+  // The same factors in the form the tiled pair kernels use:
+  // h_ij = kept_ij / (c_i + c_j), c_i per vertex (N-1 with every pair kept,
+  // the mean count with the global count, n_i with the symmetric one).
+  std::vector<double> vertex_counts() const;
+  const geom::FiberMask* mask() const { return fibers_; }  // null: every pair kept
 
  private:
   const geom::FiberMask* fibers_;

@@ -112,50 +112,24 @@ bool FiberSystem::blocks_equal() const {
   return true;
 }
 
+BulkPairs FiberSystem::bulk_pairs(const std::vector<int>& vertices) const {
+  BulkPairs pairs(X_, area_, factors_, vertices);
+  if (law_ != nullptr) pairs.set_secant_law(law_, &reference_, &strained_);
+  return pairs;
+}
+
 Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   const std::vector<int>& act = active(axis);
   const auto m = static_cast<Eigen::Index>(act.size());
   const double y = young(axis);
   Eigen::MatrixXd K(m, m);  // every entry is written below (no pass of zeros first)
-  if (y == 0.0) K.setZero();
-  if (y != 0.0) {
-    // Active vertices' coordinates and areas, gathered so the loops vectorise.
-    std::vector<double> gx[3], ga(static_cast<size_t>(m));
-    for (int d = 0; d < 3; ++d) gx[d].resize(static_cast<size_t>(m), 0.0);
-    for (Eigen::Index r = 0; r < m; ++r) {
-      const int i = act[static_cast<size_t>(r)];
-      for (int d = 0; d < dim_; ++d) gx[d][static_cast<size_t>(r)] = X_(i, d);
-      ga[static_cast<size_t>(r)] = area_[i];
-    }
-    const double *x0 = gx[0].data(), *x1 = gx[1].data(), *x2 = gx[2].data(), *a = ga.data();
-    // Off-diagonal entries -Y_a w_ij, every column whole: twice the pairs of
-    // one triangle, but contiguous writes, where mirroring a triangle
-    // (a transpose of N^2 doubles) cost more. w_ij = w_ji to the bit.
-#pragma omp parallel
-    {
-      std::vector<double> full(static_cast<size_t>(n_)), h(static_cast<size_t>(m));
-#pragma omp for schedule(dynamic, 16)
-      for (Eigen::Index c = 0; c < m; ++c) {
-        double* column = K.col(c).data();
-        const size_t j = static_cast<size_t>(c);
-        pair_row(act[j], full.data());
-        for (Eigen::Index r = 0; r < m; ++r)
-          h[static_cast<size_t>(r)] = full[static_cast<size_t>(act[static_cast<size_t>(r)])];
-        const double* hc = h.data();
-#pragma omp simd
-        for (Eigen::Index r = 0; r < m; ++r) {
-          const size_t i = static_cast<size_t>(r);
-          const double dx = x0[i] - x0[j], dy = x1[i] - x1[j], dz = x2[i] - x2[j];
-          // r == c: h = 0 gives 0 (the diagonal is set below); r2 = 1 there avoids 0/0.
-          const double r2 = i == j ? 1.0 : dx * dx + dy * dy + dz * dz;
-          column[r] = -y * bulk_weight(hc[i], a[i], a[j], std::sqrt(r2));
-        }
-      }
-    }
+  if (y == 0.0) {
+    K.setZero();
+  } else {
+    bulk_pairs(act).fill_off_diagonal(y, &K);
     // The diagonal gathers the weights to every vertex, active or not.
     const Eigen::VectorXd& diagonal = bulk_diagonal();
-    for (Eigen::Index r = 0; r < m; ++r)
-      K(r, r) = young(axis) * diagonal[act[static_cast<size_t>(r)]];
+    for (Eigen::Index r = 0; r < m; ++r) K(r, r) = y * diagonal[act[static_cast<size_t>(r)]];
   }
   if (gamma_ != 0.0) {
     std::vector<int> position(static_cast<size_t>(n_), -1);
@@ -171,79 +145,12 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
 }
 
 const Eigen::VectorXd& FiberSystem::bulk_diagonal() const {
-  if (bulk_diagonal_.size() != n_) bulk_diagonal_ = compute_bulk_diagonal();
+  if (bulk_diagonal_.size() != n_) bulk_diagonal_ = bulk_pairs().row_sums();
   return bulk_diagonal_;
 }
 
-Eigen::VectorXd FiberSystem::compute_bulk_diagonal() const {
-  const Coordinates x(X_);
-  const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data(), *a = area_.data();
-  const size_t n = static_cast<size_t>(n_);
-  Eigen::VectorXd diagonal(n_);
-#pragma omp parallel
-  {
-    std::vector<double> row(n);
-#pragma omp for schedule(dynamic, 32)
-    for (int i = 0; i < n_; ++i) {
-      const size_t u = static_cast<size_t>(i);
-      pair_row(i, row.data());
-      const double* h = row.data();
-      double sum = 0.0;
-#pragma omp simd reduction(+ : sum)
-      for (size_t j = 0; j < n; ++j) {
-        const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-        // h_ii = 0; r2 = 1 there only avoids 1/0.
-        const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-        sum += bulk_weight(h[j], a[u], a[j], std::sqrt(r2));
-      }
-      diagonal[i] = sum;
-    }
-  }
-  return diagonal;
-}
-
 Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
-  // (L v)_i = sum_j w_ij (v_i - v_j), w_ij = h_ij (a_i + a_j) / r_ij. Each pair's
-  // distance is computed once and serves every column (up to three at a time).
-  const Coordinates x(X_);
-  const int k = static_cast<int>(V.cols());
-  Eigen::MatrixXd out(n_, k);
-  const double* a = area_.data();
-  const size_t n = static_cast<size_t>(n_);
-  for (int first = 0; first < k; first += 3) {
-    const int width = std::min(3, k - first);
-    // Unused columns read zeros, so one loop body serves widths 1 to 3.
-    const std::vector<double> zeros(n, 0.0);
-    const double* v0 = V.col(first).data();
-    const double* v1 = width > 1 ? V.col(first + 1).data() : zeros.data();
-    const double* v2 = width > 2 ? V.col(first + 2).data() : zeros.data();
-    const double *x0 = x.c[0].data(), *x1 = x.c[1].data(), *x2 = x.c[2].data();
-#pragma omp parallel
-    {
-      std::vector<double> row(n);
-#pragma omp for schedule(dynamic, 32)
-      for (int i = 0; i < n_; ++i) {
-        const size_t u = static_cast<size_t>(i);
-        pair_row(i, row.data());
-        const double* h = row.data();
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-#pragma omp simd reduction(+ : s0, s1, s2)
-        for (size_t j = 0; j < n; ++j) {
-          const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-          // j == i contributes (v_i - v_i) = 0; r2 = 1 there only avoids 1/0.
-          const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
-          const double w = bulk_weight(h[j], a[u], a[j], std::sqrt(r2));
-          s0 += w * (v0[u] - v0[j]);
-          s1 += w * (v1[u] - v1[j]);
-          s2 += w * (v2[u] - v2[j]);
-        }
-        out(i, first) = s0;
-        if (width > 1) out(i, first + 1) = s1;
-        if (width > 2) out(i, first + 2) = s2;
-      }
-    }
-  }
-  return out;
+  return bulk_pairs().laplacian_product(V);
 }
 
 Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,

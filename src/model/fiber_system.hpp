@@ -10,6 +10,7 @@
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
 #include "model/model.hpp"
+#include "model/pair_kernels.hpp"
 
 namespace fiberfluid::model {
 
@@ -104,7 +105,8 @@ class FiberSystem final : public BorderedSystem {
   Eigen::VectorXd expand(const Eigen::VectorXd& reduced, const Eigen::VectorXd& U_c) const;
 
  private:
-  Eigen::VectorXd compute_bulk_diagonal() const;  // one pass over the pairs
+  // The bulk pairs of `vertices` (empty: all), with the secant law if any.
+  BulkPairs bulk_pairs(const std::vector<int>& vertices = {}) const;
   // Fills row (length N) with h_ij, times Y(e_ij) / ... for a strain-dependent law.
   void pair_row(int i, double* row) const;
 

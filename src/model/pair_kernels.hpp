@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The bulk fiber pair kernels (issue 12): the sums over all N^2 fiber pairs
+// that every run is made of. Each unordered pair is visited once (the weights
+// are symmetric), in tiles whose vertex data stays in the L1 cache, on the
+// OpenMP threads, and vectorised for the CPU the program runs on: the tile
+// loops are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 and FMA) and the
+// portable baseline (GCC's target_clones), and the loader picks one.
+//
+// Deterministic: with the same thread count the same bits (each thread owns a
+// fixed share of the tiles and its own accumulators, summed in thread order).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "model/fiber_law.hpp"
+#include "model/fiber_network.hpp"
+
+namespace fiberfluid::model {
+
+// The bulk weights of a set of vertices (paper Eq. 6, model.md section 5):
+//   w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) |x_i - x_j|),
+// with c_i from PairFactors::vertex_counts (so that h_ij = 1 / (c_i + c_j)),
+// m_ij = 1 for a kept fiber and 0 for a pruned one, and for a
+// strain-dependent law m_ij times the secant modulus Y(e_ij).
+class BulkPairs {
+ public:
+  // `vertices`: the vertices of the set in order; empty means every row of X.
+  // X and area are copied (in the layout the tiles read).
+  BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area, const PairFactors& factors,
+            const std::vector<int>& vertices = {});
+
+  // Each weight times Y(e_ij), e_ij = |y_i - y_j| / |s_i - s_j| - 1: y from
+  // `strained`, s from `reference` (#V by dim, rows by vertex). The law and
+  // both matrices must outlive this object.
+  void set_secant_law(const FiberLaw* law, const Eigen::MatrixXd* reference,
+                      const Eigen::MatrixXd* strained);
+
+  int size() const { return n_; }
+  // sum_j w_ij for each vertex i of the set.
+  Eigen::VectorXd row_sums() const;
+  // (L V)_i = sum_j w_ij (V_i - V_j); V: one row per vertex of the set.
+  Eigen::MatrixXd laplacian_product(const Eigen::MatrixXd& V) const;
+  // K(r, c) = -scale w_rc for r != c over the set (K: size() x size());
+  // the diagonal is left as it was.
+  void fill_off_diagonal(double scale, Eigen::MatrixXd* K) const;
+
+  // The tile edge: a tile's vertex data (coordinates, area, count, three
+  // columns in and out) is 11 arrays of 256 doubles, 22 KB: within L1.
+  static constexpr int kTile = 256;
+
+  struct Tile {
+    int i0, ni, j0, nj;
+    bool diagonal;  // i0 == j0: only the pairs j > i
+  };
+
+ private:
+  // The multipliers m_ij of one tile (row-major, kTile per row), for a
+  // pruned body or a strain-dependent law (otherwise every m_ij is 1).
+  void multipliers(const Tile& t, double* m) const;
+  // Runs visit(tile, multipliers or null, thread) over every tile pair, each
+  // thread a fixed share.
+  template <class Visit>
+  void for_each_tile(Visit&& visit) const;
+
+  int n_ = 0;
+  std::vector<double> x_[3], area_, count_;
+  std::vector<int> vertex_;  // the set's vertices (mask and law lookups)
+  const geom::FiberMask* mask_ = nullptr;
+  const FiberLaw* law_ = nullptr;
+  const Eigen::MatrixXd *reference_ = nullptr, *strained_ = nullptr;
+};
+
+}  // namespace fiberfluid::model
