@@ -116,30 +116,27 @@ Equilibrium::Hydrostatics Equilibrium::hydrostatics(const Eigen::MatrixXd& X,
   return h;
 }
 
-// Column pointers of the reference, current, displacement and product
-// vectors (three each; the third is all zeros in 2D).
+// Column pointers of the reference, current and displacement vectors (three
+// each; the third is all zeros in 2D).
 struct Equilibrium::Columns {
   const double* s[3];
   const double* x[3];
   const double* u[3];
-  const double* w[3] = {nullptr, nullptr, nullptr};
   std::vector<double> zeros;
 
-  Columns(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-          const Eigen::MatrixXd* W)
+  Columns(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U)
       : zeros(static_cast<size_t>(S.rows()), 0.0) {
     for (int a = 0; a < 3; ++a) {
       const bool has = a < S.cols();
       s[a] = has ? S.col(a).data() : zeros.data();
       x[a] = has ? X.col(a).data() : zeros.data();
       u[a] = has ? U.col(a).data() : zeros.data();
-      if (W != nullptr) w[a] = has ? W->col(a).data() : zeros.data();
     }
   }
 };
 
 void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch,
-                           double force[3], double product[3]) const {
+                           double force[3]) const {
   const size_t n = static_cast<size_t>(model_.num_vertices()), u = static_cast<size_t>(i);
   double* h = scratch[0].data();   // h_ij
   double* L = scratch[1].data();   // reference lengths
@@ -175,29 +172,12 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
     f2 += aY * (u2[u] - u2[j]);
   }
   force[0] = f0, force[1] = f1, force[2] = f2;
-  if (product == nullptr) return;
-  const double *w0 = c.w[0], *w1 = c.w[1], *w2 = c.w[2];
-  double p0 = 0.0, p1 = 0.0, p2 = 0.0;
-#pragma omp simd reduction(+ : p0, p1, p2)
-  for (size_t j = 0; j < n; ++j) {
-    // T w = c1 w + c2 (b.w) d (pair_stencil.hpp), as TangentOperator::apply.
-    const double a = bulk_weight(h[j], area[u], area[j], L[j]);
-    const double c1 = modulus_coefficient(a, Y[j]), c2 = slope_coefficient(a, Yp[j], r[j], L[j]);
-    const double d0 = u0[u] - u0[j], d1 = u1[u] - u1[j], d2 = u2[u] - u2[j];
-    const double v0 = w0[u] - w0[j], v1 = w1[u] - w1[j], v2 = w2[u] - w2[j];
-    const double along =
-        c2 * ((x0[u] - x0[j]) * v0 + (x1[u] - x1[j]) * v1 + (x2[u] - x2[j]) * v2);
-    p0 += c1 * v0 + along * d0;
-    p1 += c1 * v1 + along * d1;
-    p2 += c1 * v2 + along * d2;
-  }
-  product[0] = p0, product[1] = p1, product[2] = p2;
 }
 
 // Runs bulk_row over every row on the OpenMP threads, each with its own
-// scratch arrays, and hands visit(i, scratch, force, product) the results.
+// scratch arrays, and hands visit(i, scratch, force) the results.
 template <class Visit>
-void Equilibrium::parallel_rows(const Columns& columns, bool with_product, Visit&& visit) const {
+void Equilibrium::parallel_rows(const Columns& columns, Visit&& visit) const {
   const int n = model_.num_vertices();
 #pragma omp parallel
   {
@@ -205,23 +185,24 @@ void Equilibrium::parallel_rows(const Columns& columns, bool with_product, Visit
     for (auto& v : scratch) v.resize(static_cast<size_t>(n));
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      double force[3], product[3];
-      bulk_row(i, columns, scratch, force, with_product ? product : nullptr);
-      visit(i, scratch, force, product);
+      double force[3];
+      bulk_row(i, columns, scratch, force);
+      visit(i, scratch, force);
     }
   }
+}
+
+DeformedPairs Equilibrium::bulk_pairs(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const {
+  return DeformedPairs(model_.surface.V, X, U, area0_, factors_, model_.material.law);
 }
 
 Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
   const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
   const int n = model_.num_vertices(), dim = model_.dim();
   const Eigen::Vector3d m = model_.material.axis_factors;
-  const Columns columns(model_.surface.V, X, U, nullptr);
+  const Eigen::MatrixXd bulk = bulk_pairs(X, U).forces();
   Eigen::MatrixXd forces(n, dim);
-  parallel_rows(columns, false, [&](int i, const std::vector<double>*, const double* f,
-                                    const double*) {
-    for (int a = 0; a < dim; ++a) forces(i, a) = m[a] * f[a];
-  });
+  for (int a = 0; a < dim; ++a) forces.col(a) = m[a] * bulk.col(a);
   return forces + model_.material.surface_tension * (surface_ * U);
 }
 
@@ -337,11 +318,8 @@ Eigen::VectorXd Equilibrium::tangent_product(const Eigen::VectorXd& x,
   const int n = model_.num_vertices(), dim = model_.dim();
   const Eigen::Vector3d m = model_.material.axis_factors;
   Eigen::VectorXd out = Eigen::VectorXd::Zero(num_unknowns());
-  const Columns columns(model_.surface.V, X, U, &W);
-  parallel_rows(columns, true, [&](int i, const std::vector<double>*, const double*,
-                                   const double* product) {
-    for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
-  });
+  const Eigen::MatrixXd bulk = bulk_pairs(X, U).tangent_product(W);
+  for (int a = 0; a < dim; ++a) out.segment(a * n, n) = m[a] * bulk.col(a);
   add_non_bulk_product(x, factors, X, v, out);
   return out;
 }
@@ -395,25 +373,7 @@ void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>&
   op.factors_ = factors;
   op.X_ = positions(model_, x);
   op.U_ = displacements(model_, x);
-  const int n = model_.num_vertices();
-  op.weighted_modulus_.resize(n, n);
-  op.weighted_slope_.resize(n, n);
-  const Columns columns(model_.surface.V, op.X_, op.U_, nullptr);
-  parallel_rows(columns, false, [&](int i, const std::vector<double>* scratch, const double*,
-                                    const double*) {
-    // bulk_row leaves h, L, r, Y, Y' of the row in the scratch arrays.
-    const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
-    const double *Y = scratch[3].data(), *Yp = scratch[4].data(), *area = area0_.data();
-    double* c1 = op.weighted_modulus_.col(i).data();
-    double* c2 = op.weighted_slope_.col(i).data();
-    const auto u = static_cast<size_t>(i);
-#pragma omp simd
-    for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
-      const double a = bulk_weight(h[j], area[u], area[j], L[j]);
-      c1[j] = modulus_coefficient(a, Y[j]);
-      c2[j] = slope_coefficient(a, Yp[j], r[j], L[j]);
-    }
-  });
+  bulk_pairs(op.X_, op.U_).coefficients(&op.weighted_modulus_, &op.weighted_slope_);
 }
 
 Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
@@ -470,9 +430,8 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
     if (name.rfind("factor_", 0) == 0 && name.size() == 8) axis = name[7] - 'x';
     if (axis >= dim) axis = -1;
     if (axis < 0) law.modulus_derivative(name, 0.0);  // throws for an unknown name
-    const Columns columns(model_.surface.V, X, U, nullptr);
-    parallel_rows(columns, false, [&](int i, const std::vector<double>* scratch,
-                                      const double* force, const double*) {
+    const Columns columns(model_.surface.V, X, U);
+    parallel_rows(columns, [&](int i, const std::vector<double>* scratch, const double* force) {
       if (axis >= 0) {  // bulk_row's force is sum_j a Y d, before the factors
         D(axis * n + i, column) = force[axis];
         return;

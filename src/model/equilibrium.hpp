@@ -9,6 +9,7 @@
 
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
+#include "model/pair_kernels.hpp"
 #include "model/fiber_system.hpp"
 #include "model/model.hpp"
 
@@ -114,15 +115,16 @@ class Equilibrium {
   struct Hydrostatics;  // per-vertex q_i and its gradient, at x
   Hydrostatics hydrostatics(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
   Eigen::MatrixXd current_area_vectors(const Eigen::MatrixXd& X) const;  // S_i(x)
-  // The bulk fibers of row i in flat loops that vectorise: the force sum
-  // sum_j a Y d and, when W has columns, the tangent-product sum
-  // sum_j a (Y w + Y' (n.w) d / L) (the stencil of pair_stencil.hpp written
-  // out; the axis factors are applied by the caller).
+  // The bulk fibers at positions X, displacements U: forces, tangent
+  // products and coefficients, each pair once (pair_kernels.hpp).
+  DeformedPairs bulk_pairs(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const;
+  // The bulk fibers of row i, for the parameter derivatives: the force sum
+  // sum_j a Y d (the axis factors are applied by the caller), with the
+  // row's h, L, r, Y, Y' left in the scratch arrays.
   struct Columns;
-  void bulk_row(int i, const Columns& c, std::vector<double>* scratch, double force[3],
-                double product[3]) const;
+  void bulk_row(int i, const Columns& c, std::vector<double>* scratch, double force[3]) const;
   template <class Visit>
-  void parallel_rows(const Columns& columns, bool with_product, Visit&& visit) const;
+  void parallel_rows(const Columns& columns, Visit&& visit) const;
 
   const Model& model_;
   PairFactors factors_;

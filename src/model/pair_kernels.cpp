@@ -23,6 +23,25 @@ namespace {
 
 using Tile = BulkPairs::Tile;
 
+// Runs visit(tile, thread) over the tiles covering the pairs i <= j of n
+// vertices, on the OpenMP threads, each thread a fixed share (thread <
+// omp_get_max_threads()): one accumulator per thread, summed in thread order,
+// gives the same bits run after run.
+template <class Visit>
+void for_each_tile_pair(int n, Visit&& visit) {
+  constexpr int T = BulkPairs::kTile;
+  std::vector<Tile> tiles;
+  for (int i0 = 0; i0 < n; i0 += T)
+    for (int j0 = i0; j0 < n; j0 += T)
+      tiles.push_back({i0, std::min(T, n - i0), j0, std::min(T, n - j0), i0 == j0});
+#pragma omp parallel
+  {
+    const int thread = omp_get_thread_num();
+#pragma omp for schedule(static, 1)
+    for (size_t k = 0; k < tiles.size(); ++k) visit(tiles[k], thread);
+  }
+}
+
 // The set's arrays, indexed by position in the set.
 struct SetArrays {
   const double *x0, *x1, *x2, *area, *count;
@@ -34,10 +53,17 @@ struct Multipliers {
   int stride;
 };
 
-// w_ij (BulkPairs) from the squared distance r2.
+// w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) length): BulkPairs's weight, and
+// DeformedPairs's a at the reference length.
+inline double pair_weight(double m, double area_i, double area_j, double count_i,
+                          double count_j, double length) {
+  return m * (area_i + area_j) / ((count_i + count_j) * length);
+}
+
+// The same from the squared distance r2.
 inline double weight(double m, double area_i, double area_j, double count_i, double count_j,
                      double r2) {
-  return m * (area_i + area_j) / ((count_i + count_j) * std::sqrt(r2));
+  return pair_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2));
 }
 
 // (L V) over one tile for three columns: row sums into out at i, the
@@ -107,6 +133,77 @@ void block_tile(const SetArrays& s, const Tile& t, Multipliers mult, double scal
   }
 }
 
+// The lengths and strains of one tile row (pairs (i, j), j in [first, end)),
+// into the row arrays at j - j0.
+struct DeformedRow {
+  const double *s0, *s1, *s2, *x0, *x1, *x2;
+};
+
+FIBERFLUID_VECTOR_CLONES
+void lengths_row(const DeformedRow& d, int i, int j0, int first, int end, double* L, double* r,
+                 double* e) {
+  const double si0 = d.s0[i], si1 = d.s1[i], si2 = d.s2[i];
+  const double xi0 = d.x0[i], xi1 = d.x1[i], xi2 = d.x2[i];
+#pragma omp simd
+  for (int j = first; j < end; ++j) {
+    const double a0 = si0 - d.s0[j], a1 = si1 - d.s1[j], a2 = si2 - d.s2[j];
+    const double b0 = xi0 - d.x0[j], b1 = xi1 - d.x1[j], b2 = xi2 - d.x2[j];
+    const double length = std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
+    const double current = std::sqrt(b0 * b0 + b1 * b1 + b2 * b2);
+    L[j - j0] = length;
+    r[j - j0] = current;
+    e[j - j0] = current / length - 1.0;
+  }
+}
+
+// The arrays of one tile row: m (mask), L, r, Y, Y' at j - j0.
+struct RowArrays {
+  const double *m, *L, *r, *Y, *Yp;
+};
+
+FIBERFLUID_VECTOR_CLONES
+void forces_row(const double* const u[3], const double* area, const double* count, int i, int j0,
+                int first, int end, const RowArrays& row, double* const out[3]) {
+  const double *u0 = u[0], *u1 = u[1], *u2 = u[2];
+  double *o0 = out[0], *o1 = out[1], *o2 = out[2];
+  const double ui0 = u0[i], ui1 = u1[i], ui2 = u2[i], ai = area[i], ci = count[i];
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+#pragma omp simd reduction(+ : f0, f1, f2)
+  for (int j = first; j < end; ++j) {
+    const int q = j - j0;
+    const double c1 = pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]) * row.Y[q];
+    const double e0 = c1 * (ui0 - u0[j]), e1 = c1 * (ui1 - u1[j]), e2 = c1 * (ui2 - u2[j]);
+    f0 += e0, f1 += e1, f2 += e2;
+    o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
+  }
+  o0[i] += f0, o1[i] += f1, o2[i] += f2;
+}
+
+FIBERFLUID_VECTOR_CLONES
+void tangent_row(const double* const x[3], const double* const u[3], const double* const w[3],
+                 const double* area, const double* count, int i, int j0, int first, int end,
+                 const RowArrays& row, double* const out[3]) {
+  const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *u0 = u[0], *u1 = u[1], *u2 = u[2];
+  const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
+  double *o0 = out[0], *o1 = out[1], *o2 = out[2];
+  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], ui0 = u0[i], ui1 = u1[i], ui2 = u2[i];
+  const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i], ai = area[i], ci = count[i];
+  double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2)
+  for (int j = first; j < end; ++j) {
+    const int q = j - j0;
+    const double a = pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]);
+    const double c1 = a * row.Y[q], c2 = a * row.Yp[q] / (row.r[q] * row.L[q]);
+    const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
+    const double along = c2 * ((xi0 - x0[j]) * v0 + (xi1 - x1[j]) * v1 + (xi2 - x2[j]) * v2);
+    const double e0 = c1 * v0 + along * (ui0 - u0[j]), e1 = c1 * v1 + along * (ui1 - u1[j]),
+                 e2 = c1 * v2 + along * (ui2 - u2[j]);
+    p0 += e0, p1 += e1, p2 += e2;
+    o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
+  }
+  o0[i] += p0, o1[i] += p1, o2[i] += p2;
+}
+
 }  // namespace
 
 BulkPairs::BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
@@ -165,24 +262,15 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
 
 template <class Visit>
 void BulkPairs::for_each_tile(Visit&& visit) const {
-  std::vector<Tile> tiles;
-  for (int i0 = 0; i0 < n_; i0 += kTile)
-    for (int j0 = i0; j0 < n_; j0 += kTile)
-      tiles.push_back({i0, std::min(kTile, n_ - i0), j0, std::min(kTile, n_ - j0), i0 == j0});
   const bool weighted = mask_ != nullptr || law_ != nullptr;
-#pragma omp parallel
-  {
-    // Unweighted: one row of ones serves every row of every tile.
-    std::vector<double> m(weighted ? static_cast<size_t>(kTile) * kTile : kTile, 1.0);
-    const Multipliers mult{m.data(), weighted ? kTile : 0};
-    const int thread = omp_get_thread_num();
-    // A fixed share per thread: the same bits run after run.
-#pragma omp for schedule(static, 1)
-    for (size_t k = 0; k < tiles.size(); ++k) {
-      if (weighted) multipliers(tiles[k], m.data());
-      visit(tiles[k], mult, thread);
-    }
-  }
+  // Unweighted: one row of ones serves every row of every tile.
+  std::vector<std::vector<double>> m(static_cast<size_t>(omp_get_max_threads()),
+                                     std::vector<double>(weighted ? kTile * kTile : kTile, 1.0));
+  for_each_tile_pair(n_, [&](const Tile& t, int thread) {
+    double* tile_m = m[static_cast<size_t>(thread)].data();
+    if (weighted) multipliers(t, tile_m);
+    visit(t, Multipliers{tile_m, weighted ? kTile : 0}, thread);
+  });
 }
 
 Eigen::VectorXd BulkPairs::row_sums() const {
@@ -228,6 +316,112 @@ void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
   const Eigen::Index ld = K->rows();
   // Tiles write disjoint parts of K: no accumulators.
   for_each_tile([&](const Tile& t, Multipliers m, int) { block_tile(s, t, m, scale, data, ld); });
+}
+
+DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
+                             const Eigen::MatrixXd& U, const Eigen::VectorXd& area,
+                             const PairFactors& factors, const FiberLaw& law)
+    : n_(static_cast<int>(S.rows())),
+      count_(factors.vertex_counts()),
+      area_(area),
+      mask_(factors.mask()),
+      law_(law) {
+  for (int a = 0; a < 3; ++a) {
+    s_[a].assign(static_cast<size_t>(n_), 0.0);
+    x_[a].assign(static_cast<size_t>(n_), 0.0);
+    u_[a].assign(static_cast<size_t>(n_), 0.0);
+    if (a >= S.cols()) continue;
+    for (int i = 0; i < n_; ++i) {
+      s_[a][static_cast<size_t>(i)] = S(i, a);
+      x_[a][static_cast<size_t>(i)] = X(i, a);
+      u_[a][static_cast<size_t>(i)] = U(i, a);
+    }
+  }
+}
+
+struct DeformedPairs::RowScratch {
+  std::vector<double> m, L, r, e, Y, Yp;
+  RowScratch()
+      : m(BulkPairs::kTile, 1.0), L(BulkPairs::kTile), r(BulkPairs::kTile),
+        e(BulkPairs::kTile), Y(BulkPairs::kTile), Yp(BulkPairs::kTile) {}
+  RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
+};
+
+template <class Visit>
+void DeformedPairs::for_each_row(Visit&& visit) const {
+  std::vector<RowScratch> scratch(static_cast<size_t>(omp_get_max_threads()));
+  const DeformedRow geometry{s_[0].data(), s_[1].data(), s_[2].data(),
+                             x_[0].data(), x_[1].data(), x_[2].data()};
+  for_each_tile_pair(n_, [&](const Tile& t, int thread) {
+    RowScratch& row = scratch[static_cast<size_t>(thread)];
+    for (int r = 0; r < t.ni; ++r) {
+      const int i = t.i0 + r, first = t.j0 + (t.diagonal ? r + 1 : 0), end = t.j0 + t.nj;
+      if (first == end) continue;
+      const int q = first - t.j0;
+      lengths_row(geometry, i, t.j0, first, end, row.L.data(), row.r.data(), row.e.data());
+      law_.evaluate(row.e.data() + q, static_cast<size_t>(end - first), row.Y.data() + q,
+                    row.Yp.data() + q);
+      if (mask_ != nullptr) {
+        const uint8_t* kept = mask_->row(i);
+        for (int j = first; j < end; ++j) row.m[static_cast<size_t>(j - t.j0)] = kept[j];
+      }
+      visit(i, t.j0, first, end, row.arrays(), thread);
+    }
+  });
+}
+
+Eigen::MatrixXd DeformedPairs::forces() const {
+  const double* u[3] = {u_[0].data(), u_[1].data(), u_[2].data()};
+  std::vector<Eigen::MatrixXd> partial(static_cast<size_t>(omp_get_max_threads()),
+                                       Eigen::MatrixXd::Zero(n_, 3));
+  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+    Eigen::MatrixXd& p = partial[static_cast<size_t>(thread)];
+    double* const out[3] = {p.col(0).data(), p.col(1).data(), p.col(2).data()};
+    forces_row(u, area_.data(), count_.data(), i, j0, first, end, row, out);
+  });
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n_, 3);
+  for (const Eigen::MatrixXd& p : partial) sum += p;
+  return sum;
+}
+
+Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
+  std::vector<double> columns[3];
+  const double *x[3], *u[3], *w[3];
+  for (int a = 0; a < 3; ++a) {
+    columns[a].assign(static_cast<size_t>(n_), 0.0);
+    if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, columns[a].begin());
+    x[a] = x_[a].data(), u[a] = u_[a].data(), w[a] = columns[a].data();
+  }
+  std::vector<Eigen::MatrixXd> partial(static_cast<size_t>(omp_get_max_threads()),
+                                       Eigen::MatrixXd::Zero(n_, 3));
+  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+    Eigen::MatrixXd& p = partial[static_cast<size_t>(thread)];
+    double* const out[3] = {p.col(0).data(), p.col(1).data(), p.col(2).data()};
+    tangent_row(x, u, w, area_.data(), count_.data(), i, j0, first, end, row, out);
+  });
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n_, 3);
+  for (const Eigen::MatrixXd& p : partial) sum += p;
+  return sum;
+}
+
+void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+  c1->resize(n_, n_);
+  c2->resize(n_, n_);
+  c1->diagonal().setZero();
+  c2->diagonal().setZero();
+  const double *area = area_.data(), *count = count_.data();
+  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int) {
+    double* k1 = c1->col(i).data();
+    double* k2 = c2->col(i).data();
+    for (int j = first; j < end; ++j) {
+      const int q = j - j0;
+      const double a = pair_weight(row.m[q], area[i], area[j], count[i], count[j], row.L[q]);
+      k1[j] = a * row.Y[q];
+      k2[j] = a * row.Yp[q] / (row.r[q] * row.L[q]);
+      (*c1)(i, j) = k1[j];
+      (*c2)(i, j) = k2[j];
+    }
+  });
 }
 
 }  // namespace fiberfluid::model

@@ -58,8 +58,7 @@ class BulkPairs {
   // The multipliers m_ij of one tile (row-major, kTile per row), for a
   // pruned body or a strain-dependent law (otherwise every m_ij is 1).
   void multipliers(const Tile& t, double* m) const;
-  // Runs visit(tile, multipliers or null, thread) over every tile pair, each
-  // thread a fixed share.
+  // for_each_tile_pair with the tile's multipliers: visit(tile, multipliers, thread).
   template <class Visit>
   void for_each_tile(Visit&& visit) const;
 
@@ -69,6 +68,42 @@ class BulkPairs {
   const geom::FiberMask* mask_ = nullptr;
   const FiberLaw* law_ = nullptr;
   const Eigen::MatrixXd *reference_ = nullptr, *strained_ = nullptr;
+};
+
+// The bulk fibers at a deformed state, for Newton's residual and tangent
+// (model.md section 7, pair_stencil.hpp): per pair the reference length
+// L = |s_i - s_j|, the current r = |x_i - x_j|, the strain e = r / L - 1, the
+// weight a = h_ij (|S_i| + |S_j|) / L at the reference, and
+//   c1 = a Y(e),  c2 = a Y'(e) / (r L),
+// visited as BulkPairs does (each pair once, tiled, threaded, vectorised).
+class DeformedPairs {
+ public:
+  // S, X, U: reference positions, current positions, displacements (#V by
+  // dim); area: the reference |S_i|. All are kept by reference.
+  DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                const Eigen::VectorXd& area, const PairFactors& factors, const FiberLaw& law);
+
+  // sum_j c1_ij (u_i - u_j), #V by 3 (before the axis factors).
+  Eigen::MatrixXd forces() const;
+  // The bulk tangent times W (#V by dim): per pair
+  //   c1 (w_i - w_j) + c2 ((x_i - x_j) . (w_i - w_j)) (u_i - u_j),
+  // summed over j; #V by 3, before the axis factors.
+  Eigen::MatrixXd tangent_product(const Eigen::MatrixXd& W) const;
+  // c1 and c2 of every pair (N x N each, symmetric, zero diagonal).
+  void coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
+
+ private:
+  struct RowScratch;
+  // Runs visit(tile, row r, first j, scratch, thread) with the row's lengths,
+  // strains, Y, Y' and mask in the scratch.
+  template <class Visit>
+  void for_each_row(Visit&& visit) const;
+
+  int n_ = 0;
+  std::vector<double> s_[3], x_[3], u_[3], count_;
+  const Eigen::VectorXd& area_;
+  const geom::FiberMask* mask_;
+  const FiberLaw& law_;
 };
 
 }  // namespace fiberfluid::model

@@ -140,5 +140,44 @@ TEST(BulkPairs, SameThreadsSameBitsOneOrTwoThreadsClose) {
   EXPECT_LT((serial - first).cwiseAbs().maxCoeff(), 1e-13 * first.cwiseAbs().maxCoeff());
 }
 
+// DeformedPairs against the stencil written pair by pair (pair_stencil.hpp):
+// forces, the tangent product and the stored coefficients, on a pruned
+// sphere with a strain-dependent law and a non-affine displacement.
+TEST(DeformedPairs, MatchTheStencilPairByPair) {
+  const PairSet s = sphere(true);
+  const int n = static_cast<int>(s.X.rows());
+  const PairFactors factors(s.mask.get(), ConnectionCount::Symmetric, n);
+  const FiberLaw law = FiberLaw::exponential(1000.0, 8.0);
+  Eigen::MatrixXd U = 0.05 * Eigen::MatrixXd::Random(n, 3);
+  U.col(2) += 0.1 * s.X.col(2);
+  const Eigen::MatrixXd X = s.X + U, W = Eigen::MatrixXd::Random(n, 3);
+
+  Eigen::MatrixXd C1 = Eigen::MatrixXd::Zero(n, n), C2 = C1, forces = Eigen::MatrixXd::Zero(n, 3);
+  Eigen::MatrixXd product = forces;
+  std::vector<double> h(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    factors.row(i, h.data());
+    for (int j = 0; j < n; ++j) {
+      if (i == j) continue;
+      const double L = (s.X.row(i) - s.X.row(j)).norm(), r = (X.row(i) - X.row(j)).norm();
+      const double a = bulk_weight(h[static_cast<size_t>(j)], s.area[i], s.area[j], L);
+      C1(i, j) = modulus_coefficient(a, law.modulus(r / L - 1.0));
+      C2(i, j) = slope_coefficient(a, law.slope(r / L - 1.0), r, L);
+      const Eigen::RowVector3d d = U.row(i) - U.row(j), v = W.row(i) - W.row(j);
+      forces.row(i) += C1(i, j) * d;
+      product.row(i) += C1(i, j) * v + C2(i, j) * (X.row(i) - X.row(j)).dot(v) * d;
+    }
+  }
+  const DeformedPairs pairs(s.X, X, U, s.area, factors, law);
+  EXPECT_LT((pairs.forces() - forces).cwiseAbs().maxCoeff(), 1e-12 * forces.cwiseAbs().maxCoeff());
+  EXPECT_LT((pairs.tangent_product(W) - product).cwiseAbs().maxCoeff(),
+            1e-12 * product.cwiseAbs().maxCoeff());
+  Eigen::MatrixXd c1, c2;
+  pairs.coefficients(&c1, &c2);
+  EXPECT_LT((c1 - C1).cwiseAbs().maxCoeff(), 1e-14 * C1.cwiseAbs().maxCoeff());
+  EXPECT_LT((c2 - C2).cwiseAbs().maxCoeff(), 1e-14 * C2.cwiseAbs().maxCoeff());
+  EXPECT_EQ(c1, c1.transpose());
+}
+
 }  // namespace
 }  // namespace fiberfluid::model
