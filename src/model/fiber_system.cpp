@@ -6,6 +6,7 @@
 
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
+#include "geom/run_control.hpp"
 #include "model/fiber_network.hpp"
 #include "model/pair_stencil.hpp"
 
@@ -123,6 +124,7 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   const auto m = static_cast<Eigen::Index>(act.size());
   const double y = young(axis);
   Eigen::MatrixXd K(m, m);  // every entry is written below (no pass of zeros first)
+  advise_huge_pages(K.data(), 8.0 * static_cast<double>(K.size()));
   if (y == 0.0) {
     K.setZero();
   } else {
@@ -163,20 +165,25 @@ Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,
   Eigen::MatrixXd out(rows, dim_);
 #pragma omp parallel
   {
-    std::vector<double> h(n);
+    std::vector<double> w(n);
 #pragma omp for schedule(dynamic, 8)
     for (Eigen::Index r = 0; r < rows; ++r) {
       const int i = vertices[static_cast<size_t>(r)];
       const size_t u = static_cast<size_t>(i);
-      pair_row(i, h.data());
+      pair_row(i, w.data());  // h_ij, then w_ij in place: one square root per pair
+      double* weight = w.data();
+#pragma omp simd
+      for (size_t j = 0; j < n; ++j) {
+        const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
+        // h_ii = 0; r2 = 1 there only avoids 0/0.
+        const double r2 = j == u ? 1.0 : dx * dx + dy * dy + dz * dz;
+        weight[j] = bulk_weight(weight[j], a[u], a[j], std::sqrt(r2));
+      }
       for (int axis = 0; axis < dim_; ++axis) {
         const double* v = U.col(axis).data();
         double sum = 0.0;
-        for (size_t j = 0; j < n; ++j) {
-          if (j == u) continue;
-          const double dx = x0[u] - x0[j], dy = x1[u] - x1[j], dz = x2[u] - x2[j];
-          sum += bulk_weight(h[j], a[u], a[j], std::sqrt(dx * dx + dy * dy + dz * dz)) * (v[u] - v[j]);
-        }
+#pragma omp simd reduction(+ : sum)
+        for (size_t j = 0; j < n; ++j) sum += weight[j] * (v[u] - v[j]);
         out(r, axis) = young(axis) * sum + gamma_ * surface(i, axis) + S_(i, axis) * P;
       }
     }
