@@ -23,8 +23,8 @@ struct KernelSpeed {
   double orientation_tests_per_second = 3e8;   // the convexity check: N x F orientation tests
   double factor_flops_per_second = 6.5e10;     // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
   double triangular_flops_per_second = 1e10;   // solves with a dense factor (memory-bound)
-  double pair_updates_per_second = 9e8;        // one fiber pair in one axis block's product
-  double residual_pairs_per_second = 2.6e8;    // one ordered pair of the Newton residual
+  double pair_updates_per_second = 4.5e9;      // one fiber pair in one axis block's product (tiled)
+  double residual_pairs_per_second = 8e8;      // one ordered pair of the Newton residual (tiled)
   double sparse_flops_per_second = 3e9;        // CHOLMOD on dense bulk blocks
 };
 

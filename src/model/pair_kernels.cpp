@@ -11,8 +11,10 @@
 
 // Each tile loop is compiled three times, and the loader picks the widest the
 // CPU has (an ifunc): the default build stays portable. Not with clang (the
-// sanitized fuzz build), where the baseline alone is compiled.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+// fuzz build) nor under AddressSanitizer (whose runtime starts after the
+// loader runs ifunc resolvers), where the baseline alone is compiled.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
+    !defined(__SANITIZE_ADDRESS__)
 #define FIBERFLUID_VECTOR_CLONES \
   __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
