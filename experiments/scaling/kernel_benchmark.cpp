@@ -32,13 +32,7 @@
 #include "model/equilibrium.hpp"
 #include "model/fiber_system.hpp"
 #include "model/loads.hpp"
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
-    !defined(__SANITIZE_ADDRESS__)  // as src/model/pair_kernels.cpp
-#define KERNEL_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define KERNEL_CLONES
-#endif
+#include "model/vector_clones.hpp"
 
 namespace {
 
@@ -46,7 +40,7 @@ using fiberfluid::model::BoundaryMethod;
 
 // One square root and one division per unordered pair of n values, as the
 // pair kernels' tiles take them, and nothing else worth counting.
-KERNEL_CLONES
+FIBERFLUID_VECTOR_CLONES
 double sqrt_div_floor(const std::vector<double>& r2) {
   const int n = static_cast<int>(r2.size());
   double total = 0.0;

@@ -9,9 +9,9 @@
 
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
-#include "model/pair_kernels.hpp"
 #include "model/fiber_system.hpp"
 #include "model/model.hpp"
+#include "model/pair_kernels.hpp"
 
 namespace fiberfluid::model {
 

@@ -4,22 +4,13 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "geom/fiber_pruning.hpp"
 #include "geom/run_control.hpp"
-
-// Each tile loop is compiled three times, and the loader picks the widest the
-// CPU has (an ifunc): the default build stays portable. Not with clang (the
-// fuzz build) nor under AddressSanitizer (whose runtime starts after the
-// loader runs ifunc resolvers), where the baseline alone is compiled.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define FIBERFLUID_VECTOR_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define FIBERFLUID_VECTOR_CLONES
-#endif
+#include "model/pair_stencil.hpp"
+#include "model/vector_clones.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -45,6 +36,26 @@ void for_each_tile_pair(int n, Visit&& visit) {
   }
 }
 
+// One n x cols accumulator per thread, summed in thread order: with
+// for_each_tile_pair's fixed shares, the same bits run after run.
+class ThreadAccumulators {
+ public:
+  ThreadAccumulators(int n, int cols)
+      : partial_(static_cast<size_t>(omp_get_max_threads()), Eigen::MatrixXd::Zero(n, cols)) {}
+  double* column(int thread, int c) { return partial_[static_cast<size_t>(thread)].col(c).data(); }
+  std::array<double*, 3> columns(int thread) {
+    return {column(thread, 0), column(thread, 1), column(thread, 2)};
+  }
+  Eigen::MatrixXd sum() const {
+    Eigen::MatrixXd total = Eigen::MatrixXd::Zero(partial_[0].rows(), partial_[0].cols());
+    for (const Eigen::MatrixXd& p : partial_) total += p;
+    return total;
+  }
+
+ private:
+  std::vector<Eigen::MatrixXd> partial_;
+};
+
 // The set's arrays, indexed by position in the set.
 struct SetArrays {
   const double *x0, *x1, *x2, *area, *count;
@@ -57,7 +68,8 @@ struct Multipliers {
 };
 
 // w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) length): BulkPairs's weight, and
-// DeformedPairs's a at the reference length.
+// DeformedPairs's a at the reference length. pair_stencil.hpp's bulk_weight
+// with h_ij = m_ij / (c_i + c_j), written with one division instead of two.
 inline double pair_weight(double m, double area_i, double area_j, double count_i,
                           double count_j, double length) {
   return m * (area_i + area_j) / ((count_i + count_j) * length);
@@ -73,7 +85,7 @@ inline double weight(double m, double area_i, double area_j, double count_i, dou
 // opposite terms (w_ji (v_j - v_i) = -w_ij (v_i - v_j)) into out at j.
 FIBERFLUID_VECTOR_CLONES
 void product_tile(const SetArrays& s, const Tile& t, Multipliers mult, const double* const v[3],
-                  double* const out[3]) {
+                  const std::array<double*, 3>& out) {
   const double *x0 = s.x0, *x1 = s.x1, *x2 = s.x2, *a = s.area, *c = s.count;
   const double *v0 = v[0], *v1 = v[1], *v2 = v[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
@@ -174,7 +186,7 @@ struct RowArrays {
 
 FIBERFLUID_VECTOR_CLONES
 void forces_row(const double* const u[3], const double* area, const double* count, int i, int j0,
-                int first, int end, const RowArrays& row, double* const out[3]) {
+                int first, int end, const RowArrays& row, const std::array<double*, 3>& out) {
   const double *u0 = u[0], *u1 = u[1], *u2 = u[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
   const double ui0 = u0[i], ui1 = u1[i], ui2 = u2[i], ai = area[i], ci = count[i];
@@ -182,7 +194,8 @@ void forces_row(const double* const u[3], const double* area, const double* coun
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (int j = first; j < end; ++j) {
     const int q = j - j0;
-    const double c1 = pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]) * row.Y[q];
+    const double c1 =
+        modulus_coefficient(pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]), row.Y[q]);
     const double e0 = c1 * (ui0 - u0[j]), e1 = c1 * (ui1 - u1[j]), e2 = c1 * (ui2 - u2[j]);
     f0 += e0, f1 += e1, f2 += e2;
     o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
@@ -193,7 +206,7 @@ void forces_row(const double* const u[3], const double* area, const double* coun
 FIBERFLUID_VECTOR_CLONES
 void tangent_row(const double* const x[3], const double* const u[3], const double* const w[3],
                  const double* area, const double* count, int i, int j0, int first, int end,
-                 const RowArrays& row, double* const out[3]) {
+                 const RowArrays& row, const std::array<double*, 3>& out) {
   const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *u0 = u[0], *u1 = u[1], *u2 = u[2];
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
@@ -204,7 +217,8 @@ void tangent_row(const double* const x[3], const double* const u[3], const doubl
   for (int j = first; j < end; ++j) {
     const int q = j - j0;
     const double a = pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]);
-    const double c1 = a * row.Y[q], c2 = a * row.Yp[q] / (row.r[q] * row.L[q]);
+    const double c1 = modulus_coefficient(a, row.Y[q]);
+    const double c2 = slope_coefficient(a, row.Yp[q], row.r[q], row.L[q]);
     const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
     const double along = c2 * ((xi0 - x0[j]) * v0 + (xi1 - x1[j]) * v1 + (xi2 - x2[j]) * v2);
     const double e0 = c1 * v0 + along * (ui0 - u0[j]), e1 = c1 * v1 + along * (ui1 - u1[j]),
@@ -286,15 +300,11 @@ void BulkPairs::for_each_tile(Visit&& visit) const {
 
 Eigen::VectorXd BulkPairs::row_sums() const {
   const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
-  // One accumulator per thread (summed in thread order: deterministic).
-  std::vector<Eigen::VectorXd> partial(static_cast<size_t>(omp_get_max_threads()),
-                                       Eigen::VectorXd::Zero(n_));
+  ThreadAccumulators sums(n_, 1);
   for_each_tile([&](const Tile& t, Multipliers m, int thread) {
-    row_sums_tile(s, t, m, partial[static_cast<size_t>(thread)].data());
+    row_sums_tile(s, t, m, sums.column(thread, 0));
   });
-  Eigen::VectorXd sums = Eigen::VectorXd::Zero(n_);
-  for (const Eigen::VectorXd& p : partial) sums += p;
-  return sums;
+  return sums.sum().col(0);
 }
 
 Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
@@ -302,21 +312,16 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
   const auto k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
   const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(n_);
-  const size_t threads = static_cast<size_t>(omp_get_max_threads());
   // Each pair's weight serves three columns at once; unused ones read zeros.
   for (int first = 0; first < k; first += 3) {
     const int width = std::min(3, k - first);
     const double* columns[3];
     for (int c = 0; c < 3; ++c) columns[c] = c < width ? V.col(first + c).data() : zeros.data();
-    std::vector<Eigen::MatrixXd> partial(threads, Eigen::MatrixXd::Zero(n_, 3));
+    ThreadAccumulators products(n_, 3);
     for_each_tile([&](const Tile& t, Multipliers m, int thread) {
-      Eigen::MatrixXd& p = partial[static_cast<size_t>(thread)];
-      double* const outs[3] = {p.col(0).data(), p.col(1).data(), p.col(2).data()};
-      product_tile(s, t, m, columns, outs);
+      product_tile(s, t, m, columns, products.columns(thread));
     });
-    Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n_, 3);
-    for (const Eigen::MatrixXd& p : partial) sum += p;
-    out.middleCols(first, width) = sum.leftCols(width);
+    out.middleCols(first, width) = products.sum().leftCols(width);
   }
   return out;
 }
@@ -383,16 +388,11 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
 
 Eigen::MatrixXd DeformedPairs::forces() const {
   const double* u[3] = {u_[0].data(), u_[1].data(), u_[2].data()};
-  std::vector<Eigen::MatrixXd> partial(static_cast<size_t>(omp_get_max_threads()),
-                                       Eigen::MatrixXd::Zero(n_, 3));
+  ThreadAccumulators forces(n_, 3);
   for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-    Eigen::MatrixXd& p = partial[static_cast<size_t>(thread)];
-    double* const out[3] = {p.col(0).data(), p.col(1).data(), p.col(2).data()};
-    forces_row(u, area_.data(), count_.data(), i, j0, first, end, row, out);
+    forces_row(u, area_.data(), count_.data(), i, j0, first, end, row, forces.columns(thread));
   });
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n_, 3);
-  for (const Eigen::MatrixXd& p : partial) sum += p;
-  return sum;
+  return forces.sum();
 }
 
 Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
@@ -403,16 +403,12 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
     if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, columns[a].begin());
     x[a] = x_[a].data(), u[a] = u_[a].data(), w[a] = columns[a].data();
   }
-  std::vector<Eigen::MatrixXd> partial(static_cast<size_t>(omp_get_max_threads()),
-                                       Eigen::MatrixXd::Zero(n_, 3));
+  ThreadAccumulators products(n_, 3);
   for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-    Eigen::MatrixXd& p = partial[static_cast<size_t>(thread)];
-    double* const out[3] = {p.col(0).data(), p.col(1).data(), p.col(2).data()};
-    tangent_row(x, u, w, area_.data(), count_.data(), i, j0, first, end, row, out);
+    tangent_row(x, u, w, area_.data(), count_.data(), i, j0, first, end, row,
+                products.columns(thread));
   });
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n_, 3);
-  for (const Eigen::MatrixXd& p : partial) sum += p;
-  return sum;
+  return products.sum();
 }
 
 void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
@@ -429,8 +425,8 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
     for (int j = first; j < end; ++j) {
       const int q = j - j0;
       const double a = pair_weight(row.m[q], area[i], area[j], count[i], count[j], row.L[q]);
-      k1[j] = a * row.Y[q];
-      k2[j] = a * row.Yp[q] / (row.r[q] * row.L[q]);
+      k1[j] = modulus_coefficient(a, row.Y[q]);
+      k2[j] = slope_coefficient(a, row.Yp[q], row.r[q], row.L[q]);
       (*c1)(i, j) = k1[j];
       (*c2)(i, j) = k2[j];
     }
