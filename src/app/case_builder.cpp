@@ -75,9 +75,9 @@ void require_per_axis(const FieldName& field, const std::string& key, const Eige
 }
 
 // ------------------------------------------------------------ fibers
-// Bodies beyond this are not pruned: N^2 pair tests (5,000 vertices: about 2
-// minutes here) and an N^2 byte table.
-constexpr int kLargestPruned = 10000;
+// Bodies beyond this are not pruned: N^2 pair tests (a 5,000-vertex torus:
+// about 20 s here, so 20,000 vertices about 6 minutes) and an N^2 byte table.
+constexpr int kLargestPruned = 20000;
 
 // Prunes the fibers that leave a concave body and reports what it did.
 FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {

@@ -24,7 +24,7 @@ using nlohmann::json;
 std::function<geom::Surface()> read_generator(Fields& f) {
   const std::string kind =
       f.choice("generator", "", {"icosphere", "tetrahedron", "octahedron", "icosahedron", "cube",
-                                 "box", "dome", "rectangle", "polygon"});
+                                 "box", "dome", "torus", "rectangle", "polygon"});
   if (kind == "icosphere") {
     const int subdivisions = f.integer("subdivisions", 2, 0, 7);
     const double radius = f.positive("radius", 1.0);
@@ -51,6 +51,13 @@ std::function<geom::Surface()> read_generator(Fields& f) {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
     return [=] { return geom::dome(semi_axes, subdivisions); };
+  }
+  if (kind == "torus") {
+    const double major = f.positive("major_radius", 2.0), minor = f.positive("minor_radius", 0.7);
+    if (minor >= major) f.fail("minor_radius", "must be below major_radius (a ring, not a spindle)");
+    Eigen::Vector2i segments(40, 20);
+    if (f.has("segments")) segments = f.counts("segments", 2, 3, 1000);
+    return [=] { return geom::torus(major, minor, segments.x(), segments.y()); };
   }
   if (kind == "rectangle") {
     const Eigen::Vector2d min = f.vector("min", 2), max = f.vector("max", 2);

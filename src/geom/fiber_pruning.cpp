@@ -9,6 +9,8 @@
 
 #include "geom/progress.hpp"
 #include "geom/run_control.hpp"
+#include "geom/convexity_filter.hpp"
+#include "geom/segment_filter.hpp"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -62,6 +64,7 @@ using ExactMesh = CGAL::Surface_mesh<Epeck::Point_3>;
 using ExactSide = CGAL::Side_of_triangle_mesh<ExactMesh, Epeck>;
 
 Epick::Point_3 point3(const Eigen::MatrixXd& V, int i) { return {V(i, 0), V(i, 1), V(i, 2)}; }
+Epeck::Point_3 exact_point(const Eigen::MatrixXd& V, int i) { return {V(i, 0), V(i, 1), V(i, 2)}; }
 
 // Everything one thread needs to classify pieces of segments exactly. Each
 // thread builds its own, so no exact (lazy) number is shared across threads.
@@ -123,11 +126,9 @@ struct ExactSolid {
   }
 };
 
-// The shape of the solid at a vertex, from its incident faces: a convex
-// cone (no ring vertex in front of an incident face's plane), the complement
-// of one (none behind), or a saddle.
-enum class Star { Convex, Concave, Saddle };
-
+// The shape of the solid at a vertex (Star, segment_filter.hpp), from its
+// incident faces: a convex cone (no ring vertex in front of an incident
+// face's plane), the complement of one (none behind), or a saddle.
 struct VertexStars {
   std::vector<Star> star;
   std::vector<std::vector<int>> faces;  // incident faces per vertex
@@ -231,28 +232,45 @@ PruningResult prune_3d(const Surface& s) {
     triangles.emplace_back(point3(s.V, s.F(f, 0)), point3(s.V, s.F(f, 1)), point3(s.V, s.F(f, 2)));
   const Tree tree(triangles.cbegin(), triangles.cend());
   const VertexStars stars(s);
+  const SegmentFilter filter(s, stars.star);
   const int n = s.num_vertices();
-  long long fallbacks = 0;
+  long long fallbacks = 0, clear = 0, filtered = 0;
   const double pairs = 0.5 * n * (n - 1.0);
   std::atomic<long long> pairs_done{0};
   report_progress("pruning", 0.0, pairs);
-#pragma omp parallel reduction(+ : fallbacks)
+#pragma omp parallel reduction(+ : fallbacks, clear, filtered)
   {
     const ExactSolid exact(s);
     std::vector<int> faces;
 #pragma omp for schedule(dynamic, 4)
     for (int i = 0; i < n; ++i) {
       if (cancel_requested()) continue;  // no break out of an OpenMP loop: the rest is skipped
-      for (int j = i + 1; j < n; ++j)
-        if (!keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks))
-          result.mask.prune(i, j);
+      for (int j = i + 1; j < n; ++j) {
+        bool keep = true;
+        const SegmentVerdict verdict = filter.classify(i, j);
+        filtered += verdict != SegmentVerdict::Clear && verdict != SegmentVerdict::Unsure;
+        switch (verdict) {
+          case SegmentVerdict::Crosses:
+          case SegmentVerdict::Outside: keep = false; break;
+          case SegmentVerdict::Inside: break;
+          case SegmentVerdict::Clear:  // the open segment is wholly inside or outside
+            ++clear;
+            keep = !exact.outside(CGAL::midpoint(exact_point(s.V, i), exact_point(s.V, j)));
+            break;
+          case SegmentVerdict::Unsure:
+            keep = keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks);
+            break;
+        }
+        if (!keep) result.mask.prune(i, j);
+      }
       const long long done = pairs_done += n - 1 - i;
       if (omp_get_thread_num() == 0) report_progress("pruning", static_cast<double>(done), pairs);
     }
   }
   throw_if_cancelled("the fiber pruning");
   report_progress("pruning", pairs, pairs);
-  result.exact_fallbacks = fallbacks;
+  result.exact_fallbacks = fallbacks + clear;
+  result.decided_in_doubles = filtered;
   return result;
 }
 
@@ -353,7 +371,18 @@ PruningResult prune_2d(const Surface& s) {
 }  // namespace
 
 bool is_convex(const Surface& s) {
-  // N x F orientation tests: minutes on a 160,000-vertex mesh, so it reports.
+  if (s.dim == 3) {
+    if (const std::optional<ConvexityScreen> screen = screen_convexity(s)) {
+      if (screen->vertex_in_front) return false;
+      return std::none_of(screen->unsure.begin(), screen->unsure.end(), [&](const auto& pair) {
+        const auto [f, v] = pair;
+        return CGAL::orientation(point3(s.V, s.F(f, 0)), point3(s.V, s.F(f, 1)),
+                                 point3(s.V, s.F(f, 2)), point3(s.V, v)) == CGAL::POSITIVE;
+      });
+    }
+  }
+  // 2D outlines, and coordinates beyond the float filter's range: every
+  // vertex against every face with CGAL's predicates.
   const double faces = s.num_faces();
   for (int f = 0; f < s.num_faces(); ++f) {
     if (f % 1024 == 0) {

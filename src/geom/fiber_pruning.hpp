@@ -33,6 +33,7 @@ struct PruningResult {
   bool convex = false;           // the fast path: nothing to prune
   double seconds = 0.0;
   long long exact_fallbacks = 0; // pairs decided by exact constructions
+  long long decided_in_doubles = 0;  // pairs the float pre-filter certified (3D)
 };
 
 // True when no vertex lies strictly outside the plane of any face (exact
@@ -40,8 +41,10 @@ struct PruningResult {
 bool is_convex(const Surface& surface);
 
 // Keeps a fiber iff its segment lies in the closed solid (inside, or on the
-// surface: fibers along a flat face or an edge are kept). Decided with
-// CGAL's exact predicates and an AABB tree over the faces; where a segment
+// surface: fibers along a flat face or an edge are kept). In 3D a float
+// pre-filter with certified signs decides most pairs (segment_filter.hpp);
+// the rest are decided with CGAL's exact predicates and an AABB tree over the
+// faces; where a segment
 // touches the surface other than by crossing a face's interior (through a
 // vertex, along an edge, in a face's plane), exact constructions split it
 // into pieces and each piece is classified. 3D triangle meshes and 2D

@@ -259,9 +259,16 @@ TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
 
 TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
   ScratchDir dir;
-  // The bunny's 930,000 fiber pairs take seconds to prune (minutes under ASan).
-  const pid_t pid = start_cli({"run", testing::experiment_file("bunny_gravity.json").string(),
-                               "-o", (dir.path() / "out").string()},
+  // A 5,000-vertex torus: 12.5 million fiber pairs, about 20 s of pruning
+  // (minutes under ASan).
+  const auto config = dir.write("torus.json", R"({"name": "torus",
+    "surface": {"generator": "torus", "major_radius": 0.05, "minor_radius": 0.02,
+                "segments": [100, 50]},
+    "material": {"Y": 20000, "gamma": 1},
+    "supports": [{"where": "z >= 0.015"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 1}})");
+  const pid_t pid = start_cli({"run", config.string(), "-o", (dir.path() / "out").string()},
                               dir.path() / "run.log");
   // Progress lines start after 2 s: "pruning 1234/930,000 (...)".
   auto pruning = [&] { return ("\n" + read_file(dir.path() / "run.log")).find("\npruning ") != std::string::npos; };
@@ -274,7 +281,7 @@ TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
   EXPECT_NE(read_file(dir.path() / "run.log").find("interrupted during the fiber pruning"),
             std::string::npos) << read_file(dir.path() / "run.log");
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
-                          std::filesystem::directory_iterator()), 1);  // the log alone
+                          std::filesystem::directory_iterator()), 2);  // the config and the log
 }
 
 TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {

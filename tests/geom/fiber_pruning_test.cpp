@@ -264,6 +264,55 @@ TEST(FiberPruning, SharedCubeIsDecidedOnItsStoredCoordinates) {
   expect_agreement(s, r);
 }
 
+TEST(FiberPruning, FloatPreFilterDecidesMostPairsAndAgreesWithTheBruteForce) {
+  const Surface bunny =
+      remove_unused_vertices(read_surface(testing::data_mesh("Bunny.stl")).surface).surface;
+  const PruningResult r = prune_fibers(bunny);
+  EXPECT_EQ(r.mask.num_kept(), 518254);  // as before the pre-filter (bunny_gravity.json)
+  EXPECT_GT(r.decided_in_doubles, 0.99 * static_cast<double>(r.mask.num_pairs()));
+  expect_agreement(bunny, r, /*row_step=*/97);  // every pair of 15 of its 1,366 vertices
+}
+
+TEST(FiberPruning, CoordinatesBeyondTheFilterRangeGoToTheExactPathAlone) {
+  // Scaled by 2^-240 (exact), the liver's coordinates fall below 1e-60: no
+  // certified float sign holds, and CGAL decides every pair, the same way.
+  const Surface liver =
+      remove_unused_vertices(read_surface(testing::data_mesh("liver.obj")).surface).surface;
+  Surface tiny = liver;
+  tiny.V *= 0x1p-240;
+  const PruningResult reference = prune_fibers(liver), scaled = prune_fibers(tiny);
+  EXPECT_GT(reference.decided_in_doubles, 0);
+  EXPECT_EQ(scaled.decided_in_doubles, 0);
+  EXPECT_EQ(scaled.mask.num_kept(), reference.mask.num_kept());
+  for (int i = 0; i < liver.num_vertices(); ++i)
+    for (int j = i + 1; j < liver.num_vertices(); ++j)
+      ASSERT_EQ(scaled.mask.kept(i, j), reference.mask.kept(i, j)) << i << ", " << j;
+}
+
+TEST(FiberPruning, ConvexityCheckSeesAVertexOutByTheLastBits) {
+  // A box's face centre moved off its flat face by 2^-50: in front of its
+  // neighbours' planes (out) or they in front of its own (in), by less than
+  // doubles certify. The screen hands those pairs to the exact pass.
+  const Surface cube_2x2 = box({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  int centre = -1;
+  for (int i = 0; i < cube_2x2.num_vertices(); ++i)
+    if (cube_2x2.V.row(i).isApprox(Eigen::RowVector3d(0.5, 0.5, 1.0))) centre = i;
+  ASSERT_GE(centre, 0);
+  for (const double scale : {1.0, 0x1p-240}) {  // and beyond the filter's range
+    SCOPED_TRACE(scale);
+    Surface flat = cube_2x2;
+    flat.V *= scale;
+    EXPECT_TRUE(is_convex(flat));
+    for (const double move : {0x1p-50, -0x1p-50}) {
+      Surface moved = flat;
+      moved.V(centre, 2) *= 1.0 + move;
+      EXPECT_FALSE(is_convex(moved)) << move;
+    }
+  }
+  EXPECT_TRUE(is_convex(icosphere(3)));
+  EXPECT_FALSE(is_convex(torus(2.0, 0.5, 16, 8)));
+}
+
 TEST(FiberPruning, ConvexFastPathKeepsEverything) {
   const PruningResult r = prune_fibers(icosphere(3));
   EXPECT_TRUE(r.convex);
