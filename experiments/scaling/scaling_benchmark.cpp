@@ -36,7 +36,9 @@ int main(int argc, char** argv) {
   std::string solver = "dense-lu", save;
   bool gemm_peak = false;
   std::string newton_law, tangent = "auto";
-  double beta = 5.0, gravity_scale = 1.0;
+  double beta = 5.0, gravity_scale = 1.0, treecode = 0.0;
+  int steps = 0;
+  bool no_residual = false;
   cli.add_option("--subdivisions", subdivisions, "icosphere subdivisions (2: 162 vertices)");
   cli.add_option("--solver", solver, "dense-lu, block-cholesky, cholmod or pcg");
   cli.add_option("--save", save, "write the final unknowns as raw doubles");
@@ -46,6 +48,10 @@ int main(int argc, char** argv) {
   cli.add_option("--beta", beta, "the exponential law's beta");
   cli.add_option("--gravity-scale", gravity_scale, "multiplies the sphere's gravity");
   cli.add_option("--tangent", tangent, "newton tangent solve: auto, dense or krylov");
+  cli.add_option("--treecode", treecode,
+                 "the bulk product by the treecode with this relative error (pcg)");
+  cli.add_option("--steps", steps, "load steps (default: the sphere's 10)");
+  cli.add_flag("--no-residual", no_residual, "skip each step's exact O(N^2) residual");
   CLI11_PARSE(cli, argc, argv);
 
   if (gemm_peak) {
@@ -64,6 +70,10 @@ int main(int argc, char** argv) {
   config["loads"] = nlohmann::json::array({config["loads"][0]});
   for (auto& component : config["loads"][0]["acceleration"])
     component = component.get<double>() * gravity_scale;
+  if (treecode > 0.0)
+    config["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", treecode}};
+  if (steps > 0) config["stepping"]["steps"] = steps;
+  if (no_residual) config["stepping"]["measure_residual"] = false;
   if (!newton_law.empty()) {
     config["stepping"]["scheme"] = "newton";
     config["stepping"]["newton"] = {{"tangent", tangent}};
@@ -98,6 +108,7 @@ int main(int argc, char** argv) {
                  s.solver_statistics.factorization_kernel_seconds / 1e9
            : 0.0},
       {"pcg_iterations", s.solver_statistics.iterations},
+      {"treecode_tolerance", treecode},
       {"scheme", fiberfluid::solve::to_string(s.scheme)},
       {"tangent", fiberfluid::solve::to_string(s.tangent)},
       {"newton_iterations", s.newton_iterations},

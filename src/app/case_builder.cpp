@@ -85,6 +85,7 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
   report.pruning = spec.pruning;
   report.write = spec.write;
   m.connection_count = spec.count;
+  m.treecode_tolerance = spec.treecode_tolerance;
   const int n = m.num_vertices();
   report.pairs = static_cast<long long>(n) * (n - 1) / 2;
   report.kept = report.pairs;
@@ -107,6 +108,12 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
                         std::to_string(std::find(per_vertex.begin(), per_vertex.end(), 0) -
                                        per_vertex.begin()) +
                         " keeps no fiber: is the mesh self-intersecting?");
+  if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Symmetric)
+    spec.field.fail("product", "\"treecode\" needs one connection count for every fiber: this "
+                               "concave body prunes " +
+                                   std::to_string(report.pairs - report.kept) +
+                                   " fibers; set \"connection_count\": \"global\" (pruned "
+                                   "fibers are then exact corrections) or \"product\": \"exact\"");
   m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
   return report;
 }

@@ -89,6 +89,7 @@ struct FiberSpec {
   bool pruning = true;                    // "auto": prune the fibers that leave a concave body
   model::ConnectionCount count = model::ConnectionCount::Symmetric;
   std::string write = "none";             // "kept" or "pruned": DIR/fibers.vtu
+  double treecode_tolerance = 0.0;        // "product": "treecode": its relative error
   FieldName field;
 };
 

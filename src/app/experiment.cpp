@@ -414,8 +414,32 @@ FiberSpec read_fibers(Fields& root) {
                    ? model::ConnectionCount::Global
                    : model::ConnectionCount::Symmetric;
   spec.write = f.choice("write", "none", {"none", "kept", "pruned"});
+  if (f.choice("product", "exact", {"exact", "treecode"}) == "treecode") {
+    spec.treecode_tolerance = f.number("treecode_tolerance", 1e-6);
+    if (!(spec.treecode_tolerance >= 1e-10 && spec.treecode_tolerance <= 1e-2))
+      f.fail("treecode_tolerance", "expected a relative error from 1e-10 to 1e-2, got " +
+                                       std::to_string(spec.treecode_tolerance));
+  } else if (f.has("treecode_tolerance"))
+    f.fail("treecode_tolerance", "applies to \"product\": \"treecode\" only");
   f.finish();
   return spec;
+}
+
+// The treecode approximates the linear bulk product inside PCG: anything that
+// needs the exact pair sums or a dense matrix is refused by name.
+void check_treecode(Fields& root, CaseSpec& c) {
+  const auto refuse = [&](const std::string& why) {
+    root.fail("fibers", "\"product\": \"treecode\" " + why);
+  };
+  if (c.stepping.scheme != solve::Scheme::Incremental)
+    refuse("approximates the incremental scheme's linear product; Newton's tangent is exact "
+           "(\"stepping\": {\"scheme\": \"incremental\"})");
+  if (!c.material.material.law.is_constant())
+    refuse("needs a linear material (a constant \"law\")");
+  if (c.stepping.solver == solve::SolverKind::Auto) c.stepping.solver = solve::SolverKind::PCG;
+  if (c.stepping.solver != solve::SolverKind::PCG)
+    refuse("is matrix-free: it goes with \"stepping\": {\"solver\": \"pcg\"}, not \"" +
+           std::string(solve::to_string(c.stepping.solver)) + "\"");
 }
 
 // Parses one case from a complete simulation document; opens no file.
@@ -448,6 +472,7 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
     warnings->push_back("material.law: the incremental scheme without stepping.rebuild_matrix "
                         "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
                         "scheme \"newton\" for the strain-dependent law");
+  if (c.fibers.treecode_tolerance > 0.0) check_treecode(root, c);
   check_tables(root, c);
   root.finish();
   return c;

@@ -71,6 +71,11 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, const Dof
     young_ = model.material.axis_factors;
     reference_ = model.surface.V;
     strained_ = strained != nullptr ? *strained : model.surface.V;
+  } else if (model.treecode_tolerance > 0.0) {
+    if (!BulkTreecode::applicable(factors_))
+      throw std::invalid_argument("the treecode bulk product needs one connection count for "
+                                  "every fiber (no pruning, or the global count)");
+    treecode_ = std::make_shared<const BulkTreecode>(X, area_, factors_, model.treecode_tolerance);
   }
 
   active_.resize(static_cast<size_t>(dim_));
@@ -147,12 +152,13 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
 }
 
 const Eigen::VectorXd& FiberSystem::bulk_diagonal() const {
-  if (bulk_diagonal_.size() != n_) bulk_diagonal_ = bulk_pairs().row_sums();
+  if (bulk_diagonal_.size() != n_)
+    bulk_diagonal_ = treecode_ ? treecode_->row_sums() : bulk_pairs().row_sums();
   return bulk_diagonal_;
 }
 
 Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
-  return bulk_pairs().laplacian_product(V);
+  return treecode_ ? treecode_->laplacian_product(V) : bulk_pairs().laplacian_product(V);
 }
 
 Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,

@@ -10,6 +10,7 @@
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
 #include "model/model.hpp"
+#include "model/bulk_treecode.hpp"
 #include "model/pair_kernels.hpp"
 
 namespace fiberfluid::model {
@@ -84,7 +85,10 @@ class FiberSystem final : public BorderedSystem {
   // Diagonal of L_bulk (#V), computed on first use (one pass over the pairs).
   const Eigen::VectorXd& bulk_diagonal() const;
   // L_bulk V for #V by k vectors, computed pair by pair without storing L_bulk.
+  // With Model::treecode_tolerance (and a constant law) both come from the
+  // treecode; dense and sparse blocks stay exact, so that option goes with PCG.
   Eigen::MatrixXd bulk_product(const Eigen::MatrixXd& V) const;
+  bool approximate_bulk() const { return treecode_ != nullptr; }
   // K u over the reduced unknowns except P, matrix-free.
   Eigen::VectorXd apply_K(const Eigen::VectorXd& u) const override;
 
@@ -118,6 +122,8 @@ class FiberSystem final : public BorderedSystem {
   Eigen::MatrixXd S_;
   Eigen::SparseMatrix<double> surface_;
   mutable Eigen::VectorXd bulk_diagonal_;  // empty until first asked for
+  // The approximate bulk product and diagonal (Model::treecode_tolerance).
+  std::shared_ptr<const BulkTreecode> treecode_;
   Eigen::Vector3d young_;  // per axis: Y m_a, or m_a when the moduli are per pair
   // Strain-dependent law: the law, the reference and strained positions.
   const FiberLaw* law_ = nullptr;

@@ -112,6 +112,10 @@ struct Model {
   // The bulk fibers that exist: null means every pair (a convex body).
   std::shared_ptr<const geom::FiberMask> fibers;
   ConnectionCount connection_count = ConnectionCount::Symmetric;
+  // Above 0: the linear bulk product and diagonal come from a treecode with
+  // this relative error (bulk_treecode.hpp) instead of the exact pair sums.
+  // It needs one connection count for every fiber and a constant law.
+  double treecode_tolerance = 0.0;
 
   int dim() const { return surface.dim; }
   int num_vertices() const { return surface.num_vertices(); }

@@ -264,6 +264,61 @@ TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   expect_config_error(dir, c, "stepping.newton.tangent: expected one of auto, dense, krylov");
 }
 
+TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"]["subdivisions"] = 4;  // 2,562 vertices: proxies in play
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 1e-6}};
+  const Experiment approximate = load_experiment(write_config(dir, c));
+  EXPECT_EQ(approximate.cases[0].model.treecode_tolerance, 1e-6);
+  EXPECT_EQ(approximate.cases[0].stepping.solver, solve::SolverKind::PCG);  // auto: matrix-free
+  c.erase("fibers");
+  c["stepping"]["solver"] = "pcg";
+  const Experiment exact = load_experiment(write_config(dir, c));
+  const ExperimentResult a = run_experiment(approximate), e = run_experiment(exact);
+  ASSERT_TRUE(a.runs_succeeded() && e.runs_succeeded());
+  const Eigen::VectorXd& ua = a.runs[0].summary.unknowns;
+  const Eigen::VectorXd& ue = e.runs[0].summary.unknowns;
+  EXPECT_LT((ua - ue).norm(), 1e-6 * ue.norm());
+  EXPECT_GT((ua - ue).norm(), 0.0);  // it did approximate
+
+  c = base_config();
+  c["fibers"] = {{"treecode_tolerance", 1e-6}};
+  expect_config_error(dir, c, "fibers.treecode_tolerance: applies to \"product\": \"treecode\" only");
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 0.5}};
+  expect_config_error(dir, c, "fibers.treecode_tolerance: expected a relative error from 1e-10 to 1e-2");
+  c["fibers"] = {{"product", "treecode"}};
+  c["stepping"]["solver"] = "dense-lu";
+  expect_config_error(dir, c, "fibers: \"product\": \"treecode\" is matrix-free");
+  c["stepping"] = {{"scheme", "newton"}};
+  expect_config_error(dir, c, "Newton's tangent is exact");
+  // A concave body pruned with the symmetric count has no single pair factor.
+  c = base_config();
+  c["surface"] = {{"generator", "torus"}, {"segments", {16, 8}}};
+  c["supports"][0] = {{"where", "z >= 0.5"}};
+  c["fibers"] = {{"product", "treecode"}};
+  expect_config_error(dir, c, "fibers.product: \"treecode\" needs one connection count");
+  c["fibers"]["connection_count"] = "global";
+  EXPECT_GT(load_experiment(write_config(dir, c)).cases[0].fibers.pairs,
+            load_experiment(write_config(dir, c)).cases[0].fibers.kept);
+}
+
+TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"generator", "torus"}, {"major_radius", 2.0}, {"minor_radius", 0.5},
+                  {"segments", {24, 12}}};
+  c["supports"][0] = {{"where", "z >= 0.4"}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  EXPECT_EQ(ex.cases[0].model.num_vertices(), 24 * 12);
+  EXPECT_FALSE(ex.cases[0].fibers.convex);
+  c["surface"]["minor_radius"] = 2.5;
+  expect_config_error(dir, c, "surface.minor_radius: must be below major_radius");
+  c["surface"]["minor_radius"] = 0.5;
+  c["surface"]["segments"] = {2, 12};
+  expect_config_error(dir, c, "surface.segments: expected a list of 2 whole numbers from 3 to 1000");
+}
+
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   ScratchDir dir;
   nlohmann::json c = base_config();
