@@ -337,6 +337,7 @@ Case build_case(const CaseSpec& spec, const Case& earlier) {
   c.model.surface = earlier.model.surface;
   c.model.fibers = earlier.model.fibers;
   c.model.connection_count = earlier.model.connection_count;
+  c.model.treecode_tolerance = earlier.model.treecode_tolerance;
   c.fibers = earlier.fibers;
   ModelBuilder(spec, c).build();
   estimate(spec, PruningWork::None, c);  // pruned once, for the earlier case

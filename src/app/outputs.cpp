@@ -163,6 +163,8 @@ json fibers_json(const Case& c) {
   return {{"pruning", f.pruning ? "auto" : "off"},
           {"convex", f.convex},
           {"connection_count", model::to_string(c.model.connection_count)},
+          {"product", c.model.treecode_tolerance > 0.0 ? "treecode" : "exact"},
+          {"treecode_tolerance", c.model.treecode_tolerance},
           {"in_all", f.pairs},
           {"kept", f.kept},
           {"pruned", f.pairs - f.kept},

@@ -282,6 +282,16 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
   EXPECT_LT((ua - ue).norm(), 1e-6 * ue.norm());
   EXPECT_GT((ua - ue).norm(), 0.0);  // it did approximate
 
+  // Variants share the surface and its fibers, and the product with them.
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 1e-4}};
+  c["stepping"] = {{"steps", 1}};
+  c["variants"] = {{{"name", "soft"}, {"material", {{"Y", 50000}}}},
+                   {{"name", "stiff"}, {"material", {{"Y", 200000}}}}};
+  const Experiment sweep = load_experiment(write_config(dir, c));
+  ASSERT_EQ(sweep.cases.size(), 2u);
+  for (const Case& variant : sweep.cases) EXPECT_EQ(variant.model.treecode_tolerance, 1e-4);
+  c.erase("variants");
+
   c = base_config();
   c["fibers"] = {{"treecode_tolerance", 1e-6}};
   expect_config_error(dir, c, "fibers.treecode_tolerance: applies to \"product\": \"treecode\" only");
