@@ -45,27 +45,36 @@ void split(const Surface& s, std::vector<int>::iterator begin, std::vector<int>:
   split(s, middle, end, clusters);
 }
 
-// True when every point of the box is certainly behind the plane of face
-// (a, b, c): the float normal's support point over the box, plus bounds on
-// the normal's rounding and on the evaluation's.
-bool box_behind(const double* a, const double* b, const double* c, const Cluster& box) {
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+// A face's plane in doubles: its point a, the float normal (b - a) x (c - a)
+// and, per component, the permanent that bounds the normal's rounding.
+struct FacePlane {
+  const double* a;
   double normal[3], permanent[3];
-  for (int k = 0; k < 3; ++k) {
-    const int y = (k + 1) % 3, z = (k + 2) % 3;
-    normal[k] = u[y] * v[z] - u[z] * v[y];
-    permanent[k] = std::abs(u[y] * v[z]) + std::abs(u[z] * v[y]);
+
+  FacePlane(const double* a_, const double* b, const double* c) : a(a_) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    for (int k = 0; k < 3; ++k) {
+      const int y = (k + 1) % 3, z = (k + 2) % 3;
+      normal[k] = u[y] * v[z] - u[z] * v[y];
+      permanent[k] = std::abs(u[y] * v[z]) + std::abs(u[z] * v[y]);
+    }
   }
-  double support = 0.0, error = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const double corner = normal[k] > 0.0 ? box.hi[k] : box.lo[k];
-    support += normal[k] * (corner - a[k]);
-    const double reach = std::max(std::abs(box.lo[k] - a[k]), std::abs(box.hi[k] - a[k]));
-    error += (std::abs(normal[k]) + permanent[k]) * reach;
+
+  // True when every point of the box is certainly behind the plane: the
+  // float normal's support point over the box, plus bounds on the normal's
+  // rounding and on the evaluation's.
+  bool box_behind(const Cluster& box) const {
+    double support = 0.0, error = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double corner = normal[k] > 0.0 ? box.hi[k] : box.lo[k];
+      support += normal[k] * (corner - a[k]);
+      const double reach = std::max(std::abs(box.lo[k] - a[k]), std::abs(box.hi[k] - a[k]));
+      error += (std::abs(normal[k]) + permanent[k]) * reach;
+    }
+    return support + 16.0 * 0x1p-53 * error < 0.0;
   }
-  return support + 16.0 * 0x1p-53 * error < 0.0;
-}
+};
 
 }  // namespace
 
@@ -94,8 +103,9 @@ std::optional<ConvexityScreen> screen_convexity(const Surface& s) {
     for (int f = 0; f < s.num_faces(); ++f) {
       if (in_front.load(std::memory_order_relaxed) || cancel_requested()) continue;
       const double *a = point(s.F(f, 0)), *b = point(s.F(f, 1)), *c = point(s.F(f, 2));
+      const FacePlane plane(a, b, c);  // once per face, for every cluster
       for (const Cluster& cluster : clusters) {
-        if (box_behind(a, b, c, cluster)) continue;
+        if (plane.box_behind(cluster)) continue;
         for (int v : cluster.vertices) {
           if (v == s.F(f, 0) || v == s.F(f, 1) || v == s.F(f, 2)) continue;  // in its plane
           const int sign = certified_orientation(a, b, c, point(v));

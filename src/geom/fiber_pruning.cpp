@@ -76,7 +76,7 @@ struct ExactSolid {
   explicit ExactSolid(const Surface& s) {
     std::vector<ExactMesh::Vertex_index> vertex;
     for (int i = 0; i < s.num_vertices(); ++i)
-      vertex.push_back(mesh.add_vertex(Epeck::Point_3(s.V(i, 0), s.V(i, 1), s.V(i, 2))));
+      vertex.push_back(mesh.add_vertex(exact_point(s.V, i)));
     for (int f = 0; f < s.num_faces(); ++f) {
       mesh.add_face(vertex[static_cast<size_t>(s.F(f, 0))], vertex[static_cast<size_t>(s.F(f, 1))],
                     vertex[static_cast<size_t>(s.F(f, 2))]);
@@ -219,7 +219,7 @@ bool keep_fiber(const Surface& s, const Tree& tree, TriangleIterator first,
     if (const auto inside = stars.starts_inside(s, i, q)) return *inside;
     if (const auto inside = stars.starts_inside(s, j, p)) return *inside;
   }
-  const Epeck::Point_3 pe(s.V(i, 0), s.V(i, 1), s.V(i, 2)), qe(s.V(j, 0), s.V(j, 1), s.V(j, 2));
+  const Epeck::Point_3 pe = exact_point(s.V, i), qe = exact_point(s.V, j);
   if (!degenerate) return !exact.outside(CGAL::midpoint(pe, qe));
   ++fallbacks;
   return exact.segment_inside(pe, qe, faces);

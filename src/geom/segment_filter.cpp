@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include "geom/certified_sign.hpp"
 
@@ -14,6 +15,19 @@ namespace {
 constexpr int kLeafFaces = 4;
 
 bool has_vertex(const int* v, int i) { return v[0] == i || v[1] == i || v[2] == i; }
+
+// Where a line goes against a triangle, from the certified signs of the
+// volumes it spans with the three edges: mixed signs put it beside the
+// closed triangle, equal non-zero ones through its interior.
+enum class LineAtTriangle { Beside, Through, Unsure };
+
+LineAtTriangle line_at_triangle(int e0, int e1, int e2) {
+  const bool seen_positive = e0 > 0 || e1 > 0 || e2 > 0,
+             seen_negative = e0 < 0 || e1 < 0 || e2 < 0;
+  if (seen_positive && seen_negative) return LineAtTriangle::Beside;
+  if (e0 == 0 || e1 == 0 || e2 == 0) return LineAtTriangle::Unsure;
+  return LineAtTriangle::Through;
+}
 
 }  // namespace
 
@@ -30,22 +44,23 @@ SegmentFilter::SegmentFilter(const Surface& s, std::vector<Star> stars)
   // grown by far more than that never lose a face the segment meets.
   margin_ = 1e-9 * largest;
   reach_ = 4.0 * largest;
-  input_faces_.resize(static_cast<size_t>(s.num_faces()));
+  std::vector<Face> faces(static_cast<size_t>(s.num_faces()));
   for (int f = 0; f < s.num_faces(); ++f) {
-    Face& face = input_faces_[static_cast<size_t>(f)];
+    Face& face = faces[static_cast<size_t>(f)];
     double* corner[3] = {face.a, face.b, face.c};
     for (int k = 0; k < 3; ++k) {
       face.v[k] = s.F(f, k);
-      incident_[static_cast<size_t>(face.v[k])].push_back(f);
       for (int x = 0; x < 3; ++x) corner[k][x] = s.V(face.v[k], x);
     }
   }
-  std::vector<int> order(input_faces_.size());
+  std::vector<int> order(faces.size());
   std::iota(order.begin(), order.end(), 0);
   nodes_.reserve(2 * order.size() / kLeafFaces + 2);
-  build(order, input_faces_, 0, static_cast<int>(order.size()));
+  build(order, faces, 0, static_cast<int>(order.size()));
   faces_.reserve(order.size());
-  for (int f : order) faces_.push_back(input_faces_[static_cast<size_t>(f)]);
+  for (int f : order) faces_.push_back(faces[static_cast<size_t>(f)]);
+  for (size_t position = 0; position < faces_.size(); ++position)
+    for (int v : faces_[position].v) incident_[static_cast<size_t>(v)].push_back(static_cast<int>(position));
 }
 
 // Median split along the longest axis of the face centroids' box.
@@ -116,10 +131,25 @@ bool SegmentFilter::crosses_box(const Node& node, const Segment& segment) const 
   return t_in <= t_out;
 }
 
+template <class Visit>
+bool SegmentFilter::for_each_face_along(const Segment& segment, Visit&& visit) const {
+  for (size_t k = 0; k < nodes_.size();) {
+    const Node& node = nodes_[k];
+    if (!crosses_box(node, segment)) {
+      k = static_cast<size_t>(node.skip);
+      continue;
+    }
+    for (int f = node.begin; f < node.end; ++f)
+      if (!visit(faces_[static_cast<size_t>(f)])) return false;
+    ++k;
+  }
+  return true;
+}
+
 int SegmentFilter::starts_inside(int v, const double* x) const {
   bool any_front = false, all_front = true;
   for (int f : incident_[static_cast<size_t>(v)]) {
-    const Face& face = input_faces_[static_cast<size_t>(f)];
+    const Face& face = faces_[static_cast<size_t>(f)];
     const int sign = certified_orientation(face.a, face.b, face.c, x);
     if (sign == 0) return 2;
     any_front |= sign > 0;
@@ -139,34 +169,31 @@ SegmentVerdict SegmentFilter::classify(int i, int j) const {
   if (!usable_) return SegmentVerdict::Unsure;
   const double p[3] = {surface_.V(i, 0), surface_.V(i, 1), surface_.V(i, 2)};
   const double q[3] = {surface_.V(j, 0), surface_.V(j, 1), surface_.V(j, 2)};
-  const Segment segment(p, q);
   bool unsure = false;
-  for (size_t k = 0; k < nodes_.size();) {
-    const Node& node = nodes_[k];
-    if (!crosses_box(node, segment)) {
-      k = static_cast<size_t>(node.skip);
-      continue;
+  std::optional<SegmentVerdict> decided;
+  for_each_face_along(Segment(p, q), [&](const Face& face) {
+    const bool at_i = has_vertex(face.v, i), at_j = has_vertex(face.v, j);
+    if (at_i && at_j) {  // the fiber is an edge, on the surface
+      decided = SegmentVerdict::Inside;
+      return false;
     }
-    for (int f = node.begin; f < node.end; ++f) {
-      const Face& face = faces_[static_cast<size_t>(f)];
-      const bool at_i = has_vertex(face.v, i), at_j = has_vertex(face.v, j);
-      if (at_i && at_j) return SegmentVerdict::Inside;  // the fiber is an edge, on the surface
-      if (at_i || at_j) continue;  // decided with the stars below
-      const int sp = certified_orientation(face.a, face.b, face.c, p);
-      const int sq = certified_orientation(face.a, face.b, face.c, q);
-      if (sp != 0 && sp == sq) continue;  // both ends on one side of the face's plane
-      const int e0 = certified_orientation(p, q, face.a, face.b);
-      const int e1 = certified_orientation(p, q, face.b, face.c);
-      const int e2 = certified_orientation(p, q, face.c, face.a);
-      const bool seen_positive = e0 > 0 || e1 > 0 || e2 > 0,
-                 seen_negative = e0 < 0 || e1 < 0 || e2 < 0;
-      if (seen_positive && seen_negative) continue;  // the line passes beside the face
-      if (sp != 0 && sq != 0 && e0 != 0 && e1 != 0 && e2 != 0)
-        return SegmentVerdict::Crosses;  // wherever else it touches, part of it is outside
-      unsure = true;
+    if (at_i || at_j) return true;  // decided with the stars below
+    const int sp = certified_orientation(face.a, face.b, face.c, p);
+    const int sq = certified_orientation(face.a, face.b, face.c, q);
+    if (sp != 0 && sp == sq) return true;  // both ends on one side of the face's plane
+    const LineAtTriangle line =
+        line_at_triangle(certified_orientation(p, q, face.a, face.b),
+                         certified_orientation(p, q, face.b, face.c),
+                         certified_orientation(p, q, face.c, face.a));
+    if (line == LineAtTriangle::Beside) return true;
+    if (line == LineAtTriangle::Through && sp != 0 && sq != 0) {
+      decided = SegmentVerdict::Crosses;  // wherever else it touches, part of it is outside
+      return false;
     }
-    ++k;
-  }
+    unsure = true;
+    return true;
+  });
+  if (decided) return *decided;
   if (unsure) return SegmentVerdict::Unsure;
   // The faces at either end meet the segment only there, unless the other
   // end is in their plane; the star tests certify that too.
@@ -201,48 +228,34 @@ int SegmentFilter::ray_parity(const double* p, const double* q, const double* di
   const double m[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
   const double far[3] = {m[0] + reach_ * direction[0], m[1] + reach_ * direction[1],
                          m[2] + reach_ * direction[2]};
-  const Segment ray(m, far);
-  auto mean_sign = [](double dp, double bp, double dq, double bq) {
-    return certified_mean_sign(dp, bp, dq, bq);
-  };
   // orientation(m, x, y, z): the ray's line against the edge yz when x is far.
   auto volume_from_midpoint = [&](const double* x, const double* y, const double* z) {
     double dp, bp, dq, bq;
     orientation_with_bound(p, x, y, z, dp, bp);
     orientation_with_bound(q, x, y, z, dq, bq);
-    return mean_sign(dp, bp, dq, bq);
+    return certified_mean_sign(dp, bp, dq, bq);
   };
   // orientation(a, b, c, m): the midpoint's side of a face's plane.
   auto midpoint_side = [&](const double* a, const double* b, const double* c) {
     double dp, bp, dq, bq;
     orientation_with_bound(a, b, c, p, dp, bp);
     orientation_with_bound(a, b, c, q, dq, bq);
-    return mean_sign(dp, bp, dq, bq);
+    return certified_mean_sign(dp, bp, dq, bq);
   };
   int crossings = 0;
-  for (size_t k = 0; k < nodes_.size();) {
-    const Node& node = nodes_[k];
-    if (!crosses_box(node, ray)) {
-      k = static_cast<size_t>(node.skip);
-      continue;
-    }
-    for (int f = node.begin; f < node.end; ++f) {
-      const Face& face = faces_[static_cast<size_t>(f)];
-      const int e0 = volume_from_midpoint(far, face.a, face.b);
-      const int e1 = volume_from_midpoint(far, face.b, face.c);
-      const int e2 = volume_from_midpoint(far, face.c, face.a);
-      const bool seen_positive = e0 > 0 || e1 > 0 || e2 > 0,
-                 seen_negative = e0 < 0 || e1 < 0 || e2 < 0;
-      if (seen_positive && seen_negative) continue;  // the ray's line passes beside the face
-      if (e0 == 0 || e1 == 0 || e2 == 0) return -1;  // near an edge or a corner
-      const int side_m = midpoint_side(face.a, face.b, face.c);
-      const int side_far = certified_orientation(face.a, face.b, face.c, far);
-      if (side_m == 0 || side_far == 0) return -1;
-      if (side_m != side_far) ++crossings;
-    }
-    ++k;
-  }
-  return crossings % 2;
+  const bool certain = for_each_face_along(Segment(m, far), [&](const Face& face) {
+    const LineAtTriangle line = line_at_triangle(volume_from_midpoint(far, face.a, face.b),
+                                                 volume_from_midpoint(far, face.b, face.c),
+                                                 volume_from_midpoint(far, face.c, face.a));
+    if (line == LineAtTriangle::Beside) return true;
+    if (line == LineAtTriangle::Unsure) return false;  // near an edge or a corner
+    const int side_m = midpoint_side(face.a, face.b, face.c);
+    const int side_far = certified_orientation(face.a, face.b, face.c, far);
+    if (side_m == 0 || side_far == 0) return false;
+    if (side_m != side_far) ++crossings;
+    return true;
+  });
+  return certain ? crossings % 2 : -1;
 }
 
 }  // namespace fiberfluid::geom

@@ -54,6 +54,10 @@ class SegmentFilter {
 
   void build(std::vector<int>& order, const std::vector<Face>& faces, int begin, int end);
   bool crosses_box(const Node& node, const Segment& segment) const;
+  // visit(face) for each face whose box the segment crosses, until it
+  // returns false; false when it did.
+  template <class Visit>
+  bool for_each_face_along(const Segment& segment, Visit&& visit) const;
   // Where the star of v decides a segment from v towards x that meets no face
   // but at v: +1 inside, -1 outside, 0 undecided; 2 when a sign is unsure.
   int starts_inside(int v, const double* x) const;
@@ -66,9 +70,8 @@ class SegmentFilter {
 
   const Surface& surface_;
   std::vector<Star> stars_;
-  std::vector<std::vector<int>> incident_;  // faces at each vertex (input order)
-  std::vector<Face> input_faces_;
   std::vector<Face> faces_;  // leaf order
+  std::vector<std::vector<int>> incident_;  // each vertex's faces, as positions in faces_
   std::vector<Node> nodes_;
   double reach_ = 0.0;       // a ray's length that leaves every box
   double margin_ = 0.0;      // box inflation covering the slab test's rounding

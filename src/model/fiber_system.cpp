@@ -71,10 +71,7 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, const Dof
     young_ = model.material.axis_factors;
     reference_ = model.surface.V;
     strained_ = strained != nullptr ? *strained : model.surface.V;
-  } else if (model.treecode_tolerance > 0.0) {
-    if (!BulkTreecode::applicable(factors_))
-      throw std::invalid_argument("the treecode bulk product needs one connection count for "
-                                  "every fiber (no pruning, or the global count)");
+  } else if (model.treecode_tolerance > 0.0) {  // refuses factors without one pair factor
     treecode_ = std::make_shared<const BulkTreecode>(X, area_, factors_, model.treecode_tolerance);
   }
 
