@@ -9,11 +9,16 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: obj off stl_ascii stl_binary
 #                                             ply_ascii ply_binary experiment model_setup
+#                                             fit_section compare_2d compare_3d
+#
+# A target with a dictionary (tests/fuzz/dictionaries/TARGET.dict: the
+# fields, names and path pieces it is likely to miss) is given it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
-all=(obj off stl_ascii stl_binary ply_ascii ply_binary experiment model_setup)
+all=(obj off stl_ascii stl_binary ply_ascii ply_binary experiment model_setup fit_section
+     compare_2d compare_3d)
 targets=("${@:-${all[@]}}")
 
 scripts/install-deps.sh
@@ -30,7 +35,8 @@ shared_inputs() {
   case "$1" in
     obj) ls data/meshes/*.obj data/targets/*.obj ;;
     stl_*) ls data/meshes/*.stl ;;
-    experiment | model_setup) ls experiments/*.json ;;
+    experiment | model_setup | fit_section) ls experiments/*.json ;;
+    compare_*) ls data/meshes/*.obj ;;
   esac
 }
 
@@ -40,7 +46,9 @@ fuzz_one() {
   cp -n tests/fuzz/seeds/"$target"/* "$corpus"/ 2>/dev/null || true
   for f in $(shared_inputs "$target"); do cp -n "$f" "$corpus"/; done
   local log=build-fuzz/$target.log status=0
-  build-fuzz/tests/fuzz/fuzz_"$target" "$corpus" -max_total_time="$seconds" -timeout=25 \
+  local dictionary=()
+  [ -f tests/fuzz/dictionaries/"$target".dict ] && dictionary=(-dict=tests/fuzz/dictionaries/"$target".dict)
+  build-fuzz/tests/fuzz/fuzz_"$target" "$corpus" "${dictionary[@]}" -max_total_time="$seconds" -timeout=25 \
     -rss_limit_mb=3072 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts" \
     >"$log" 2>&1 || status=$?
   local runs cov ft corp

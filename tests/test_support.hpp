@@ -16,6 +16,11 @@ inline std::filesystem::path data_mesh(const std::string& name) {
   return std::filesystem::path(FIBERFLUID_MESHES) / name;
 }
 
+// data/targets/NAME: the measured (or made) deformed surfaces the fits use.
+inline std::filesystem::path data_target(const std::string& name) {
+  return std::filesystem::path(FIBERFLUID_MESHES).parent_path() / "targets" / name;
+}
+
 inline std::filesystem::path experiment_file(const std::string& name) {
   return std::filesystem::path(FIBERFLUID_EXPERIMENTS) / name;
 }

@@ -42,7 +42,7 @@ std::vector<Integrator> read_solvers(Fields& f, const std::string& key, bool wit
   for (const std::string& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
   if (!list.is_array() || list.empty()) f.fail(key, "expected a non-empty list of solvers (" + expected + ")");
   for (const json& item : list) {
-    const std::string name = item.is_string() ? item.get<std::string>() : item.dump();
+    const std::string name = item.is_string() ? item.get<std::string>() : excerpt(item);
     if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
       f.fail(key, "unknown solver \"" + name + "\" (expected " + expected + ")");
     for (const auto& [known, kind] : integrator_names())

@@ -18,10 +18,15 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
   c.approximation = approximation_label;
   c.undeformed = undeformed ? undeformed_label : "";
   c.dim = reference.dim;
-  c.surface_error =
-      metrics::surface_error(reference, approximation, reference_label, approximation_label);
-  c.reference_measure = metrics::enclosed_measure(reference);
-  c.symmetric_difference = c.surface_error * c.reference_measure;
+  try {
+    c.surface_error =
+        metrics::surface_error(reference, approximation, reference_label, approximation_label);
+    c.reference_measure = metrics::enclosed_measure(reference);
+    c.symmetric_difference = *c.surface_error * *c.reference_measure;
+  } catch (const InputError& e) {
+    if (c.dim != 3) throw;  // a 2D comparison has nothing else to give
+    c.surface_error_missing = e.what();
+  }
 
   if (undeformed) {
     const int n = undeformed->num_vertices();
@@ -38,6 +43,8 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
         metrics::enclosed_measure(*undeformed), c.dim);
   }
   if (c.dim == 3) {
+    if (!approximation.V.allFinite())
+      throw InputError(approximation_label + ": a vertex coordinate is not finite");
     const fit::TargetDistance distance(
         fit::make_target(reference_label, reference.V, reference.F));
     const std::vector<fit::TargetDistance::Closest> closest = distance.closest(approximation.V);
@@ -67,8 +74,11 @@ std::string comparison_text(const Comparison& c) {
   const char* measure = c.dim == 2 ? "area" : "volume";
   out << "reference (M): " << c.reference << "\napproximation (M'): " << c.approximation << "\n";
   if (!c.undeformed.empty()) out << "undeformed (M0): " << c.undeformed << "\n";
-  out << "E_s = " << c.surface_error << "  (|M xor M'| = " << c.symmetric_difference << " of the "
-      << measure << " |M| = " << c.reference_measure << ", exact Booleans)\n";
+  if (c.surface_error)
+    out << "E_s = " << *c.surface_error << "  (|M xor M'| = " << *c.symmetric_difference
+        << " of the " << measure << " |M| = " << *c.reference_measure << ", exact Booleans)\n";
+  else
+    out << "E_s: not computed: it needs two closed solids: " << c.surface_error_missing << "\n";
   if (c.energy_norm) out << "E_n = " << *c.energy_norm << "  (|u' - u| / |u|)\n";
   if (c.interior_error)
     out << "E_i = " << *c.interior_error
@@ -87,9 +97,10 @@ nlohmann::json comparison_json(const Comparison& c) {
   nlohmann::json j = {{"reference", c.reference},
                       {"approximation", c.approximation},
                       {"dim", c.dim},
-                      {"reference_measure", c.reference_measure},
-                      {"symmetric_difference", c.symmetric_difference},
-                      {"E_s", c.surface_error}};
+                      {"reference_measure", c.reference_measure ? nlohmann::json(*c.reference_measure) : nlohmann::json()},
+                      {"symmetric_difference", c.symmetric_difference ? nlohmann::json(*c.symmetric_difference) : nlohmann::json()},
+                      {"E_s", c.surface_error ? nlohmann::json(*c.surface_error) : nlohmann::json()}};
+  if (!c.surface_error) j["E_s_missing"] = c.surface_error_missing;
   if (!c.undeformed.empty()) j["undeformed"] = c.undeformed;
   if (c.energy_norm) j["E_n"] = *c.energy_norm;
   if (c.interior_error) {

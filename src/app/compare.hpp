@@ -17,9 +17,12 @@ namespace fiberfluid::app {
 struct Comparison {
   std::string reference, approximation, undeformed;  // the files ("" : no undeformed mesh)
   int dim = 3;
-  double reference_measure = 0.0;       // |Int(M)|: area (2D) or volume (3D)
-  double symmetric_difference = 0.0;    // |Int(M) xor Int(M')|
-  double surface_error = 0.0;           // E_s
+  // E_s needs two closed solids: in 3D, a scan that is a triangle soup or a
+  // point cloud still gets the distances, and E_s says why it is missing.
+  std::optional<double> reference_measure;     // |Int(M)|: area (2D) or volume (3D)
+  std::optional<double> symmetric_difference;  // |Int(M) xor Int(M')|
+  std::optional<double> surface_error;         // E_s
+  std::string surface_error_missing;           // why E_s is not there
   // With the undeformed mesh and the same vertices in all three:
   std::optional<double> energy_norm;    // E_n
   std::optional<double> interior_error; // E_i, over the surface nodes weighted by |S_i|
@@ -28,7 +31,9 @@ struct Comparison {
 };
 
 // Compares two surfaces (M the reference, M' the approximation; M0 the
-// undeformed one, optional). The labels name them in errors.
+// undeformed one, optional). The labels name them in errors. In 3D, M and M'
+// may be triangle soups or point clouds (M' a point cloud, M triangles or
+// points): then only the distances are computed.
 Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface& approximation,
                             const geom::Surface* undeformed, const std::string& reference_label,
                             const std::string& approximation_label,

@@ -2,11 +2,14 @@
 #include "app/experiment.hpp"
 
 #include "app/json_fields.hpp"
+#include "app/output_folder.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <fstream>
 #include <functional>
+#include <istream>
+#include <utility>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -74,7 +77,7 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   for (size_t k = 0; k < points.size(); ++k) {
     if (!points[k].is_array() || points[k].size() != 2 || !points[k][0].is_number() ||
         !points[k][1].is_number())
-      f.fail("points", "expected [x, y] pairs, got " + points[k].dump());
+      f.fail("points", "expected [x, y] pairs, got " + excerpt(points[k]));
     P.row(static_cast<Eigen::Index>(k)) << points[k][0].get<double>(), points[k][1].get<double>();
   }
   return [=] { return geom::polygon(P); };
@@ -488,6 +491,13 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     target.file = t.string("file");
     if (target.file.is_relative()) target.file = folder / target.file;
     target.step = t.integer("step", 0, 1, 100000);
+    if (t.has("scale") && t.has("units"))
+      t.fail("units", "give the scan's units or its scale, not both");
+    if (t.has("units")) {
+      const std::string units = t.choice("units", "m", {"m", "cm", "mm", "um"});
+      target.scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
+    }
+    target.scale = t.positive("scale", target.scale);
     t.finish();
     spec.targets.push_back(target);
   }
@@ -495,33 +505,48 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   for (Fields p : f.objects("parameters")) {
     FitParameterSpec parameter;
     parameter.field = p.field();
-    parameter.name = p.string("name");
+    parameter.request.name = p.string("name");
     for (const FitParameterSpec& other : spec.parameters)
-      if (other.name == parameter.name) p.fail("name", "\"" + parameter.name + "\" is fitted twice");
-    if (p.has("start")) parameter.start = p.number("start");
-    if (p.has("lower")) parameter.lower = p.number("lower");
-    if (p.has("upper")) parameter.upper = p.number("upper");
-    if (p.has("log_scale")) parameter.log_scale = p.boolean("log_scale", false);
+      if (other.request.name == parameter.request.name)
+        p.fail("name", "\"" + parameter.request.name + "\" is fitted twice");
+    if (p.has("start")) parameter.request.start = p.number("start");
+    if (p.has("lower")) parameter.request.lower = p.number("lower");
+    if (p.has("upper")) parameter.request.upper = p.number("upper");
+    if (p.has("log_scale")) parameter.request.log_scale = p.boolean("log_scale", false);
     p.finish();
     spec.parameters.push_back(parameter);
   }
   if (spec.parameters.empty()) f.fail("parameters", "expected at least one parameter to fit");
+  if (f.has("start_from")) {
+    spec.start_from = f.string("start_from");
+    if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;
+  }
+  // The options' values are checked once, by fit::check_options, for every
+  // front end alike (its messages begin with the option's name); here only
+  // their types.
+  const auto named = [&f](const std::string& key, const InputError& e) {
+    const std::string what = e.what();
+    const size_t colon = what.find(": ");
+    f.fail(key, colon == std::string::npos ? what : what.substr(colon + 2));
+  };
   fit::FitOptions& o = spec.options;
-  const std::string method = f.choice("method", "levenberg-marquardt",
-                                      {"levenberg-marquardt", "bobyqa", "direct-l", "crs2"});
-  o.method = method == "bobyqa"     ? fit::Method::Bobyqa
-             : method == "direct-l" ? fit::Method::DirectL
-             : method == "crs2"     ? fit::Method::Crs2
-                                    : fit::Method::LevenbergMarquardt;
+  try {
+    o.method = fit::method_from_string(f.string("method", "levenberg-marquardt"));
+  } catch (const InputError& e) {
+    named("method", e);
+  }
   o.finite_differences =
       f.choice("jacobian", "analytic", {"analytic", "finite-differences"}) == "finite-differences";
-  o.difference_step = f.positive("difference_step", o.difference_step);
+  o.difference_step = f.number("difference_step", o.difference_step);
   if (f.has("objective")) {
     Fields objective = f.object("objective");
     o.symmetric = objective.boolean("symmetric", false);
-    const std::string loss = objective.choice("loss", "squared", {"squared", "huber", "cauchy"});
-    o.loss = loss == "huber" ? fit::Loss::Huber : loss == "cauchy" ? fit::Loss::Cauchy : fit::Loss::Squared;
-    o.loss_scale = objective.positive("loss_scale", o.loss_scale);
+    try {
+      o.loss = fit::loss_from_string(objective.string("loss", "squared"));
+    } catch (const InputError& e) {
+      named("objective.loss", e);
+    }
+    o.loss_scale = objective.number("loss_scale", o.loss_scale);
     if (objective.has("exclude")) {
       Fields exclude = objective.object("exclude");
       spec.exclude = read_selection(exclude);
@@ -529,12 +554,20 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     }
     objective.finish();
   }
-  o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
-  o.max_evaluations = f.integer("max_evaluations", o.max_evaluations, 1, 1000000);
-  o.function_tolerance = f.positive("function_tolerance", o.function_tolerance);
-  o.parameter_tolerance = f.positive("parameter_tolerance", o.parameter_tolerance);
+  const int any_min = std::numeric_limits<int>::min(), any_max = std::numeric_limits<int>::max();
+  o.max_iterations = f.integer("max_iterations", o.max_iterations, any_min, any_max);
+  o.max_evaluations = f.integer("max_evaluations", o.max_evaluations, any_min, any_max);
+  o.function_tolerance = f.number("function_tolerance", o.function_tolerance);
+  o.parameter_tolerance = f.number("parameter_tolerance", o.parameter_tolerance);
   o.initial_trust_region_radius =
-      f.positive("initial_trust_region_radius", o.initial_trust_region_radius);
+      f.number("initial_trust_region_radius", o.initial_trust_region_radius);
+  try {
+    fit::check_options(o);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    const std::string option = what.substr(0, what.find(':'));
+    named(option == "loss_scale" ? "objective.loss_scale" : option, e);
+  }
   f.finish();
   return spec;
 }
@@ -545,13 +578,8 @@ const char* const kExperimentFields[] = {"name", "description", "kind", "variant
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
-  const bool safe = !name.empty() && name != "." && name != ".." &&
-                    std::all_of(name.begin(), name.end(), [](unsigned char ch) {
-                      return std::isalnum(ch) || ch == '_' || ch == '-' || ch == '.';
-                    });
-  if (!safe)
-    f.fail("name", "expected a non-empty name of letters, digits, '_', '-' or '.' (it names "
-                   "the variant's output folder), got \"" + name + "\"");
+  if (const std::string problem = folder_name_problem(name); !problem.empty())
+    f.fail("name", "expected " + problem);
   for (const CaseSpec& c : earlier)
     if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
 }
@@ -614,6 +642,8 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   Fields root(document, "", label);
   Experiment ex;
   ex.name = root.string("name", "experiment");
+  if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
+    root.fail("name", "expected " + problem);
   ex.description = root.string("description", "");
   const std::string kind = root.choice("kind", "simulate", {"simulate", "areas", "benchmark"});
   ex.kind = kind == "areas"       ? Experiment::Kind::Areas
@@ -673,16 +703,40 @@ Experiment parse_experiment(const json& document, const std::filesystem::path& f
   return ex;
 }
 
+namespace {
+
+template <class Input>
+json parse_json_from(Input&& input, const std::string& label) {
+  struct TooDeep {};
+  const json::parser_callback_t guard = [](int depth, json::parse_event_t event, json&) {
+    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+        depth >= kDeepestJson)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    return json::parse(std::forward<Input>(input), guard);
+  } catch (const TooDeep&) {
+    throw InputError(label + ": nested more than " + std::to_string(kDeepestJson) +
+                     " levels deep (an experiment needs a few)");
+  } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
+    throw InputError(label + ": not valid JSON: " + e.what());
+  }
+}
+
+}  // namespace
+
+json parse_json(std::istream& in, const std::string& label) { return parse_json_from(in, label); }
+json parse_json(const std::string& text, const std::string& label) {
+  return parse_json_from(text, label);
+}
+
 Experiment load_experiment(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open the experiment file");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
-    throw InputError(path.string() + ": not valid JSON: " + e.what());
-  }
-  if (document.is_object() && !document.contains("name")) document["name"] = path.stem().string();
+  json document = parse_json(in, path.string());
+  if (document.is_object() && !document.contains("name"))
+    document["name"] = folder_name_from(path.stem().string());
   Experiment ex = parse_experiment(document, path.parent_path(), path.string());
   ex.source = path;
   return ex;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <istream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -78,6 +79,15 @@ struct Experiment {
 // positive number") for an unknown field, a wrong type, a missing or bad
 // mesh, a selection that selects nothing; nothing is written.
 Experiment load_experiment(const std::filesystem::path& path);
+
+// The deepest nesting of arrays and objects a JSON document may have: an
+// experiment needs a handful; a deeper one is refused while it is parsed,
+// before anything copies it (copies recurse).
+constexpr int kDeepestJson = 64;
+// Parses JSON text, refusing documents nested deeper than kDeepestJson and
+// syntax errors with an InputError naming `label`.
+nlohmann::json parse_json(std::istream& in, const std::string& label);
+nlohmann::json parse_json(const std::string& text, const std::string& label);
 
 // The same from a JSON document built in a program (e.g. a Python dict):
 // relative mesh paths are taken from `folder`, and errors name `label`.

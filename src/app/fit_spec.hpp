@@ -16,20 +16,21 @@ struct FitTargetSpec {
   FieldName field;
   std::filesystem::path file;
   int step = 0;  // the load step it was measured at; 0: the last
+  double scale = 1.0;  // the scan's coordinates times this are in m ("units": "mm" is 1e-3)
 };
 
 struct FitParameterSpec {
   FieldName field;
-  std::string name;
-  std::optional<double> start;  // default: the material's value (0 for the alignment)
-  std::optional<double> lower, upper;
-  std::optional<bool> log_scale;  // default: fit::log_scale_by_default(name)
+  fit::ParameterRequest request;
 };
 
 struct FitSpec {
   FieldName field;
   std::vector<FitTargetSpec> targets;
   std::vector<FitParameterSpec> parameters;
+  // A fit.json whose parameters' values are the starts (an interrupted or
+  // earlier fit, continued).
+  std::optional<std::filesystem::path> start_from;
   fit::FitOptions options;                // all but counted_vertices and progress
   std::optional<SelectionSpec> exclude;   // vertices whose distances do not count
 };

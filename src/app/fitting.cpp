@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <limits>
+#include <algorithm>
+#include <fstream>
+#include <map>
 #include <sstream>
 
 #include "geom/error.hpp"
@@ -32,7 +35,52 @@ json statistics_json(const fit::DistanceStatistics& s) {
             {"largest", number(s.share(s.largest))}}}};
 }
 
+json iteration_json(const fit::IterationRecord& it, const std::vector<std::string>& names) {
+  json values = json::object();
+  for (size_t k = 0; k < names.size(); ++k) values[names[k]] = it.values[static_cast<Eigen::Index>(k)];
+  json out = {{"iteration", it.iteration}, {"cost", number(it.cost)},
+              {"accepted", it.accepted}, {"trial_cost", number(it.trial_cost)},
+              {"values", values}, {"forward_runs", it.forward_runs},
+              {"seconds", it.seconds}};
+  if (!it.trial_failure.empty()) out["trial_failure"] = it.trial_failure;
+  return out;
+}
+
 }  // namespace
+
+std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file) {
+  std::ifstream in(fit_json_file);
+  if (!in) throw InputError(fit_json_file.string() + ": cannot open (expected the fit.json of an earlier fit)");
+  const json doc = parse_json(in, fit_json_file.string());
+  std::map<std::string, double> values;
+  if (doc.is_object() && doc.contains("parameters") && doc["parameters"].is_array())
+    for (const json& p : doc["parameters"])
+      if (p.is_object() && p.contains("name") && p["name"].is_string() && p.contains("value") &&
+          p["value"].is_number() && std::isfinite(p["value"].get<double>()))
+        values[p["name"].get<std::string>()] = p["value"].get<double>();
+  if (values.empty())
+    throw InputError(fit_json_file.string() + ": expected a fit.json with parameters[].name and "
+                     "parameters[].value");
+  return values;
+}
+
+int fit_exit_status(fit::FitStatus status) {
+  switch (status) {
+    case fit::FitStatus::Converged: return 0;
+    case fit::FitStatus::ConvergedAtBounds: return 4;
+    case fit::FitStatus::Interrupted: return 130;
+    case fit::FitStatus::NotIdentifiable:
+    case fit::FitStatus::IterationLimit:
+    case fit::FitStatus::ForwardRunsFailed:
+    case fit::FitStatus::StartFailed:
+    case fit::FitStatus::OptimizerFailed: break;
+  }
+  return 2;
+}
+
+bool fit_result_kept(fit::FitStatus status) {
+  return status == fit::FitStatus::Converged || status == fit::FitStatus::ConvergedAtBounds;
+}
 
 FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::IterationRecord&)> progress) {
   if (!ex.fit) throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");
@@ -43,7 +91,7 @@ FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::Iteration
   for (const FitTargetSpec& t : spec.targets) {
     fit::Target target;
     try {
-      target = fit::read_target(t.file);
+      target = fit::read_target(t.file, t.scale);
     } catch (const InputError& e) {
       t.field.fail("file", e.what());
     }
@@ -53,24 +101,28 @@ FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::Iteration
                                std::to_string(c.stepping.steps) + " steps");
     setup.targets.push_back({target, step});
   }
+  // The starts of an earlier fit (an interrupted one, continued).
+  std::map<std::string, double> earlier;
+  if (spec.start_from) earlier = fitted_values(*spec.start_from);
   std::vector<fit::Parameter> parameters;
   for (const FitParameterSpec& p : spec.parameters) {
-    fit::Parameter parameter;
-    parameter.name = p.name;
-    const bool alignment = fit::is_alignment_parameter(p.name);
-    if (!alignment && !model::is_material_parameter(c.model.material, p.name)) {
-      std::string known;
-      for (const std::string& n : model::material_parameter_names(c.model.material, 3))
-        known += (known.empty() ? "" : ", ") + n;
-      p.field.fail("name", "\"" + p.name + "\" is not a parameter of this material (" + known +
-                               ") or of the alignment (rotation_x..z, translation_x..z)");
+    fit::ParameterRequest request = p.request;
+    if (spec.start_from) {
+      if (!earlier.count(request.name))
+        spec.field.fail("start_from", spec.start_from->string() + " has no value for \"" +
+                                          request.name + "\"");
+      request.start = earlier.at(request.name);
     }
-    parameter.initial =
-        p.start ? *p.start : alignment ? 0.0 : fit::material_parameter(c.model.material, p.name);
-    if (p.lower) parameter.lower = *p.lower;
-    if (p.upper) parameter.upper = *p.upper;
-    parameter.log_scale = p.log_scale.value_or(fit::log_scale_by_default(p.name));
-    parameters.push_back(parameter);
+    try {
+      parameters.push_back(fit::make_parameter(request, c.model.material));
+    } catch (const InputError& e) {
+      p.field.fail("name", e.what());
+    }
+    try {  // its start and bounds, by the calibration's own rules, named here
+      fit::ParameterMap({parameters.back()}, c.model.material, c.model.dim());
+    } catch (const InputError& e) {
+      p.field.fail("", e.what());
+    }
   }
   fit::FitOptions options = spec.options;
   options.progress = std::move(progress);
@@ -122,9 +174,12 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
   for (size_t k = 0; k < r.names.size(); ++k) {
     const Eigen::Index i = static_cast<Eigen::Index>(k);
     const fit::Parameter& p = c.parameters().parameters()[k];
+    const bool at_bound =
+        std::find(r.at_bounds.begin(), r.at_bounds.end(), r.names[k]) != r.at_bounds.end();
     parameters.push_back({{"name", r.names[k]},
                           {"initial", r.initial[i]},
-                          {"value", r.values[i]},
+                          {"value", number(r.values[i])},
+                          {"at_bound", at_bound},
                           {"standard_error", number(r.standard_errors[i])},
                           {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}},
                           {"bounds", {number(p.lower), number(p.upper)}},
@@ -137,49 +192,73 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     correlation.push_back(row);
   }
   json iterations = json::array();
-  for (const fit::IterationRecord& it : r.iterations) {
-    json values = json::object();
-    for (size_t k = 0; k < r.names.size(); ++k) values[r.names[k]] = it.values[static_cast<Eigen::Index>(k)];
-    iterations.push_back({{"iteration", it.iteration}, {"cost", it.cost},
-                          {"accepted", it.accepted}, {"trial_cost", it.trial_cost},
-                          {"values", values}, {"forward_runs", it.forward_runs},
-                          {"seconds", it.seconds}});
-  }
+  for (const fit::IterationRecord& it : r.iterations) iterations.push_back(iteration_json(it, r.names));
   json targets = json::array();
-  for (size_t t = 0; t < setup.targets.size(); ++t)
-    targets.push_back({{"file", setup.targets[t].target.label},
-                       {"step", setup.targets[t].step},
-                       {"read", setup.targets[t].target.description},
-                       {"distance", statistics_json(r.statistics[t])}});
+  for (size_t t = 0; t < setup.targets.size(); ++t) {
+    json target = {{"file", setup.targets[t].target.label},
+                   {"step", setup.targets[t].step},
+                   {"read", setup.targets[t].target.description},
+                   {"points", setup.targets[t].target.points.rows()}};
+    if (t < r.statistics.size()) target["distance"] = statistics_json(r.statistics[t]);
+    targets.push_back(target);
+  }
   json checks = json::array();
   for (const FigureCheck& check : run.checks)
     checks.push_back({{"figure", check.expected.figure}, {"passed", check.passed},
                       {"actual", number(check.actual)}, {"text", check.Describe()}});
-  return {{"experiment", ex.name},
-          {"success", r.success},
-          {"message", r.message},
-          {"method", fit::to_string(r.method)},
-          {"jacobian", r.analytic_jacobian ? "analytic: Newton sensitivities, one tangent solve per "
-                                             "material parameter"
-                                           : "finite differences of whole forward runs (central)"},
-          {"loss", fit::to_string(ex.fit->options.loss)},
-          {"symmetric", ex.fit->options.symmetric},
-          {"parameters", parameters},
-          {"covariance", r.covariance_ok ? "ceres covariance at the optimum, scaled by the "
-                                           "residual variance"
-                                         : "not available: the Jacobian is rank deficient"},
-          {"correlation", correlation},
-          {"cost", {{"initial", r.initial_cost}, {"final", r.final_cost}}},
-          {"iterations", iterations},
-          {"forward_runs", r.forward_runs},
-          {"sensitivity_solves", r.sensitivity_solves},
-          {"failed_runs", r.failed_runs},
-          {"seconds", r.seconds},
-          {"body_length", c.body_length()},
-          {"body_length_is", "the largest extent of the rest surface's bounding box"},
-          {"targets", targets},
-          {"distance", statistics_json(r.overall)},
-          {"checks", checks}};
+  json failures = json::object();
+  for (const auto& [cause, count] : r.failures_by_cause) failures[cause] = count;
+  json examples = json::array();
+  for (const fit::FailedRun& f : r.failed_examples) {
+    json values = json::object();
+    for (size_t k = 0; k < r.names.size(); ++k) values[r.names[k]] = f.values[static_cast<Eigen::Index>(k)];
+    examples.push_back({{"values", values}, {"message", f.message}});
+  }
+  const int counted = c.num_counted_vertices();
+  int target_points = 0;
+  for (const fit::MeasuredStep& t : setup.targets) target_points += static_cast<int>(t.target.points.rows());
+  json doc = {
+      {"experiment", ex.name},
+      {"status", fit::to_string(r.status)},
+      {"status_detail", r.status_detail},
+      {"success", r.success},
+      {"message", r.message},
+      {"method", fit::to_string(r.method)},
+      {"jacobian", r.analytic_jacobian ? "analytic: Newton sensitivities, one tangent solve per "
+                                         "material parameter"
+                                       : "finite differences of whole forward runs (central)"},
+      {"loss", fit::to_string(ex.fit->options.loss)},
+      {"symmetric", ex.fit->options.symmetric},
+      {"parameters", parameters},
+      {"covariance", r.covariance_ok ? "ceres covariance at the optimum, scaled by the "
+                                       "residual variance"
+                                     : "not available (see status)"},
+      {"correlation", correlation},
+      {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
+      {"iterations", iterations},
+      {"forward_runs", r.forward_runs},
+      {"sensitivity_solves", r.sensitivity_solves},
+      {"failed_runs", r.failed_runs},
+      {"failed_runs_by_cause", failures},
+      {"failed_run_examples", examples},
+      {"seconds", r.seconds},
+      {"body_length", c.body_length()},
+      {"body_length_is", "the largest extent of the rest surface's bounding box"},
+      {"counts",
+       {{"model_vertices_counted", counted},
+        {"targets", setup.targets.size()},
+        {"target_points", target_points},
+        {"forward_distances", counted * static_cast<int>(setup.targets.size())},
+        {"symmetric_distances", ex.fit->options.symmetric ? target_points : 0},
+        {"residuals", c.num_residuals()},
+        {"what_distance_counts",
+         "distance.count and targets[].distance.count are forward distances: one per counted "
+         "model vertex and target. The symmetric distances (each target point to the simulated "
+         "surface), when asked, enter the cost and the residuals, not these statistics"}}},
+      {"targets", targets},
+      {"checks", checks}};
+  if (!r.statistics.empty()) doc["distance"] = statistics_json(r.overall);
+  return doc;
 }
 
 void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
@@ -197,6 +276,7 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
     iterations << "\n";
   }
   geom::write_text_file(folder / "fit_iterations.csv", iterations.str());
+  if (r.positions.size() != setup.targets.size()) return;  // no run at the fitted values
 
   const Case& c = ex.cases.front();
   std::ostringstream distances;

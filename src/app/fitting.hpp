@@ -23,6 +23,15 @@ struct FitSetup {
 FitSetup setup_fit(const Experiment& experiment,
                    std::function<void(const fit::IterationRecord&)> progress = {});
 
+// The parameters' values in the fit.json of an earlier fit (fit.start_from).
+std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file);
+
+// The command line's exit status for a fit that ended so: 0 converged, 4
+// converged with parameters on their bounds, 130 interrupted, 2 otherwise.
+int fit_exit_status(fit::FitStatus status);
+// Whether the output folder takes a fit that ended so (else DIR.failed).
+bool fit_result_kept(fit::FitStatus status);
+
 // The fit's headline figures, "fit.NAME" for each parameter and the
 // distance statistics (fit.distance_sd_share is the method paper's figure).
 std::map<std::string, double> fit_figures(const fit::FitResult& result);

@@ -15,6 +15,15 @@
 
 namespace fiberfluid::app {
 
+// A value as a message quotes it: its JSON text, cut to a short excerpt (a
+// bad value may be a whole document).
+inline std::string excerpt(const nlohmann::json& value) {
+  constexpr size_t kLongest = 80;
+  std::string text = value.dump();
+  if (text.size() > kLongest) text = text.substr(0, kLongest) + "... (" + std::to_string(text.size()) + " characters)";
+  return text;
+}
+
 // Reads the fields of one JSON object, naming "file: path.to.field" in every
 // error, and rejects fields nobody asked for.
 class Fields {
@@ -42,7 +51,7 @@ class Fields {
 
   double number(const std::string& key) {
     const nlohmann::json& v = raw(key);
-    if (!v.is_number()) fail(key, "expected a number, got " + v.dump());
+    if (!v.is_number()) fail(key, "expected a number, got " + excerpt(v));
     const double x = v.get<double>();
     if (!std::isfinite(x)) fail(key, "expected a finite number");
     return x;
@@ -64,18 +73,18 @@ class Fields {
     if (!has(key)) return seen_.insert(key), fallback;
     const nlohmann::json& v = raw(key);
     const std::string range = "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
-    if (!v.is_number_integer() || !fits(v, min, max)) fail(key, "expected " + range + ", got " + v.dump());
+    if (!v.is_number_integer() || !fits(v, min, max)) fail(key, "expected " + range + ", got " + excerpt(v));
     return static_cast<int>(v.get<long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
     if (!has(key)) return seen_.insert(key), fallback;
     const nlohmann::json& v = raw(key);
-    if (!v.is_boolean()) fail(key, "expected true or false, got " + v.dump());
+    if (!v.is_boolean()) fail(key, "expected true or false, got " + excerpt(v));
     return v.get<bool>();
   }
   std::string string(const std::string& key) {
     const nlohmann::json& v = raw(key);
-    if (!v.is_string()) fail(key, "expected a string, got " + v.dump());
+    if (!v.is_string()) fail(key, "expected a string, got " + excerpt(v));
     return v.get<std::string>();
   }
   std::string string(const std::string& key, const std::string& fallback) {
@@ -85,7 +94,7 @@ class Fields {
                      const std::vector<std::string>& allowed) {
     const std::string s = string(key, fallback);
     if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
-      fail(key, "expected one of " + join(allowed) + ", got \"" + s + "\"");
+      fail(key, "expected one of " + join(allowed) + ", got " + excerpt(s));
     return s;
   }
   // A list of `size` numbers (any size when size < 0).
@@ -94,11 +103,11 @@ class Fields {
     const std::string want = size < 0 ? "a list of numbers"
                                       : "a list of " + std::to_string(size) + " numbers";
     if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size))
-      fail(key, "expected " + want + ", got " + v.dump());
+      fail(key, "expected " + want + ", got " + excerpt(v));
     Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
     for (size_t k = 0; k < v.size(); ++k) {
       if (!v[k].is_number() || !std::isfinite(v[k].get<double>()))
-        fail(key, "expected " + want + ", got " + v.dump());
+        fail(key, "expected " + want + ", got " + excerpt(v));
       out[static_cast<Eigen::Index>(k)] = v[k].get<double>();
     }
     return out;
@@ -108,11 +117,11 @@ class Fields {
     const nlohmann::json& v = raw(key);
     const std::string want = "a list of " + std::to_string(size) + " whole numbers from " +
                              std::to_string(min) + " to " + std::to_string(max);
-    if (!v.is_array() || static_cast<int>(v.size()) != size) fail(key, "expected " + want + ", got " + v.dump());
+    if (!v.is_array() || static_cast<int>(v.size()) != size) fail(key, "expected " + want + ", got " + excerpt(v));
     Eigen::VectorXi out(size);
     for (int k = 0; k < size; ++k) {
       const nlohmann::json& item = v[static_cast<size_t>(k)];
-      if (!item.is_number_integer() || !fits(item, min, max)) fail(key, "expected " + want + ", got " + v.dump());
+      if (!item.is_number_integer() || !fits(item, min, max)) fail(key, "expected " + want + ", got " + excerpt(v));
       out[k] = static_cast<int>(item.get<long long>());
     }
     return out;
@@ -124,7 +133,7 @@ class Fields {
     for (const nlohmann::json& item : v) {
       if (!item.is_number_integer() || !fits(item, 0, std::numeric_limits<int>::max()))
         fail(key, "expected vertex indices (whole numbers from 0 to " +
-                      std::to_string(std::numeric_limits<int>::max()) + "), got " + item.dump());
+                      std::to_string(std::numeric_limits<int>::max()) + "), got " + excerpt(item));
       out.push_back(static_cast<int>(item.get<long long>()));
     }
     return out;

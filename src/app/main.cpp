@@ -4,7 +4,9 @@
 #include <csignal>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <iostream>
@@ -16,6 +18,7 @@
 #include "app/compare.hpp"
 #include "app/experiment.hpp"
 #include "app/fitting.hpp"
+#include "app/output_folder.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "geom/error.hpp"
@@ -43,6 +46,9 @@ void stop_on_interrupt() {
   action.sa_flags = SA_RESETHAND;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG, reported
+  // with the file's name, instead of the signal ending the process.
+  signal(SIGXFSZ, SIG_IGN);
 }
 
 // Throws Interrupted after a phase that returned early because of Ctrl-C,
@@ -194,9 +200,7 @@ int run_command(const std::string& path, const RunFlags& flags) {
   if (ex.fit)
     std::cerr << "note: " << path << " has a \"fit\" section: `run` simulates at the starting "
               << "values; `fiberfluid fit` calibrates\n";
-  const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
-
-  app::OutputWriter writer(ex, output);
+  app::OutputWriter writer(ex, app::output_folder(flags.output, ex.name));
   writer.begin();
   app::RunOptions options;
   options.jobs = flags.jobs;
@@ -210,6 +214,7 @@ int run_command(const std::string& path, const RunFlags& flags) {
   fiberfluid::set_progress_sink({});
   stop_if_interrupted("the run");  // the writer's staging folder goes with it
   writer.finish(result);
+  for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
   if (ex.kind == app::Experiment::Kind::Simulate) {
@@ -246,77 +251,137 @@ int run_command(const std::string& path, const RunFlags& flags) {
   return kOk;
 }
 
+// Prints one line per iteration of a fit: its cost and point, and for a
+// rejected step why (its cost, or its forward run's failure).
+void print_iteration(const fiberfluid::fit::IterationRecord& r, const std::vector<std::string>& names) {
+  std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2";
+  if (!r.accepted && !r.trial_failure.empty())
+    std::cerr << " (step rejected: its forward run failed: " << r.trial_failure << ")";
+  else if (!r.accepted)
+    std::cerr << " (step rejected: it cost " << r.trial_cost << ")";
+  else if (!r.trial_failure.empty())
+    std::cerr << " (after a trial point whose forward run failed: " << r.trial_failure << ")";
+  std::cerr << ";";
+  for (size_t k = 0; k < names.size(); ++k)
+    std::cerr << (k ? ", " : " ") << names[k] << " = " << r.values[static_cast<Eigen::Index>(k)];
+  std::cerr << "; " << r.forward_runs << " runs, " << r.seconds << " s\n";
+}
+
+void print_fit(const fiberfluid::fit::FitResult& fitted) {
+  namespace fit = fiberfluid::fit;
+  for (size_t k = 0; k < fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    std::cout << "  " << fitted.names[k] << " = " << fitted.values[i];
+    if (std::find(fitted.at_bounds.begin(), fitted.at_bounds.end(), fitted.names[k]) !=
+        fitted.at_bounds.end())
+      std::cout << " (on its bound: no standard error";
+    else if (std::isfinite(fitted.standard_errors[i]))
+      std::cout << " +- " << fitted.standard_errors[i] << " (95%: " << fitted.lower_95[i] << " .. "
+                << fitted.upper_95[i];
+    else
+      std::cout << " (no standard error";
+    std::cout << "; start " << fitted.initial[i] << ")\n";
+  }
+  if (!fitted.statistics.empty()) {
+    const auto& d = fitted.overall;
+    std::cout << "  distance (" << d.count << " model vertices to their targets): mean " << d.mean
+              << ", rms " << d.rms << ", sd " << d.standard_deviation << " ("
+              << 100.0 * d.share(d.standard_deviation) << "% of the body's length " << d.length
+              << "), largest " << d.largest << " m\n";
+  }
+  std::cout << "  " << fitted.forward_runs << " forward runs";
+  if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed)";
+  std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds << " s\n";
+  for (const auto& [cause, count] : fitted.failures_by_cause)
+    std::cout << "  failed forward runs: " << count << " x " << cause << "\n";
+  if (!fitted.failed_examples.empty()) {
+    const fit::FailedRun& f = fitted.failed_examples.front();
+    std::cout << "  first failure at";
+    for (size_t k = 0; k < fitted.names.size(); ++k)
+      std::cout << (k ? ", " : " ") << fitted.names[k] << " = " << f.values[static_cast<Eigen::Index>(k)];
+    std::cout << ": " << f.message << "\n";
+  }
+}
+
 // Calibrates the material of an experiment to its "fit" targets, then runs
 // it at the fitted values and writes the usual outputs with the fit's files.
+// Every fit file is in the folder before it moves into place: DIR for a fit
+// that converged, DIR.failed for one that did not, DIR.interrupted (the best
+// point so far, for fit.start_from) for one stopped by SIGINT or SIGTERM.
 int fit_command(const std::string& path, const RunFlags& flags) {
+  namespace fit = fiberfluid::fit;
   fiberfluid::set_memory_budget(flags.max_memory);
   fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
   const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
-  const app::FitSetup setup = app::setup_fit(ex, [&](const fiberfluid::fit::IterationRecord& r) {
-    if (flags.quiet) return;
-    std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2";
-    if (!r.accepted) std::cerr << " (step rejected: it cost " << r.trial_cost << ")";
-    std::cerr << ";";
-    const auto& names = ex.fit->parameters;
-    for (size_t k = 0; k < names.size(); ++k)
-      std::cerr << (k ? ", " : " ") << names[k].name << " = " << r.values[static_cast<Eigen::Index>(k)];
-    std::cerr << "; " << r.forward_runs << " runs, " << r.seconds << " s\n";
+  const std::filesystem::path folder = app::output_folder(flags.output, ex.name);  // refused now, not after the fit
+  std::vector<std::string> names;
+  if (ex.fit)
+    for (const auto& p : ex.fit->parameters) names.push_back(p.request.name);
+  const app::FitSetup setup = app::setup_fit(ex, [&](const fit::IterationRecord& r) {
+    if (!flags.quiet) print_iteration(r, names);
   });
   for (const auto& t : setup.targets)
     std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
               << "\n";
   std::cout << "fitting " << setup.calibration->parameters().size() << " parameters to "
             << setup.calibration->num_residuals() << " distances ("
-            << fiberfluid::fit::to_string(ex.fit->options.method) << ", "
+            << fit::to_string(ex.fit->options.method) << ", "
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
             << ")\n";
-  const fiberfluid::fit::FitResult fitted = setup.calibration->run();
-  stop_if_interrupted("the fit");
-  if (fitted.values.size() == 0) {  // the start itself failed
-    std::cerr << "error: " << fitted.message << "\n";
-    return kSolverFailed;
-  }
+  const fit::FitResult fitted = setup.calibration->run();
 
   const app::Experiment at_fit = app::with_fitted_material(ex, *setup.calibration, fitted);
-  const std::string output = flags.output.empty() ? "out/" + ex.name : flags.output;
-  app::OutputWriter writer(at_fit, output);
+  app::OutputWriter writer(at_fit, folder);
   writer.begin();
-  app::ExperimentResult result = app::run_experiment(
-      at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
-        writer.on_step(run, r, x);
-      });
-  stop_if_interrupted("the run at the fitted values");
-  for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
-  result.checks = app::check_expected(at_fit, result);
-  writer.finish(result);
-  if (result.runs_succeeded()) app::write_fit_files(writer.folder(), at_fit, setup, fitted, result);
-
-  std::cout << ex.name << ": " << fitted.message << "; results in " << writer.folder().string() << "\n";
-  for (size_t k = 0; k < fitted.names.size(); ++k) {
-    const auto i = static_cast<Eigen::Index>(k);
-    std::cout << "  " << fitted.names[k] << " = " << fitted.values[i] << " +- "
-              << fitted.standard_errors[i] << " (95%: " << fitted.lower_95[i] << " .. "
-              << fitted.upper_95[i] << "; start " << fitted.initial[i] << ")\n";
+  if (fitted.status == fit::FitStatus::Interrupted) {
+    const app::ExperimentResult none;
+    writer.keep_interrupted("the fit was interrupted after " + std::to_string(fitted.iterations.size()) +
+                                " iterations; fit.json holds the best point so far (continue "
+                                "with \"start_from\" in the fit section)",
+                            [&](const std::filesystem::path& dir) {
+                              app::write_fit_files(dir, at_fit, setup, fitted, none);
+                            });
+    std::cerr << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
+              << (writer.folder() / "fit.json").string() << " (continue with \"start_from\": \""
+              << (writer.folder() / "fit.json").string() << "\" in the fit section)\n";
+    return app::fit_exit_status(fitted.status);
   }
-  const auto& d = fitted.overall;
-  std::cout << "  distance: mean " << d.mean << ", rms " << d.rms << ", sd " << d.standard_deviation
-            << " (" << 100.0 * d.share(d.standard_deviation) << "% of the body's length "
-            << d.length << "), largest " << d.largest << " m\n";
-  std::cout << "  " << fitted.forward_runs << " forward runs";
-  if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed: rejected steps)";
-  std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds << " s\n";
+  app::ExperimentResult result;
+  if (fitted.status != fit::FitStatus::StartFailed) {
+    result = app::run_experiment(
+        at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
+          writer.on_step(run, r, x);
+        });
+    stop_if_interrupted("the run at the fitted values");
+    for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
+    result.checks = app::check_expected(at_fit, result);
+  }
+  if (!app::fit_result_kept(fitted.status))
+    result.failure = std::string("the fit ended ") + fit::to_string(fitted.status) + ": " +
+                     fitted.message + (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
+  writer.finish(result, [&](const std::filesystem::path& dir) {
+    app::write_fit_files(dir, at_fit, setup, fitted, result);
+  });
+  for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
+
+  std::cout << ex.name << ": " << fit::to_string(fitted.status) << ": " << fitted.message
+            << "; results in " << writer.folder().string() << "\n";
+  if (!fitted.status_detail.empty()) std::cout << "  " << fitted.status_detail << "\n";
+  print_fit(fitted);
   for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
   if (!result.runs_succeeded()) {
     for (const app::RunResult& run : result.runs)
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
-  if (!fitted.success) {
-    std::cerr << "error: the fit did not converge: " << fitted.message << "\n";
-    return kSolverFailed;
-  }
+  if (fitted.status == fit::FitStatus::ConvergedAtBounds)
+    std::cerr << "warning: the fit converged on bounds: " << fitted.status_detail
+              << ". A bound is no estimate: widen it, fix the parameter, or check the model\n";
+  else if (!app::fit_result_kept(fitted.status))
+    std::cerr << "error: " << result.failure << "\n";
+  if (const int status = app::fit_exit_status(fitted.status); status != kOk) return status;
   if (flags.check_expected && !result.checks_passed()) {
     std::cerr << "error: some expected figures were not met (see above)\n";
     return kChecksFailed;
@@ -444,6 +509,15 @@ int main(int argc, char** argv) {
     return kBadInput;
   } catch (const std::bad_alloc&) {
     std::cerr << "error: out of memory; use a coarser mesh\n";
+    return kSolverFailed;
+  } catch (const nlohmann::json::exception& e) {
+    std::cerr << "error: bad JSON: " << e.what() << "\n";
+    return kBadInput;
+  } catch (const std::exception& e) {  // the standard library's, CGAL's: a failure, never a crash
+    std::cerr << "error: " << e.what() << "\n";
+    return kSolverFailed;
+  } catch (...) {
+    std::cerr << "error: an unknown failure\n";
     return kSolverFailed;
   }
 }

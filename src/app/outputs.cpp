@@ -11,7 +11,9 @@
 #include <cstring>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
+#include "app/output_folder.hpp"
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
@@ -204,33 +206,6 @@ class CsvTable {
   std::vector<std::string> cells_;
   std::ostringstream out_;
 };
-
-bool process_alive(long pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
-
-// Removes "DIR.running-PID" folders whose process has gone (killed runs).
-void remove_abandoned_staging(const fs::path& target) {
-  const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  if (!fs::is_directory(parent)) return;
-  const std::string prefix = target.filename().string() + ".running-";
-  for (const fs::directory_entry& entry : fs::directory_iterator(parent)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    char* end = nullptr;
-    const long pid = std::strtol(name.c_str() + prefix.size(), &end, 10);
-    if (end && *end == '\0' && !process_alive(pid)) fs::remove_all(entry.path());
-  }
-}
-
-// Puts `from` at `to` in one step, replacing what `to` held (then removed).
-void move_into_place(const fs::path& from, const fs::path& to) {
-  if (!fs::exists(to)) {
-    fs::rename(from, to);
-    return;
-  }
-  if (renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_EXCHANGE) != 0)
-    throw InputError(to.string() + ": cannot replace the folder: " + std::strerror(errno));
-  fs::remove_all(from);  // now the previous result
-}
 
 }  // namespace
 
@@ -447,24 +422,17 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
 }
 
 OutputWriter::OutputWriter(const Experiment& experiment, fs::path folder)
-    : experiment_(experiment), target_(std::move(folder)) {
-  const bool replaceable = !fs::exists(target_) ||
-                           (fs::is_directory(target_) &&
-                            (fs::is_empty(target_) || fs::exists(target_ / "summary.json")));
-  if (!replaceable)
-    throw InputError(target_.string() +
-                     ": exists and is not a fiberfluid output folder (no summary.json); "
-                     "choose another output folder with -o");
-  staging_ = target_;
-  staging_ += ".running-" + std::to_string(getpid());
-  result_folder_ = target_;
+    : experiment_(experiment), target_(std::move(folder)), result_folder_(target_) {
+  check_replaceable(target_);
 }
 
 OutputWriter::~OutputWriter() { abandon(); }
 
 void OutputWriter::abandon() noexcept {
-  std::error_code ignored;  // finish() moved it away already, or begin() never made it
+  if (staging_.empty()) return;  // begin() never made it
+  std::error_code ignored;       // finish() moved it away already
   fs::remove_all(staging_, ignored);
+  staging_.clear();
 }
 
 fs::path OutputWriter::run_folder(size_t run) const {
@@ -473,10 +441,7 @@ fs::path OutputWriter::run_folder(size_t run) const {
 }
 
 void OutputWriter::begin() {
-  if (!target_.parent_path().empty()) fs::create_directories(target_.parent_path());
-  remove_abandoned_staging(target_);
-  fs::remove_all(staging_);
-  fs::create_directories(staging_);
+  staging_ = create_staging_folder(target_, experiment_.name);
   geom::write_text_file(staging_ / "INCOMPLETE",
                         "fiberfluid is writing this folder, or was stopped while it did: "
                         "these are not the results of a complete run.\n");
@@ -534,7 +499,7 @@ void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
     write_state(run, record.step, unknowns);
 }
 
-void OutputWriter::finish(const ExperimentResult& result) {
+void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& more) {
   for (size_t r = 0; r < result.runs.size(); ++r) {
     const Case& c = experiment_.cases[r];
     const RunResult& run = result.runs[r];
@@ -569,26 +534,39 @@ void OutputWriter::finish(const ExperimentResult& result) {
   }
   geom::write_text_file(staging_ / "summary.json",
                         summary_json(experiment_, result).dump(2) + "\n");
+  if (more) more(staging_);
 
-  if (result.runs_succeeded()) {
-    fs::remove(staging_ / "INCOMPLETE");
-    move_into_place(staging_, target_);
-    result_folder_ = target_;
+  if (result.runs_succeeded() && result.failure.empty()) {
+    place(target_);
     return;
   }
   std::string why = result.failure.empty() ? "" : result.failure + "\n";
   for (const RunResult& run : result.runs)
     if (!run.summary.success)
       why += (run.variant.empty() ? "" : run.variant + ": ") + run.summary.message + "\n";
-  geom::write_text_file(staging_ / "FAILED",
-                        "this run failed; the last complete result (if any) is in " +
-                            target_.filename().string() + "\n" + why);
+  set_aside("FAILED", "failed", "this run failed", why);
+}
+
+void OutputWriter::keep_interrupted(const std::string& why, const FolderFiller& more) {
+  if (more) more(staging_);
+  set_aside("INTERRUPTED", "interrupted", "this run was interrupted", why + "\n");
+}
+
+void OutputWriter::set_aside(const char* mark, const char* suffix, const std::string& what,
+                             const std::string& why) {
+  geom::write_text_file(staging_ / mark, what + "; the last complete result (if any) is in " +
+                                             target_.filename().string() + "\n" + why);
+  fs::path aside = target_;
+  aside += std::string(".") + suffix;
+  place(aside);
+}
+
+void OutputWriter::place(const fs::path& where) {
   fs::remove(staging_ / "INCOMPLETE");
-  fs::path failed = target_;
-  failed += ".failed";
-  fs::remove_all(failed);
-  fs::rename(staging_, failed);
-  result_folder_ = failed;
+  // From here on the folder is never removed: a move that fails names it.
+  const fs::path staged = std::exchange(staging_, fs::path());
+  move_into_place(staged, where, &warnings_);
+  result_folder_ = where;
 }
 
 }  // namespace fiberfluid::app

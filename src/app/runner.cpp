@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cmath>
 #include <omp.h>
+#include <exception>
+#include <functional>
 #include <thread>
 #include <sstream>
 
@@ -197,6 +199,38 @@ static int effective_jobs(const RunOptions& options, size_t cases) {
   return std::max(1, std::min(wanted, static_cast<int>(cases)));
 }
 
+// Calls run_case(r) for every case, on `jobs` threads: each worker takes the
+// next case, and OpenMP threads are shared out so that jobs x threads stays
+// at the core count. An exception in a worker (a write that failed: a full
+// disk, a file-size limit) stops the others from taking new cases and is
+// rethrown here, the first by case order, as if the cases ran one by one.
+static void for_each_case(size_t count, int jobs, const std::function<void(size_t)>& run_case) {
+  if (jobs == 1) {
+    for (size_t r = 0; r < count; ++r) run_case(r);
+    return;
+  }
+  const int threads_per_job = std::max(1, core_count() / jobs);
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::vector<std::exception_ptr> errors(count);
+  std::vector<std::thread> workers;
+  for (int w = 0; w < jobs; ++w)
+    workers.emplace_back([&] {
+      omp_set_num_threads(threads_per_job);
+      for (size_t r = next++; r < count && !failed; r = next++) {
+        try {
+          run_case(r);
+        } catch (...) {
+          errors[r] = std::current_exception();
+          failed = true;
+        }
+      }
+    });
+  for (std::thread& worker : workers) worker.join();
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
 ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
                                 const RunOptions& options) {
   ExperimentResult result;
@@ -225,22 +259,7 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
                         static_cast<double>(ex.cases.size()));
     };
     if (ex.cases.size() > 1) report_progress("variants", 0.0, static_cast<double>(ex.cases.size()));
-    const int jobs = effective_jobs(options, ex.cases.size());
-    if (jobs == 1) {
-      for (size_t r = 0; r < ex.cases.size(); ++r) run_case(r);
-    } else {
-      // A small pool: each worker takes the next case; OpenMP threads are
-      // shared out so that jobs x threads stays at the core count.
-      const int threads_per_job = std::max(1, core_count() / jobs);
-      std::atomic<size_t> next{0};
-      std::vector<std::thread> workers;
-      for (int w = 0; w < jobs; ++w)
-        workers.emplace_back([&] {
-          omp_set_num_threads(threads_per_job);
-          for (size_t r = next++; r < ex.cases.size(); r = next++) run_case(r);
-        });
-      for (std::thread& worker : workers) worker.join();
-    }
+    for_each_case(ex.cases.size(), effective_jobs(options, ex.cases.size()), run_case);
     if (ex.fem_reference && !ex.cases.empty()) {
       report_progress("FEM reference", 0.0, 1.0);
       auto reference = std::make_shared<FemReferenceResult>(

@@ -9,9 +9,13 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <sstream>
+#include <Eigen/SVD>
+#include <cctype>
 
 #include "fit/optimizers.hpp"
 #include "geom/error.hpp"
+#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 
 namespace fiberfluid::fit {
@@ -21,18 +25,22 @@ using Jet = ceres::Jet<double, 3>;
 
 // The rigid alignment of the targets, T(p) = R(omega) p + t, with the
 // derivatives of its action on one point by the rotation vector (Jets).
+// A similarity: distances in the target's frame are 1/scale of the body's.
 struct Alignment {
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero(), translation = Eigen::Vector3d::Zero();
+  double scale = 1.0;
 
-  // T(p) and dT(p)/domega (3 x 3).
+  // T(p) = s R p + t and dT(p)/domega (3 x 3).
   Eigen::Vector3d apply(const Eigen::Vector3d& p, Eigen::Matrix3d* d_rotation) const {
-    return rotate(rotation, p, d_rotation) + translation;
+    const Eigen::Vector3d q = scale * rotate(rotation, p, d_rotation) + translation;
+    if (d_rotation) *d_rotation *= scale;
+    return q;
   }
-  // T^-1(x) = R^T (x - t), with d/domega (3 x 3); d/dt is -R^T.
+  // T^-1(x) = R^T (x - t) / s, with d/domega (3 x 3); d/dt is -R^T / s.
   Eigen::Vector3d inverse(const Eigen::Vector3d& x, Eigen::Matrix3d* d_rotation) const {
     Eigen::Matrix3d d;
-    const Eigen::Vector3d q = rotate(-rotation, x - translation, &d);
-    if (d_rotation) *d_rotation = -d;  // the rotation vector enters with a minus sign
+    const Eigen::Vector3d q = rotate(-rotation, x - translation, &d) / scale;
+    if (d_rotation) *d_rotation = -d / scale;  // the rotation vector enters with a minus sign
     return q;
   }
   Eigen::Matrix3d inverse_rotation() const {
@@ -109,6 +117,43 @@ const char* to_string(Loss loss) {
   return "?";
 }
 
+Method method_from_string(const std::string& name) {
+  for (Method m : {Method::LevenbergMarquardt, Method::Bobyqa, Method::DirectL, Method::Crs2})
+    if (name == to_string(m)) return m;
+  throw InputError("method: expected levenberg-marquardt, bobyqa, direct-l or crs2, got \"" +
+                   name.substr(0, 40) + "\"");
+}
+
+Loss loss_from_string(const std::string& name) {
+  for (Loss l : {Loss::Squared, Loss::Huber, Loss::Cauchy})
+    if (name == to_string(l)) return l;
+  throw InputError("loss: expected squared, huber or cauchy, got \"" + name.substr(0, 40) + "\"");
+}
+
+void check_options(const FitOptions& o) {
+  auto positive = [](const char* name, double x, double largest, const char* what) {
+    if (!(x > 0.0 && x <= largest)) {
+      std::ostringstream message;
+      message << name << ": expected " << what << ", got " << x;
+      throw InputError(message.str());
+    }
+  };
+  positive("difference_step", o.difference_step, 0.5,
+           "a step in the fitted variable above 0 and at most 0.5 (a share of the value, or of "
+           "its logarithm)");
+  positive("loss_scale", o.loss_scale, std::numeric_limits<double>::max(),
+           "a positive finite length in m");
+  positive("function_tolerance", o.function_tolerance, 1.0, "a relative change in (0, 1]");
+  positive("parameter_tolerance", o.parameter_tolerance, 1.0, "a relative change in (0, 1]");
+  positive("initial_trust_region_radius", o.initial_trust_region_radius,
+           std::numeric_limits<double>::max(), "a positive finite number");
+  if (o.max_iterations < 1 || o.max_iterations > 100000)
+    throw InputError("max_iterations: expected 1 to 100000, got " + std::to_string(o.max_iterations));
+  if (o.max_evaluations < 1 || o.max_evaluations > 10000000)
+    throw InputError("max_evaluations: expected 1 to 10000000, got " +
+                     std::to_string(o.max_evaluations));
+}
+
 struct Calibration::Impl {
   model::Model model;
   solve::SteppingOptions stepping;
@@ -128,7 +173,9 @@ struct Calibration::Impl {
         stepping(std::move(s)),
         targets(std::move(t)),
         map(std::move(p), model.material, model.dim()),
-        options(std::move(o)) {}
+        options(std::move(o)) {
+    check_options(options);
+  }
 };
 
 Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
@@ -165,6 +212,15 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
       throw InputError(t.target.label + ": the target does not overlap the body (its bounding box "
                        "lies more than half the body's length away): wrong units or another "
                        "specimen?");
+    // Nor of another size altogether: a scan in mm against a body in m.
+    const double size = (t_high - t_low).maxCoeff();
+    if (size > 10.0 * m.length || size < 0.01 * m.length) {
+      std::ostringstream why;
+      why << t.target.label << ": the target is " << size / m.length << " times the body's size ("
+          << size << " against " << m.length << " m): wrong units? (give the scan's \"units\" "
+          << "or \"scale\")";
+      throw InputError(why.str());
+    }
     m.distances.emplace_back(t.target);
     if (std::find(m.target_steps.begin(), m.target_steps.end(), t.step) == m.target_steps.end())
       m.target_steps.push_back(t.step);
@@ -189,6 +245,7 @@ const ParameterMap& Calibration::parameters() const { return impl_->map; }
 const model::Model& Calibration::model() const { return impl_->model; }
 bool Calibration::analytic_jacobian() const { return impl_->analytic; }
 int Calibration::num_residuals() const { return impl_->residuals; }
+int Calibration::num_counted_vertices() const { return static_cast<int>(impl_->counted.size()); }
 double Calibration::body_length() const { return impl_->length; }
 
 double Calibration::cost(const Eigen::VectorXd& r) const {
@@ -272,7 +329,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   }
   // The chain through the closest points is the same for both kinds of sensitivity.
   Alignment align;
-  map.alignment(values, &align.rotation, &align.translation);
+  map.alignment(values, &align.rotation, &align.translation, &align.scale);
   const Eigen::Matrix3d R_inverse = align.inverse_rotation();
   e.residuals.resize(m.residuals);
   if (with_jacobian) e.jacobian = Eigen::MatrixXd::Zero(m.residuals, P);
@@ -286,14 +343,17 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     }
     return dx;
   };
-  // Adds the alignment's columns: d residual / d (rotation, translation) = n . dq.
+  // Adds the alignment's columns: d residual / d (rotation, translation) =
+  // n . dq (dq in the body's frame), and d residual / d scale.
   auto add_alignment = [&](Eigen::Index row, const Eigen::Vector3d& n, const Eigen::Matrix3d& dq_domega,
-                           const Eigen::Matrix3d& dq_dt) {
+                           const Eigen::Matrix3d& dq_dt, double d_scale) {
     for (int a = 0; a < 3; ++a) {
       const int r = map.alignment_index(a), t = map.alignment_index(3 + a);
       if (r >= 0) e.jacobian(row, r) += n.dot(dq_domega.col(a)) * dvalue[r];
       if (t >= 0) e.jacobian(row, t) += n.dot(dq_dt.col(a)) * dvalue[t];
     }
+    const int s = map.alignment_index(6);
+    if (s >= 0) e.jacobian(row, s) += d_scale * dvalue[s];
   };
 
   Eigen::Index row = 0;
@@ -310,13 +370,15 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
       queries.row(static_cast<Eigen::Index>(c)) =
           align.inverse(X.row(m.counted[c]).transpose(), &dq_domega[c]).transpose();
     const std::vector<TargetDistance::Closest> hits = m.distances[t].closest(queries);
+    // The distance in the body's frame: s times the one in the target's
+    // (T is a similarity), so that both directions measure alike.
     for (size_t c = 0; c < m.counted.size(); ++c, ++row) {
       const Eigen::Vector3d q = queries.row(static_cast<Eigen::Index>(c)).transpose();
-      e.residuals[row] = hits[c].distance;
+      e.residuals[row] = align.scale * hits[c].distance;
       if (!with_jacobian) continue;
       const Eigen::Vector3d n = direction(q, hits[c].point, target, hits[c].primitive);
       if (S) e.jacobian.row(row) += n.transpose() * R_inverse * vertex_sensitivity(*S, m.counted[c]);
-      add_alignment(row, n, dq_domega[c], -R_inverse);
+      add_alignment(row, n, align.scale * dq_domega[c], -R_inverse, hits[c].distance - n.dot(q));
     }
     if (!m.options.symmetric) continue;
     // Symmetric: each target point, taken into the body's frame, to the simulated surface.
@@ -346,7 +408,8 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
       if (S)
         for (int k = 0; k < 3; ++k)
           e.jacobian.row(row) -= b[k] * n.transpose() * vertex_sensitivity(*S, corners[k]);
-      add_alignment(row, n, dp_domega[static_cast<size_t>(j)], Eigen::Matrix3d::Identity());
+      add_alignment(row, n, dp_domega[static_cast<size_t>(j)], Eigen::Matrix3d::Identity(),
+                    n.dot(p - align.translation) / align.scale);  // dT(p)/ds = R p
     }
   }
 
@@ -355,62 +418,166 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   return e;
 }
 
+namespace {
+
+// A failure's message with its numbers taken out, so that failures of one
+// kind count together: "step 3: runaway: face 12 turned over" ->
+// "step #: runaway: face # turned over".
+std::string failure_cause(const std::string& message) {
+  std::string cause;
+  for (size_t i = 0; i < message.size(); ++i) {
+    const char ch = message[i];
+    const bool digit = std::isdigit(static_cast<unsigned char>(ch)) != 0;
+    const bool in_number = digit || ((ch == '.' || ch == 'e' || ch == '-' || ch == '+') &&
+                                     !cause.empty() && cause.back() == '#' && i + 1 < message.size() &&
+                                     std::isdigit(static_cast<unsigned char>(message[i + 1])));
+    if (!in_number) cause += ch;
+    else if (cause.empty() || cause.back() != '#') cause += '#';
+  }
+  return cause;
+}
+
+}  // namespace
+
+const Evaluation* EvaluationCache::kept(const Eigen::VectorXd& phi, bool with_jacobian) const {
+  for (const Entry& entry : kept_) {
+    if (entry.phi.size() != phi.size() || entry.phi != phi) continue;
+    if (with_jacobian && !entry.has_jacobian) continue;
+    // A point whose finite-difference runs failed still has valid residuals
+    // in its Jacobian-free entry: a failed Jacobian must not hide them.
+    if (!with_jacobian && entry.has_jacobian && !entry.evaluation.ok) continue;
+    return &entry.evaluation;
+  }
+  return nullptr;
+}
+
 const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jacobian) {
-  for (auto entry = kept_.begin(); entry != kept_.end(); ++entry)
-    if (entry->phi.size() == phi.size() && entry->phi == phi &&
-        (entry->has_jacobian || !with_jacobian)) {
-      if (entry != kept_.begin()) std::rotate(kept_.begin(), entry, std::next(entry));
-      return kept_.front().evaluation;
-    }
+  if (const Evaluation* found = kept(phi, with_jacobian)) {
+    const auto entry = std::find_if(kept_.begin(), kept_.end(),
+                                    [&](const Entry& e) { return &e.evaluation == found; });
+    if (entry != kept_.begin()) std::rotate(kept_.begin(), entry, std::next(entry));
+    return kept_.front().evaluation;
+  }
   Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian)};
   forward_runs += entry.evaluation.forward_runs;
   sensitivity_solves += entry.evaluation.sensitivity_solves;
-  if (!entry.evaluation.ok) ++failed_runs;
+  if (!entry.evaluation.ok) {
+    ++failed_runs;
+    last_failure = entry.evaluation.message;
+    ++failures_by_cause[failure_cause(last_failure)];
+    if (failed_examples.size() < kKeptFailures)
+      failed_examples.push_back({calibration_.parameters().values(phi), last_failure});
+  }
   kept_.push_front(std::move(entry));
   if (kept_.size() > kKept) kept_.pop_back();
   return kept_.front().evaluation;
 }
 
+const char* to_string(FitStatus status) {
+  switch (status) {
+    case FitStatus::Converged: return "converged";
+    case FitStatus::ConvergedAtBounds: return "converged_at_bounds";
+    case FitStatus::IterationLimit: return "iteration_limit";
+    case FitStatus::NotIdentifiable: return "not_identifiable";
+    case FitStatus::ForwardRunsFailed: return "forward_runs_failed";
+    case FitStatus::StartFailed: return "start_failed";
+    case FitStatus::OptimizerFailed: return "optimizer_failed";
+    case FitStatus::Interrupted: return "interrupted";
+  }
+  return "?";
+}
+
+namespace {
+
+// Why a Jacobian cannot separate its parameters: a column that is zero or
+// not finite (no distance changes with that parameter), else the
+// combination its smallest singular value leaves unseen.
+std::string unidentifiable_because(const Eigen::MatrixXd& J, const std::vector<std::string>& names) {
+  for (Eigen::Index k = 0; k < J.cols(); ++k) {
+    if (!J.col(k).allFinite())
+      return "the derivatives of the distances by \"" + names[static_cast<size_t>(k)] + "\" are not finite";
+    if (J.col(k).norm() == 0.0)
+      return "no distance changes with \"" + names[static_cast<size_t>(k)] +
+             "\" (does the load act? is difference_step large enough to move the result?)";
+  }
+  if (J.cols() < 2) return "the Jacobian is rank deficient";
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+  const Eigen::VectorXd v = svd.matrixV().col(J.cols() - 1);
+  std::string which;
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    if (std::abs(v[k]) >= 0.3) which += (which.empty() ? "\"" : ", \"") + names[static_cast<size_t>(k)] + "\"";
+  return "the distances cannot tell " + which + " apart (the Jacobian is rank deficient): fix "
+         "one of them, or add targets that separate them";
+}
+
+// Where phi lies on a bound, to a millionth of the parameter's range.
+bool on_bound(double phi, double lower, double upper) {
+  const double range = std::isfinite(upper - lower) ? upper - lower : std::max(1.0, std::abs(phi));
+  const double tolerance = 1e-6 * range;
+  return (std::isfinite(lower) && phi - lower <= tolerance) ||
+         (std::isfinite(upper) && upper - phi <= tolerance);
+}
+
+}  // namespace
+
 FitResult Calibration::run() const {
   const Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
+  const int P = m.map.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   FitResult result;
   result.method = m.options.method;
   result.analytic_jacobian = m.analytic;
   result.names = m.map.names();
   result.initial = m.map.values(m.map.initial_phi());
+  // Sized from the start, whatever the ending: a report never reads past them.
+  result.values = result.initial;
+  result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
+  result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
+  result.initial_cost = result.final_cost = nan;
   EvaluationCache evaluations(*this);
-  auto count_runs = [&] {
+  auto finish = [&](FitStatus status, std::string message) {
+    result.status = status;
+    result.success = status == FitStatus::Converged || status == FitStatus::ConvergedAtBounds;
+    if (!message.empty()) result.message = std::move(message);
     result.forward_runs = evaluations.forward_runs;
     result.sensitivity_solves = evaluations.sensitivity_solves;
     result.failed_runs = evaluations.failed_runs;
+    result.failures_by_cause = evaluations.failures_by_cause;
+    result.failed_examples = evaluations.failed_examples;
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
   };
   // The start, as Levenberg-Marquardt will ask for it (with analytic
   // sensitivities): a failure here is the user's to fix, not a rejected step.
   const bool levenberg_marquardt = m.options.method == Method::LevenbergMarquardt;
   const Evaluation& first = evaluations.at(m.map.initial_phi(), levenberg_marquardt && m.analytic);
   if (!first.ok) {
-    count_runs();
-    result.message = "the forward run at the starting parameters failed: " + first.message;
-    return result;
+    if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+    return finish(FitStatus::StartFailed,
+                  "the forward run at the starting parameters failed: " + first.message);
   }
   result.initial_cost = cost(first.residuals);
+  if (!std::isfinite(result.initial_cost))
+    return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
   const OptimizerOutcome outcome = levenberg_marquardt ? fit_levenberg_marquardt(evaluations, m.options)
                                                        : fit_nlopt(evaluations, m.options);
-  result.success = outcome.success;
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.values = m.map.values(outcome.phi);
+  if (!result.iterations.empty()) result.final_cost = result.iterations.back().cost;
 
-  // At the optimum (usually kept from the optimiser): the run, the distances,
-  // and the covariance. A copy: the cache's entries move.
-  const Evaluation best = evaluations.at(outcome.phi, false);
-  count_runs();
+  // At the optimum (usually kept from the optimiser): the run and the
+  // distances. An interrupted fit takes only what it has already run.
+  const Evaluation* kept = evaluations.kept(outcome.phi, false);
+  if (outcome.status == FitStatus::Interrupted && (kept == nullptr || !kept->ok))
+    return finish(FitStatus::Interrupted, "");
+  const Evaluation best = kept != nullptr ? *kept : evaluations.at(outcome.phi, false);  // a copy: entries move
   if (!best.ok) {
-    result.success = false;
-    result.message = "the forward run at the fitted parameters failed: " + best.message;
-    return result;
+    if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+    return finish(FitStatus::ForwardRunsFailed,
+                  "the forward run at the fitted parameters failed: " + best.message);
   }
   result.final_cost = cost(best.residuals);
   result.summary = best.summary;
@@ -419,7 +586,7 @@ FitResult Calibration::run() const {
   Eigen::Index row = 0;
   std::vector<double> all;
   for (size_t t = 0; t < m.targets.size(); ++t) {
-    Eigen::VectorXd per_vertex = Eigen::VectorXd::Constant(nv, std::numeric_limits<double>::quiet_NaN());
+    Eigen::VectorXd per_vertex = Eigen::VectorXd::Constant(nv, nan);
     Eigen::VectorXd counted(static_cast<Eigen::Index>(m.counted.size()));
     for (size_t c = 0; c < m.counted.size(); ++c, ++row) {
       per_vertex[m.counted[c]] = best.residuals[row];
@@ -431,33 +598,64 @@ FitResult Calibration::run() const {
     result.statistics.push_back(distance_statistics(counted, m.length));
   }
   result.overall = distance_statistics(Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())), m.length);
+  // The parameters on a bound, said whatever the ending (a fit that ran out
+  // of iterations against a bound is the usual sign of a wrong model).
+  const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
+  auto describe_bounds = [&](bool with_correlation) {
+    result.at_bounds.clear();
+    result.status_detail.clear();
+    for (int k = 0; k < P; ++k) {
+      const double phi = outcome.phi[k];
+      if (!on_bound(phi, lower[k], upper[k])) continue;
+      const std::string& name = result.names[static_cast<size_t>(k)];
+      result.at_bounds.push_back(name);
+      std::ostringstream why;
+      why << name << " = " << result.values[k] << " is on its "
+          << (phi - lower[k] <= upper[k] - phi ? "lower" : "upper") << " bound";
+      int partner = -1;
+      for (int j = 0; j < P && with_correlation; ++j)
+        if (j != k && (partner < 0 || std::abs(result.correlation(k, j)) > std::abs(result.correlation(k, partner))))
+          partner = j;
+      if (partner >= 0)
+        why << " (its correlation with " << result.names[static_cast<size_t>(partner)] << " is "
+            << result.correlation(k, partner) << ")";
+      result.status_detail += (result.status_detail.empty() ? "" : "; ") + why.str();
+    }
+  };
+  describe_bounds(false);
+  if (outcome.status != FitStatus::Converged) return finish(outcome.status, "");
 
+  // Converged: is it an estimate? The covariance needs a full-rank Jacobian.
   Eigen::MatrixXd covariance;
   result.covariance_ok = phi_covariance(evaluations, m.options, outcome.phi, &covariance);
-  count_runs();
-  const int P = m.map.size();
-  result.standard_errors = result.lower_95 = result.upper_95 =
-      Eigen::VectorXd::Constant(P, std::numeric_limits<double>::quiet_NaN());
-  result.correlation = Eigen::MatrixXd::Constant(P, P, std::numeric_limits<double>::quiet_NaN());
-  if (result.covariance_ok) {
-    const int dof = m.residuals - P;
-    const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
-    const Eigen::MatrixXd scaled = variance * covariance;
-    for (int k = 0; k < P; ++k) {
-      const double sigma = std::sqrt(std::max(0.0, scaled(k, k)));
-      const bool log = m.map.parameters()[static_cast<size_t>(k)].log_scale;
-      const double phi = outcome.phi[k];
-      result.standard_errors[k] = log ? result.values[k] * sigma : sigma;
-      result.lower_95[k] = log ? std::exp(phi - 1.96 * sigma) : phi - 1.96 * sigma;
-      result.upper_95[k] = log ? std::exp(phi + 1.96 * sigma) : phi + 1.96 * sigma;
-      for (int j = 0; j < P; ++j) {
-        const double denominator = std::sqrt(covariance(k, k) * covariance(j, j));
-        result.correlation(k, j) = denominator > 0.0 ? covariance(k, j) / denominator : 0.0;
-      }
-    }
+  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+  if (!result.covariance_ok) {
+    const Evaluation* with_jacobian = evaluations.kept(outcome.phi, true);
+    result.status_detail = with_jacobian != nullptr && with_jacobian->ok
+                               ? unidentifiable_because(with_jacobian->jacobian, result.names)
+                               : "the Jacobian at the optimum could not be evaluated: " +
+                                     evaluations.last_failure;
+    return finish(FitStatus::NotIdentifiable, "");
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result;
+  const int dof = m.residuals - P;
+  const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
+  const Eigen::MatrixXd scaled = variance * covariance;
+  for (int k = 0; k < P; ++k)
+    for (int j = 0; j < P; ++j) {
+      const double denominator = std::sqrt(covariance(k, k) * covariance(j, j));
+      result.correlation(k, j) = denominator > 0.0 ? covariance(k, j) / denominator : 0.0;
+    }
+  describe_bounds(true);
+  for (int k = 0; k < P; ++k) {
+    if (on_bound(outcome.phi[k], lower[k], upper[k])) continue;  // a bound is no estimate: no standard error
+    const double sigma = std::sqrt(std::max(0.0, scaled(k, k)));
+    const bool log = m.map.parameters()[static_cast<size_t>(k)].log_scale;
+    const double phi = outcome.phi[k];
+    result.standard_errors[k] = log ? result.values[k] * sigma : sigma;
+    result.lower_95[k] = log ? std::exp(phi - 1.96 * sigma) : phi - 1.96 * sigma;
+    result.upper_95[k] = log ? std::exp(phi + 1.96 * sigma) : phi + 1.96 * sigma;
+  }
+  return finish(result.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
 }
 
 }  // namespace fiberfluid::fit

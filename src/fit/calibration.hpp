@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,9 +35,33 @@ enum class Method {
   Crs2,                // NLopt, global (controlled random search), then BOBYQA
 };
 const char* to_string(Method method);
+// "levenberg-marquardt", "bobyqa", "direct-l", "crs2"; throws InputError listing them.
+Method method_from_string(const std::string& name);
 
 enum class Loss { Squared, Huber, Cauchy };
 const char* to_string(Loss loss);
+// "squared", "huber", "cauchy"; throws InputError listing them.
+Loss loss_from_string(const std::string& name);
+
+// How a fit ended. Only Converged gives an estimate to take as it is.
+enum class FitStatus {
+  Converged,          // the optimiser converged inside the bounds; standard errors are valid
+  ConvergedAtBounds,  // converged with parameters on their bounds: those are the bounds, not estimates
+  IterationLimit,     // max_iterations (LM) or max_evaluations (NLopt) ran out first
+  NotIdentifiable,    // the distances cannot tell the parameters apart, or do not change with one
+  ForwardRunsFailed,  // the optimiser stopped because forward runs failed
+  StartFailed,        // the forward run at the starting parameters failed: the set-up
+  OptimizerFailed,    // the optimiser stopped for another reason (its message says which)
+  Interrupted,        // SIGINT or SIGTERM: the best point so far
+};
+// "converged", "converged_at_bounds", "iteration_limit", ... as in fit.json.
+const char* to_string(FitStatus status);
+
+// A forward run that failed during a fit: where, and why.
+struct FailedRun {
+  Eigen::VectorXd values;  // the parameters' values
+  std::string message;
+};
 
 struct IterationRecord {
   int iteration = 0;
@@ -45,6 +70,9 @@ struct IterationRecord {
   // and its cost (a rejected one costs more than `cost`).
   bool accepted = true;
   double trial_cost = 0.0;
+  // Why the forward run of a trial point tried in this iteration failed, if
+  // one did (the step is then rejected, or a smaller one accepted).
+  std::string trial_failure;
   Eigen::VectorXd values;     // the parameters' values at the current point
   int forward_runs = 0;       // so far
   double seconds = 0.0;       // since the start
@@ -77,6 +105,11 @@ struct FitOptions {
   std::function<void(const IterationRecord&)> progress;
 };
 
+// The one check of a fit's options, whichever front end set them: throws
+// InputError naming the option (as the "fit" section spells it) and what
+// was expected. Calibration's constructor calls it.
+void check_options(const FitOptions& options);
+
 // The residuals at one point of the parameter space, and their Jacobian.
 struct Evaluation {
   bool ok = false;
@@ -90,8 +123,14 @@ struct Evaluation {
 };
 
 struct FitResult {
-  bool success = false;
+  FitStatus status = FitStatus::StartFailed;
+  bool success = false;  // Converged or ConvergedAtBounds: the optimiser converged
   std::string message;
+  // Why the status is what it is, in a sentence: the parameters at their
+  // bounds and their strongest correlation, the parameter no distance
+  // depends on, ... (empty for Converged).
+  std::string status_detail;
+  std::vector<std::string> at_bounds;  // the parameters on a bound (ConvergedAtBounds)
   Method method = Method::LevenbergMarquardt;
   bool analytic_jacobian = true;
   std::vector<std::string> names;
@@ -106,9 +145,15 @@ struct FitResult {
   double initial_cost = 0.0, final_cost = 0.0;
   int forward_runs = 0, sensitivity_solves = 0;
   int failed_runs = 0;  // trial points whose forward run failed: rejected steps
+  // The failed runs counted by cause (their message with the numbers taken
+  // out: "step #: runaway: face # turned over"), and the first few whole.
+  std::map<std::string, int> failures_by_cause;
+  std::vector<FailedRun> failed_examples;
   double seconds = 0.0;
   // At the fitted values: the run, and per target the distance of every
-  // model vertex (NaN where it does not count) and its statistics.
+  // model vertex (NaN where it does not count) and its statistics. Empty
+  // when no run at the fitted values exists (StartFailed, and Interrupted
+  // before the best point was run again).
   solve::SteppingSummary summary;
   std::vector<Eigen::MatrixXd> positions;
   std::vector<Eigen::VectorXd> vertex_distances;
@@ -132,6 +177,8 @@ class Calibration {
   const model::Model& model() const;
   bool analytic_jacobian() const;
   int num_residuals() const;
+  // The model vertices whose distances count (all unless excluded).
+  int num_counted_vertices() const;
   // The body's length the distance shares refer to: its largest extent.
   double body_length() const;
 

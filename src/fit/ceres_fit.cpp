@@ -101,6 +101,12 @@ class Recorder final : public ceres::IterationCallback {
     // current point's is the last accepted one.
     r.accepted = s.iteration == 0 || s.step_is_successful;
     r.trial_cost = s.cost;
+    // A trial point whose forward run failed since the last report: say why,
+    // not its stand-in cost. (Ceres reports no iteration for a trial point
+    // it could not evaluate: it shrinks the region and tries again.)
+    const int failed = shared_.cache().failed_runs;
+    if (failed > failures_seen_) r.trial_failure = shared_.cache().last_failure;
+    failures_seen_ = failed;
     r.cost = r.accepted || outcome_.iterations.empty() ? s.cost : outcome_.iterations.back().cost;
     r.values = calibration_.parameters().values(phi_);  // update_state_every_iteration
     r.forward_runs = shared_.cache().forward_runs;
@@ -117,6 +123,7 @@ class Recorder final : public ceres::IterationCallback {
   const SharedEvaluation& shared_;
   OptimizerOutcome& outcome_;
   std::chrono::steady_clock::time_point start_;
+  int failures_seen_ = 0;
 };
 
 }  // namespace
@@ -142,12 +149,31 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   solver.callbacks.push_back(&recorder);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &p.problem, &summary);
-  outcome.phi = phi;
-  outcome.success = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
-  outcome.message = outcome.success ? "converged: " + summary.message
-                                    : "levenberg-marquardt: " + summary.message;
-  if (summary.termination_type == ceres::NO_CONVERGENCE)
-    outcome.message += " (max_iterations " + std::to_string(options.max_iterations) + ")";
+  outcome.phi = phi;  // the best point: Ceres keeps it in phi, also when stopped
+  outcome.message = "levenberg-marquardt: " + summary.message;
+  switch (summary.termination_type) {
+    case ceres::CONVERGENCE:
+      outcome.status = FitStatus::Converged;
+      break;
+    case ceres::NO_CONVERGENCE:
+      outcome.status = FitStatus::IterationLimit;
+      outcome.message += " (max_iterations " + std::to_string(options.max_iterations) + ")";
+      break;
+    case ceres::USER_SUCCESS:
+    case ceres::USER_FAILURE:
+      outcome.status = cancel_requested() ? FitStatus::Interrupted : FitStatus::OptimizerFailed;
+      break;
+    case ceres::FAILURE:
+      // Ceres fails when a point it must have (the Jacobian at an accepted
+      // point, a finite-difference run) cannot be evaluated.
+      outcome.status = p.shared.cache().failed_runs > 0 ? FitStatus::ForwardRunsFailed
+                                                         : FitStatus::OptimizerFailed;
+      if (p.shared.cache().failed_runs > 0)
+        outcome.message += ": " + p.shared.cache().last_failure;
+      break;
+  }
+  // A stop asked for ends Ceres in whichever way the runs it cut short lead to.
+  if (cancel_requested()) outcome.status = FitStatus::Interrupted;
   return outcome;
 }
 

@@ -36,7 +36,9 @@ struct Objective {
     const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(x, P);
     const Evaluation& e = evaluations.at(phi, false);
     ++calls;
-    const double cost = e.ok ? calibration.cost(e.residuals) : kFailedCost;
+    const double cost = e.ok && std::isfinite(calibration.cost(e.residuals))
+                            ? calibration.cost(e.residuals)
+                            : kFailedCost;
     if (cancel_requested() && running) nlopt_force_stop(running);
     if (cost < best) {
       best = cost;
@@ -133,11 +135,16 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& optio
     const int global = options.max_evaluations / 2;
     minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, calibration,
              options, objective, phi, global);
-    result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi,
-                      options.max_evaluations - objective.calls);
+    result = cancel_requested() ? NLOPT_FORCED_STOP
+                                : minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi,
+                                           options.max_evaluations - objective.calls);
   }
   outcome.phi = phi;
-  outcome.success = result > 0 && result != NLOPT_MAXEVAL_REACHED && objective.best < kFailedCost;
+  if (cancel_requested()) outcome.status = FitStatus::Interrupted;
+  else if (!(objective.best < kFailedCost)) outcome.status = FitStatus::ForwardRunsFailed;
+  else if (result == NLOPT_MAXEVAL_REACHED) outcome.status = FitStatus::IterationLimit;
+  else if (result > 0) outcome.status = FitStatus::Converged;
+  else outcome.status = FitStatus::OptimizerFailed;
   outcome.message = std::string(to_string(options.method)) + ": " + describe(result) + " after " +
                     std::to_string(objective.calls) + " evaluations";
   return outcome;

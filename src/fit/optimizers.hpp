@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <deque>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,16 @@ class EvaluationCache {
   // it is evaluated again). The reference stays valid until the next call.
   const Evaluation& at(const Eigen::VectorXd& phi, bool with_jacobian);
 
+  // The evaluation at phi if it was kept (with the Jacobian when asked), or null.
+  const Evaluation* kept(const Eigen::VectorXd& phi, bool with_jacobian) const;
+
   int forward_runs = 0, sensitivity_solves = 0;
   int failed_runs = 0;  // points whose forward run failed (rejected, not fatal)
+  std::map<std::string, int> failures_by_cause;
+  std::vector<FailedRun> failed_examples;  // the first kKeptFailures
+  std::string last_failure;                // the latest failed run's message
+
+  static constexpr size_t kKeptFailures = 5;
 
  private:
   static constexpr size_t kKept = 8;  // a few trial points past the optimum
@@ -38,7 +47,8 @@ class EvaluationCache {
 };
 
 struct OptimizerOutcome {
-  bool success = false;
+  // Converged, IterationLimit, ForwardRunsFailed, OptimizerFailed or Interrupted.
+  FitStatus status = FitStatus::OptimizerFailed;
   std::string message;
   Eigen::VectorXd phi;                    // the best point found
   std::vector<IterationRecord> iterations;

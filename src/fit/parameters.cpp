@@ -11,8 +11,9 @@
 namespace fiberfluid::fit {
 namespace {
 
-const char* const kAlignment[6] = {"rotation_x",    "rotation_y",    "rotation_z",
-                                   "translation_x", "translation_y", "translation_z"};
+const char* const kAlignment[7] = {"rotation_x",    "rotation_y",    "rotation_z",
+                                   "translation_x", "translation_y", "translation_z",
+                                   "scale"};
 
 std::string number(double x) {
   std::ostringstream out;
@@ -26,8 +27,27 @@ bool is_alignment_parameter(const std::string& name) {
   return std::find(std::begin(kAlignment), std::end(kAlignment), name) != std::end(kAlignment);
 }
 
+Parameter make_parameter(const ParameterRequest& request, const model::Material& material) {
+  Parameter p;
+  p.name = request.name;
+  const bool alignment = is_alignment_parameter(p.name);
+  if (!alignment && !model::is_material_parameter(material, p.name)) {
+    std::string known;
+    for (const std::string& n : model::material_parameter_names(material, 3))
+      known += (known.empty() ? "" : ", ") + n;
+    throw InputError("\"" + p.name + "\" is not a parameter of this material (" + known +
+                     ") or of the alignment (rotation_x..z, translation_x..z, scale)");
+  }
+  p.initial = request.start ? *request.start : alignment ? (p.name == "scale" ? 1.0 : 0.0)
+                                                         : material_parameter(material, p.name);
+  if (request.lower) p.lower = *request.lower;
+  if (request.upper) p.upper = *request.upper;
+  p.log_scale = request.log_scale.value_or(log_scale_by_default(p.name));
+  return p;
+}
+
 bool log_scale_by_default(const std::string& name) {
-  return !is_alignment_parameter(name) && name != "beta" && name != "transition";
+  return name == "scale" || (!is_alignment_parameter(name) && name != "beta");
 }
 
 void set_material_parameter(model::Material& material, const std::string& name, double value) {
@@ -67,7 +87,14 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
                        "(expected one of " + list + ", rotation_x..z, translation_x..z)");
     }
     if (!std::isfinite(p.initial)) throw InputError(who + ": the start is not finite");
-    if (!(p.lower <= p.upper)) throw InputError(who + ": the lower bound exceeds the upper");
+    if (std::isnan(p.lower) || std::isnan(p.upper) || std::isinf(p.lower) && p.lower > 0 ||
+        std::isinf(p.upper) && p.upper < 0)
+      throw InputError(who + ": expected numbers for the bounds, got [" + number(p.lower) + ", " +
+                       number(p.upper) + "]");
+    if (!(p.lower < p.upper))
+      throw InputError(who + ": expected a lower bound below the upper one, got [" +
+                       number(p.lower) + ", " + number(p.upper) + "] (to hold a parameter at a "
+                       "value, leave it out of the fit and set it in the material)");
     if (p.initial < p.lower || p.initial > p.upper)
       throw InputError(who + ": the start " + number(p.initial) + " lies outside the bounds [" +
                        number(p.lower) + ", " + number(p.upper) + "]");
@@ -133,11 +160,12 @@ model::Material ParameterMap::material(const model::Material& base,
 }
 
 void ParameterMap::alignment(const Eigen::VectorXd& values, Eigen::Vector3d* rotation,
-                             Eigen::Vector3d* translation) const {
+                             Eigen::Vector3d* translation, double* scale) const {
   for (int a = 0; a < 3; ++a) {
     (*rotation)[a] = alignment_index_[a] >= 0 ? values[alignment_index_[a]] : 0.0;
     (*translation)[a] = alignment_index_[3 + a] >= 0 ? values[alignment_index_[3 + a]] : 0.0;
   }
+  *scale = alignment_index_[6] >= 0 ? values[alignment_index_[6]] : 1.0;
 }
 
 }  // namespace fiberfluid::fit

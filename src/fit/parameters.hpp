@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,8 @@ namespace fiberfluid::fit {
 // One fitted parameter: a material parameter by name (the law's: Y, Y0, beta,
 // Y_t, Y_c, scale; "gamma"; "factor_x" / "factor_y" / "factor_z"), or one of
 // the rigid alignment of the targets ("rotation_x/y/z", a rotation vector in
-// radians, and "translation_x/y/z" in m: scans are rarely registered).
+// radians, "translation_x/y/z" in m, and "scale", a uniform scale of the
+// scans: they are rarely registered, and their units may be unsure).
 struct Parameter {
   std::string name;
   double initial = 0.0;
@@ -25,8 +27,21 @@ struct Parameter {
 };
 
 bool is_alignment_parameter(const std::string& name);
-// The default for a parameter: log scale for a positive material parameter
-// (a modulus, gamma, a factor); linear for beta, the transition and alignment.
+
+// A fitted parameter as every front end (JSON, Python, C++) describes it:
+// a name, and optionally a start (default: the material's value, 0 for the
+// alignment), bounds and a log scale (default: log_scale_by_default).
+// Throws InputError when the name is neither the material's nor the
+// alignment's, listing both.
+struct ParameterRequest {
+  std::string name;
+  std::optional<double> start, lower, upper;
+  std::optional<bool> log_scale;
+};
+Parameter make_parameter(const ParameterRequest& request, const model::Material& material);
+// The default for a parameter: log scale for a positive one (a modulus,
+// gamma, a factor, the alignment's scale); linear for beta and the
+// alignment's rotation and translation.
 bool log_scale_by_default(const std::string& name);
 
 // The parameters in the optimiser's variables phi (log or linear) and back.
@@ -54,17 +69,18 @@ class ParameterMap {
 
   // The material with the parameters' values set.
   model::Material material(const model::Material& base, const Eigen::VectorXd& values) const;
-  // The alignment's rotation vector and translation (zero where not fitted).
+  // The alignment T(p) = scale R(rotation) p + translation of the targets:
+  // zero rotation and translation, scale 1 where not fitted.
   void alignment(const Eigen::VectorXd& values, Eigen::Vector3d* rotation,
-                 Eigen::Vector3d* translation) const;
-  // The position among all parameters of rotation_x.. translation_z, or -1.
+                 Eigen::Vector3d* translation, double* scale) const;
+  // The position among all parameters of rotation_x.. translation_z, scale (k = 0..6), or -1.
   int alignment_index(int k) const { return alignment_index_[static_cast<size_t>(k)]; }
 
  private:
   std::vector<Parameter> parameters_;
   std::vector<std::string> material_names_;
   std::vector<int> material_indices_;
-  int alignment_index_[6] = {-1, -1, -1, -1, -1, -1};
+  int alignment_index_[7] = {-1, -1, -1, -1, -1, -1, -1};
   bool has_alignment_ = false;
 };
 

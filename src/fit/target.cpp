@@ -59,11 +59,19 @@ Target make_target(std::string label, const Eigen::MatrixXd& points,
   return t;
 }
 
-Target read_target(const std::filesystem::path& path) {
+Target read_target(const std::filesystem::path& path, double scale) {
+  if (!(scale > 0.0) || !std::isfinite(scale))
+    throw InputError(path.string() + ": the scale must be a positive finite number");
   const geom::ReadResult read = geom::read_surface(path);
   if (read.surface.dim != 3)
     throw InputError(path.string() + ": a target is a 3D surface or point cloud, not a 2D polygon");
-  return make_target(path.string(), read.surface.V, read.surface.F);
+  Target t = make_target(path.string(), scale * read.surface.V, read.surface.F);
+  if (scale != 1.0) {
+    std::ostringstream note;
+    note << "; coordinates scaled by " << scale << " to m";
+    t.description += note.str();
+  }
+  return t;
 }
 
 DistanceStatistics distance_statistics(const Eigen::VectorXd& d, double length) {

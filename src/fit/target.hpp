@@ -22,11 +22,12 @@ struct Target {
   bool is_point_cloud() const { return triangles.rows() == 0; }
 };
 
-// Reads a target from an OBJ, OFF, STL or PLY file. Drops unused vertices
-// and degenerate triangles (zero area: they have no closest point of their
-// own) and says so in `description`. Throws InputError naming the file for a
-// file it cannot read, a non-finite coordinate, or no point at all.
-Target read_target(const std::filesystem::path& path);
+// Reads a target from an OBJ, OFF, STL or PLY file, its coordinates times
+// `scale` (a scan in mm: 1e-3). Drops unused vertices and degenerate
+// triangles (zero area: they have no closest point of their own) and says so
+// in `description`. Throws InputError naming the file for a file it cannot
+// read, a non-finite coordinate (also after scaling), or no point at all.
+Target read_target(const std::filesystem::path& path, double scale = 1.0);
 
 // The same checks on a target built by a program (e.g. a deformed surface).
 Target make_target(std::string label, const Eigen::MatrixXd& points,

@@ -43,13 +43,20 @@ double surface_area(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
 }
 
 double enclosed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  if (F.rows() == 0 || V.rows() == 0) return 0.0;
+  // Summed about the centre of the bounding box, not the origin: for a body
+  // far from the origin the terms about the origin are huge and cancel
+  // (a unit cube at 1e8 loses every digit). For a closed surface the sum
+  // does not depend on the point.
+  const Eigen::RowVectorXd centre = 0.5 * (V.colwise().minCoeff() + V.colwise().maxCoeff());
   double volume = 0.0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     if (V.cols() == 3) {
-      const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      const Eigen::Vector3d a = V.row(F(f, 0)) - centre, b = V.row(F(f, 1)) - centre,
+                            c = V.row(F(f, 2)) - centre;
       volume += a.dot(b.cross(c)) / 6.0;
     } else {
-      const Eigen::Vector2d a = V.row(F(f, 0)), b = V.row(F(f, 1));
+      const Eigen::Vector2d a = V.row(F(f, 0)) - centre, b = V.row(F(f, 1)) - centre;
       volume += 0.5 * (a.x() * b.y() - b.x() * a.y());
     }
   }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cctype>
 #include <cstdint>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
@@ -502,15 +503,23 @@ void write_text_file(const std::filesystem::path& path, const std::string& conte
   std::filesystem::path temporary = path;
   temporary += ".partial";
   {
+    errno = 0;
     std::ofstream out(temporary, std::ios::binary);
-    if (!out) throw InputError(path.string() + ": cannot open the file for writing");
+    if (!out)
+      throw InputError(path.string() + ": cannot open the file for writing" +
+                       (errno != 0 ? std::string(": ") + std::strerror(errno) : std::string()));
     out << content;
-    if (!out.flush()) {
-      std::filesystem::remove(temporary);
-      throw InputError(path.string() + ": writing failed");
+    out.close();
+    if (out.fail()) {  // a full disk, a file-size limit (EFBIG), a quota
+      const std::string why = errno != 0 ? std::strerror(errno) : "unknown cause";
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw InputError(path.string() + ": writing failed: " + why);
     }
   }
-  std::filesystem::rename(temporary, path);
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw InputError(path.string() + ": cannot put the file in place: " + error.message());
 }
 
 void write_obj(const std::filesystem::path& path, const Surface& s) {

@@ -25,14 +25,15 @@ double enclosed_measure(const geom::Surface& surface) {
 
 double surface_error(const geom::Surface& reference, const geom::Surface& approximation,
                      const std::string& what_reference, const std::string& what_approximation) {
+  // The Booleans first: they check both surfaces (coordinates, closedness).
+  const double difference =
+      symmetric_difference_measure(reference, approximation, what_reference, what_approximation);
   const double measure = enclosed_measure(reference);
   if (!(measure > 0.0))
     throw InputError(what_reference + ": encloses no positive " +
                      std::string(reference.dim == 2 ? "area" : "volume") +
                      " (is it closed and outward?)");
-  return symmetric_difference_measure(reference, approximation, what_reference,
-                                      what_approximation) /
-         measure;
+  return difference / measure;
 }
 
 Eigen::VectorXd boundary_node_measures(const geom::Surface& surface) {

@@ -34,13 +34,32 @@ using CheckKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CheckMesh = CGAL::Surface_mesh<CheckKernel::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
-void require_finite(const geom::Surface& s, const std::string& what) {
-  if (!s.V.allFinite()) throw InputError(what + ": a vertex coordinate is not finite");
+// The exact Booleans are given only what they and doubles can carry: finite
+// coordinates of magnitude at most 1e50 (their constructions multiply up to
+// six of them; beyond, CGAL's interval filters overflow), and a body whose
+// extent keeps at least six digits of its coordinates.
+void require_representable(const geom::Surface& s, const std::string& what) {
+  constexpr double kLargest = 1e50, kDigits = 1e-6 / 1.1e-16;
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < s.V.rows(); ++i)
+    for (Eigen::Index a = 0; a < s.V.cols(); ++a) {
+      const double x = s.V(i, a);
+      if (!std::isfinite(x) || std::abs(x) > kLargest)
+        throw InputError(what + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " +
+                         std::to_string(x) + ": expected a finite coordinate of magnitude at most "
+                         "1e50 (rescale the meshes, e.g. to m)");
+      largest = std::max(largest, std::abs(x));
+    }
+  const double extent = s.V.rows() > 0 ? (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).maxCoeff() : 0.0;
+  if (!(extent > 0.0) || largest / extent > kDigits)
+    throw InputError(what + ": the body (extent " + std::to_string(extent) + ") is too small for "
+                     "its distance from the origin (" + std::to_string(largest) + ") to keep six "
+                     "digits in doubles: move it nearer the origin");
 }
 
 // The 2D surface's segments as one closed loop, counterclockwise.
 Polygon polygon(const geom::Surface& s, const std::string& what) {
-  require_finite(s, what);
+  require_representable(s, what);
   const int n = s.num_vertices();
   std::vector<int> next(static_cast<size_t>(n), -1);
   for (int f = 0; f < s.num_faces(); ++f) {
@@ -103,7 +122,9 @@ MeshType build_mesh(const geom::Surface& s, const std::string& what) {
 // A closed, outward, self-intersection-free triangle mesh (checked with
 // filtered predicates, built again with exact constructions).
 Mesh solid(const geom::Surface& s, const std::string& what) {
-  require_finite(s, what);
+  require_representable(s, what);
+  if (s.num_faces() == 0)
+    throw InputError(what + ": has no faces (a point cloud), so it bounds no solid");
   const CheckMesh check = build_mesh<CheckMesh>(s, what);
   if (check.is_empty() || !CGAL::is_closed(check))
     throw InputError(what + ": the mesh is not closed, so it bounds no solid");
@@ -117,14 +138,17 @@ Mesh solid(const geom::Surface& s, const std::string& what) {
 // The enclosed volume, summed in doubles from the exactly placed vertices:
 // an exact sum of thousands of rational tetrahedra (PMP::volume on this
 // kernel) spends seconds on gcds for digits a double result drops anyway.
-double volume(const Mesh& mesh) {
+// About `centre`, a point near the bodies: about the origin, the terms of a
+// body far from it cancel (geom::enclosed_volume does the same).
+double volume(const Mesh& mesh, const Eigen::Vector3d& centre) {
   double sum = 0.0;
   for (const auto f : mesh.faces()) {
     Eigen::Vector3d corner[3];
     int k = 0;
     for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
       const Kernel::Point_3& point = mesh.point(v);
-      corner[k++] = {CGAL::to_double(point.x()), CGAL::to_double(point.y()), CGAL::to_double(point.z())};
+      corner[k++] = Eigen::Vector3d(CGAL::to_double(point.x()), CGAL::to_double(point.y()),
+                                    CGAL::to_double(point.z())) - centre;
     }
     sum += corner[0].dot(corner[1].cross(corner[2]));
   }
@@ -134,12 +158,13 @@ double volume(const Mesh& mesh) {
 double symmetric_difference_3d(const geom::Surface& a, const geom::Surface& b,
                                const std::string& what_a, const std::string& what_b) {
   Mesh p = solid(a, what_a), q = solid(b, what_b);
-  const double volume_p = volume(p), volume_q = volume(q);
+  const Eigen::Vector3d centre = 0.5 * (a.V.colwise().minCoeff() + a.V.colwise().maxCoeff()).transpose();
+  const double volume_p = volume(p, centre), volume_q = volume(q, centre);
   Mesh common;
   if (!PMP::corefine_and_compute_intersection(p, q, common))
     throw InputError("the intersection of " + what_a + " and " + what_b +
                      " is not a closed solid (CGAL corefinement)");
-  return volume_p + volume_q - 2.0 * volume(common);
+  return volume_p + volume_q - 2.0 * volume(common, centre);
 }
 
 }  // namespace

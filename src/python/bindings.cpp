@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/experiment.hpp"
+#include "app/output_folder.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "fit/calibration.hpp"
@@ -19,6 +20,7 @@
 #include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
+#include "geom/run_control.hpp"
 
 namespace py = pybind11;
 namespace ff = fiberfluid;
@@ -28,7 +30,7 @@ namespace {
 // A plain dict (or list) to JSON, through Python's own json module.
 nlohmann::json to_json(const py::object& document) {
   const std::string text = py::module_::import("json").attr("dumps")(document).cast<std::string>();
-  return nlohmann::json::parse(text);
+  return ff::app::parse_json(text, "<dict>");
 }
 
 py::object to_python(const nlohmann::json& document) {
@@ -117,7 +119,7 @@ py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output)
     if (output.empty()) {
       result = ff::app::run_experiment(ex, {}, options);
     } else {
-      ff::app::OutputWriter writer(ex, output);
+      ff::app::OutputWriter writer(ex, ff::app::output_folder(output, ex.name));
       writer.begin();
       result = ff::app::run_experiment(
           ex,
@@ -161,48 +163,35 @@ py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
   for (size_t k = 0; k < targets.size(); ++k) {
     const py::dict t = targets[k].cast<py::dict>();
     const std::string label = "targets[" + std::to_string(k) + "]";
-    const Eigen::MatrixXd V = t["vertices"].cast<Eigen::MatrixXd>();
+    const double scale = t.contains("scale") ? t["scale"].cast<double>() : 1.0;
+    if (!(scale > 0.0) || !std::isfinite(scale))
+      throw ff::InputError(label + ": scale: expected a positive finite number");
+    const Eigen::MatrixXd V = scale * t["vertices"].cast<Eigen::MatrixXd>();
     const Eigen::MatrixXi F = t.contains("faces") ? t["faces"].cast<Eigen::MatrixXi>() : Eigen::MatrixXi();
     const int step = t.contains("step") ? t["step"].cast<int>() : c.stepping.steps;
     measured.push_back({ff::fit::make_target(label, V, F), step});
   }
+  // The same set-up and the same checks as the "fit" section of a file:
+  // fit::make_parameter, the *_from_string readers and fit::check_options
+  // (in Calibration's constructor).
   std::vector<ff::fit::Parameter> fitted;
   for (const py::handle& item : parameters) {
     const py::dict p = item.cast<py::dict>();
-    ff::fit::Parameter q;
-    q.name = p["name"].cast<std::string>();
-    const bool alignment = ff::fit::is_alignment_parameter(q.name);
-    if (!alignment && !ff::model::is_material_parameter(c.model.material, q.name))
-      throw ff::InputError("fit: parameter \"" + q.name + "\" is not a parameter of this material "
-                           "or of the alignment");
-    q.initial = p.contains("start") ? p["start"].cast<double>()
-                : alignment ? 0.0
-                            : ff::fit::material_parameter(c.model.material, q.name);
-    if (p.contains("lower")) q.lower = p["lower"].cast<double>();
-    if (p.contains("upper")) q.upper = p["upper"].cast<double>();
-    q.log_scale = p.contains("log_scale") ? p["log_scale"].cast<bool>()
-                                          : ff::fit::log_scale_by_default(q.name);
-    fitted.push_back(q);
+    ff::fit::ParameterRequest request;
+    request.name = p["name"].cast<std::string>();
+    if (p.contains("start")) request.start = p["start"].cast<double>();
+    if (p.contains("lower")) request.lower = p["lower"].cast<double>();
+    if (p.contains("upper")) request.upper = p["upper"].cast<double>();
+    if (p.contains("log_scale")) request.log_scale = p["log_scale"].cast<bool>();
+    fitted.push_back(ff::fit::make_parameter(request, c.model.material));
   }
   ff::fit::FitOptions options;
-  const std::map<std::string, ff::fit::Method> methods = {
-      {"levenberg-marquardt", ff::fit::Method::LevenbergMarquardt},
-      {"bobyqa", ff::fit::Method::Bobyqa},
-      {"direct-l", ff::fit::Method::DirectL},
-      {"crs2", ff::fit::Method::Crs2}};
-  if (!methods.count(method))
-    throw ff::InputError("fit: method \"" + method + "\": expected levenberg-marquardt, bobyqa, "
-                         "direct-l or crs2");
-  options.method = methods.at(method);
+  options.method = ff::fit::method_from_string(method);
   if (jacobian != "analytic" && jacobian != "finite-differences")
-    throw ff::InputError("fit: jacobian: expected analytic or finite-differences");
+    throw ff::InputError("jacobian: expected analytic or finite-differences, got \"" + jacobian + "\"");
   options.finite_differences = jacobian == "finite-differences";
   options.symmetric = symmetric;
-  if (loss != "squared" && loss != "huber" && loss != "cauchy")
-    throw ff::InputError("fit: loss: expected squared, huber or cauchy");
-  options.loss = loss == "huber" ? ff::fit::Loss::Huber
-                 : loss == "cauchy" ? ff::fit::Loss::Cauchy
-                                    : ff::fit::Loss::Squared;
+  options.loss = ff::fit::loss_from_string(loss);
   options.loss_scale = loss_scale;
   options.max_iterations = max_iterations;
   const ff::fit::Calibration calibration(c.model, c.stepping, measured, fitted, options);
@@ -212,8 +201,11 @@ py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
     r = calibration.run();
   }
   py::dict out;
+  out["status"] = ff::fit::to_string(r.status);
+  out["status_detail"] = r.status_detail;
   out["success"] = r.success;
   out["message"] = r.message;
+  out["failed_runs"] = r.failed_runs;
   out["analytic_jacobian"] = r.analytic_jacobian;
   py::dict values, errors, intervals;
   for (size_t k = 0; k < r.names.size(); ++k) {
@@ -250,6 +242,18 @@ PYBIND11_MODULE(fiberfluid, m) {
   m.doc() = "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
             "SI units throughout: m, N, Pa.";
   py::register_exception<ff::InputError>(m, "InputError", PyExc_ValueError);
+  // Every other exception that reaches Python becomes a Python exception
+  // too: an interruption a KeyboardInterrupt, bad JSON a ValueError (the
+  // standard library's and CGAL's: RuntimeError, by pybind11's rules).
+  py::register_exception_translator([](std::exception_ptr error) {
+    try {
+      if (error) std::rethrow_exception(error);
+    } catch (const ff::Interrupted& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    } catch (const nlohmann::json::exception& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
 
   m.def(
       "read_mesh",
@@ -341,7 +345,7 @@ PYBIND11_MODULE(fiberfluid, m) {
       [](const std::filesystem::path& folder) {
         std::ifstream in(folder / "summary.json");
         if (!in) throw ff::InputError((folder / "summary.json").string() + ": cannot open");
-        return to_python(nlohmann::json::parse(in));
+        return to_python(ff::app::parse_json(in, (folder / "summary.json").string()));
       },
       py::arg("folder"), "Reads the summary.json of a result folder as a dict.");
   m.attr("__version__") = FIBERFLUID_VERSION;

@@ -15,30 +15,22 @@
 
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
+#include "app/cli_support.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {
 namespace {
 
 using testing::ScratchDir;
+using testing::Outcome;
+using testing::run_cli;
+using testing::start_cli;
+using testing::count_files;
+using testing::staging_of;
+using testing::wait_for;
+using testing::read_file;
 
-struct Outcome {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
 
-Outcome run_cli(const std::string& arguments) {
-  Outcome outcome;
-  const std::string command = std::string(FIBERFLUID_CLI) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return outcome;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) outcome.output.append(buffer, n);
-  const int raw = pclose(pipe);
-  outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return outcome;
-}
 
 TEST(Cli, CheckReportsAGoodMesh) {
   const Outcome o = run_cli("check " + testing::data_mesh("torus.obj").string());
@@ -135,26 +127,7 @@ TEST(Cli, SupportsOnEveryVertexAreNamed) {
 }
 
 // Starts the tool in the background; its standard output and error go to a file.
-pid_t start_cli(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::FILE* out = std::freopen(log.c_str(), "w", stdout);
-    if (out != nullptr) dup2(fileno(stdout), STDERR_FILENO);
-    std::vector<char*> argv{const_cast<char*>(FIBERFLUID_CLI)};
-    for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(FIBERFLUID_CLI, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
 
-int count_files(const std::filesystem::path& folder) {
-  if (!std::filesystem::exists(folder)) return 0;
-  int n = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) n += entry.is_regular_file();
-  return n;
-}
 
 // A run long enough to be stopped part way: 642 vertices, A rebuilt every
 // step (about 10 ms each), a .vtu per step.
@@ -169,6 +142,7 @@ nlohmann::json many_steps(int steps) {
   return config;
 }
 
+
 TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
   ScratchDir dir;
   const std::filesystem::path out = dir.path() / "out";
@@ -180,10 +154,11 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
   auto kill_part_way = [&](const std::string& name) {
     const pid_t pid = start_cli({"run", long_run.string(), "-o", out.string()},
                                 dir.path() / (name + ".log"));
-    std::filesystem::path staging = out;
-    staging += ".running-" + std::to_string(pid);
-    for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait)
+    std::filesystem::path staging;
+    for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      staging = staging_of(out, pid);
+    }
     kill(pid, SIGKILL);
     int status = 0;
     waitpid(pid, &status, 0);
@@ -216,19 +191,7 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
             summary);
 }
 
-// Waits for a background run; its exit status, or -1 when it was killed by a signal.
-int wait_for(pid_t pid, double* seconds = nullptr) {
-  const auto start = std::chrono::steady_clock::now();
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
-std::string read_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
   ScratchDir dir;
@@ -241,10 +204,11 @@ TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
   config["stepping"]["steps"] = 4000;
   const pid_t pid = start_cli({"run", dir.write("long.json", config.dump()).string(), "-o",
                                out.string()}, dir.path() / "run.log");
-  std::filesystem::path staging = out;
-  staging += ".running-" + std::to_string(pid);
-  for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait)
+  std::filesystem::path staging;
+  for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    staging = staging_of(out, pid);
+  }
   ASSERT_GE(count_files(staging / "vtk"), 5) << "the run did not get going";
   kill(pid, SIGINT);
   double seconds = 0.0;
@@ -364,11 +328,28 @@ TEST(Cli, CompareGivesTheMetricsAsTextAndJson) {
   EXPECT_NEAR(j["E_n"].get<double>(), 0.1 * std::sqrt(static_cast<double>(cube.V.rows()) / u2), 1e-12);
   EXPECT_GT(j["E_i"].get<double>(), 0.0);
   EXPECT_NEAR(j["distance"]["largest"].get<double>(), 0.1, 1e-12);
-  // An open mesh bounds no solid: the file is named.
+  // An open scan bounds no solid: E_s says so, naming the file, and the
+  // distances are still given (a scan is rarely closed).
   std::ofstream(dir.path() / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\n";
-  const Outcome bad = run_cli("compare " + m.string() + " " + (dir.path() / "open.obj").string());
-  EXPECT_EQ(bad.status, 1);
-  EXPECT_NE(bad.output.find("open.obj: the mesh is not closed"), std::string::npos) << bad.output;
+  const Outcome open = run_cli("compare " + m.string() + " " + (dir.path() / "open.obj").string());
+  EXPECT_EQ(open.status, 0) << open.output;
+  for (const char* part : {"E_s: not computed: it needs two closed solids", "open.obj: the mesh is not closed",
+                           "distance from M' to M"})
+    EXPECT_NE(open.output.find(part), std::string::npos) << part << "\n" << open.output;
+  // A point cloud (vertices only) against the reference: the distances.
+  std::ofstream(dir.path() / "cloud.obj") << "v 0.5 0.5 1.0\nv 0.5 0.5 0.0\nv 0.25 0.5 0.8\n";
+  const Outcome cloud = run_cli("compare " + m.string() + " " + (dir.path() / "cloud.obj").string() + " --json");
+  ASSERT_EQ(cloud.status, 0) << cloud.output;
+  const nlohmann::json c = nlohmann::json::parse(cloud.output.substr(cloud.output.find('{')));
+  EXPECT_TRUE(c["E_s"].is_null());
+  EXPECT_EQ(c["distance"]["count"].get<int>(), 3);
+  EXPECT_NEAR(c["distance"]["largest"].get<double>(), 0.2, 1e-12);  // (0.5, 0.5, 1) to the top at 0.8
+  // 2D polygons have nothing but E_s: an open one is still an error, naming the file.
+  std::ofstream(dir.path() / "a.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 1\n";
+  std::ofstream(dir.path() / "b.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n";
+  const Outcome flat = run_cli("compare " + (dir.path() / "a.obj").string() + " " + (dir.path() / "b.obj").string());
+  EXPECT_EQ(flat.status, 1) << flat.output;
+  EXPECT_NE(flat.output.find("b.obj"), std::string::npos) << flat.output;
 }
 
 }  // namespace

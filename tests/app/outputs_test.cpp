@@ -90,7 +90,7 @@ TEST(Sweep, BadVariantsAreNamed) {
   c["variants"] = {{{"name", "a"}}, {{"name", "a"}}};
   expect_error(c, "variants[1].name: \"a\" names another variant already");
   c["variants"] = {{{"name", "../up"}}};
-  expect_error(c, "variants[0].name: expected a non-empty name");
+  expect_error(c, "variants[0].name: expected a name of letters, digits");
   c["variants"] = {{{"name", "x"}, {"expected", json::array()}}};
   expect_error(c, "variants[0].expected: belongs to the whole experiment");
   c["variants"] = json::array();

@@ -6,10 +6,14 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
+#include "app/compare.hpp"
 #include "app/experiment.hpp"
+#include "app/fitting.hpp"
+#include "app/output_folder.hpp"
 #include "app/runner.hpp"
 #include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
+#include "geom/generators.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/run_control.hpp"
@@ -51,12 +55,28 @@ void read_mesh(geom::MeshFormat format, const char* name, const uint8_t* data, s
 }
 
 // ---------------------------------------------------------------- experiments
+// Through the program's own reader (its nesting limit included).
 std::optional<nlohmann::json> parse_json(const uint8_t* data, size_t size) {
   try {
-    return nlohmann::json::parse(data, data + size);
-  } catch (const nlohmann::json::exception&) {
+    return app::parse_json(std::string(reinterpret_cast<const char*>(data), size), "fuzz.json");
+  } catch (const InputError& e) {
+    require(std::string(e.what()).size() < 1000, "a JSON error quotes a short excerpt");
     return std::nullopt;
   }
+}
+
+// Names that make paths never leave the output root: out/NAME is one
+// folder below out/, or the name is refused.
+void check_output_name(const std::string& name) {
+  std::filesystem::path folder;
+  try {
+    folder = app::output_folder("", name);
+  } catch (const InputError&) {
+    return;
+  }
+  require(folder.parent_path() == "out" && folder.filename() == name && name != ".." && name != "." &&
+              name.find('/') == std::string::npos,
+          "an accepted name is one folder below out/");
 }
 
 const std::filesystem::path kExperiments = FIBERFLUID_EXPERIMENTS;
@@ -66,7 +86,9 @@ void read_experiment(const uint8_t* data, size_t size) {
   if (!document) return;
   try {
     const app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    check_output_name(ex.name);
     for (const app::CaseSpec& spec : ex.specs) {
+      if (!spec.variant.empty()) check_output_name(spec.variant);
       std::string why;
       require(spec.stepping.IsValid(&why), "parsed stepping options are valid");
     }
@@ -108,6 +130,69 @@ void build_and_run(const uint8_t* data, size_t size) {
   }
 }
 
+// The fit section (issue 27): read, set up on the built model, the options
+// checked as every front end's are; when the case is small, one forward run
+// at the start. Only InputError may stop it.
+void set_up_fit(const uint8_t* data, size_t size) {
+  const std::optional<nlohmann::json> document = parse_json(data, size);
+  if (!document) return;
+  struct Budgets {
+    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.02); }
+    ~Budgets() { set_memory_budget(0.0), set_time_budget(0.0); }
+  } budgets;
+  try {
+    app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    check_output_name(ex.name);
+    if (!ex.fit) return;
+    fit::check_options(ex.fit->options);  // read_fit checked them: they pass again
+    app::build_experiment(ex);
+    const app::FitSetup setup = app::setup_fit(ex);
+    const fit::Calibration& c = *setup.calibration;
+    require(c.num_residuals() >= c.parameters().size(), "a fit has at least one distance per parameter");
+    const fit::Evaluation e = c.evaluate(c.parameters().initial_phi(), false);
+    if (!e.ok) {
+      require(!e.message.empty(), "a failed forward run says why");
+      return;
+    }
+    require(e.residuals.size() == c.num_residuals() && e.residuals.allFinite() &&
+                (e.residuals.array() >= 0.0).all(),
+            "distances are finite and not negative");
+  } catch (const InputError&) {
+  }
+}
+
+// `compare` (issue 27): a mesh read from the input against a unit square or
+// cube, both ways round. Every metric it gives is finite; E_s of a solid
+// with itself is 0.
+void compare_with_unit(int dim, const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  geom::Surface m;
+  try {
+    m = geom::read_surface_bytes(bytes, geom::MeshFormat::Obj, "fuzz.obj").surface;
+  } catch (const InputError&) {
+    return;
+  }
+  if (m.dim != dim || m.num_vertices() > 2000) return;
+  const geom::Surface unit = dim == 2 ? geom::rectangle({0, 0}, {1, 1}) : geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
+  for (const bool fuzzed_first : {true, false}) {
+    try {
+      const app::Comparison c = fuzzed_first ? app::compare_surfaces(m, unit, nullptr, "fuzz.obj", "unit")
+                                             : app::compare_surfaces(unit, m, nullptr, "unit", "fuzz.obj");
+      if (c.surface_error) {
+        require(std::isfinite(*c.surface_error) && *c.surface_error >= -1e-9, "E_s is finite and not negative");
+        require(std::isfinite(*c.reference_measure) && *c.reference_measure > 0.0, "|M| is positive");
+      } else {
+        require(dim == 3 && !c.surface_error_missing.empty(), "a missing E_s says why (3D only)");
+      }
+      if (c.distances)
+        require(std::isfinite(c.distances->mean) && std::isfinite(c.distances->largest) &&
+                    c.distances->largest >= 0.0,
+                "distances are finite");
+    } catch (const InputError&) {
+    }
+  }
+}
+
 }  // namespace
 
 const std::vector<Target>& targets() {
@@ -125,6 +210,9 @@ const std::vector<Target>& targets() {
        [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Ply, "fuzz.ply", d, n); }},
       {"experiment", ".json", read_experiment},
       {"model_setup", ".json", build_and_run},
+      {"fit_section", ".json", set_up_fit},
+      {"compare_2d", ".obj", [](const uint8_t* d, size_t n) { compare_with_unit(2, d, n); }},
+      {"compare_3d", ".obj", [](const uint8_t* d, size_t n) { compare_with_unit(3, d, n); }},
   };
   return all;
 }

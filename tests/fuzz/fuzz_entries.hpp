@@ -24,6 +24,10 @@ struct Target {
 // experiment: parse the JSON and read every field (no file is opened).
 // model_setup: build the experiment (meshes named relative to the
 // experiments folder) and run it when its estimate is small.
+// fit_section: read and set up a fit, one forward run when small.
+// compare_2d, compare_3d: `compare` between an OBJ and a unit square or cube.
+// Names that make paths (the experiment's, the variants') are checked to
+// stay one folder below out/ in experiment, model_setup and fit_section.
 const std::vector<Target>& targets();
 const Target* find_target(const std::string& name);
 

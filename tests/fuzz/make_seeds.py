@@ -153,6 +153,62 @@ def main():
         text = json.dumps(dict(name=name, **document), indent=1)
         write("experiment", name + ".json", text)
         write("model_setup", name + ".json", text)
+    fit_and_compare_seeds()
+
+
+def fit_sphere(**fit_changes):
+    """experiments/fit_sphere.json, small, with changes to its fit section."""
+    document = {
+        "surface": {"generator": "icosphere", "subdivisions": 1, "radius": 1.0},
+        "material": {"Y": 1000, "gamma": 9000},
+        "supports": [{"where": "z >= 0.8", "axes": "xyz", "label": "cap"}],
+        "loads": [{"type": "gravity", "acceleration": [0, 0, -10], "density": 1000}],
+        "stepping": {"steps": 3},
+        "fit": {"targets": [{"file": "../data/targets/sphere_final.obj"}],
+                "parameters": [{"name": "Y", "lower": 10, "upper": 1e6},
+                               {"name": "gamma", "lower": 10, "upper": 1e6}],
+                "objective": {"exclude": {"where": "z >= 0.8"}}}}
+    document["fit"].update(fit_changes)
+    return document
+
+
+def fit_and_compare_seeds():
+    """Issues 27 and 30: each reproducer found from outside is a seed."""
+    fits = {
+        "plain": fit_sphere(),
+        "difference_step_5": fit_sphere(jacobian="finite-differences", difference_step=5),
+        "difference_step_tiny": fit_sphere(jacobian="finite-differences", difference_step=1e-300),
+        "equal_bounds": fit_sphere(parameters=[{"name": "Y", "lower": 1000, "upper": 1000}]),
+        "loss_scale_zero": fit_sphere(objective={"loss": "huber", "loss_scale": 0}),
+        "scan_in_mm": fit_sphere(targets=[{"file": "../data/targets/sphere_final.obj", "units": "mm"}]),
+        "alignment_scale": fit_sphere(parameters=[{"name": "scale", "lower": 0.5, "upper": 2},
+                                                  {"name": "translation_z"}]),
+        "start_from_missing": fit_sphere(start_from="no_such_fit.json"),
+    }
+    for name, document in fits.items():
+        write("fit_section", name + ".json", json.dumps(dict(name=name, **document), indent=1))
+    escaping = fit_sphere()
+    escaping["name"] = "../victim"
+    write("fit_section", "name_escapes.json", json.dumps(escaping))
+    write("experiment", "name_escapes.json", json.dumps(escaping))
+    long_variant = dict(fit_sphere(), name="long", variants=[{"name": "v" * 300}])
+    del long_variant["fit"]
+    write("experiment", "variant_name_300.json", json.dumps(long_variant))
+    nested = '{"name": "deep", "stepping": {"steps": ' + "[" * 30000 + "]" * 30000 + "}}"
+    write("experiment", "nested_30000.json", nested)
+    write("fit_section", "nested_30000.json", nested)
+
+    # compare: polygons (2D) and solids (3D) against a unit square or cube.
+    write("compare_2d", "square_far.obj", obj([(x + 1e8, y + 1e8, 0) for x, y in [(0, 0), (1, 0), (1, 1), (0, 1)]], [])
+          + "l 1 2\nl 2 3\nl 3 4\nl 4 1\n")
+    write("compare_2d", "huge_coordinate.obj", "v 0 0 0\nv 1e301 0 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 1\n")
+    write("compare_2d", "l_shape.obj", obj([(x, y, 0) for x, y in L_XY], [])
+          + "".join(f"l {k + 1} {(k + 1) % 6 + 1}\n" for k in range(6)))
+    write("compare_3d", "cube_far.obj", obj([(x + 1e8, y + 1e8, z + 1e8) for x, y, z in CUBE_V], CUBE_F))
+    write("compare_3d", "cube_moved.obj", obj([(x + 0.5, y + 0.5, z + 0.5) for x, y, z in CUBE_V], CUBE_F))
+    write("compare_3d", "open_soup.obj", obj(TET_V, TET_F[:3]))
+    write("compare_3d", "point_cloud.obj", "v 0.5 0.5 1\nv 0.5 0.5 0\nv 0.2 0.5 0.8\n")
+    write("compare_3d", "huge_coordinate.obj", obj([(x * 1e301, y, z) for x, y, z in TET_V], TET_F))
 
 
 if __name__ == "__main__":

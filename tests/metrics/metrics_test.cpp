@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "geom/area_vectors.hpp"
 #include "geom/error.hpp"
 #include "geom/generators.hpp"
 
@@ -86,6 +87,45 @@ TEST(EnergyNorm, HandMadeCases) {
   EXPECT_NEAR(relative_energy_norm(u, 2.0 * u), 1.0, 1e-15);
   EXPECT_THROW(relative_energy_norm(Eigen::MatrixXd::Zero(2, 2), v), InputError);
   EXPECT_THROW(relative_energy_norm(u, Eigen::MatrixXd::Zero(3, 2)), InputError);
+}
+
+// Issue 30: volumes summed about the origin cancel for a body far from it
+// (a unit cube at 1e8 and the same moved by 0.5 gave E_s = -0.375).
+TEST(SurfaceError, ABodyFarFromTheOriginKeepsItsDigits) {
+  const Eigen::RowVector3d far(1e8, 1e8, 1e8);
+  const geom::Surface cube = translated(geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1}), far);
+  EXPECT_NEAR(geom::enclosed_volume(cube.V, cube.F), 1.0, 1e-8);
+  EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(0.5, 0.0, 0.0))), 1.0, 1e-8);
+  // Moved by 0.5 along each axis: overlap 0.125, |xor| = 2 - 0.25.
+  EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(0.5, 0.5, 0.5))), 1.75, 1e-8);
+  // The same in 2D (exact areas there, but the same rule for the inputs).
+  const geom::Surface square = translated(geom::rectangle({0, 0}, {1, 1}, 1, 1), Eigen::RowVector2d(1e8, 1e8));
+  EXPECT_NEAR(surface_error(square, translated(square, Eigen::RowVector2d(0.5, 0.5))), 1.5, 1e-8);
+}
+
+// Issue 27: a coordinate of 1e301 reached undefined behaviour inside CGAL's
+// Booleans; inputs beyond what the exact kernel and doubles carry are refused.
+TEST(SurfaceError, CoordinatesTheExactBooleansCannotCarryAreRefusedByName) {
+  auto expect_refused = [](const geom::Surface& a, const geom::Surface& b, const std::string& part) {
+    try {
+      surface_error(a, b, "m.obj", "m_prime.obj");
+      ADD_FAILURE() << "no error, expected one mentioning " << part;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  const geom::Surface square = geom::rectangle({0, 0}, {1, 1}, 1, 1);
+  geom::Surface huge = square;
+  huge.V(2, 0) = 1e301;
+  expect_refused(square, huge, "m_prime.obj: vertex 2 has x = ");
+  geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
+  geom::Surface far_cube = translated(cube, Eigen::RowVector3d(1e60, 0, 0));
+  expect_refused(cube, far_cube, "magnitude at most 1e50");
+  // A micrometre body at 1e12 m: its shape has no digits left.
+  geom::Surface speck = cube;
+  speck.V *= 1e-6;
+  speck.V.rowwise() += Eigen::RowVector3d(1e12, 0, 0);
+  expect_refused(speck, speck, "too small for its distance from the origin");
 }
 
 TEST(InteriorError, WeightedDisplacementErrorOverTheBodysScale) {

@@ -1,0 +1,230 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The reproducers of issues 27 and 30, run as a user ran them: results are
+// never lost, nothing is written outside its place, a fit always ends with a
+// status that says what happened, and nothing ends in a crash.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "app/cli_support.hpp"
+#include "test_support.hpp"
+
+namespace fiberfluid {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::Outcome;
+using testing::read_file;
+using testing::run_cli;
+using testing::run_cli_command;
+using testing::ScratchDir;
+
+const char kSmall[] = R"({"name": "small",
+  "surface": {"generator": "icosphere", "subdivisions": 1},
+  "material": {"Y": 3000, "gamma": 3000},
+  "supports": [{"where": "z >= 0.8"}],
+  "loads": [{"type": "gravity", "acceleration": [0, 0, -10], "density": 1000}],
+  "stepping": {"steps": 2}})";
+
+// `fiberfluid ARGUMENTS` run from `folder` (for the default output folder out/NAME).
+Outcome run_in(const fs::path& folder, const std::string& arguments, const std::string& shell_prefix = "") {
+  return run_cli_command("cd '" + folder.string() + "' && " + shell_prefix + std::string(FIBERFLUID_CLI) +
+                         " " + arguments);
+}
+
+json fit_sphere() {
+  std::ifstream in(testing::experiment_file("fit_sphere.json"));
+  json d = json::parse(in);
+  d["fit"]["targets"][0]["file"] = testing::data_target("sphere_final.obj").string();
+  d["expected"] = json::array();
+  return d;
+}
+
+TEST(CliSafety, ANameFromAFileNeverWritesOutsideTheOutputRoot) {
+  ScratchDir dir;
+  fs::create_directories(dir.path() / "victim");
+  std::ofstream(dir.path() / "victim" / "thesis.tex") << "years of work";
+  json config = json::parse(kSmall);
+  config["name"] = "../victim";
+  const auto file = dir.write("shared.json", config.dump());
+  const Outcome o = run_in(dir.path(), "run shared.json -q");
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("shared.json: name: expected a name of letters, digits"), std::string::npos)
+      << o.output;
+  EXPECT_EQ(read_file(dir.path() / "victim" / "thesis.tex"), "years of work");
+  EXPECT_FALSE(fs::exists(dir.path() / "out"));
+  // A good name goes to out/NAME; a file with no name takes its stem, made safe.
+  config.erase("name");
+  dir.write("my scan (2).json", config.dump());
+  const Outcome unnamed = run_in(dir.path(), "run 'my scan (2).json' -q");
+  EXPECT_EQ(unnamed.status, 0) << unnamed.output;
+  EXPECT_TRUE(fs::exists(dir.path() / "out" / "my_scan__2_" / "summary.json"));
+}
+
+TEST(CliSafety, AFolderFiberfluidDidNotWriteIsNeverReplacedAndTheRunNeverStarts) {
+  ScratchDir dir;
+  const fs::path data = dir.path() / "data";
+  fs::create_directories(data);
+  std::ofstream(data / "summary.json") << R"({"written by": "another tool"})";
+  std::ofstream(data / "scan_0001.ply") << "ply";
+  const auto file = dir.write("small.json", kSmall);
+  const Outcome o = run_cli("run " + file.string() + " -q -o " + data.string());
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find(data.string() + ": exists and was not written by fiberfluid"),
+            std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("results in"), std::string::npos) << o.output;  // refused before the run
+  EXPECT_TRUE(fs::exists(data / "scan_0001.ply"));
+  // The same for a fit, before its forward runs.
+  const Outcome fit = run_cli("fit " + dir.write("fit.json", fit_sphere().dump()).string() + " -o " + data.string());
+  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_EQ(fit.output.find("fit: iteration"), std::string::npos) << fit.output;
+}
+
+TEST(CliSafety, AnOutputPathWithATrailingSlashIsTheFolder) {
+  ScratchDir dir;
+  const auto file = dir.write("small.json", kSmall);
+  const Outcome o = run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_TRUE(fs::exists(dir.path() / "out" / "small" / "summary.json"));
+  // And again: the folder it wrote is replaced, nothing is left beside it.
+  EXPECT_EQ(run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/").status, 0);
+  for (const auto& entry : fs::directory_iterator(dir.path() / "out"))
+    EXPECT_EQ(entry.path().filename(), "small") << entry.path();
+}
+
+// A write past the file-size limit (a full disk behaves alike): a named
+// error, exit 1, the earlier result kept; never SIGXFSZ or an abort.
+TEST(CliSafety, AFailedWriteIsANamedErrorAndTheEarlierResultStays) {
+  ScratchDir dir;
+  json config = json::parse(kSmall);
+  config["variants"] = {{{"name", "a"}}, {{"name", "b"}}, {{"name", "c"}}};
+  const auto file = dir.write("sweep.json", config.dump());
+  const fs::path out = dir.path() / "out";
+  ASSERT_EQ(run_cli("run " + file.string() + " -q -o " + out.string()).status, 0);
+  const std::string earlier = read_file(out / "summary.json");
+  // 8 KiB a file: the marker fits, the .vtu files of the variants do not.
+  const Outcome o = run_in(dir.path(), "run sweep.json -q -j 2 -o out", "ulimit -f 8; ");
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("writing failed: File too large"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("terminate called"), std::string::npos) << o.output;
+  EXPECT_EQ(read_file(out / "summary.json"), earlier);
+  for (const auto& entry : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".running-"), std::string::npos) << entry.path();
+}
+
+TEST(CliSafety, FitOptionsThatCrashedAreNamedErrorsAndNothingIsWritten) {
+  ScratchDir dir;
+  const struct {
+    const char* what;
+    std::function<void(json&)> change;
+    const char* message;
+  } cases[] = {
+      {"difference_step 5", [](json& d) { d["fit"]["jacobian"] = "finite-differences"; d["fit"]["difference_step"] = 5; },
+       "fit.difference_step: expected a step in the fitted variable above 0 and at most 0.5"},
+      {"lower == upper", [](json& d) { d["fit"]["parameters"][0]["lower"] = 1000; d["fit"]["parameters"][0]["upper"] = 1000; },
+       "fit.parameters[0]: parameter \"Y\": expected a lower bound below the upper one"},
+      {"variant name of 300", [](json& d) { d.erase("fit"); d["variants"] = {{{"name", std::string(300, 'v')}}}; },
+       "variants[0].name: expected a name of at most 100 characters"},
+  };
+  for (const auto& c : cases) {
+    json d = fit_sphere();
+    c.change(d);
+    const auto file = dir.write("case.json", d.dump());
+    const Outcome o = run_cli(std::string(d.contains("fit") ? "fit " : "run ") + file.string() + " -o " +
+                              (dir.path() / "out").string());
+    EXPECT_EQ(o.status, 1) << c.what << "\n" << o.output;
+    EXPECT_NE(o.output.find(c.message), std::string::npos) << c.what << "\n" << o.output;
+    EXPECT_FALSE(fs::exists(dir.path() / "out")) << c.what;
+    EXPECT_FALSE(fs::exists(dir.path() / "out.failed")) << c.what;
+  }
+  // An experiment nested 100,000 deep (valid JSON, 200 KB): refused with a short message.
+  const auto deep = dir.write("deep.json", "{\"stepping\": {\"steps\": " + std::string(100000, '[') +
+                                               std::string(100000, ']') + "}}");
+  for (const char* command : {"run ", "fit "}) {
+    const Outcome o = run_cli(command + deep.string());
+    EXPECT_EQ(o.status, 1) << o.output.substr(0, 300);
+    EXPECT_NE(o.output.find("nested more than 64 levels deep"), std::string::npos) << o.output.substr(0, 300);
+    EXPECT_LT(o.output.size(), 400u);
+  }
+}
+
+// A fit whose parameters end on their bounds: converged, status 4, the
+// bounds named with the correlation that explains them; the folder has
+// every fit file.
+TEST(CliSafety, AFitOnItsBoundsSaysSoAndExitsWith4) {
+  ScratchDir dir;
+  json d = fit_sphere();
+  d["fit"]["parameters"][1]["lower"] = 3500;
+  const auto file = dir.write("bounds.json", d.dump());
+  const Outcome o = run_cli("fit " + file.string() + " -q -o " + (dir.path() / "out").string());
+  EXPECT_EQ(o.status, 4) << o.output;
+  for (const char* part : {"converged_at_bounds", "Y = 10 is on its lower bound (its correlation with gamma is",
+                           "Y = 10 (on its bound: no standard error", "warning: the fit converged on bounds"})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
+  const json report = json::parse(read_file(dir.path() / "out" / "fit.json"));
+  EXPECT_EQ(report["status"], "converged_at_bounds");
+  EXPECT_TRUE(report["parameters"][0]["at_bound"].get<bool>());
+  EXPECT_TRUE(report["parameters"][0]["standard_error"].is_null());
+  EXPECT_EQ(report["counts"]["model_vertices_counted"].get<int>(), report["distance"]["count"].get<int>());
+}
+
+// A fit that cannot see its parameters (no load) is "not identifiable", its
+// folder DIR.failed with every fit file, never "converged +- nan".
+TEST(CliSafety, AFitThatCannotSeeItsParametersFailsWithItsReasonAndKeepsItsFiles) {
+  ScratchDir dir;
+  json d = fit_sphere();
+  d["loads"][0]["acceleration"] = {0, 0, 0};
+  d["loads"][1]["force"] = {0, 0, 0};
+  const auto file = dir.write("still.json", d.dump());
+  const fs::path out = dir.path() / "out";
+  const Outcome o = run_cli("fit " + file.string() + " -q -o " + out.string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("not_identifiable"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("no distance changes with \"Y\""), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("+- nan"), std::string::npos) << o.output;
+  EXPECT_FALSE(fs::exists(out));
+  fs::path failed = out;
+  failed += ".failed";
+  EXPECT_NE(read_file(failed / "FAILED").find("not_identifiable"), std::string::npos);
+  EXPECT_EQ(json::parse(read_file(failed / "fit.json"))["status"], "not_identifiable");
+}
+
+// SIGINT during a fit: the best point so far is kept in DIR.interrupted, and
+// "start_from" continues from it.
+TEST(CliSafety, AnInterruptedFitKeepsItsBestPointAndCanBeContinued) {
+  ScratchDir dir;
+  json slow = fit_sphere();
+  slow["surface"]["subdivisions"] = 3;  // about 5 s per iteration: time to interrupt it
+  const auto file = dir.write("slow.json", slow.dump());
+  const fs::path out = dir.path() / "out", log = dir.path() / "fit.log";
+  const pid_t pid = testing::start_cli({"fit", file.string(), "-o", out.string()}, log);
+  for (int wait = 0; wait < 1200 && read_file(log).find("fit: iteration 0:") == std::string::npos; ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(read_file(log).find("fit: iteration 0:"), std::string::npos) << read_file(log);
+  kill(pid, SIGINT);
+  EXPECT_EQ(testing::wait_for(pid), 130) << read_file(log);
+  fs::path interrupted = out;
+  interrupted += ".interrupted";
+  ASSERT_TRUE(fs::exists(interrupted / "fit.json")) << read_file(log);
+  EXPECT_TRUE(fs::exists(interrupted / "INTERRUPTED"));
+  EXPECT_FALSE(fs::exists(out));
+  const json report = json::parse(read_file(interrupted / "fit.json"));
+  EXPECT_EQ(report["status"], "interrupted");
+  EXPECT_EQ(report["parameters"][0]["value"].get<double>(), 1000.0);  // the start: iteration 0's point
+  EXPECT_NE(read_file(log).find("start_from"), std::string::npos) << read_file(log);
+
+  // Continued (on the quicker mesh) from that point: it starts there and converges.
+  json next = fit_sphere();
+  next["fit"]["start_from"] = (interrupted / "fit.json").string();
+  next["fit"]["parameters"][0].erase("start");
+  const Outcome o = run_cli("fit " + dir.write("next.json", next.dump()).string() + " -o " + out.string());
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("Y = 1000, gamma = 9000"), std::string::npos) << o.output;
+  EXPECT_EQ(json::parse(read_file(out / "fit.json"))["status"], "converged");
+}
+
+}  // namespace
+}  // namespace fiberfluid
