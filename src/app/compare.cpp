@@ -18,6 +18,8 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
   c.approximation = approximation_label;
   c.undeformed = undeformed ? undeformed_label : "";
   c.dim = reference.dim;
+  metrics::require_representable(reference, reference_label);
+  metrics::require_representable(approximation, approximation_label);
   try {
     c.surface_error =
         metrics::surface_error(reference, approximation, reference_label, approximation_label);

@@ -22,6 +22,13 @@ double relative_energy_norm(const Eigen::MatrixXd& u_reference, const Eigen::Mat
 // the volume inside a 3D triangle mesh (signed: positive when outward).
 double enclosed_measure(const geom::Surface& surface);
 
+// Throws InputError naming `what`, the vertex and the axis unless every
+// coordinate is finite and at most 1e50 in magnitude (the exact Booleans
+// multiply up to six of them; distances square them), and the body's extent
+// keeps six digits of its distance from the origin. The metrics below check
+// their inputs with it.
+void require_representable(const geom::Surface& surface, const std::string& what);
+
 // |Int(A) xor Int(B)|, exactly: CGAL's 2D Boolean operations on polygons, or
 // its 3D corefinement (|A| + |B| - 2 |A and B|) on closed triangle meshes.
 // Throws InputError naming `what_a` / `what_b` when a surface does not bound

@@ -34,28 +34,6 @@ using CheckKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CheckMesh = CGAL::Surface_mesh<CheckKernel::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
-// The exact Booleans are given only what they and doubles can carry: finite
-// coordinates of magnitude at most 1e50 (their constructions multiply up to
-// six of them; beyond, CGAL's interval filters overflow), and a body whose
-// extent keeps at least six digits of its coordinates.
-void require_representable(const geom::Surface& s, const std::string& what) {
-  constexpr double kLargest = 1e50, kDigits = 1e-6 / 1.1e-16;
-  double largest = 0.0;
-  for (Eigen::Index i = 0; i < s.V.rows(); ++i)
-    for (Eigen::Index a = 0; a < s.V.cols(); ++a) {
-      const double x = s.V(i, a);
-      if (!std::isfinite(x) || std::abs(x) > kLargest)
-        throw InputError(what + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " +
-                         std::to_string(x) + ": expected a finite coordinate of magnitude at most "
-                         "1e50 (rescale the meshes, e.g. to m)");
-      largest = std::max(largest, std::abs(x));
-    }
-  const double extent = s.V.rows() > 0 ? (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).maxCoeff() : 0.0;
-  if (!(extent > 0.0) || largest / extent > kDigits)
-    throw InputError(what + ": the body (extent " + std::to_string(extent) + ") is too small for "
-                     "its distance from the origin (" + std::to_string(largest) + ") to keep six "
-                     "digits in doubles: move it nearer the origin");
-}
 
 // The 2D surface's segments as one closed loop, counterclockwise.
 Polygon polygon(const geom::Surface& s, const std::string& what) {
@@ -138,9 +116,17 @@ Mesh solid(const geom::Surface& s, const std::string& what) {
 // The enclosed volume, summed in doubles from the exactly placed vertices:
 // an exact sum of thousands of rational tetrahedra (PMP::volume on this
 // kernel) spends seconds on gcds for digits a double result drops anyway.
-// About `centre`, a point near the bodies: about the origin, the terms of a
-// body far from it cancel (geom::enclosed_volume does the same).
-double volume(const Mesh& mesh, const Eigen::Vector3d& centre) {
+// About the centre of the mesh's bounding box: about the origin, the terms
+// of a body far from it cancel (geom::enclosed_volume does the same).
+double volume(const Mesh& mesh) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(HUGE_VAL), high = -low;
+  for (const auto v : mesh.vertices()) {
+    const Kernel::Point_3& point = mesh.point(v);
+    const Eigen::Vector3d x(CGAL::to_double(point.x()), CGAL::to_double(point.y()), CGAL::to_double(point.z()));
+    low = low.cwiseMin(x);
+    high = high.cwiseMax(x);
+  }
+  const Eigen::Vector3d centre = 0.5 * (low + high);
   double sum = 0.0;
   for (const auto f : mesh.faces()) {
     Eigen::Vector3d corner[3];
@@ -158,16 +144,38 @@ double volume(const Mesh& mesh, const Eigen::Vector3d& centre) {
 double symmetric_difference_3d(const geom::Surface& a, const geom::Surface& b,
                                const std::string& what_a, const std::string& what_b) {
   Mesh p = solid(a, what_a), q = solid(b, what_b);
-  const Eigen::Vector3d centre = 0.5 * (a.V.colwise().minCoeff() + a.V.colwise().maxCoeff()).transpose();
-  const double volume_p = volume(p, centre), volume_q = volume(q, centre);
+  const double volume_p = volume(p), volume_q = volume(q);
   Mesh common;
   if (!PMP::corefine_and_compute_intersection(p, q, common))
     throw InputError("the intersection of " + what_a + " and " + what_b +
                      " is not a closed solid (CGAL corefinement)");
-  return volume_p + volume_q - 2.0 * volume(common, centre);
+  return volume_p + volume_q - 2.0 * volume(common);
 }
 
 }  // namespace
+
+// The exact Booleans are given only what they and doubles can carry: finite
+// coordinates of magnitude at most 1e50 (their constructions multiply up to
+// six of them; beyond, CGAL's interval filters overflow), and a body whose
+// extent keeps at least six digits of its coordinates.
+void require_representable(const geom::Surface& s, const std::string& what) {
+  constexpr double kLargest = 1e50, kDigits = 1e-6 / 1.1e-16;
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < s.V.rows(); ++i)
+    for (Eigen::Index a = 0; a < s.V.cols(); ++a) {
+      const double x = s.V(i, a);
+      if (!std::isfinite(x) || std::abs(x) > kLargest)
+        throw InputError(what + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " +
+                         std::to_string(x) + ": expected a finite coordinate of magnitude at most "
+                         "1e50 (rescale the meshes, e.g. to m)");
+      largest = std::max(largest, std::abs(x));
+    }
+  const double extent = s.V.rows() > 0 ? (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).maxCoeff() : 0.0;
+  if (!(extent > 0.0) || largest / extent > kDigits)
+    throw InputError(what + ": the body (extent " + std::to_string(extent) + ") is too small for "
+                     "its distance from the origin (" + std::to_string(largest) + ") to keep six "
+                     "digits in doubles: move it nearer the origin");
+}
 
 double symmetric_difference_measure(const geom::Surface& a, const geom::Surface& b,
                                     const std::string& what_a, const std::string& what_b) {

@@ -334,9 +334,12 @@ PYBIND11_MODULE(fiberfluid, m) {
         py::arg("max_iterations") = 50,
         "Fits the material (and optionally a rigid alignment) of a one-run experiment to measured "
         "surfaces. targets: a list of dicts with vertices (#P x 3), faces (#T x 3, omit for a point "
-        "cloud) and step (default: the last); parameters: dicts with name (Y0, beta, gamma, "
-        "factor_x, rotation_y, ...), and optionally start, lower, upper, log_scale. Returns a dict: "
-        "success, message, values, standard_errors, interval_95, correlation, cost_per_iteration, "
+        "cloud), step (default: the last) and scale (the vertices times it are in m); parameters: "
+        "dicts with name (Y0, beta, gamma, factor_x, rotation_y, scale, ...), and optionally start, "
+        "lower, upper, log_scale. Options are checked as a file's fit section is (ValueError naming "
+        "the option). Returns a dict: status (converged, converged_at_bounds, iteration_limit, "
+        "not_identifiable, forward_runs_failed, start_failed, interrupted), status_detail, "
+        "success, message, failed_runs, values, standard_errors, interval_95, correlation, cost_per_iteration, "
         "distance (mean, rms, standard_deviation, largest, share_of_length), forward_runs, "
         "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
 

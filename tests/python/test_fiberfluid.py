@@ -150,5 +150,37 @@ def test_a_fit_without_json():
     assert result["values"]["Y"] == pytest.approx(3000.0, rel=1e-6)
     assert result["values"]["gamma"] == pytest.approx(3000.0, rel=1e-6)
     assert result["distance"]["largest"] < 1e-8
+    assert result["status"] == "converged"
     with pytest.raises(ValueError, match="not a parameter"):
         fiberfluid.fit(start, targets=[{"vertices": truth["positions"]}], parameters=[{"name": "E"}])
+    # The options go through the same check as a file's (issue 30): no success at the start value.
+    with pytest.raises(ValueError, match="loss_scale: expected a positive finite length"):
+        fiberfluid.fit(start, targets=[{"vertices": truth["positions"]}], parameters=[{"name": "Y"}],
+                       loss="huber", loss_scale=0)
+    with pytest.raises(ValueError, match="method: expected levenberg-marquardt"):
+        fiberfluid.fit(start, targets=[{"vertices": truth["positions"]}], parameters=[{"name": "Y"}],
+                       method="newton")
+    with pytest.raises(ValueError, match="expected a lower bound below the upper one"):
+        fiberfluid.fit(start, targets=[{"vertices": truth["positions"]}],
+                       parameters=[{"name": "Y", "lower": 1000, "upper": 1000}])
+    # A scan in mm, scaled by its target's "scale".
+    scaled = fiberfluid.fit(start, targets=[{"vertices": 1000 * truth["positions"], "faces": mesh["faces"],
+                                             "scale": 1e-3}],
+                            parameters=[{"name": "Y"}, {"name": "gamma"}])
+    assert scaled["values"]["Y"] == pytest.approx(3000.0, rel=1e-6)
+
+
+def test_a_name_never_makes_a_path_outside_the_output_root(tmp_path):
+    with open(os.path.join(EXPERIMENTS, "rectangle.json")) as f:
+        document = json.load(f)
+    document["name"] = "../victim"
+    with pytest.raises(ValueError, match="name: expected a name of letters, digits"):
+        fiberfluid.Experiment.from_dict(document)
+    # A folder another tool wrote is never replaced, and the run never starts.
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "summary.json").write_text("{}")
+    document["name"] = "rectangle"
+    with pytest.raises(ValueError, match="was not written by fiberfluid"):
+        fiberfluid.Experiment.from_dict(document).run(output=str(data))
+    assert (data / "summary.json").read_text() == "{}"
