@@ -223,6 +223,15 @@ TEST(FitStatus, ALoadThatMovesNothingIsNotIdentifiable) {
   const nlohmann::json report = nlohmann::json::parse(in);
   EXPECT_EQ(report["status"], "not_identifiable");
   EXPECT_TRUE(report["parameters"][0]["standard_error"].is_null());
+
+  // The same class: a difference step too small to move a forward run.
+  nlohmann::json tiny = sphere_fit_document();
+  tiny["fit"]["jacobian"] = "finite-differences";
+  tiny["fit"]["difference_step"] = 1e-300;
+  const fit::FitResult t =
+      setup_fit(parse_experiment(tiny, testing::experiment_file("").parent_path(), "doc")).calibration->run();
+  EXPECT_EQ(t.status, fit::FitStatus::NotIdentifiable) << t.message;
+  EXPECT_NE(t.status_detail.find("no distance changes with \"Y\""), std::string::npos) << t.status_detail;
 }
 
 TEST(FitStatus, TheIterationLimitAndFailedRunsAreCountedByCause) {

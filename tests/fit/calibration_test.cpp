@@ -75,7 +75,8 @@ TEST(Calibration, JacobianMatchesFiniteDifferencesForEveryParameterKind) {
   const Calibration c(m, newton(2), targets,
                       {parameter("Y0", 2500.0), parameter("beta", 4.0, false),
                        parameter("gamma", 350.0), parameter("factor_x", 1.2),
-                       parameter("rotation_y", 0.02, false), parameter("translation_z", -0.01, false)},
+                       parameter("rotation_y", 0.02, false), parameter("translation_z", -0.01, false),
+                       parameter("scale", 1.03)},
                       options);
   EXPECT_TRUE(c.analytic_jacobian());
   const Eigen::VectorXd phi = c.parameters().initial_phi();
@@ -166,6 +167,24 @@ TEST(Calibration, EvaluationsAreKeptAndCounted) {
   EXPECT_EQ(cache.forward_runs, 3);
   cache.at(phi, false);  // still kept
   EXPECT_EQ(cache.forward_runs, 3);
+}
+
+// A scan of unsure units: a similarity T(q) = s q + t takes it back.
+TEST(Calibration, AlignmentRecoversAKnownScale) {
+  const model::Model m = hanging_sphere();
+  std::vector<MeasuredStep> targets = synthetic_targets(m, newton(1), {1});
+  const Eigen::RowVector3d shift(0.01, -0.02, 0.005);
+  for (Eigen::Index i = 0; i < targets[0].target.points.rows(); ++i)
+    targets[0].target.points.row(i) = targets[0].target.points.row(i) / 1.04 - shift;
+  const FitResult r = Calibration(m, newton(1), targets,
+                                  {parameter("scale", 1.0), parameter("translation_x", 0.0, false),
+                                   parameter("translation_y", 0.0, false),
+                                   parameter("translation_z", 0.0, false)})
+                          .run();
+  ASSERT_EQ(r.status, FitStatus::Converged) << r.message << " " << r.status_detail;
+  EXPECT_NEAR(r.values[0], 1.04, 1e-8);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(r.values[1 + a], 1.04 * shift[a], 1e-8);
+  EXPECT_LT(r.overall.largest, 1e-9);
 }
 
 TEST(Calibration, AlignmentRecoversAKnownRigidMotion) {
