@@ -96,6 +96,12 @@ void read_experiment(const uint8_t* data, size_t size) {
   }
 }
 
+// Small budgets while one input runs (the replay test shares the process).
+struct SmallBudgets {
+  SmallBudgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.02); }
+  ~SmallBudgets() { set_memory_budget(0.0), set_time_budget(0.0); }
+};
+
 // A model is built and run only when its estimate is small (0.02 s in Release,
 // a second or so in this instrumented build): the fuzzer looks for wrong
 // answers and crashes, not for long runs, which the estimate refuses before
@@ -103,10 +109,7 @@ void read_experiment(const uint8_t* data, size_t size) {
 void build_and_run(const uint8_t* data, size_t size) {
   const std::optional<nlohmann::json> document = parse_json(data, size);
   if (!document) return;
-  struct Budgets {  // small while this input runs (the replay test shares the process)
-    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.02); }
-    ~Budgets() { set_memory_budget(0.0), set_time_budget(0.0); }
-  } budgets;  // the estimate refuses longer cases before pruning
+  const SmallBudgets budgets;  // the estimate refuses longer cases before pruning
   try {
     app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
     if (ex.kind != app::Experiment::Kind::Simulate || ex.specs.size() > 4) return;
@@ -136,10 +139,7 @@ void build_and_run(const uint8_t* data, size_t size) {
 void set_up_fit(const uint8_t* data, size_t size) {
   const std::optional<nlohmann::json> document = parse_json(data, size);
   if (!document) return;
-  struct Budgets {
-    Budgets() { set_memory_budget(256.0 * 1024 * 1024), set_time_budget(0.02); }
-    ~Budgets() { set_memory_budget(0.0), set_time_budget(0.0); }
-  } budgets;
+  const SmallBudgets budgets;
   try {
     app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
     check_output_name(ex.name);
