@@ -325,9 +325,15 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   for (const auto& t : setup.targets)
     std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
               << "\n";
+  const int counted = setup.calibration->num_counted_vertices();
+  const int forward = counted * static_cast<int>(setup.targets.size());
   std::cout << "fitting " << setup.calibration->parameters().size() << " parameters to "
-            << setup.calibration->num_residuals() << " distances ("
-            << fit::to_string(ex.fit->options.method) << ", "
+            << setup.calibration->num_residuals() << " distances (" << counted
+            << " model vertices to each of " << setup.targets.size() << " target(s)";
+  if (setup.calibration->num_residuals() > forward)
+    std::cout << ", and " << setup.calibration->num_residuals() - forward
+              << " target points to the simulated surface";
+  std::cout << "; " << fit::to_string(ex.fit->options.method) << ", "
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
             << ")\n";
   const fit::FitResult fitted = setup.calibration->run();

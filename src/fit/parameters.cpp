@@ -87,8 +87,8 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
                        "(expected one of " + list + ", rotation_x..z, translation_x..z)");
     }
     if (!std::isfinite(p.initial)) throw InputError(who + ": the start is not finite");
-    if (std::isnan(p.lower) || std::isnan(p.upper) || std::isinf(p.lower) && p.lower > 0 ||
-        std::isinf(p.upper) && p.upper < 0)
+    if (std::isnan(p.lower) || std::isnan(p.upper) || (std::isinf(p.lower) && p.lower > 0) ||
+        (std::isinf(p.upper) && p.upper < 0))
       throw InputError(who + ": expected numbers for the bounds, got [" + number(p.lower) + ", " +
                        number(p.upper) + "]");
     if (!(p.lower < p.upper))
