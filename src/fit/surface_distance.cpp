@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "fit/target.hpp"
+#include "geom/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -95,9 +96,17 @@ std::vector<TargetDistance::Closest> TargetDistance::closest(const Eigen::Matrix
   std::vector<Closest> out(static_cast<size_t>(queries.rows()));
   // The trees are read-only once built (the AABB tree's distance accelerator
   // is built in the constructor), so queries may run in parallel.
+  ThreadFailure failure;
 #pragma omp parallel for schedule(static)
-  for (Eigen::Index i = 0; i < queries.rows(); ++i)
-    out[static_cast<size_t>(i)] = closest(Eigen::Vector3d(queries.row(i).transpose()));
+  for (Eigen::Index i = 0; i < queries.rows(); ++i) {
+    if (failure.happened()) continue;
+    try {
+      out[static_cast<size_t>(i)] = closest(Eigen::Vector3d(queries.row(i).transpose()));
+    } catch (...) {
+      failure.capture();
+    }
+  }
+  failure.rethrow_if_any();
   return out;
 }
 

@@ -238,35 +238,49 @@ PruningResult prune_3d(const Surface& s) {
   const double pairs = 0.5 * n * (n - 1.0);
   std::atomic<long long> pairs_done{0};
   report_progress("pruning", 0.0, pairs);
+  ThreadFailure failure;
 #pragma omp parallel reduction(+ : fallbacks, clear, filtered)
   {
-    const ExactSolid exact(s);
+    // Every thread reaches the loop (its barrier waits for all), failed or not.
+    std::optional<ExactSolid> solid;
+    try {
+      solid.emplace(s);
+    } catch (...) {
+      failure.capture();
+    }
     std::vector<int> faces;
 #pragma omp for schedule(dynamic, 4)
     for (int i = 0; i < n; ++i) {
-      if (cancel_requested()) continue;  // no break out of an OpenMP loop: the rest is skipped
-      for (int j = i + 1; j < n; ++j) {
-        bool keep = true;
-        const SegmentVerdict verdict = filter.classify(i, j);
-        filtered += verdict != SegmentVerdict::Clear && verdict != SegmentVerdict::Unsure;
-        switch (verdict) {
-          case SegmentVerdict::Crosses:
-          case SegmentVerdict::Outside: keep = false; break;
-          case SegmentVerdict::Inside: break;
-          case SegmentVerdict::Clear:  // the open segment is wholly inside or outside
-            ++clear;
-            keep = !exact.outside(CGAL::midpoint(exact_point(s.V, i), exact_point(s.V, j)));
-            break;
-          case SegmentVerdict::Unsure:
-            keep = keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks);
-            break;
+      // No break out of an OpenMP loop: the rest is skipped.
+      if (cancel_requested() || failure.happened() || !solid) continue;
+      const ExactSolid& exact = *solid;
+      try {
+        for (int j = i + 1; j < n; ++j) {
+          bool keep = true;
+          const SegmentVerdict verdict = filter.classify(i, j);
+          filtered += verdict != SegmentVerdict::Clear && verdict != SegmentVerdict::Unsure;
+          switch (verdict) {
+            case SegmentVerdict::Crosses:
+            case SegmentVerdict::Outside: keep = false; break;
+            case SegmentVerdict::Inside: break;
+            case SegmentVerdict::Clear:  // the open segment is wholly inside or outside
+              ++clear;
+              keep = !exact.outside(CGAL::midpoint(exact_point(s.V, i), exact_point(s.V, j)));
+              break;
+            case SegmentVerdict::Unsure:
+              keep = keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks);
+              break;
+          }
+          if (!keep) result.mask.prune(i, j);
         }
-        if (!keep) result.mask.prune(i, j);
+      } catch (...) {
+        failure.capture();
       }
       const long long done = pairs_done += n - 1 - i;
       if (omp_get_thread_num() == 0) report_progress("pruning", static_cast<double>(done), pairs);
     }
   }
+  failure.rethrow_if_any();
   throw_if_cancelled("the fiber pruning");
   report_progress("pruning", pairs, pairs);
   result.exact_fallbacks = fallbacks + clear;

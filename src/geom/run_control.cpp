@@ -86,4 +86,14 @@ void advise_huge_pages(void* data, double bytes) {
 #endif
 }
 
+void ThreadFailure::capture() noexcept {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!first_) first_ = std::current_exception();
+  happened_ = true;
+}
+
+void ThreadFailure::rethrow_if_any() const {
+  if (first_) std::rethrow_exception(first_);
+}
+
 }  // namespace fiberfluid

@@ -4,6 +4,9 @@
 // the application sets them, long loops and the memory checks read them.
 #pragma once
 
+#include <atomic>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -56,5 +59,23 @@ class Interrupted : public std::runtime_error {
 };
 // Throws Interrupted("interrupted during WHAT") when a stop was requested.
 void throw_if_cancelled(const std::string& what);
+
+// ---------------------------------------------------------------- threads
+// An exception thrown inside an OpenMP region ends the process
+// (std::terminate). Loops whose bodies can throw (CGAL's exact arithmetic
+// allocates) catch into one of these, skip the rest, and rethrow the first
+// after the region: the caller sees it as from a serial loop.
+class ThreadFailure {
+ public:
+  // Call from a catch block: keeps the first exception of any thread.
+  void capture() noexcept;
+  bool happened() const noexcept { return happened_.load(std::memory_order_relaxed); }
+  void rethrow_if_any() const;
+
+ private:
+  std::atomic<bool> happened_{false};
+  std::mutex mutex_;
+  std::exception_ptr first_;
+};
 
 }  // namespace fiberfluid
