@@ -17,6 +17,7 @@
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "geom/error.hpp"
+#include "geom/run_control.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::app {
@@ -209,6 +210,26 @@ TEST(Runner, AnExceptionInAWorkerReachesTheCaller) {
                    },
                    options),
                std::runtime_error);
+}
+
+TEST(Threads, AnExceptionInAnOpenMPLoopIsRethrownAfterIt) {
+  ThreadFailure failure;
+  std::atomic<int> ran{0};
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int i = 0; i < 1000; ++i) {
+    if (failure.happened()) continue;
+    try {
+      ++ran;
+      if (i == 7) throw InputError("item 7 failed");
+    } catch (...) {
+      failure.capture();
+    }
+  }
+  EXPECT_TRUE(failure.happened());
+  EXPECT_LT(ran.load(), 1000);  // the rest was skipped
+  EXPECT_EQ(error_of([&] { failure.rethrow_if_any(); }), "item 7 failed");
+  ThreadFailure none;
+  EXPECT_NO_THROW(none.rethrow_if_any());
 }
 
 }  // namespace
