@@ -720,7 +720,10 @@ json parse_json_from(Input&& input, const std::string& label) {
     throw InputError(label + ": nested more than " + std::to_string(kDeepestJson) +
                      " levels deep (an experiment needs a few)");
   } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
-    throw InputError(label + ": not valid JSON: " + e.what());
+    // The parser quotes the token it last read, which may be a whole line: cut it short.
+    std::string what = e.what();
+    if (what.size() > 200) what = what.substr(0, 200) + "...";
+    throw InputError(label + ": not valid JSON: " + what);
   }
 }
 
