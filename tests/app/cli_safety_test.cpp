@@ -192,6 +192,29 @@ TEST(CliSafety, AFitThatCannotSeeItsParametersFailsWithItsReasonAndKeepsItsFiles
   EXPECT_EQ(json::parse(read_file(failed / "fit.json"))["status"], "not_identifiable");
 }
 
+// The crash of difference_step 5, at its root: a central-difference run
+// that fails (here at the start, a step of 0.5 in log Y) stops Ceres; the
+// fit says so with the run's own message and writes every file (fit.json
+// read the missing standard errors, SIGSEGV).
+TEST(CliSafety, AFailedDifferenceRunEndsTheFitWithItsCause) {
+  ScratchDir dir;
+  json d = fit_sphere();
+  d["fit"]["difference_step"] = 0.5;
+  const fs::path out = dir.path() / "out";
+  const Outcome o = run_cli("fit " + dir.write("steep.json", d.dump()).string() + " -q -o " + out.string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  for (const char* part : {"forward_runs_failed", "a finite-difference run failed: step 2: runaway",
+                           "failed forward runs: 1 x a finite-difference run failed: step #: runaway",
+                           "first failure at Y = 1000, gamma = 9000"})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
+  fs::path failed = out;
+  failed += ".failed";
+  const json report = json::parse(read_file(failed / "fit.json"));
+  EXPECT_EQ(report["status"], "forward_runs_failed");
+  EXPECT_NEAR(report["failed_run_examples"][0]["values"]["Y"].get<double>(), 1000.0, 1e-9);
+  EXPECT_TRUE(report["parameters"][0]["standard_error"].is_null());
+}
+
 // SIGINT during a fit: the best point so far is kept in DIR.interrupted, and
 // "start_from" continues from it.
 TEST(CliSafety, AnInterruptedFitKeepsItsBestPointAndCanBeContinued) {
