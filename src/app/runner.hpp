@@ -68,7 +68,7 @@ Eigen::MatrixXd input_positions(const Case& c, const Eigen::VectorXd& unknowns);
 //   max_displacement, final_pressure, final_volume, initial_volume,
 //   volume_change_relative, mean_displacement_over_diagonal (the paper's
 //   Eq. 9), surface_area, steps, factorizations, newton_iterations,
-//   max_newton_iterations_per_step, step_cuts, max_final_relative_residual,
+//   max_newton_iterations_per_step, step_cuts, max_equilibrium_residual,
 //   paddle_force.LABEL (along its axis, on the body), paddle_contacts.LABEL,
 //   position.I.x / displacement.I.y (I an input vertex index).
 std::optional<double> run_figure(const Case& c, const RunResult& run, const std::string& name);

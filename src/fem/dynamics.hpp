@@ -8,8 +8,10 @@
 //  - ImplicitNewmark: b = g = 1/2 (the paper's reference; average acceleration);
 //  - ExplicitConsistent: b = 0, g = 1/2 with the consistent mass (a solve
 //    with M + h C / 2 per step);
-//  - ExplicitLumped: b = 0, g = 1/2 with the lumped mass and a diagonal
-//    damping alpha M_L + beta diag(K): no linear solve;
+//  - ExplicitLumped: b = 0, g = 1/2 with the lumped mass: no linear solve.
+//    Its damping alpha M_L + beta K uses the full K: the mass-proportional
+//    part acts at the new velocity, the stiffness-proportional part at the
+//    predicted one (explicitly, a product with K);
 //  - ImplicitLumped: b = g = 1/2 with the lumped mass;
 //  - QuasiStatic: K u+ = f+, no history.
 // Prescribed unknowns follow a given path u_h(t); their accelerations are

@@ -43,9 +43,11 @@ double surface_error(const geom::Surface& reference, const geom::Surface& approx
                      const std::string& what_approximation = "the approximation");
 
 // Each node's share of the body's measure for E_i. For a surface-only model
-// (no interior nodes) the share of the boundary: a third of the area of the
-// triangles around a vertex (3D), half the length of the edges at a vertex
-// (2D): |S_i| of benchmarks.md.
+// (no interior nodes) the share of the boundary: |S_i|, the magnitude of the
+// model's normalised area vector (model.md: the summed area vectors of the
+// faces at vertex i, scaled by C so that sum |S_i| is the surface's area).
+// Where the surface curves this differs from a third of the areas around
+// the vertex (3D) or half the lengths of its edges (2D).
 Eigen::VectorXd boundary_node_measures(const geom::Surface& surface);
 
 // E_i = sum_i w_i |p_i - p'_i| / |Int(M0)|^(1/d): the integral over M0 of the

@@ -123,11 +123,13 @@ void FiberLaw::evaluate(const double* strain, size_t n, double* Y, double* Yp) c
         Yp[k] = b_ * Y[k];
       }
       return;
-    default:
+    case Kind::Bilinear:
+    case Kind::Tabulated:  // named, so that a new kind is a -Wswitch warning here
       for (size_t k = 0; k < n; ++k) {
         Y[k] = modulus(strain[k]);
         Yp[k] = slope(strain[k]);
       }
+      return;
   }
 }
 
