@@ -158,7 +158,7 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
   if (!law.is_constant()) {
     double* strain = scratch[5].data();
 #pragma omp simd
-    for (size_t j = 0; j < n; ++j) strain[j] = r[j] / L[j] - 1.0;
+    for (size_t j = 0; j < n; ++j) strain[j] = fiber_strain(r[j], L[j]);
   }
   law.evaluate(scratch[5].data(), n, Y, Yp);
   const double* area = area0_.data();
@@ -429,7 +429,8 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
     int axis = -1;  // factor_x: the fiber force of that axis over its factor
     if (name.rfind("factor_", 0) == 0 && name.size() == 8) axis = name[7] - 'x';
     if (axis >= dim) axis = -1;
-    if (axis < 0) law.modulus_derivative(name, 0.0);  // throws for an unknown name
+    // The law's parameter, resolved once (throws for an unknown name), not per pair.
+    const int parameter = axis < 0 ? law.parameter_index(name) : -1;
     const Columns columns(model_.surface.V, X, U);
     parallel_rows(columns, [&](int i, const std::vector<double>* scratch, const double* force) {
       if (axis >= 0) {  // bulk_row's force is sum_j a Y d, before the factors
@@ -443,7 +444,7 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
       for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
         if (h[j] == 0.0) continue;
         const double a = bulk_weight(h[j], area0_[i], area0_[static_cast<Eigen::Index>(j)], L[j]);
-        const double dY = law.modulus_derivative(name, r[j] / L[j] - 1.0);
+        const double dY = law.modulus_derivative(parameter, fiber_strain(r[j], L[j]));
         for (int c = 0; c < 3; ++c) sum[c] += a * dY * (columns.u[c][u] - columns.u[c][j]);
       }
       for (int a = 0; a < dim; ++a) D(a * n + i, column) = m[a] * sum[a];

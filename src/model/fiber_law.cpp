@@ -146,26 +146,28 @@ const std::vector<std::string>& FiberLaw::parameter_names() const {
 }
 
 double FiberLaw::parameter(const std::string& name) const {
-  const auto& names = parameter_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end())
-    throw std::invalid_argument("the " + std::string(this->name()) + " law has no parameter '" +
-                                name + "'");
-  return it == names.begin() ? a_ : b_;
+  return parameter_index(name) == 0 ? a_ : b_;
 }
 
 void FiberLaw::set_parameter(const std::string& name, double value) {
+  (parameter_index(name) == 0 ? a_ : b_) = value;
+}
+
+int FiberLaw::parameter_index(const std::string& name) const {
   const auto& names = parameter_names();
   const auto it = std::find(names.begin(), names.end(), name);
   if (it == names.end())
     throw std::invalid_argument("the " + std::string(this->name()) + " law has no parameter '" +
                                 name + "'");
-  (it == names.begin() ? a_ : b_) = value;
+  return static_cast<int>(it - names.begin());
 }
 
 double FiberLaw::modulus_derivative(const std::string& name, double e) const {
-  const bool first = parameter_names().front() == name;
-  if (!first) parameter(name);  // throws for an unknown name
+  return modulus_derivative(parameter_index(name), e);
+}
+
+double FiberLaw::modulus_derivative(int index, double e) const {
+  const bool first = index == 0;
   switch (kind_) {
     case Kind::Constant: return 1.0;
     case Kind::Exponential: return first ? std::exp(b_ * e) : a_ * e * std::exp(b_ * e);

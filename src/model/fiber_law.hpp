@@ -47,6 +47,11 @@ class FiberLaw {
   void set_parameter(const std::string& name, double value);
   // dY/dtheta at a strain, for the parameter `name`.
   double modulus_derivative(const std::string& name, double strain) const;
+  // The position of a parameter among parameter_names() (throws
+  // std::invalid_argument for an unknown name), and dY/dtheta by that
+  // position: resolved once, outside the pair loops.
+  int parameter_index(const std::string& name) const;
+  double modulus_derivative(int index, double strain) const;
 
   // "" when the law is usable, else why not (naming the parameter): a
   // non-positive or non-finite modulus at a strain in [lowest, highest], a

@@ -103,7 +103,7 @@ void FiberSystem::pair_row(int i, double* row) const {
   for (int j = 0; j < n_; ++j) {
     if (row[j] == 0.0) continue;
     const double length = (reference_.row(i) - reference_.row(j)).norm();
-    const double strain = (strained_.row(i) - strained_.row(j)).norm() / length - 1.0;
+    const double strain = fiber_strain((strained_.row(i) - strained_.row(j)).norm(), length);
     row[j] *= law_->modulus(strain);
   }
 }

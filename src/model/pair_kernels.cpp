@@ -175,7 +175,7 @@ void lengths_row(const DeformedRow& d, int i, int j0, int first, int end, double
     const double current = std::sqrt(b0 * b0 + b1 * b1 + b2 * b2);
     L[j - j0] = length;
     r[j - j0] = current;
-    e[j - j0] = current / length - 1.0;
+    e[j - j0] = fiber_strain(current, length);
   }
 }
 
@@ -277,7 +277,7 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
     for (int q = 0; q < t.nj; ++q) {
       const double length = (reference_->row(vi) - reference_->row(vj[q])).norm();
       strain[static_cast<size_t>(q)] =
-          vj[q] == vi ? 0.0 : (strained_->row(vi) - strained_->row(vj[q])).norm() / length - 1.0;
+          vj[q] == vi ? 0.0 : fiber_strain((strained_->row(vi) - strained_->row(vj[q])).norm(), length);
     }
     law_->evaluate(strain.data(), static_cast<size_t>(t.nj), modulus.data(), slope.data());
     for (int q = 0; q < t.nj; ++q)

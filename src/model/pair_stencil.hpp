@@ -20,6 +20,11 @@ inline double surface_weight(double area_i, double area_k, double length_squared
   return (area_i + area_k) / (2.0 * length_squared);
 }
 
+// A fiber's strain from its current and reference lengths: e = r / L - 1.
+// Every pair loop takes the strain from here (the secant modulus Y(e), the
+// tangent's slope Y'(e), a law parameter's derivative dY/dtheta(e)).
+inline double fiber_strain(double current, double length) { return current / length - 1.0; }
+
 // A bulk fiber (i, j) at a deformed state (model.md section 7). With
 // d = u_i - u_j, b = x_i - x_j, r = |b|, e = r / L - 1, the force on i along
 // axis a (m_a: the axis factor) is
