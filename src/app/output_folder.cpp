@@ -75,7 +75,13 @@ std::string replace_problem(const fs::path& folder) {
     return "is a symbolic link (give the folder it points to, or another one, with -o)";
   if (!fs::is_directory(status)) return "exists and is not a folder";
   if (fs::is_empty(folder, error) || has_marker(folder)) return "";
-  return "exists and was not written by fiberfluid (it has no " + std::string(kOutputMarker) +
+  const std::string marker = std::string(kOutputMarker);
+  std::ifstream summary(folder / "summary.json");
+  const nlohmann::json old = nlohmann::json::parse(summary, nullptr, /*allow_exceptions=*/false);
+  if (old.is_object() && old.contains("fiberfluid_version"))  // before the marker existed
+    return "holds results of an older fiberfluid (it has no " + marker + "), and only folders "
+           "with it are replaced: remove it by hand, or choose another output folder with -o";
+  return "exists and was not written by fiberfluid (it has no " + marker +
          "), so it is never replaced; choose another output folder with -o";
 }
 

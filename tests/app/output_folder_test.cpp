@@ -92,6 +92,12 @@ TEST(OutputFolder, OnlyFoldersFiberfluidWroteAreReplaced) {
   std::ofstream(data / "scan.obj") << "v 0 0 0\n";
   EXPECT_NE(error_of([&] { check_replaceable(data); }).find("data: exists and was not written by fiberfluid"),
             std::string::npos);
+  // An older fiberfluid's folder (before the marker) is named as such, and kept.
+  const fs::path old = dir.path() / "old";
+  fs::create_directories(old);
+  std::ofstream(old / "summary.json") << R"({"fiberfluid_version": "0.1.0"})";
+  EXPECT_NE(error_of([&] { check_replaceable(old); }).find("holds results of an older fiberfluid"),
+            std::string::npos);
   // A marker of another format does not count either.
   std::ofstream(data / kOutputMarker) << R"({"format": "something-else", "version": 1})";
   EXPECT_THROW(check_replaceable(data), InputError);
