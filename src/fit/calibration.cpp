@@ -439,23 +439,26 @@ std::string failure_cause(const std::string& message) {
 
 }  // namespace
 
-const Evaluation* EvaluationCache::kept(const Eigen::VectorXd& phi, bool with_jacobian) const {
-  for (const Entry& entry : kept_) {
-    if (entry.phi.size() != phi.size() || entry.phi != phi) continue;
-    if (with_jacobian && !entry.has_jacobian) continue;
+std::deque<EvaluationCache::Entry>::const_iterator EvaluationCache::find(const Eigen::VectorXd& phi,
+                                                                         bool with_jacobian) const {
+  return std::find_if(kept_.begin(), kept_.end(), [&](const Entry& entry) {
+    if (entry.phi.size() != phi.size() || entry.phi != phi) return false;
+    if (with_jacobian) return entry.has_jacobian;
     // A point whose finite-difference runs failed still has valid residuals
     // in its Jacobian-free entry: a failed Jacobian must not hide them.
-    if (!with_jacobian && entry.has_jacobian && !entry.evaluation.ok) continue;
-    return &entry.evaluation;
-  }
-  return nullptr;
+    return !entry.has_jacobian || entry.evaluation.ok;
+  });
+}
+
+const Evaluation* EvaluationCache::kept(const Eigen::VectorXd& phi, bool with_jacobian) const {
+  const auto entry = find(phi, with_jacobian);
+  return entry == kept_.end() ? nullptr : &entry->evaluation;
 }
 
 const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jacobian) {
-  if (const Evaluation* found = kept(phi, with_jacobian)) {
-    const auto entry = std::find_if(kept_.begin(), kept_.end(),
-                                    [&](const Entry& e) { return &e.evaluation == found; });
-    if (entry != kept_.begin()) std::rotate(kept_.begin(), entry, std::next(entry));
+  if (const auto entry = find(phi, with_jacobian); entry != kept_.end()) {
+    const auto position = kept_.begin() + (entry - kept_.cbegin());
+    if (position != kept_.begin()) std::rotate(kept_.begin(), position, std::next(position));
     return kept_.front().evaluation;
   }
   Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian)};
