@@ -78,9 +78,7 @@ int fit_exit_status(fit::FitStatus status) {
   return 2;
 }
 
-bool fit_result_kept(fit::FitStatus status) {
-  return status == fit::FitStatus::Converged || status == fit::FitStatus::ConvergedAtBounds;
-}
+bool fit_result_kept(fit::FitStatus status) { return fit::converged(status); }
 
 FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::IterationRecord&)> progress) {
   if (!ex.fit) throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");

@@ -541,7 +541,7 @@ FitResult Calibration::run() const {
   EvaluationCache evaluations(*this);
   auto finish = [&](FitStatus status, std::string message) {
     result.status = status;
-    result.success = status == FitStatus::Converged || status == FitStatus::ConvergedAtBounds;
+    result.success = converged(status);
     if (!message.empty()) result.message = std::move(message);
     result.forward_runs = evaluations.forward_runs;
     result.sensitivity_solves = evaluations.sensitivity_solves;

@@ -56,6 +56,10 @@ enum class FitStatus {
 };
 // "converged", "converged_at_bounds", "iteration_limit", ... as in fit.json.
 const char* to_string(FitStatus status);
+// Converged or ConvergedAtBounds: the optimiser converged (FitResult::success).
+inline bool converged(FitStatus status) {
+  return status == FitStatus::Converged || status == FitStatus::ConvergedAtBounds;
+}
 
 // A forward run that failed during a fit: where, and why.
 struct FailedRun {
