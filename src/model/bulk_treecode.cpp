@@ -3,6 +3,8 @@
 
 #include <stdexcept>
 
+#include "model/pair_stencil.hpp"
+
 namespace fiberfluid::model {
 
 namespace {
@@ -31,13 +33,13 @@ BulkTreecode::BulkTreecode(const Eigen::MatrixXd& X, const Eigen::VectorXd& area
         "the treecode product needs one connection count for all fibers (no pruning, or the "
         "global count)");
   const std::vector<double> counts = factors.vertex_counts();
-  h_ = counts.empty() ? 0.0 : 0.5 / counts.front();
+  h_ = counts.empty() ? 0.0 : connection_factor(1.0, counts.front(), counts.front());
   if (const geom::FiberMask* mask = factors.mask())
     for (int i = 0; i < mask->num_vertices(); ++i) {
       const uint8_t* kept = mask->row(i);
       for (int j = i + 1; j < mask->num_vertices(); ++j)
         if (kept[j] == 0)
-          pruned_.push_back({i, j, h_ * (area[i] + area[j]) / (X.row(i) - X.row(j)).norm()});
+          pruned_.push_back({i, j, bulk_weight(h_, area[i], area[j], (X.row(i) - X.row(j)).norm())});
     }
   Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(X.rows(), 1);
   row_sums_ = weighted_sums(ones).col(0);

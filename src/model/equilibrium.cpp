@@ -41,21 +41,6 @@ Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::Matr
   return k == 1 ? m : Eigen::Matrix3d(-m);
 }
 
-Eigen::SparseMatrix<double> reference_surface_laplacian(const Model& model,
-                                                        const Eigen::VectorXd& area) {
-  const Eigen::MatrixXi edges = geom::unique_edges(model.surface);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
-    const int i = edges(e, 0), k = edges(e, 1);
-    const double w = surface_weight(area[i], area[k],
-                                    (model.surface.V.row(i) - model.surface.V.row(k)).squaredNorm());
-    entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
-  }
-  Eigen::SparseMatrix<double> L(model.num_vertices(), model.num_vertices());
-  L.setFromTriplets(entries.begin(), entries.end());
-  return L;
-}
-
 }  // namespace
 
 struct Equilibrium::Hydrostatics {
@@ -86,7 +71,7 @@ Equilibrium::Equilibrium(const Model& model)
       throw InputError("vertices " + std::to_string(std::min(order[k - 1], order[k])) + " and " +
                        std::to_string(std::max(order[k - 1], order[k])) +
                        " coincide: the fiber between them has zero length");
-  surface_ = reference_surface_laplacian(model, area0_);
+  surface_ = surface_tension_laplacian(V, area0_, geom::unique_edges(model.surface));
   for (const Load& load : model.loads) {
     double level = 0.0;
     const double magnitude = load.acceleration.norm();
@@ -135,8 +120,7 @@ struct Equilibrium::Columns {
   }
 };
 
-void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch,
-                           double force[3]) const {
+void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch) const {
   const size_t n = static_cast<size_t>(model_.num_vertices()), u = static_cast<size_t>(i);
   double* h = scratch[0].data();   // h_ij
   double* L = scratch[1].data();   // reference lengths
@@ -151,8 +135,8 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
     // j == i: h = 0 makes the pair vanish; lengths 1 there only avoid 0/0.
     const double a0 = s0[u] - s0[j], a1 = s1[u] - s1[j], a2 = s2[u] - s2[j];
     const double b0 = x0[u] - x0[j], b1 = x1[u] - x1[j], b2 = x2[u] - x2[j];
-    L[j] = j == u ? 1.0 : std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
-    r[j] = j == u ? 1.0 : std::sqrt(b0 * b0 + b1 * b1 + b2 * b2);
+    L[j] = j == u ? 1.0 : pair_length(a0, a1, a2);
+    r[j] = j == u ? 1.0 : pair_length(b0, b1, b2);
   }
   const FiberLaw& law = model_.material.law;
   if (!law.is_constant()) {
@@ -161,21 +145,10 @@ void Equilibrium::bulk_row(int i, const Columns& c, std::vector<double>* scratch
     for (size_t j = 0; j < n; ++j) strain[j] = fiber_strain(r[j], L[j]);
   }
   law.evaluate(scratch[5].data(), n, Y, Yp);
-  const double* area = area0_.data();
-  const double *u0 = c.u[0], *u1 = c.u[1], *u2 = c.u[2];
-  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
-#pragma omp simd reduction(+ : f0, f1, f2)
-  for (size_t j = 0; j < n; ++j) {
-    const double aY = modulus_coefficient(bulk_weight(h[j], area[u], area[j], L[j]), Y[j]);
-    f0 += aY * (u0[u] - u0[j]);
-    f1 += aY * (u1[u] - u1[j]);
-    f2 += aY * (u2[u] - u2[j]);
-  }
-  force[0] = f0, force[1] = f1, force[2] = f2;
 }
 
 // Runs bulk_row over every row on the OpenMP threads, each with its own
-// scratch arrays, and hands visit(i, scratch, force) the results.
+// scratch arrays, and hands visit(i, scratch) the results.
 template <class Visit>
 void Equilibrium::parallel_rows(const Columns& columns, Visit&& visit) const {
   const int n = model_.num_vertices();
@@ -185,15 +158,15 @@ void Equilibrium::parallel_rows(const Columns& columns, Visit&& visit) const {
     for (auto& v : scratch) v.resize(static_cast<size_t>(n));
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      double force[3];
-      bulk_row(i, columns, scratch, force);
-      visit(i, scratch, force);
+      bulk_row(i, columns, scratch);
+      visit(i, scratch);
     }
   }
 }
 
 DeformedPairs Equilibrium::bulk_pairs(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const {
-  return DeformedPairs(model_.surface.V, X, U, area0_, factors_, model_.material.law);
+  return DeformedPairs(model_.surface.V, X, U, area0_, factors_, model_.material.law,
+                       model_.material.kinematics);
 }
 
 Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
@@ -248,38 +221,38 @@ Eigen::MatrixXd Equilibrium::tangent(const Eigen::VectorXd& x,
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(num_unknowns(), num_unknowns());
   // Bulk blocks, column by column (the pair coefficients are symmetric, so
   // column j of the stored arrays runs over i): for j != i,
-  //   J(a i, b j) = -m_a (c1_ij delta_ab + c2_ij d_a (x_i - x_j)_b),
+  //   J(a i, b j) = -m_a T_ab(i, j)   (the stencil's pair_tangent_entry),
   // and each diagonal block is minus the sum of its row's off-diagonal ones.
+  with_kinematics(model_.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+    // T_ab of the pair (i, j) with its coefficients c.
+    const auto block = [&](int i, int j, const PairCoefficients& c, int a, int b) {
+      return pair_tangent_entry<K>(c, a == b, X(i, a) - X(j, a), U(i, a) - U(j, a),
+                                   X(i, b) - X(j, b));
+    };
 #pragma omp parallel for schedule(dynamic, 16)
-  for (int j = 0; j < n; ++j) {
-    const double* c1 = op.weighted_modulus_.col(j).data();
-    const double* c2 = op.weighted_slope_.col(j).data();
-    for (int a = 0; a < dim; ++a)
-      for (int b = 0; b < dim; ++b) {
-        double* column = J.col(b * n + j).data() + a * n;
-        const double* ua = U.col(a).data();
-        const double* xb = X.col(b).data();
-        const double identity = a == b ? 1.0 : 0.0;
-        for (int i = 0; i < n; ++i)
-          if (i != j)
-            column[i] = -m[a] * (c1[i] * identity + c2[i] * (ua[i] - ua[j]) * (xb[i] - xb[j]));
-      }
-  }
+    for (int j = 0; j < n; ++j) {
+      const double* c1 = op.weighted_modulus_.col(j).data();
+      const double* c2 = op.weighted_slope_.col(j).data();
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) {
+          double* column = J.col(b * n + j).data() + a * n;
+          for (int i = 0; i < n; ++i)
+            if (i != j) column[i] = -m[a] * block(i, j, {c1[i], c2[i]}, a, b);
+        }
+    }
 #pragma omp parallel for schedule(dynamic, 16)
-  for (int i = 0; i < n; ++i) {
-    const double* c1 = op.weighted_modulus_.col(i).data();
-    const double* c2 = op.weighted_slope_.col(i).data();
-    for (int a = 0; a < dim; ++a)
-      for (int b = 0; b < dim; ++b) {
-        const double* ua = U.col(a).data();
-        const double* xb = X.col(b).data();
-        const double identity = a == b ? 1.0 : 0.0;
-        double sum = 0.0;  // c1_ii = c2_ii = 0: the pair (i, i) adds nothing
-        for (int j = 0; j < n; ++j)
-          sum += c1[j] * identity + c2[j] * (ua[i] - ua[j]) * (xb[i] - xb[j]);
-        J(a * n + i, b * n + i) = m[a] * sum;
-      }
-  }
+    for (int i = 0; i < n; ++i) {
+      const double* c1 = op.weighted_modulus_.col(i).data();
+      const double* c2 = op.weighted_slope_.col(i).data();
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) {
+          double sum = 0.0;  // c1_ii = c2_ii = 0: the pair (i, i) adds nothing
+          for (int j = 0; j < n; ++j) sum += block(i, j, {c1[j], c2[j]}, a, b);
+          J(a * n + i, b * n + i) = m[a] * sum;
+        }
+    }
+  });
   const double gamma = model_.material.surface_tension;
   for (int col = 0; col < surface_.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it)
@@ -389,24 +362,28 @@ Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
     w[a] = a < dim ? W.col(a).data() : zeros.data();
   }
   Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());
+  with_kinematics(model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
 #pragma omp parallel for schedule(dynamic, 16)
-  for (int i = 0; i < n; ++i) {
-    const double* c1 = weighted_modulus_.col(i).data();
-    const double* c2 = weighted_slope_.col(i).data();
-    const auto u = static_cast<size_t>(i);
-    double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double* c1 = weighted_modulus_.col(i).data();
+      const double* c2 = weighted_slope_.col(i).data();
+      const auto u = static_cast<size_t>(i);
+      double p0 = 0.0, p1 = 0.0, p2 = 0.0;
 #pragma omp simd reduction(+ : p0, p1, p2)
-    for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
-      const double v0 = w[0][u] - w[0][j], v1 = w[1][u] - w[1][j], v2 = w[2][u] - w[2][j];
-      const double along = c2[j] * ((x[0][u] - x[0][j]) * v0 + (x[1][u] - x[1][j]) * v1 +
-                                    (x[2][u] - x[2][j]) * v2);
-      p0 += c1[j] * v0 + along * (d[0][u] - d[0][j]);
-      p1 += c1[j] * v1 + along * (d[1][u] - d[1][j]);
-      p2 += c1[j] * v2 + along * (d[2][u] - d[2][j]);
+      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+        const PairCoefficients c{c1[j], c2[j]};
+        const double b0 = x[0][u] - x[0][j], b1 = x[1][u] - x[1][j], b2 = x[2][u] - x[2][j];
+        const double v0 = w[0][u] - w[0][j], v1 = w[1][u] - w[1][j], v2 = w[2][u] - w[2][j];
+        const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+        p0 += pair_tangent<K>(c, v0, b_dot_v, b0, d[0][u] - d[0][j]);
+        p1 += pair_tangent<K>(c, v1, b_dot_v, b1, d[1][u] - d[1][j]);
+        p2 += pair_tangent<K>(c, v2, b_dot_v, b2, d[2][u] - d[2][j]);
+      }
+      const double product[3] = {p0, p1, p2};
+      for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
     }
-    const double product[3] = {p0, p1, p2};
-    for (int a = 0; a < dim; ++a) out[a * n + i] = m[a] * product[a];
-  }
+  });
   equilibrium_->add_non_bulk_product(x_, factors_, X_, v, out);
   return out;
 }
@@ -432,22 +409,31 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
     // The law's parameter, resolved once (throws for an unknown name), not per pair.
     const int parameter = axis < 0 ? law.parameter_index(name) : -1;
     const Columns columns(model_.surface.V, X, U);
-    parallel_rows(columns, [&](int i, const std::vector<double>* scratch, const double* force) {
-      if (axis >= 0) {  // bulk_row's force is sum_j a Y d, before the factors
-        D(axis * n + i, column) = force[axis];
-        return;
-      }
-      // m_a sum_j a dY/dtheta(e_ij) d_a, from the row's h, L and r.
-      const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
-      const auto u = static_cast<size_t>(i);
-      double sum[3] = {0.0, 0.0, 0.0};
-      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
-        if (h[j] == 0.0) continue;
-        const double a = bulk_weight(h[j], area0_[i], area0_[static_cast<Eigen::Index>(j)], L[j]);
-        const double dY = law.modulus_derivative(parameter, fiber_strain(r[j], L[j]));
-        for (int c = 0; c < 3; ++c) sum[c] += a * dY * (columns.u[c][u] - columns.u[c][j]);
-      }
-      for (int a = 0; a < dim; ++a) D(a * n + i, column) = m[a] * sum[a];
+    with_kinematics(model_.material.kinematics, [&](auto policy) {
+      using K = decltype(policy);
+      parallel_rows(columns, [&](int i, const std::vector<double>* scratch) {
+        // From the row's h, L, r, Y: the bulk force before the axis factors
+        // (its derivative in factor_a), or m_a times the force's derivative
+        // in the law's parameter.
+        const double *h = scratch[0].data(), *L = scratch[1].data(), *r = scratch[2].data();
+        const double *Y = scratch[3].data(), *Yp = scratch[4].data();
+        const auto u = static_cast<size_t>(i);
+        double sum[3] = {0.0, 0.0, 0.0};
+        for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+          if (h[j] == 0.0) continue;
+          const double a = bulk_weight(h[j], area0_[i], area0_[static_cast<Eigen::Index>(j)], L[j]);
+          const PairCoefficients c = K::coefficients(a, Y[j], Yp[j], r[j], L[j]);
+          const double dY = axis >= 0 ? 0.0 : law.modulus_derivative(parameter, fiber_strain(r[j], L[j]));
+          for (int k = 0; k < 3; ++k) {
+            const double b = columns.x[k][u] - columns.x[k][j], d = columns.u[k][u] - columns.u[k][j];
+            sum[k] += axis >= 0 ? pair_force<K>(c, b, d) : pair_parameter_force<K>(a, dY, r[j], L[j], b, d);
+          }
+        }
+        if (axis >= 0)
+          D(axis * n + i, column) = sum[axis];
+        else
+          for (int a = 0; a < dim; ++a) D(a * n + i, column) = m[a] * sum[a];
+      });
     });
   }
   return D;

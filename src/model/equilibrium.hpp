@@ -118,11 +118,10 @@ class Equilibrium {
   // The bulk fibers at positions X, displacements U: forces, tangent
   // products and coefficients, each pair once (pair_kernels.hpp).
   DeformedPairs bulk_pairs(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const;
-  // The bulk fibers of row i, for the parameter derivatives: the force sum
-  // sum_j a Y d (the axis factors are applied by the caller), with the
-  // row's h, L, r, Y, Y' left in the scratch arrays.
+  // The bulk fibers of row i, for the parameter derivatives: the row's h,
+  // L, r, Y, Y' (and strains) into the scratch arrays.
   struct Columns;
-  void bulk_row(int i, const Columns& c, std::vector<double>* scratch, double force[3]) const;
+  void bulk_row(int i, const Columns& c, std::vector<double>* scratch) const;
   template <class Visit>
   void parallel_rows(const Columns& columns, Visit&& visit) const;
 

@@ -51,16 +51,30 @@ std::vector<double> PairFactors::vertex_counts() const {
 
 void PairFactors::row(int i, double* row) const {
   if (fibers_ == nullptr) {
-    std::fill(row, row + n_, 0.5 / global_);
+    std::fill(row, row + n_, connection_factor(1.0, global_, global_));
   } else {
     const uint8_t* kept = fibers_->row(i);
-    for (int j = 0; j < n_; ++j)
-      row[j] = kept[j] == 0 ? 0.0
-               : count_ == ConnectionCount::Global
-                   ? 0.5 / global_
-                   : 1.0 / (kept_[static_cast<size_t>(i)] + kept_[static_cast<size_t>(j)]);
+    const bool global = count_ == ConnectionCount::Global;
+    const auto count = [&](int k) { return global ? global_ : kept_[static_cast<size_t>(k)]; };
+    for (int j = 0; j < n_; ++j) row[j] = connection_factor(kept[j], count(i), count(j));
   }
   row[i] = 0.0;
+}
+
+Eigen::SparseMatrix<double> surface_tension_laplacian(const Eigen::MatrixXd& X,
+                                                      const Eigen::VectorXd& area,
+                                                      const Eigen::MatrixXi& edges) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(4 * edges.rows()));
+  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
+    const int i = edges(e, 0), k = edges(e, 1);
+    fiber_length(X, i, k);  // throws for coincident ends
+    const double w = surface_weight(area[i], area[k], (X.row(i) - X.row(k)).squaredNorm());
+    entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
+  }
+  Eigen::SparseMatrix<double> L(X.rows(), X.rows());
+  L.setFromTriplets(entries.begin(), entries.end());
+  return L;
 }
 
 FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
@@ -78,11 +92,7 @@ FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd
       if (h[static_cast<size_t>(j)] != 0.0)
         add_fiber(out.bulk, i, j, bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
   }
-  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
-    const int i = edges(e, 0), k = edges(e, 1);
-    const double length = fiber_length(X, i, k);
-    add_fiber(out.surface, i, k, surface_weight(area[i], area[k], length * length));
-  }
+  out.surface = Eigen::MatrixXd(surface_tension_laplacian(X, area, edges));
   return out;
 }
 

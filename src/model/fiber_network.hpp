@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "model/model.hpp"
 
@@ -38,6 +39,14 @@ class PairFactors {
   std::vector<double> kept_;  // n_i
   double global_ = 0.0;       // the count for ConnectionCount::Global or a full body
 };
+
+// The surface-tension Laplacian gamma-free (paper Eq. 7), sparse: weight
+// (|S_i| + |S_k|) / (2 |x_i - x_k|^2) on every mesh edge (i, k). The one
+// builder of it (the linear system, Newton's equilibrium, the oracle).
+// Throws InputError when an edge has zero length.
+Eigen::SparseMatrix<double> surface_tension_laplacian(const Eigen::MatrixXd& X,
+                                                      const Eigen::VectorXd& area,
+                                                      const Eigen::MatrixXi& edges);
 
 // X: #V by dim positions giving the fiber lengths; area: #V vertex area
 // magnitudes |S_i|; edges: #E by 2 mesh edges; fibers and count as in the

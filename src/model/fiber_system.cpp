@@ -13,25 +13,6 @@
 namespace fiberfluid::model {
 namespace {
 
-Eigen::SparseMatrix<double> build_surface_laplacian(const Eigen::MatrixXd& X,
-                                              const Eigen::VectorXd& area,
-                                              const Eigen::MatrixXi& edges) {
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(static_cast<size_t>(4 * edges.rows()));
-  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
-    const int i = edges(e, 0), k = edges(e, 1);
-    const double length2 = (X.row(i) - X.row(k)).squaredNorm();
-    if (!(length2 > 0.0))
-      throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(k) +
-                       " coincide: the fiber between them has zero length");
-    const double w = surface_weight(area[i], area[k], length2);
-    entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
-  }
-  Eigen::SparseMatrix<double> L(X.rows(), X.rows());
-  L.setFromTriplets(entries.begin(), entries.end());
-  return L;
-}
-
 // Column-major copies of the coordinates, so the pair loops vectorise.
 struct Coordinates {
   std::vector<double> c[3];
@@ -64,7 +45,7 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, const Dof
   const geom::VertexAreaVectors areas = geom::vertex_area_vectors(X, model.surface.F);
   area_ = areas.magnitude;
   S_ = areas.S;
-  surface_ = build_surface_laplacian(X, area_, geom::unique_edges(model.surface));
+  surface_ = surface_tension_laplacian(X, area_, geom::unique_edges(model.surface));
   if (!model.material.law.is_constant()) {
     // Y_a(e) = m_a Y(e): the factors here, Y(e) in every pair weight.
     law_ = &model.material.law;

@@ -9,6 +9,7 @@
 #include "geom/fiber_pruning.hpp"
 #include "geom/surface.hpp"
 #include "model/fiber_law.hpp"
+#include "model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 
@@ -20,6 +21,8 @@ struct Material {
   FiberLaw law = FiberLaw::constant(1.0);
   Eigen::Vector3d axis_factors = Eigen::Vector3d::Ones();
   double surface_tension = 0.0;  // gamma, force per length (N/m)
+  // How a bulk fiber's force follows its ends (pair_stencil.hpp).
+  FiberKinematics kinematics = FiberKinematics::VectorSpring;
 
   // The small-strain modulus per axis, axis_factors Y(0): what the linear model uses.
   Eigen::Vector3d young_modulus() const { return law.modulus(0.0) * axis_factors; }

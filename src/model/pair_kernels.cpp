@@ -67,18 +67,11 @@ struct Multipliers {
   int stride;
 };
 
-// w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) length): BulkPairs's weight, and
-// DeformedPairs's a at the reference length. pair_stencil.hpp's bulk_weight
-// with h_ij = m_ij / (c_i + c_j), written with one division instead of two.
-inline double pair_weight(double m, double area_i, double area_j, double count_i,
-                          double count_j, double length) {
-  return m * (area_i + area_j) / ((count_i + count_j) * length);
-}
-
-// The same from the squared distance r2.
+// BulkPairs's weight w_ij from the squared distance r2 (the stencil's
+// counted_bulk_weight; DeformedPairs's a is the same at the reference length).
 inline double weight(double m, double area_i, double area_j, double count_i, double count_j,
                      double r2) {
-  return pair_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2));
+  return counted_bulk_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2));
 }
 
 // (L V) over one tile for three columns: row sums into out at i, the
@@ -171,8 +164,7 @@ void lengths_row(const DeformedRow& d, int i, int j0, int first, int end, double
   for (int j = first; j < end; ++j) {
     const double a0 = si0 - d.s0[j], a1 = si1 - d.s1[j], a2 = si2 - d.s2[j];
     const double b0 = xi0 - d.x0[j], b1 = xi1 - d.x1[j], b2 = xi2 - d.x2[j];
-    const double length = std::sqrt(a0 * a0 + a1 * a1 + a2 * a2);
-    const double current = std::sqrt(b0 * b0 + b1 * b1 + b2 * b2);
+    const double length = pair_length(a0, a1, a2), current = pair_length(b0, b1, b2);
     L[j - j0] = length;
     r[j - j0] = current;
     e[j - j0] = fiber_strain(current, length);
@@ -184,30 +176,52 @@ struct RowArrays {
   const double *m, *L, *r, *Y, *Yp;
 };
 
-FIBERFLUID_VECTOR_CLONES
-void forces_row(const double* const u[3], const double* area, const double* count, int i, int j0,
-                int first, int end, const RowArrays& row, const std::array<double*, 3>& out) {
-  const double *u0 = u[0], *u1 = u[1], *u2 = u[2];
+// The pair's coefficients from the row arrays at q (stencil: weight, then policy).
+template <class K>
+inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i,
+                                         double area_j, double count_i, double count_j) {
+  const double a = counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q]);
+  return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q]);
+}
+
+// The positions and displacements a row kernel reads (three columns each).
+struct PairColumns {
+  const double *x[3], *u[3];
+};
+
+PairColumns columns_of(const std::vector<double> (&x)[3], const std::vector<double> (&u)[3]) {
+  return {{x[0].data(), x[1].data(), x[2].data()}, {u[0].data(), u[1].data(), u[2].data()}};
+}
+
+template <class K>
+FIBERFLUID_VECTOR_CLONES void forces_row(const PairColumns& p, const double* area,
+                                         const double* count, int i, int j0, int first, int end,
+                                         const RowArrays& row, const std::array<double*, 3>& out) {
+  const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
+  const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
-  const double ui0 = u0[i], ui1 = u1[i], ui2 = u2[i], ai = area[i], ci = count[i];
+  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], ui0 = u0[i], ui1 = u1[i], ui2 = u2[i];
+  const double ai = area[i], ci = count[i];
   double f0 = 0.0, f1 = 0.0, f2 = 0.0;
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (int j = first; j < end; ++j) {
-    const int q = j - j0;
-    const double c1 =
-        modulus_coefficient(pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]), row.Y[q]);
-    const double e0 = c1 * (ui0 - u0[j]), e1 = c1 * (ui1 - u1[j]), e2 = c1 * (ui2 - u2[j]);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
+    const double e0 = pair_force<K>(c, xi0 - x0[j], ui0 - u0[j]),
+                 e1 = pair_force<K>(c, xi1 - x1[j], ui1 - u1[j]),
+                 e2 = pair_force<K>(c, xi2 - x2[j], ui2 - u2[j]);
     f0 += e0, f1 += e1, f2 += e2;
     o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
   }
   o0[i] += f0, o1[i] += f1, o2[i] += f2;
 }
 
-FIBERFLUID_VECTOR_CLONES
-void tangent_row(const double* const x[3], const double* const u[3], const double* const w[3],
-                 const double* area, const double* count, int i, int j0, int first, int end,
-                 const RowArrays& row, const std::array<double*, 3>& out) {
-  const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *u0 = u[0], *u1 = u[1], *u2 = u[2];
+template <class K>
+FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* const w[3],
+                                          const double* area, const double* count, int i, int j0,
+                                          int first, int end, const RowArrays& row,
+                                          const std::array<double*, 3>& out) {
+  const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
+  const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
   const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], ui0 = u0[i], ui1 = u1[i], ui2 = u2[i];
@@ -215,14 +229,13 @@ void tangent_row(const double* const x[3], const double* const u[3], const doubl
   double p0 = 0.0, p1 = 0.0, p2 = 0.0;
 #pragma omp simd reduction(+ : p0, p1, p2)
   for (int j = first; j < end; ++j) {
-    const int q = j - j0;
-    const double a = pair_weight(row.m[q], ai, area[j], ci, count[j], row.L[q]);
-    const double c1 = modulus_coefficient(a, row.Y[q]);
-    const double c2 = slope_coefficient(a, row.Yp[q], row.r[q], row.L[q]);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
+    const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
     const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
-    const double along = c2 * ((xi0 - x0[j]) * v0 + (xi1 - x1[j]) * v1 + (xi2 - x2[j]) * v2);
-    const double e0 = c1 * v0 + along * (ui0 - u0[j]), e1 = c1 * v1 + along * (ui1 - u1[j]),
-                 e2 = c1 * v2 + along * (ui2 - u2[j]);
+    const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+    const double e0 = pair_tangent<K>(c, v0, b_dot_v, b0, ui0 - u0[j]),
+                 e1 = pair_tangent<K>(c, v1, b_dot_v, b1, ui1 - u1[j]),
+                 e2 = pair_tangent<K>(c, v2, b_dot_v, b2, ui2 - u2[j]);
     p0 += e0, p1 += e1, p2 += e2;
     o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
   }
@@ -336,12 +349,14 @@ void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
 
 DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
                              const Eigen::MatrixXd& U, const Eigen::VectorXd& area,
-                             const PairFactors& factors, const FiberLaw& law)
+                             const PairFactors& factors, const FiberLaw& law,
+                             FiberKinematics kinematics)
     : n_(static_cast<int>(S.rows())),
       count_(factors.vertex_counts()),
       area_(area),
       mask_(factors.mask()),
-      law_(law) {
+      law_(law),
+      kinematics_(kinematics) {
   for (int a = 0; a < 3; ++a) {
     s_[a].assign(static_cast<size_t>(n_), 0.0);
     x_[a].assign(static_cast<size_t>(n_), 0.0);
@@ -387,26 +402,34 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
 }
 
 Eigen::MatrixXd DeformedPairs::forces() const {
-  const double* u[3] = {u_[0].data(), u_[1].data(), u_[2].data()};
+  const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators forces(n_, 3);
-  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-    forces_row(u, area_.data(), count_.data(), i, j0, first, end, row, forces.columns(thread));
+  with_kinematics(kinematics_, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+      forces_row<K>(p, area_.data(), count_.data(), i, j0, first, end, row,
+                    forces.columns(thread));
+    });
   });
   return forces.sum();
 }
 
 Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
-  std::vector<double> columns[3];
-  const double *x[3], *u[3], *w[3];
+  std::vector<double> directions[3];
+  const double* w[3];
   for (int a = 0; a < 3; ++a) {
-    columns[a].assign(static_cast<size_t>(n_), 0.0);
-    if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, columns[a].begin());
-    x[a] = x_[a].data(), u[a] = u_[a].data(), w[a] = columns[a].data();
+    directions[a].assign(static_cast<size_t>(n_), 0.0);
+    if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, directions[a].begin());
+    w[a] = directions[a].data();
   }
+  const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators products(n_, 3);
-  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-    tangent_row(x, u, w, area_.data(), count_.data(), i, j0, first, end, row,
-                products.columns(thread));
+  with_kinematics(kinematics_, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+      tangent_row<K>(p, w, area_.data(), count_.data(), i, j0, first, end, row,
+                     products.columns(thread));
+    });
   });
   return products.sum();
 }
@@ -419,17 +442,18 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
   c1->diagonal().setZero();
   c2->diagonal().setZero();
   const double *area = area_.data(), *count = count_.data();
-  for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int) {
-    double* k1 = c1->col(i).data();
-    double* k2 = c2->col(i).data();
-    for (int j = first; j < end; ++j) {
-      const int q = j - j0;
-      const double a = pair_weight(row.m[q], area[i], area[j], count[i], count[j], row.L[q]);
-      k1[j] = modulus_coefficient(a, row.Y[q]);
-      k2[j] = slope_coefficient(a, row.Yp[q], row.r[q], row.L[q]);
-      (*c1)(i, j) = k1[j];
-      (*c2)(i, j) = k2[j];
-    }
+  with_kinematics(kinematics_, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int) {
+      double* k1 = c1->col(i).data();
+      double* k2 = c2->col(i).data();
+      for (int j = first; j < end; ++j) {
+        const PairCoefficients c = row_coefficients<K>(row, j - j0, area[i], area[j], count[i],
+                                                       count[j]);
+        k1[j] = (*c1)(i, j) = c.c1;
+        k2[j] = (*c2)(i, j) = c.c2;
+      }
+    });
   });
 }
 

@@ -15,6 +15,7 @@
 
 #include "model/fiber_law.hpp"
 #include "model/fiber_network.hpp"
+#include "model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 
@@ -73,20 +74,22 @@ class BulkPairs {
 // The bulk fibers at a deformed state, for Newton's residual and tangent
 // (model.md section 7, pair_stencil.hpp): per pair the reference length
 // L = |s_i - s_j|, the current r = |x_i - x_j|, the strain e = r / L - 1, the
-// weight a = h_ij (|S_i| + |S_j|) / L at the reference, and
-//   c1 = a Y(e),  c2 = a Y'(e) / (r L),
+// weight a = h_ij (|S_i| + |S_j|) / L at the reference, and the kinematics'
+// coefficients c1, c2 (for the vector spring c1 = a Y(e), c2 = a Y'(e) / (r L)),
 // visited as BulkPairs does (each pair once, tiled, threaded, vectorised).
 class DeformedPairs {
  public:
   // S, X, U: reference positions, current positions, displacements (#V by
   // dim); area: the reference |S_i|. All are kept by reference.
   DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                const Eigen::VectorXd& area, const PairFactors& factors, const FiberLaw& law);
+                const Eigen::VectorXd& area, const PairFactors& factors, const FiberLaw& law,
+                FiberKinematics kinematics);
 
-  // sum_j c1_ij (u_i - u_j), #V by 3 (before the axis factors).
+  // sum_j c1_ij g_ij (the vector spring: g = u_i - u_j), #V by 3 (before the
+  // axis factors).
   Eigen::MatrixXd forces() const;
   // The bulk tangent times W (#V by dim): per pair
-  //   c1 (w_i - w_j) + c2 ((x_i - x_j) . (w_i - w_j)) (u_i - u_j),
+  //   c1 (w_i - w_j) + c2 ((x_i - x_j) . (w_i - w_j)) g_ij,
   // summed over j; #V by 3, before the axis factors.
   Eigen::MatrixXd tangent_product(const Eigen::MatrixXd& W) const;
   // c1 and c2 of every pair (N x N each, symmetric, zero diagonal).
@@ -104,6 +107,7 @@ class DeformedPairs {
   const Eigen::VectorXd& area_;
   const geom::FiberMask* mask_;
   const FiberLaw& law_;
+  FiberKinematics kinematics_;
 };
 
 }  // namespace fiberfluid::model

@@ -1,18 +1,41 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The fiber stencils: the one place where the weight of a fiber and the
-// coefficients of its force and tangent in a deformed state are written.
-// Every pair kernel (FiberSystem, the Laplacians, the Newton residual,
-// tangent and parameter derivatives) uses these.
+// The fiber stencils: the one place where a fiber's weight, strain, force,
+// tangent and parameter derivative are written. Every pair loop (the tiled
+// kernels of pair_kernels.cpp, FiberSystem's rows, Equilibrium's dense
+// tangent and dR/dtheta, the stored-coefficient tangent operator, the
+// treecode's pruned corrections) calls these; they are scalar and inline so
+// that the loops around them vectorise.
+//
+// How a bulk fiber's force follows its two ends is a policy (the fiber
+// kinematics, below): a second kinematics is one new policy struct and one
+// case in with_kinematics(), not an edit of every loop.
 #pragma once
 
-#include <Eigen/Core>
+#include <cmath>
+#include <stdexcept>
 
 namespace fiberfluid::model {
 
+// ---- Weights (the reference configuration) --------------------------------
+
 // Bulk fiber weight (paper Eq. 6): a_ij = h_ij (|S_i| + |S_j|) / L_ij, with
-// h_ij = 1 / (2 (N-1)), or the pruned connection count (PairFactors).
+// h_ij = 1 / (2 (N-1)), or the pruned connection factor below.
 inline double bulk_weight(double h, double area_i, double area_j, double length) {
   return h * (area_i + area_j) / length;
+}
+
+// The connection factor of a pair from its ends' connection counts c_i, c_j
+// (model.md section 5, PairFactors): h_ij = m_ij / (c_i + c_j), m_ij = 1 for a
+// kept fiber and 0 for a pruned one.
+inline double connection_factor(double kept, double count_i, double count_j) {
+  return kept / (count_i + count_j);
+}
+
+// bulk_weight(connection_factor(kept, c_i, c_j), ...) written with one
+// division instead of two: the form the tiled kernels use.
+inline double counted_bulk_weight(double kept, double area_i, double area_j, double count_i,
+                                  double count_j, double length) {
+  return kept * (area_i + area_j) / ((count_i + count_j) * length);
 }
 
 // Surface fiber weight (paper Eq. 7): (|S_i| + |S_k|) / (2 |s_i - s_k|^2).
@@ -20,22 +43,99 @@ inline double surface_weight(double area_i, double area_k, double length_squared
   return (area_i + area_k) / (2.0 * length_squared);
 }
 
+// ---- A pair's state at a deformed configuration ---------------------------
+
+// |(d0, d1, d2)|: a fiber's length from the difference of its ends.
+inline double pair_length(double d0, double d1, double d2) {
+  return std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+}
+
 // A fiber's strain from its current and reference lengths: e = r / L - 1.
 // Every pair loop takes the strain from here (the secant modulus Y(e), the
 // tangent's slope Y'(e), a law parameter's derivative dY/dtheta(e)).
 inline double fiber_strain(double current, double length) { return current / length - 1.0; }
 
-// A bulk fiber (i, j) at a deformed state (model.md section 7). With
-// d = u_i - u_j, b = x_i - x_j, r = |b|, e = r / L - 1, the force on i along
-// axis a (m_a: the axis factor) is
-//   f_a = m_a a Y(e) d_a
-// and its 3x3 tangent block, df_a/du_i,b = -df_a/du_j,b, is
-//   T = m_a (c1 I + c2 d b^T),  c1 = a Y(e),  c2 = a Y'(e) / (r L):
-// not symmetric once Y depends on the strain. A parameter theta of the law
-// adds m_a a dY/dtheta d_a. The pair kernels store or stream c1 and c2.
-inline double modulus_coefficient(double weight, double modulus) { return weight * modulus; }
-inline double slope_coefficient(double weight, double slope, double current, double length) {
-  return weight * slope / (current * length);
+// The two coefficients of a pair's force and tangent (see the policies).
+struct PairCoefficients {
+  double c1, c2;
+};
+
+// ---- Fiber kinematics (policies) -------------------------------------------
+//
+// For a pair (i, j) with reference length L, current length r, weight a, the
+// law's secant modulus Y = Y(e), slope Y' = Y'(e), b = x_i - x_j (current) and
+// d = u_i - u_j (displacements), a policy gives
+//   - along(b_a, d_a): the component of the vector g the force lies along;
+//   - coefficients(a, Y, Y', r, L) -> (c1, c2), with which
+//       the force on i          f   = c1 g,
+//       the tangent on w        T w = c1 (w_i - w_j) + c2 (b . (w_i - w_j)) g,
+//       (df_a / dx_i,b = -df_a / dx_j,b = c1 delta_ab + c2 g_a b_b);
+//   - parameter_coefficient(a, dY/dtheta, r, L) -> p, with df/dtheta = p g.
+// The axis factors multiply each component afterwards (Material).
+
+// The paper's vector spring (model.md section 7): f = a Y(e) (u_i - u_j).
+// It resists every relative displacement alike, across the fiber as much as
+// along it; with Y constant it is the paper's linear model exactly.
+struct VectorSpring {
+  static constexpr const char* name = "vector_spring";
+  static double along(double /*b*/, double d) { return d; }
+  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L) {
+    return {a * Y, a * Yp / (r * L)};  // d(a Y(e) d)/dx_i = a Y I + a Y' d (de/dx_i)^T
+  }
+  static double parameter_coefficient(double a, double dY, double /*r*/, double /*L*/) {
+    return a * dY;
+  }
+};
+
+// The kinematics a material's bulk fibers use (Material::kinematics).
+enum class FiberKinematics {
+  VectorSpring,
+};
+
+inline const char* kinematics_name(FiberKinematics k) {
+  switch (k) {
+    case FiberKinematics::VectorSpring: return VectorSpring::name;
+  }
+  return "?";
+}
+
+// Calls body(Policy{}) with the policy of `k`: the one switch over the kinematics.
+template <class Body>
+decltype(auto) with_kinematics(FiberKinematics k, Body&& body) {
+  switch (k) {
+    case FiberKinematics::VectorSpring: return body(VectorSpring{});
+  }
+  throw std::logic_error("unknown fiber kinematics");
+}
+
+// ---- The pair's contributions, for any policy ----------------------------
+
+// The component a of the force on i: c1 g_a.
+template <class K>
+inline double pair_force(const PairCoefficients& c, double b, double d) {
+  return c.c1 * K::along(b, d);
+}
+
+// The component a of the tangent applied to v = w_i - w_j, given
+// b_dot_v = b . v: c1 v_a + c2 (b . v) g_a.
+template <class K>
+inline double pair_tangent(const PairCoefficients& c, double v, double b_dot_v, double b,
+                           double d) {
+  return c.c1 * v + c.c2 * b_dot_v * K::along(b, d);
+}
+
+// The entry (a, b) of the 3x3 tangent block df_a/dx_i,b: c1 delta_ab + c2 g_a b_b.
+template <class K>
+inline double pair_tangent_entry(const PairCoefficients& c, bool same_axis, double b_a,
+                                 double d_a, double b_b) {
+  return c.c1 * (same_axis ? 1.0 : 0.0) + c.c2 * K::along(b_a, d_a) * b_b;
+}
+
+// The component a of df/dtheta for a law parameter theta: p g_a.
+template <class K>
+inline double pair_parameter_force(double a, double dY, double r, double L, double b,
+                                   double d) {
+  return K::parameter_coefficient(a, dY, r, L) * K::along(b, d);
 }
 
 }  // namespace fiberfluid::model

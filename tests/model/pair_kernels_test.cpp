@@ -140,7 +140,8 @@ TEST(BulkPairs, SameThreadsSameBitsOneOrTwoThreadsClose) {
   EXPECT_LT((serial - first).cwiseAbs().maxCoeff(), 1e-13 * first.cwiseAbs().maxCoeff());
 }
 
-// DeformedPairs against the stencil written pair by pair (pair_stencil.hpp):
+// DeformedPairs against the vector spring written out pair by pair here
+// (model.md section 7: c1 = a Y(e), c2 = a Y'(e) / (r L)):
 // forces, the tangent product and the stored coefficients, on a pruned
 // sphere with a strain-dependent law and a non-affine displacement.
 TEST(DeformedPairs, MatchTheStencilPairByPair) {
@@ -161,14 +162,14 @@ TEST(DeformedPairs, MatchTheStencilPairByPair) {
       if (i == j) continue;
       const double L = (s.X.row(i) - s.X.row(j)).norm(), r = (X.row(i) - X.row(j)).norm();
       const double a = bulk_weight(h[static_cast<size_t>(j)], s.area[i], s.area[j], L);
-      C1(i, j) = modulus_coefficient(a, law.modulus(r / L - 1.0));
-      C2(i, j) = slope_coefficient(a, law.slope(r / L - 1.0), r, L);
+      C1(i, j) = a * law.modulus(r / L - 1.0);
+      C2(i, j) = a * law.slope(r / L - 1.0) / (r * L);
       const Eigen::RowVector3d d = U.row(i) - U.row(j), v = W.row(i) - W.row(j);
       forces.row(i) += C1(i, j) * d;
       product.row(i) += C1(i, j) * v + C2(i, j) * (X.row(i) - X.row(j)).dot(v) * d;
     }
   }
-  const DeformedPairs pairs(s.X, X, U, s.area, factors, law);
+  const DeformedPairs pairs(s.X, X, U, s.area, factors, law, FiberKinematics::VectorSpring);
   EXPECT_LT((pairs.forces() - forces).cwiseAbs().maxCoeff(), 1e-12 * forces.cwiseAbs().maxCoeff());
   EXPECT_LT((pairs.tangent_product(W) - product).cwiseAbs().maxCoeff(),
             1e-12 * product.cwiseAbs().maxCoeff());
