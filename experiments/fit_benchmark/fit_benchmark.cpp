@@ -57,9 +57,9 @@ int main(int argc, char** argv) {
   for (const char* name : {"Y0", "beta", "gamma"}) {
     ff::fit::Parameter p;
     p.name = name;
-    const double value = ff::fit::material_parameter(truth_material, name);
+    const double value = truth_material.parameter(name);
     p.initial = std::string(name) == "gamma" ? 3.0 * value : value / 3.0;  // a factor 3 away
-    p.log_scale = ff::fit::log_scale_by_default(name);
+    p.log_scale = ff::fit::log_scale_by_default(name, truth_material);
     parameters.push_back(p);
   }
 
@@ -92,8 +92,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   std::printf("\ntruth: Y0 %.6g, beta %.6g, gamma %.6g; start a factor 3 away\n",
-              ff::fit::material_parameter(truth_material, "Y0"),
-              ff::fit::material_parameter(truth_material, "beta"),
-              ff::fit::material_parameter(truth_material, "gamma"));
+              truth_material.parameter("Y0"),
+              truth_material.parameter("beta"),
+              truth_material.parameter("gamma"));
   return 0;
 }

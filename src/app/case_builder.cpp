@@ -199,15 +199,18 @@ class ModelBuilder {
 
   model::Load load(const LoadSpec& spec) const {
     model::Load load = spec.load;
-    const bool point = load.kind == model::Load::Kind::Point;
-    require_per_axis(spec.field, point ? "force" : "acceleration", spec.vector, dim_);
-    if (point) {
-      load.vertex = model_vertex(spec.field, "vertex", spec.input_vertex);
-      load.force.head(dim_) = spec.vector;
-    } else {
-      load.acceleration.head(dim_) = spec.vector;
+    switch (load.kind) {
+      case model::Load::Kind::Point:
+        require_per_axis(spec.field, "force", spec.vector, dim_);
+        load.vertex = model_vertex(spec.field, "vertex", spec.input_vertex);
+        load.force.head(dim_) = spec.vector;
+        return load;
+      case model::Load::Kind::Hydrostatic:
+        require_per_axis(spec.field, "acceleration", spec.vector, dim_);
+        load.acceleration.head(dim_) = spec.vector;
+        return load;
     }
-    return load;
+    spec.field.fail("type", "a load of an unknown kind");
   }
 
   std::vector<int> select(const SelectionSpec& spec) const {

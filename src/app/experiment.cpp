@@ -167,9 +167,10 @@ double required_positive(Fields& f, const std::string& key) {
 }
 
 model::FiberLaw read_law(Fields f) {
-  const std::string type =
-      f.choice("type", "constant", {"constant", "exponential", "bilinear", "tabulated"});
-  model::FiberLaw law;
+  std::vector<std::string> types = {"constant", "exponential", "bilinear", "tabulated"};
+  for (const std::string& name : model::registered_law_names()) types.push_back(name);
+  const std::string type = f.choice("type", "constant", types);
+  model::FiberLaw law = model::FiberLaw::constant(1.0);
   if (type == "constant") {
     const double Y = f.number("Y");
     if (Y < 0.0) f.fail("Y", "expected a number >= 0, got " + std::to_string(Y));
@@ -179,6 +180,12 @@ model::FiberLaw read_law(Fields f) {
   } else if (type == "bilinear") {
     const double Y_t = required_positive(f, "Y_t"), Y_c = required_positive(f, "Y_c");
     law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
+  } else if (type != "tabulated") {
+    // A law registered by the program that links the library: its parameters by name.
+    const std::shared_ptr<const model::LawModel> registered = model::find_registered_law(type);
+    std::vector<double> values;
+    for (const std::string& name : registered->parameter_names()) values.push_back(f.number(name));
+    law = model::FiberLaw(registered, values);
   } else {
     const Eigen::VectorXd strain = f.vector("strain", -1), stress = f.vector("stress", -1);
     if (stress.size() != strain.size())

@@ -114,14 +114,21 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
   Eigen::VectorXd f = Eigen::VectorXd::Zero(out.mesh.num_dofs());
   for (const model::Load& load : m.loads) {
     const double factor = load.schedule.factor(steps, steps);
-    if (load.kind == model::Load::Kind::Point) {
-      const int node = boundary.nodes[static_cast<size_t>(nearest_row(boundary.surface.V, V.row(load.vertex)))];
-      f.segment(3 * node, 3) += factor * load.force;
-    } else {
-      fem::Material fluid = material;
-      fluid.density = load.density;
-      f += fem::body_forces(out.mesh, fluid, factor * load.acceleration);
+    switch (load.kind) {
+      case model::Load::Kind::Point: {
+        const int node = boundary.nodes[static_cast<size_t>(nearest_row(boundary.surface.V, V.row(load.vertex)))];
+        f.segment(3 * node, 3) += factor * load.force;
+        continue;
+      }
+      case model::Load::Kind::Hydrostatic: {
+        // The fluid's weight as the solid's body force of the same density.
+        fem::Material fluid = material;
+        fluid.density = load.density;
+        f += fem::body_forces(out.mesh, fluid, factor * load.acceleration);
+        continue;
+      }
     }
+    fail("a load of an unknown kind");
   }
   const auto solve_start = std::chrono::steady_clock::now();
   Eigen::VectorXd u;

@@ -61,11 +61,8 @@ json law_json(const model::Material& material, int dim) {
   const model::FiberLaw& law = material.law;
   json out = {{"type", law.name()}};
   for (const std::string& name : law.parameter_names()) out[name] = law.parameter(name);
-  if (law.kind() == model::FiberLaw::Kind::Bilinear) out["transition"] = law.transition();
-  if (law.kind() == model::FiberLaw::Kind::Tabulated) {
-    out["strain"] = law.table_strain();
-    out["stress"] = law.table_stress();
-  }
+  for (const model::LawModel::Setting& s : law.settings())
+    out[s.name] = s.scalar && s.values.size() == 1 ? json(s.values[0]) : json(s.values);
   out["axis_factors"] = vector_json(material.axis_factors, dim);
   return out;
 }

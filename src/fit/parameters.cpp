@@ -31,42 +31,31 @@ Parameter make_parameter(const ParameterRequest& request, const model::Material&
   Parameter p;
   p.name = request.name;
   const bool alignment = is_alignment_parameter(p.name);
-  if (!alignment && !model::is_material_parameter(material, p.name)) {
+  if (!alignment && !material.has_parameter(p.name)) {
     std::string known;
-    for (const std::string& n : model::material_parameter_names(material, 3))
+    for (const std::string& n : material.parameter_names())
       known += (known.empty() ? "" : ", ") + n;
     throw InputError("\"" + p.name + "\" is not a parameter of this material (" + known +
                      ") or of the alignment (rotation_x..z, translation_x..z, scale)");
   }
   p.initial = request.start ? *request.start : alignment ? (p.name == "scale" ? 1.0 : 0.0)
-                                                         : material_parameter(material, p.name);
+                                                         : material.parameter(p.name);
   if (request.lower) p.lower = *request.lower;
   if (request.upper) p.upper = *request.upper;
-  p.log_scale = request.log_scale.value_or(log_scale_by_default(p.name));
+  p.log_scale = request.log_scale.value_or(log_scale_by_default(p.name, material));
   return p;
 }
 
-bool log_scale_by_default(const std::string& name) {
-  return name == "scale" || (!is_alignment_parameter(name) && name != "beta");
-}
-
-void set_material_parameter(model::Material& material, const std::string& name, double value) {
-  if (name == "gamma") material.surface_tension = value;
-  else if (name.rfind("factor_", 0) == 0 && name.size() == 8) material.axis_factors[name[7] - 'x'] = value;
-  else material.law.set_parameter(name, value);
-}
-
-double material_parameter(const model::Material& material, const std::string& name) {
-  if (name == "gamma") return material.surface_tension;
-  if (name.rfind("factor_", 0) == 0 && name.size() == 8) return material.axis_factors[name[7] - 'x'];
-  return material.law.parameter(name);
+bool log_scale_by_default(const std::string& name, const model::Material& material) {
+  if (is_alignment_parameter(name)) return name == "scale";
+  return material.is_positive_parameter(name);
 }
 
 ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Material& material,
                            int dim)
     : parameters_(std::move(parameters)) {
   if (parameters_.empty()) throw InputError("nothing to fit: no parameter given");
-  const std::vector<std::string> known = model::material_parameter_names(material, dim);
+  const std::vector<std::string> known = material.parameter_names(dim);
   for (size_t k = 0; k < parameters_.size(); ++k) {
     const Parameter& p = parameters_[k];
     const std::string who = "parameter \"" + p.name + "\"";
@@ -79,6 +68,7 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
       has_alignment_ = true;
     } else if (std::find(known.begin(), known.end(), p.name) != known.end()) {
       material_names_.push_back(p.name);
+      material_parameters_.push_back(material.resolve(p.name, dim));
       material_indices_.push_back(static_cast<int>(k));
     } else {
       std::string list;
@@ -154,8 +144,8 @@ Eigen::VectorXd ParameterMap::value_derivatives(const Eigen::VectorXd& phi) cons
 model::Material ParameterMap::material(const model::Material& base,
                                        const Eigen::VectorXd& values) const {
   model::Material m = base;
-  for (size_t j = 0; j < material_names_.size(); ++j)
-    set_material_parameter(m, material_names_[j], values[material_indices_[j]]);
+  for (size_t j = 0; j < material_parameters_.size(); ++j)
+    m.set_parameter(material_parameters_[j], values[material_indices_[j]]);
   return m;
 }
 

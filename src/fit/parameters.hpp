@@ -40,9 +40,9 @@ struct ParameterRequest {
 };
 Parameter make_parameter(const ParameterRequest& request, const model::Material& material);
 // The default for a parameter: log scale for a positive one (a modulus,
-// gamma, a factor, the alignment's scale); linear for beta and the
-// alignment's rotation and translation.
-bool log_scale_by_default(const std::string& name);
+// gamma, a factor, the alignment's scale: Material::is_positive_parameter);
+// linear for an exponent (beta) and the alignment's rotation and translation.
+bool log_scale_by_default(const std::string& name, const model::Material& material);
 
 // The parameters in the optimiser's variables phi (log or linear) and back.
 class ParameterMap {
@@ -79,13 +79,10 @@ class ParameterMap {
  private:
   std::vector<Parameter> parameters_;
   std::vector<std::string> material_names_;
+  std::vector<model::MaterialParameter> material_parameters_;  // resolved once
   std::vector<int> material_indices_;
   int alignment_index_[7] = {-1, -1, -1, -1, -1, -1, -1};
   bool has_alignment_ = false;
 };
-
-// Sets one material parameter by name (as Equilibrium::parameter_derivatives names them).
-void set_material_parameter(model::Material& material, const std::string& name, double value);
-double material_parameter(const model::Material& material, const std::string& name);
 
 }  // namespace fiberfluid::fit

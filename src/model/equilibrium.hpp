@@ -12,18 +12,14 @@
 #include "model/fiber_system.hpp"
 #include "model/model.hpp"
 #include "model/pair_kernels.hpp"
+#include "model/terms.hpp"
 
 namespace fiberfluid::model {
 
 class Equilibrium;
 
-// The names Equilibrium::parameter_derivatives knows for this material: the
-// law's parameters, "gamma", and "factor_x" / "factor_y" / "factor_z".
-std::vector<std::string> material_parameter_names(const Material& material, int dim);
-bool is_material_parameter(const Material& material, const std::string& name);
-
 // The tangent at one state as an operator: the bulk fibers' pair
-// coefficients a Y(e) and a Y'(e) / (r L) stored once (two N x N arrays,
+// coefficients (the stencil's c1, c2) stored once (two N x N arrays,
 // bytes_for(N)), so that each product is one pass over memory rather than
 // square roots and law evaluations per pair. Equilibrium::linearize builds it.
 class TangentOperator {
@@ -43,13 +39,15 @@ class TangentOperator {
 // The equilibrium equations of the Newton scheme (model.md section 7) at any
 // state x = [u; P] of the paper's layout and load factors lambda:
 //
-//   R_i = sum_j a_ij m Y(e_ij) (u_i - u_j) + gamma sum_k b_ik (u_i - u_k)
+//   R_i = sum_j m f(i, j) + gamma sum_k b_ik (u_i - u_k)
 //         + (P - q_i(x)) S_i(x) - F_i(lambda)
 //   g   = dim C0 (V(x) - V0)
 //
-// with the weights a_ij, b_ik of the reference (so a constant law gives
-// exactly K u), S_i(x) = C0 sum_{f at i} A_f(x) from the current geometry and
-// the reference constant C0 (so dg/dx_i = S_i(x)), q_i = sum over hydrostatic
+// a sum of named terms (terms.hpp): the bulk fibers f(i, j) of the
+// material's kinematics (the vector spring: a_ij Y(e_ij) (u_i - u_j)), with
+// the weights a_ij, b_ik of the reference (so a constant law gives exactly
+// K u), S_i(x) = C0 sum_{f at i} A_f(x) from the current geometry and the
+// reference constant C0 (so dg/dx_i = S_i(x)), q_i = sum over hydrostatic
 // loads of lambda rho |a| (depth of x_i below the highest reference point),
 // and F the point loads. At the reference with P = 0 and no load, the
 // tangent is the paper's A.
@@ -57,8 +55,11 @@ class TangentOperator {
 // Rows of R at held unknowns are the forces the supports (or paddles) exert.
 class Equilibrium {
  public:
-  // Throws InputError when two vertices coincide.
+  // Throws InputError when two vertices coincide, std::invalid_argument for
+  // a load of an unknown kind. Keeps a reference to the model.
   explicit Equilibrium(const Model& model);
+  Equilibrium(const Equilibrium&) = delete;  // the terms point into it
+  Equilibrium& operator=(const Equilibrium&) = delete;
 
   const Model& model() const { return model_; }
   int num_unknowns() const { return model_.num_unknowns(); }
@@ -66,6 +67,8 @@ class Equilibrium {
   // dim C0 V0: the size of g for a relative measure.
   double volume_scale() const { return model_.dim() * C0_ * std::abs(volume0_); }
   double area_constant() const { return C0_; }
+  // The terms' names in the order they are summed (bulk fibers first).
+  std::vector<std::string> term_names() const;
 
   Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
   // The loads alone, F_i + q_i S_i (follower), full layout with 0 for g.
@@ -100,37 +103,26 @@ class Equilibrium {
                                                    bool strained) const;
   Eigen::VectorXd load_vector(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
 
-  // dR/dtheta, one column per name: a parameter of the law ("Y", "Y0",
-  // "beta", "Y_t", "Y_c", "scale"), "gamma", or "factor_x" / "factor_y" /
-  // "factor_z". Throws std::invalid_argument for another name.
+  // dR/dtheta, one column per name of Material::parameter_names (the law's
+  // parameters, "gamma", "factor_x" ...). Throws std::invalid_argument for
+  // another name.
   Eigen::MatrixXd parameter_derivatives(const Eigen::VectorXd& x,
                                         const std::vector<std::string>& names) const;
 
  private:
   friend class TangentOperator;
-  // The surface-tension, pressure, follower-load and volume rows of dR/dx v.
-  void add_non_bulk_product(const Eigen::VectorXd& x, const std::vector<double>& factors,
-                            const Eigen::MatrixXd& X, const Eigen::VectorXd& v,
-                            Eigen::VectorXd& out) const;
-  struct Hydrostatics;  // per-vertex q_i and its gradient, at x
-  Hydrostatics hydrostatics(const Eigen::MatrixXd& X, const std::vector<double>& factors) const;
-  Eigen::MatrixXd current_area_vectors(const Eigen::MatrixXd& X) const;  // S_i(x)
-  // The bulk fibers at positions X, displacements U: forces, tangent
-  // products and coefficients, each pair once (pair_kernels.hpp).
-  DeformedPairs bulk_pairs(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const;
-  // The bulk fibers of row i, for the parameter derivatives: the row's h,
-  // L, r, Y, Y' (and strains) into the scratch arrays.
-  struct Columns;
-  void bulk_row(int i, const Columns& c, std::vector<double>* scratch) const;
-  template <class Visit>
-  void parallel_rows(const Columns& columns, Visit&& visit) const;
+  // out += dR/dx v of every term but the bulk fibers.
+  void add_other_products(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
+                          Eigen::VectorXd& out) const;
 
   const Model& model_;
   PairFactors factors_;
   Eigen::VectorXd area0_;                 // |S_i| at the reference
   Eigen::SparseMatrix<double> surface_;   // gamma-free surface Laplacian of the reference
   double C0_ = 0.0, volume0_ = 0.0;
-  std::vector<double> levels_;            // per load: the highest reference point along a
+  TermContext context_;                   // refers to the members above
+  BulkFiberTerm bulk_;
+  std::vector<std::unique_ptr<EquilibriumTerm>> terms_;  // the others, in order
 };
 
 }  // namespace fiberfluid::model

@@ -3,36 +3,108 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
 namespace fiberfluid::model {
 
-FiberLaw FiberLaw::constant(double Y) {
-  FiberLaw law;
-  law.kind_ = Kind::Constant;
-  law.a_ = Y;
-  return law;
-}
-
-FiberLaw FiberLaw::exponential(double Y0, double beta) {
-  FiberLaw law;
-  law.kind_ = Kind::Exponential;
-  law.a_ = Y0;
-  law.b_ = beta;
-  return law;
-}
-
-FiberLaw FiberLaw::bilinear(double Y_t, double Y_c, double transition) {
-  FiberLaw law;
-  law.kind_ = Kind::Bilinear;
-  law.a_ = Y_t;
-  law.b_ = Y_c;
-  law.c_ = transition;
-  return law;
+void LawModel::evaluate(const double* p, const double* strain, size_t n, double* Y,
+                        double* Yp) const {
+  for (size_t k = 0; k < n; ++k) {
+    Y[k] = modulus(p, strain[k]);
+    Yp[k] = slope(p, strain[k]);
+  }
 }
 
 namespace {
+
+std::string finite_parameters(const LawModel& law, const double* p) {
+  const std::vector<std::string> names = law.parameter_names();
+  for (size_t k = 0; k < names.size(); ++k)
+    if (!std::isfinite(p[k])) return names[k] + " must be a finite number";
+  return {};
+}
+
+// "" when Y is positive and finite at every strain of `strains`, else the
+// first strain where it is not, and which parameter to look at.
+std::string positive_modulus(const LawModel& law, const double* p,
+                             const std::vector<double>& strains, double lowest, double highest,
+                             const std::string& suspect) {
+  for (double e : strains) {
+    const double y = law.modulus(p, e);
+    if (!(y > 0.0) || !std::isfinite(y)) {
+      std::ostringstream out;
+      out << "the modulus is " << y << " at strain " << e << " (it must be a positive number "
+          << "for strains from " << lowest << " to " << highest << "): check " << suspect;
+      return out.str();
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string LawModel::check(const double* p, double lowest, double highest) const {
+  if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
+  std::vector<double> strains;
+  constexpr int kSamples = 64;
+  for (int k = 0; k <= kSamples; ++k) strains.push_back(lowest + (highest - lowest) * k / kSamples);
+  const std::vector<std::string> names = parameter_names();
+  return positive_modulus(*this, p, strains, lowest, highest,
+                          names.empty() ? std::string("the law") : names.back());
+}
+
+namespace {
+
+// ---- The built-in laws -----------------------------------------------------
+
+class ConstantLaw final : public LawModel {
+ public:
+  std::string name() const override { return "constant"; }
+  std::vector<std::string> parameter_names() const override { return {"Y"}; }
+  double modulus(const double* p, double) const override { return p[0]; }
+  double slope(const double*, double) const override { return 0.0; }
+  double modulus_derivative(const double*, int, double) const override { return 1.0; }
+  void evaluate(const double* p, const double*, size_t n, double* Y, double* Yp) const override {
+    std::fill(Y, Y + n, p[0]);
+    std::fill(Yp, Yp + n, 0.0);
+  }
+  std::string check(const double* p, double, double) const override {
+    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
+    return p[0] >= 0.0 ? "" : "Y must be a number >= 0";
+  }
+  bool is_constant() const override { return true; }
+};
+
+class ExponentialLaw final : public LawModel {
+ public:
+  std::string name() const override { return "exponential"; }
+  std::vector<std::string> parameter_names() const override { return {"Y0", "beta"}; }
+  double modulus(const double* p, double e) const override { return p[0] * std::exp(p[1] * e); }
+  double slope(const double* p, double e) const override {
+    return p[0] * p[1] * std::exp(p[1] * e);
+  }
+  double modulus_derivative(const double* p, int k, double e) const override {
+    return k == 0 ? std::exp(p[1] * e) : p[0] * e * std::exp(p[1] * e);
+  }
+  bool is_positive(int k) const override { return k == 0; }  // beta takes either sign
+  void evaluate(const double* p, const double* strain, size_t n, double* Y,
+                double* Yp) const override {
+    const double Y0 = p[0], beta = p[1];
+    for (size_t k = 0; k < n; ++k) {
+      Y[k] = Y0 * std::exp(beta * strain[k]);
+      Yp[k] = beta * Y[k];
+    }
+  }
+  std::string check(const double* p, double lowest, double highest) const override {
+    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
+    if (!(p[0] > 0.0)) return "Y0 must be positive";
+    // Monotone in e: the ends bound it.
+    return positive_modulus(*this, p, {lowest, highest}, lowest, highest, "beta");
+  }
+};
 
 // The share of Y_t in the bilinear law: 0 below -w, 1 above w, and the C1
 // cubic 1/2 + 3t/4 - t^3/4 (t = e / w) between; w = 0 is a sharp step.
@@ -48,141 +120,54 @@ double tension_share_slope(double e, double w) {
   return 0.75 * (1.0 - t * t) / w;
 }
 
-}  // namespace
-
-FiberLaw FiberLaw::tabulated(std::vector<double> strain, std::vector<double> stress) {
-  FiberLaw law;
-  law.kind_ = Kind::Tabulated;
-  law.a_ = 1.0;
-  law.strain_ = std::move(strain);
-  law.stress_ = std::move(stress);
-  return law;
-}
-
-const char* FiberLaw::name() const {
-  switch (kind_) {
-    case Kind::Constant: return "constant";
-    case Kind::Exponential: return "exponential";
-    case Kind::Bilinear: return "bilinear";
-    case Kind::Tabulated: return "tabulated";
+class BilinearLaw final : public LawModel {
+ public:
+  explicit BilinearLaw(double transition) : w_(transition) {}
+  std::string name() const override { return "bilinear"; }
+  std::vector<std::string> parameter_names() const override { return {"Y_t", "Y_c"}; }
+  double modulus(const double* p, double e) const override {
+    return p[1] + (p[0] - p[1]) * tension_share(e, w_);
   }
-  return "?";
-}
-
-size_t FiberLaw::segment(double strain) const {
-  // Segment k spans [strain_[k], strain_[k+1]]; e = 0 falls in the segment
-  // that starts there, so Y(0) is the initial slope in tension.
-  const auto it = std::upper_bound(strain_.begin(), strain_.end(), strain);
-  const auto k = static_cast<size_t>(std::max<std::ptrdiff_t>(1, it - strain_.begin()) - 1);
-  return std::min(k, strain_.size() - 2);
-}
-
-double FiberLaw::modulus(double e) const {
-  switch (kind_) {
-    case Kind::Constant: return a_;
-    case Kind::Exponential: return a_ * std::exp(b_ * e);
-    case Kind::Bilinear: return b_ + (a_ - b_) * tension_share(e, c_);
-    case Kind::Tabulated: {
-      // sigma = s_k + m (e - e_k) = m e + c on the segment: Y = m + c / e. The
-      // segments that end at (0, 0) have c = 0 exactly, so Y is finite there.
-      const size_t k = segment(e);
-      const double m = (stress_[k + 1] - stress_[k]) / (strain_[k + 1] - strain_[k]);
-      const bool through_origin = strain_[k] == 0.0 || strain_[k + 1] == 0.0;
-      const double c = through_origin ? 0.0 : stress_[k] - m * strain_[k];
-      return a_ * (c == 0.0 ? m : m + c / e);
-    }
+  double slope(const double* p, double e) const override {
+    return (p[0] - p[1]) * tension_share_slope(e, w_);
   }
-  return a_;
-}
-
-double FiberLaw::slope(double e) const {
-  switch (kind_) {
-    case Kind::Constant: return 0.0;
-    case Kind::Bilinear: return (a_ - b_) * tension_share_slope(e, c_);
-    case Kind::Exponential: return a_ * b_ * std::exp(b_ * e);
-    case Kind::Tabulated: {
-      const size_t k = segment(e);
-      const double m = (stress_[k + 1] - stress_[k]) / (strain_[k + 1] - strain_[k]);
-      const bool through_origin = strain_[k] == 0.0 || strain_[k + 1] == 0.0;
-      const double c = through_origin ? 0.0 : stress_[k] - m * strain_[k];
-      return c == 0.0 ? 0.0 : -a_ * c / (e * e);
-    }
+  double modulus_derivative(const double*, int k, double e) const override {
+    const double share = tension_share(e, w_);
+    return k == 0 ? share : 1.0 - share;
   }
-  return 0.0;
-}
-
-void FiberLaw::evaluate(const double* strain, size_t n, double* Y, double* Yp) const {
-  switch (kind_) {
-    case Kind::Constant:
-      std::fill(Y, Y + n, a_);
-      std::fill(Yp, Yp + n, 0.0);
-      return;
-    case Kind::Exponential:
-      for (size_t k = 0; k < n; ++k) {
-        Y[k] = a_ * std::exp(b_ * strain[k]);
-        Yp[k] = b_ * Y[k];
-      }
-      return;
-    case Kind::Bilinear:
-    case Kind::Tabulated:  // named, so that a new kind is a -Wswitch warning here
-      for (size_t k = 0; k < n; ++k) {
-        Y[k] = modulus(strain[k]);
-        Yp[k] = slope(strain[k]);
-      }
-      return;
+  std::string check(const double* p, double lowest, double highest) const override {
+    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
+    if (!(w_ >= 0.0 && w_ < 1.0)) return "transition must be a strain from 0 to 1";
+    if (!(p[0] > 0.0)) return "Y_t must be positive";
+    if (!(p[1] > 0.0)) return "Y_c must be positive";
+    return positive_modulus(*this, p, {lowest, highest}, lowest, highest, "Y_c");
   }
-}
+  std::vector<Setting> settings() const override { return {{"transition", {w_}, true}}; }
 
-const std::vector<std::string>& FiberLaw::parameter_names() const {
-  static const std::vector<std::string> constant{"Y"}, exponential{"Y0", "beta"},
-      bilinear{"Y_t", "Y_c"}, tabulated{"scale"};
-  switch (kind_) {
-    case Kind::Constant: return constant;
-    case Kind::Exponential: return exponential;
-    case Kind::Bilinear: return bilinear;
-    case Kind::Tabulated: return tabulated;
+ private:
+  double w_;
+};
+
+class TabulatedLaw final : public LawModel {
+ public:
+  TabulatedLaw(std::vector<double> strain, std::vector<double> stress)
+      : strain_(std::move(strain)), stress_(std::move(stress)) {}
+  std::string name() const override { return "tabulated"; }
+  std::vector<std::string> parameter_names() const override { return {"scale"}; }
+  // sigma = s_k + m (e - e_k) = m e + c on the segment: Y = m + c / e. The
+  // segments that end at (0, 0) have c = 0 exactly, so Y is finite there.
+  double modulus(const double* p, double e) const override {
+    const Segment s = segment(e);
+    return p[0] * (s.c == 0.0 ? s.m : s.m + s.c / e);
   }
-  return constant;
-}
-
-double FiberLaw::parameter(const std::string& name) const {
-  return parameter_index(name) == 0 ? a_ : b_;
-}
-
-void FiberLaw::set_parameter(const std::string& name, double value) {
-  (parameter_index(name) == 0 ? a_ : b_) = value;
-}
-
-int FiberLaw::parameter_index(const std::string& name) const {
-  const auto& names = parameter_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end())
-    throw std::invalid_argument("the " + std::string(this->name()) + " law has no parameter '" +
-                                name + "'");
-  return static_cast<int>(it - names.begin());
-}
-
-double FiberLaw::modulus_derivative(const std::string& name, double e) const {
-  return modulus_derivative(parameter_index(name), e);
-}
-
-double FiberLaw::modulus_derivative(int index, double e) const {
-  const bool first = index == 0;
-  switch (kind_) {
-    case Kind::Constant: return 1.0;
-    case Kind::Exponential: return first ? std::exp(b_ * e) : a_ * e * std::exp(b_ * e);
-    case Kind::Bilinear: {
-      const double share = tension_share(e, c_);
-      return first ? share : 1.0 - share;
-    }
-    case Kind::Tabulated: return modulus(e) / a_;
+  double slope(const double* p, double e) const override {
+    const Segment s = segment(e);
+    return s.c == 0.0 ? 0.0 : -p[0] * s.c / (e * e);
   }
-  return 0.0;
-}
-
-std::string FiberLaw::check(double lowest, double highest) const {
-  std::ostringstream out;
-  if (kind_ == Kind::Tabulated) {
+  double modulus_derivative(const double* p, int, double e) const override {
+    return modulus(p, e) / p[0];
+  }
+  std::string check(const double* p, double, double) const override {
     if (strain_.size() != stress_.size() || strain_.size() < 2)
       return "the table needs at least two (strain, stress) points, as many strains as stresses";
     for (size_t k = 0; k < strain_.size(); ++k)
@@ -196,28 +181,124 @@ std::string FiberLaw::check(double lowest, double highest) const {
     const auto zero = std::find(strain_.begin(), strain_.end(), 0.0);
     if (zero == strain_.end() || stress_[static_cast<size_t>(zero - strain_.begin())] != 0.0)
       return "the table must contain the point (0, 0): no stress at zero strain";
-    if (!(a_ > 0.0) || !std::isfinite(a_)) return "scale must be a positive number";
+    if (!(p[0] > 0.0) || !std::isfinite(p[0])) return "scale must be a positive number";
     return {};
   }
-  const std::vector<std::string>& names = parameter_names();
-  for (const std::string& name : names)
-    if (!std::isfinite(parameter(name))) return name + " must be a finite number";
-  if (kind_ == Kind::Constant)
-    return a_ >= 0.0 ? "" : "Y must be a number >= 0";
-  if (kind_ == Kind::Bilinear && !(c_ >= 0.0 && c_ < 1.0))
-    return "transition must be a strain from 0 to 1";
-  for (const std::string& name : {names.front(), kind_ == Kind::Bilinear ? names.back() : ""})
-    if (!name.empty() && !(parameter(name) > 0.0)) return name + " must be positive";
-  // The modulus is monotone in e for these laws: its ends bound it.
-  for (double e : {lowest, highest}) {
-    const double y = modulus(e);
-    if (!(y > 0.0) || !std::isfinite(y)) {
-      out << "the modulus is " << y << " at strain " << e << " (it must be a positive number "
-          << "for strains from " << lowest << " to " << highest << "): check " << names.back();
-      return out.str();
-    }
+  std::vector<Setting> settings() const override {
+    return {{"strain", strain_, false}, {"stress", stress_, false}};
   }
-  return {};
+
+ private:
+  struct Segment {
+    double m, c;  // sigma = m e + c on it
+  };
+  // The segment holding e (end segments extended). Segment k spans
+  // [strain_k, strain_k+1]; e = 0 falls in the segment that starts there, so
+  // Y(0) is the initial slope in tension.
+  Segment segment(double e) const {
+    // A table without a segment (check() names it) gives NaN, never a read past it.
+    if (strain_.size() < 2 || stress_.size() != strain_.size()) return {std::nan(""), 0.0};
+    const auto it = std::upper_bound(strain_.begin(), strain_.end(), e);
+    const auto k = std::min(
+        static_cast<size_t>(std::max<std::ptrdiff_t>(1, it - strain_.begin()) - 1),
+        strain_.size() - 2);
+    const double m = (stress_[k + 1] - stress_[k]) / (strain_[k + 1] - strain_[k]);
+    const bool through_origin = strain_[k] == 0.0 || strain_[k + 1] == 0.0;
+    return {m, through_origin ? 0.0 : stress_[k] - m * strain_[k]};
+  }
+
+  std::vector<double> strain_, stress_;
+};
+
+}  // namespace
+
+FiberLaw::FiberLaw(std::shared_ptr<const LawModel> model, std::vector<double> parameters)
+    : model_(std::move(model)), parameters_(std::move(parameters)) {
+  if (!model_) throw std::invalid_argument("a fiber law needs a law model");
+  names_ = model_->parameter_names();
+  if (names_.size() != parameters_.size())
+    throw std::invalid_argument("the " + model_->name() + " law takes " +
+                                std::to_string(names_.size()) + " parameters, got " +
+                                std::to_string(parameters_.size()));
+}
+
+FiberLaw FiberLaw::constant(double Y) {
+  static const auto model = std::make_shared<const ConstantLaw>();
+  return {model, {Y}};
+}
+
+FiberLaw FiberLaw::exponential(double Y0, double beta) {
+  static const auto model = std::make_shared<const ExponentialLaw>();
+  return {model, {Y0, beta}};
+}
+
+FiberLaw FiberLaw::bilinear(double Y_t, double Y_c, double transition) {
+  return {std::make_shared<const BilinearLaw>(transition), {Y_t, Y_c}};
+}
+
+FiberLaw FiberLaw::tabulated(std::vector<double> strain, std::vector<double> stress) {
+  return {std::make_shared<const TabulatedLaw>(std::move(strain), std::move(stress)), {1.0}};
+}
+
+int FiberLaw::parameter_index(const std::string& name) const {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  if (it == names_.end())
+    throw std::invalid_argument("the " + this->name() + " law has no parameter '" + name + "'");
+  return static_cast<int>(it - names_.begin());
+}
+
+double FiberLaw::parameter(const std::string& name) const {
+  return parameters_[static_cast<size_t>(parameter_index(name))];
+}
+
+void FiberLaw::set_parameter(const std::string& name, double value) {
+  parameters_[static_cast<size_t>(parameter_index(name))] = value;
+}
+
+// ---- The registry ------------------------------------------------------------
+
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, std::shared_ptr<const LawModel>> laws;
+};
+
+Registry& registry() {
+  static Registry r;
+  return r;
+}
+
+bool is_builtin(const std::string& name) {
+  return name == "constant" || name == "exponential" || name == "bilinear" || name == "tabulated";
+}
+
+}  // namespace
+
+void register_law(std::shared_ptr<const LawModel> model) {
+  if (!model) throw std::invalid_argument("register_law: no law model");
+  const std::string name = model->name();
+  if (name.empty()) throw std::invalid_argument("register_law: a law needs a name");
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  if (is_builtin(name) || r.laws.count(name) != 0)
+    throw std::invalid_argument("register_law: a law named '" + name + "' exists already");
+  r.laws.emplace(name, std::move(model));
+}
+
+std::shared_ptr<const LawModel> find_registered_law(const std::string& name) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  const auto it = r.laws.find(name);
+  return it == r.laws.end() ? nullptr : it->second;
+}
+
+std::vector<std::string> registered_law_names() {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& entry : r.laws) names.push_back(entry.first);
+  return names;
 }
 
 }  // namespace fiberfluid::model

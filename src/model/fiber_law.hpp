@@ -1,75 +1,125 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace fiberfluid::model {
 
-// The stress-strain law of a bulk fiber (model.md section 7): its secant
-// modulus Y(e) = sigma(e) / e as a function of the fiber's strain
-// e = |x_i - x_j| / L_ij - 1, with Y(0) the small-strain modulus, and the
-// derivatives that the Newton tangent and the calibration need. Parameters
-// have names so that a fitter can vary them ("Y", "Y0", "beta", ...).
+// One kind of stress-strain law of a bulk fiber (model.md section 7): its
+// secant modulus Y(e) = sigma(e) / e as a function of the fiber's strain
+// e = |x_i - x_j| / L_ij - 1 and of a parameter vector p, with Y(0) the
+// small-strain modulus, and the derivatives the Newton tangent and the
+// calibration need. Everything else (the stencil, the kernels, Newton, the
+// sensitivities, the fitter, the JSON reader) works from this interface, so
+// a new law is one class: derive, then register_law() it (see the test
+// FiberLaw.ALawAddedFromOutsideTheLibraryRunsNewtonAndSensitivities).
+class LawModel {
+ public:
+  virtual ~LawModel() = default;
+  // The name experiment files give as the law's "type".
+  virtual std::string name() const = 0;
+  // The parameters p by name, in order ("Y", "Y0", "beta", ...): what a fit varies.
+  virtual std::vector<std::string> parameter_names() const = 0;
+  virtual double modulus(const double* p, double e) const = 0;  // Y(e)
+  virtual double slope(const double* p, double e) const = 0;    // dY/de
+  // dY/dp_k at e.
+  virtual double modulus_derivative(const double* p, int k, double e) const = 0;
+  // Y and dY/de at n strains (a loop over modulus and slope unless overridden).
+  virtual void evaluate(const double* p, const double* strain, size_t n, double* Y,
+                        double* Yp) const;
+  // "" when the law is usable, else why not, naming the parameter. The
+  // default: every parameter finite, and Y positive and finite at 65 strains
+  // spread over [lowest, highest].
+  virtual std::string check(const double* p, double lowest, double highest) const;
+  // True when Y does not depend on the strain (the linear model).
+  virtual bool is_constant() const { return false; }
+  // Whether parameter k is positive by nature (a modulus: a fit may vary it
+  // in log scale), or may take either sign (an exponent).
+  virtual bool is_positive(int /*k*/) const { return true; }
+
+  // Fixed settings that are not fitted (a transition width, a table), for
+  // output files: name and values (one value for a scalar).
+  struct Setting {
+    std::string name;
+    std::vector<double> values;
+    bool scalar = true;
+  };
+  virtual std::vector<Setting> settings() const { return {}; }
+};
+
+// A law: its kind (a LawModel, shared) and its parameter values.
 class FiberLaw {
  public:
-  enum class Kind {
-    Constant,     // Y: the paper's linear model
-    Exponential,  // Y0 exp(beta e): stiffening in tension, softening in compression
-    Bilinear,     // Y_t in tension, Y_c in compression, joined smoothly over |e| < transition
-    Tabulated,    // a piecewise-linear sigma(e), e.g. from a tensile test, times `scale`
-  };
+  // Throws std::invalid_argument when the values do not match the names.
+  FiberLaw(std::shared_ptr<const LawModel> model, std::vector<double> parameters);
 
-  static FiberLaw constant(double Y);
+  // The built-in laws.
+  static FiberLaw constant(double Y);  // the paper's linear model
+  // Y0 exp(beta e): stiffening in tension, softening in compression.
   static FiberLaw exponential(double Y0, double beta);
-  // The secant modulus jumps at e = 0, and with the paper's vector spring so
-  // does the force (u_i - u_j need not vanish where e does), which stalls
-  // Newton. A C1 blend over |e| < transition (a strain; 0 for the sharp law)
-  // removes the jump; Y(0) is then the mean of Y_t and Y_c.
+  // Y_t in tension, Y_c in compression. The secant modulus jumps at e = 0, and
+  // with the paper's vector spring so does the force (u_i - u_j need not
+  // vanish where e does), which stalls Newton. A C1 blend over
+  // |e| < transition (a strain; 0 for the sharp law) removes the jump; Y(0)
+  // is then the mean of Y_t and Y_c.
   static FiberLaw bilinear(double Y_t, double Y_c, double transition = 0.005);
-  double transition() const { return c_; }
-  // strain strictly increasing, one point (0, 0); outside the table the end
-  // segments are extended.
+  // A piecewise-linear sigma(e), e.g. from a tensile test, times the
+  // parameter `scale`: strain strictly increasing, one point (0, 0); outside
+  // the table the end segments are extended.
   static FiberLaw tabulated(std::vector<double> strain, std::vector<double> stress);
 
-  Kind kind() const { return kind_; }
-  const char* name() const;  // "constant", "exponential", "bilinear", "tabulated"
-  bool is_constant() const { return kind_ == Kind::Constant; }
+  std::string name() const { return model_->name(); }
+  bool is_constant() const { return model_->is_constant(); }
+  const LawModel& model() const { return *model_; }
 
-  double modulus(double strain) const;  // Y(e)
-  double slope(double strain) const;    // dY/de
+  double modulus(double strain) const { return model_->modulus(p(), strain); }  // Y(e)
+  double slope(double strain) const { return model_->slope(p(), strain); }      // dY/de
   // Y and dY/de at n strains (strain may alias neither output): the pair
-  // kernels call this once per row, with the law's switch outside the loop.
-  void evaluate(const double* strain, size_t n, double* modulus, double* slope) const;
+  // kernels call this once per row, with the law's dispatch outside the loop.
+  void evaluate(const double* strain, size_t n, double* modulus, double* slope) const {
+    model_->evaluate(p(), strain, n, modulus, slope);
+  }
 
-  const std::vector<std::string>& parameter_names() const;
+  const std::vector<std::string>& parameter_names() const { return names_; }
+  const std::vector<double>& parameters() const { return parameters_; }
   double parameter(const std::string& name) const;  // throws std::invalid_argument
   void set_parameter(const std::string& name, double value);
-  // dY/dtheta at a strain, for the parameter `name`.
-  double modulus_derivative(const std::string& name, double strain) const;
   // The position of a parameter among parameter_names() (throws
   // std::invalid_argument for an unknown name), and dY/dtheta by that
   // position: resolved once, outside the pair loops.
   int parameter_index(const std::string& name) const;
-  double modulus_derivative(int index, double strain) const;
+  double modulus_derivative(int index, double strain) const {
+    return model_->modulus_derivative(p(), index, strain);
+  }
+  double modulus_derivative(const std::string& name, double strain) const {
+    return modulus_derivative(parameter_index(name), strain);
+  }
 
   // "" when the law is usable, else why not (naming the parameter): a
   // non-positive or non-finite modulus at a strain in [lowest, highest], a
   // table that is not strictly increasing, or one without the point (0, 0).
-  std::string check(double lowest_strain = -0.9, double highest_strain = 2.0) const;
-
-  const std::vector<double>& table_strain() const { return strain_; }
-  const std::vector<double>& table_stress() const { return stress_; }
+  std::string check(double lowest_strain = -0.9, double highest_strain = 2.0) const {
+    return model_->check(p(), lowest_strain, highest_strain);
+  }
+  std::vector<LawModel::Setting> settings() const { return model_->settings(); }
 
  private:
-  // The table segment holding `strain` (end segments extended).
-  size_t segment(double strain) const;
+  const double* p() const { return parameters_.data(); }
 
-  Kind kind_ = Kind::Constant;
-  double a_ = 1.0;  // Y, Y0, Y_t, or the table's scale
-  double b_ = 0.0;  // beta or Y_c
-  double c_ = 0.0;  // the bilinear law's transition width
-  std::vector<double> strain_, stress_;  // Tabulated
+  std::shared_ptr<const LawModel> model_;
+  std::vector<std::string> names_;
+  std::vector<double> parameters_;
 };
+
+// The law kinds that experiment files can name besides the built-ins
+// (constant, exponential, bilinear, tabulated): a registered law is read as
+// {"type": name, <each parameter>: number}. Throws std::invalid_argument when
+// the name is taken or empty. Thread-safe.
+void register_law(std::shared_ptr<const LawModel> model);
+// The registered law of that name, or null.
+std::shared_ptr<const LawModel> find_registered_law(const std::string& name);
+std::vector<std::string> registered_law_names();
 
 }  // namespace fiberfluid::model

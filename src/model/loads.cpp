@@ -2,6 +2,8 @@
 #include "model/loads.hpp"
 
 #include <cassert>
+#include <stdexcept>
+#include <string>
 
 namespace fiberfluid::model {
 
@@ -23,12 +25,26 @@ double Schedule::factor(int step, int steps) const {
   return 0.0;
 }
 
-Eigen::VectorXd hydrostatic_depths(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration) {
+double hydrostatic_level(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration) {
+  const double magnitude = acceleration.norm();
+  if (magnitude == 0.0 || X.rows() == 0) return 0.0;
+  return (X * (acceleration.head(X.cols()) / magnitude)).minCoeff();
+}
+
+Eigen::VectorXd hydrostatic_heads(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration,
+                                  double level) {
   const double magnitude = acceleration.norm();
   if (magnitude == 0.0) return Eigen::VectorXd::Zero(X.rows());
-  const Eigen::VectorXd direction = acceleration.head(X.cols()) / magnitude;
-  const Eigen::VectorXd along = X * direction;
-  return along.array() - along.minCoeff();
+  const Eigen::VectorXd along = X * (acceleration.head(X.cols()) / magnitude);
+  return along.array() - level;
+}
+
+Eigen::VectorXd hydrostatic_depths(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration) {
+  return hydrostatic_heads(X, acceleration, hydrostatic_level(X, acceleration));
+}
+
+double hydrostatic_pressure_per_depth(const Load& load, double factor) {
+  return factor * load.density * load.acceleration.norm();
 }
 
 Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X,
@@ -39,15 +55,19 @@ Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X,
     const Load& load = model.loads[l];
     const double f = factors[l];
     if (f == 0.0) continue;
-    if (load.kind == Load::Kind::Point) {
-      for (int a = 0; a < dim; ++a) B[model.dof(load.vertex, a)] += f * load.force[a];
-      continue;
+    switch (load.kind) {
+      case Load::Kind::Point:
+        for (int a = 0; a < dim; ++a) B[model.dof(load.vertex, a)] += f * load.force[a];
+        continue;
+      case Load::Kind::Hydrostatic: {
+        // Outward on each vertex, rho |a| h_i S_i (hydrostatic_heads).
+        const double scale = hydrostatic_pressure_per_depth(load, f);
+        const Eigen::VectorXd h = hydrostatic_depths(X, load.acceleration);
+        for (int a = 0; a < dim; ++a) B.segment(a * n, n) += scale * h.cwiseProduct(S.col(a));
+        continue;
+      }
     }
-    // The fluid pushes outward on each vertex with rho |a| h_i S_i; over a
-    // closed surface these sum to the fluid's weight rho a V.
-    const Eigen::VectorXd h = hydrostatic_depths(X, load.acceleration);
-    const double scale = f * load.density * load.acceleration.norm();
-    for (int a = 0; a < dim; ++a) B.segment(a * n, n) += scale * h.cwiseProduct(S.col(a));
+    throw std::invalid_argument("load " + std::to_string(l) + " is of an unknown kind");
   }
   return B;
 }

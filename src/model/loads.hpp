@@ -8,9 +8,22 @@
 
 namespace fiberfluid::model {
 
-// Depth of each vertex below the highest point of X along the acceleration
-// direction: h_i = (x_i - x_top) . a / |a| >= 0. X: #V by dim.
+// The hydrostatic load (paper Eq. 4's fluid weight): the fluid pushes on
+// vertex i with rho |a| h_i S_i, h_i its depth below a level along the
+// acceleration a. Written once here; the paper's incremental scheme measures
+// depth below the highest point of the geometry it linearises at
+// (hydrostatic_depths), Newton's equilibrium below the highest reference
+// point (a fixed level, so that q_i is smooth in x).
+
+// The level of the highest point of X along a: min_i x_i . a / |a| (0 for a = 0).
+double hydrostatic_level(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration);
+// h_i = x_i . a / |a| - level for every row of X (zeros for a = 0). X: #V by dim.
+Eigen::VectorXd hydrostatic_heads(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration,
+                                  double level);
+// Depth below X's own highest point: heads at hydrostatic_level(X, a), >= 0.
 Eigen::VectorXd hydrostatic_depths(const Eigen::MatrixXd& X, const Eigen::Vector3d& acceleration);
+// The pressure per unit depth of a hydrostatic load at load factor f: f rho |a|.
+double hydrostatic_pressure_per_depth(const Load& load, double factor);
 
 // The load part of the right-hand side B (paper Eq. 4) at positions X with
 // vertex area vectors S (#V by dim), each load scaled by factors[l]. Length

@@ -13,6 +13,18 @@
 
 namespace fiberfluid::model {
 
+// A material parameter resolved from its name once (Material::resolve), so
+// that loops over pairs or fit evaluations never compare strings.
+struct MaterialParameter {
+  enum class Kind {
+    Law,             // the law's parameter `index` ("Y", "Y0", "beta", ...)
+    SurfaceTension,  // "gamma"
+    AxisFactor,      // "factor_x", "factor_y", "factor_z": axis `index`
+  };
+  Kind kind = Kind::Law;
+  int index = 0;
+};
+
 // The material: the bulk fibers' law Y(e) (force per area, Pa), the paper's
 // per-axis moduli as multipliers of the law (the x block uses
 // axis_factors.x() Y(e), and so on), and a constant surface tension on mesh
@@ -34,6 +46,21 @@ struct Material {
   static Material linear(double Y, double gamma = 0.0) {
     return {FiberLaw::constant(Y), Eigen::Vector3d::Ones(), gamma};
   }
+
+  // The parameters by name, the one list every front end and the fitter use:
+  // the law's, "gamma", then "factor_x" ... (one per axis of a dim-D model).
+  std::vector<std::string> parameter_names(int dim = 3) const;
+  // Throws std::invalid_argument for a name not in parameter_names(dim),
+  // listing them.
+  MaterialParameter resolve(const std::string& name, int dim = 3) const;
+  bool has_parameter(const std::string& name, int dim = 3) const;
+  double parameter(const MaterialParameter& p) const;
+  double parameter(const std::string& name) const { return parameter(resolve(name)); }
+  void set_parameter(const MaterialParameter& p, double value);
+  void set_parameter(const std::string& name, double value) { set_parameter(resolve(name), value); }
+  // Whether the parameter is positive by nature (a modulus, gamma, a
+  // factor), so that a fit may vary it in log scale; false for an exponent.
+  bool is_positive_parameter(const std::string& name) const;
 };
 
 // How a load or a prescribed displacement grows over the load steps: the

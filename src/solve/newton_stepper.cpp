@@ -384,7 +384,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   why = paddle_problem(model, options.steps);
   if (!why.empty()) return fail(why);
   for (const std::string& name : options.sensitivities.parameters)
-    if (!model::is_material_parameter(model.material, name))
+    if (!model.material.has_parameter(name, model.dim()))
       return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
   model::DofPartition partition;
   std::unique_ptr<NewtonSolver> solver;

@@ -10,6 +10,7 @@
 
 #include "geom/error.hpp"
 #include "model/assembly.hpp"
+#include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::model {
@@ -164,6 +165,39 @@ TEST(Equilibrium, ParameterDerivativesMatchCentralDifferences) {
   EXPECT_THROW(Equilibrium(small_sphere(FiberLaw::constant(1.0)))
                    .parameter_derivatives(Eigen::VectorXd::Zero(127), {"beta"}),
                std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fiberfluid::model
+
+namespace fiberfluid::model {
+namespace {
+
+// The equations are a sum of named terms, one per load; a load of a kind no
+// term knows is an error, never silently another kind.
+TEST(EquilibriumTerms, EachLoadIsATermAndAnUnknownKindIsAnError) {
+  Model m = small_sphere(FiberLaw::constant(3000.0));
+  const std::vector<std::string> expected = {"bulk fibers", "surface tension",
+                                             "pressure and volume", "hydrostatic load",
+                                             "point load"};
+  EXPECT_EQ(Equilibrium(m).term_names(), expected);
+  m.loads[0].kind = static_cast<Load::Kind>(7);
+  EXPECT_THROW(Equilibrium{m}, std::invalid_argument);
+  const std::vector<double> factors(m.loads.size(), 1.0);
+  EXPECT_THROW(load_vector(m, m.surface.V, m.surface.V, factors), std::invalid_argument);
+}
+
+// The loads' residual is minus the external force, term by term: the
+// residual without loads plus the external forces gives the residual.
+TEST(EquilibriumTerms, ExternalForcesAreTheLoadTermsAlone) {
+  const Model m = small_sphere(FiberLaw::exponential(3000.0, 4.0));
+  const Equilibrium eq(m);
+  const Eigen::VectorXd x = random_state(m, 4);
+  const std::vector<double> factors = {0.7, 0.4}, none = {0.0, 0.0};
+  const Eigen::VectorXd loaded = eq.residual(x, factors), unloaded = eq.residual(x, none);
+  const Eigen::VectorXd F = eq.external_forces(x, factors);
+  EXPECT_GT(F.norm(), 0.0);
+  EXPECT_LT((unloaded - F - loaded).norm(), 1e-12 * loaded.norm());
 }
 
 }  // namespace

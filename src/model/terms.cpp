@@ -1,0 +1,463 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/terms.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "geom/area_vectors.hpp"
+#include "model/assembly.hpp"
+#include "model/loads.hpp"
+#include "model/pair_kernels.hpp"
+#include "model/pair_stencil.hpp"
+
+namespace fiberfluid::model {
+
+TermState::TermState(const TermContext& c, const Eigen::VectorXd& x_,
+                     const std::vector<double>& factors_)
+    : x(x_),
+      factors(factors_),
+      X(positions(c.model, x_)),
+      U(displacements(c.model, x_)),
+      S(c.C0 * geom::summed_face_area_vectors(X, c.model.surface.F)),
+      P(x_[c.model.pressure_dof()]) {}
+
+namespace {
+
+Eigen::Vector3d row3(const Eigen::MatrixXd& M, Eigen::Index i) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  v.head(M.cols()) = M.row(i).transpose();
+  return v;
+}
+
+Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d m;
+  m << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return m;
+}
+
+// dA_f/dx_v for the k-th corner of face f (dim x dim, padded to 3x3). 3D:
+// A_f = (x0 x x1 + x1 x x2 + x2 x x0) / 2, so dA_f/dx_k = [x_{k+2} - x_{k+1}]_x / 2.
+// 2D: A_f = (d_y, -d_x), d = x_1 - x_0.
+Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
+                                     Eigen::Index f, int k) {
+  if (X.cols() == 3) {
+    const Eigen::Vector3d next = X.row(F(f, (k + 1) % 3)), after = X.row(F(f, (k + 2) % 3));
+    return 0.5 * cross_matrix(after - next);
+  }
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  m(0, 1) = 1.0;
+  m(1, 0) = -1.0;
+  return k == 1 ? m : Eigen::Matrix3d(-m);
+}
+
+// The terms c_i S_i(x) (pressure: c = P; hydrostatic load: c = -q) have the
+// geometric tangent c_i dS_i/dx_v = c_i C0 sum over faces f at i and v of
+// dA_f/dx_v. J += it.
+void add_area_vector_tangent(const TermContext& ctx, const Eigen::MatrixXd& X,
+                             const Eigen::VectorXd& c, Eigen::MatrixXd& J) {
+  const int n = ctx.model.num_vertices(), dim = ctx.model.dim();
+  const Eigen::MatrixXi& F = ctx.model.surface.F;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < F.cols(); ++k) {
+      const Eigen::Matrix3d dA = ctx.C0 * face_area_derivative(X, F, f, k);
+      const int v = F(f, k);
+      for (int corner = 0; corner < F.cols(); ++corner) {
+        const int i = F(f, corner);
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim; ++b) J(a * n + i, b * n + v) += c[i] * dA(a, b);
+      }
+    }
+}
+
+// The same applied to W (#V by dim): row i is c_i dS_i/dx W; #V by 3.
+Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixXd& X,
+                                    const Eigen::VectorXd& c, const Eigen::MatrixXd& W) {
+  const Eigen::MatrixXi& F = ctx.model.surface.F;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    // sum_v dA_f/dx_v w_v, then spread over the corners with their c_i.
+    Eigen::Vector3d dA = Eigen::Vector3d::Zero();
+    for (int k = 0; k < F.cols(); ++k) dA += face_area_derivative(X, F, f, k) * row3(W, F(f, k));
+    for (int corner = 0; corner < F.cols(); ++corner)
+      out.row(F(f, corner)) += ctx.C0 * c[F(f, corner)] * dA.transpose();
+  }
+  return out;
+}
+
+// ---- Surface tension -----------------------------------------------------------
+
+class SurfaceTensionTerm final : public EquilibriumTerm {
+ public:
+  explicit SurfaceTensionTerm(const TermContext& c) : c_(c) {}
+  const char* name() const override { return "surface tension"; }
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
+    add_rows(gamma() * (c_.surface * s.U), R);
+  }
+  void add_tangent(const TermState&, Eigen::MatrixXd& J) const override {
+    const int n = c_.model.num_vertices();
+    for (int col = 0; col < c_.surface.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it)
+        for (int a = 0; a < c_.model.dim(); ++a)
+          J(a * n + it.row(), a * n + it.col()) += gamma() * it.value();
+  }
+  void add_tangent_product(const TermState&, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
+                           Eigen::VectorXd& out) const override {
+    add_rows(gamma() * (c_.surface * W), out);
+  }
+  void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
+                                Eigen::Ref<Eigen::VectorXd> column) const override {
+    if (p.kind != MaterialParameter::Kind::SurfaceTension) return;
+    const Eigen::MatrixXd L = c_.surface * s.U;
+    const int n = c_.model.num_vertices();
+    for (int a = 0; a < c_.model.dim(); ++a) column.segment(a * n, n) += L.col(a);
+  }
+
+ private:
+  double gamma() const { return c_.model.material.surface_tension; }
+  void add_rows(const Eigen::MatrixXd& rows, Eigen::VectorXd& out) const {
+    const int n = c_.model.num_vertices();
+    for (int a = 0; a < c_.model.dim(); ++a) out.segment(a * n, n) += rows.col(a);
+  }
+  const TermContext& c_;
+};
+
+// ---- Pressure and volume -------------------------------------------------------
+
+class PressureVolumeTerm final : public EquilibriumTerm {
+ public:
+  explicit PressureVolumeTerm(const TermContext& c) : c_(c) {}
+  const char* name() const override { return "pressure and volume"; }
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    for (int a = 0; a < dim; ++a) R.segment(a * n, n) += s.P * s.S.col(a);
+    R[c_.model.pressure_dof()] +=
+        dim * c_.C0 * (geom::enclosed_volume(s.X, c_.model.surface.F) - c_.volume0);
+  }
+  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim(), p = c_.model.pressure_dof();
+    add_area_vector_tangent(c_, s.X, Eigen::VectorXd::Constant(n, s.P), J);
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a < dim; ++a) {
+        J(a * n + i, p) += s.S(i, a);  // dR_i/dP
+        J(p, a * n + i) += s.S(i, a);  // dg/dx_i = S_i(x)
+      }
+  }
+  void add_tangent_product(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
+                           Eigen::VectorXd& out) const override {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim(), p = c_.model.pressure_dof();
+    const Eigen::MatrixXd geometric =
+        area_vector_product(c_, s.X, Eigen::VectorXd::Constant(n, s.P), W);
+    double volume_rate = 0.0;
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a < dim; ++a) {
+        out[a * n + i] += geometric(i, a) + s.S(i, a) * v[p];
+        volume_rate += s.S(i, a) * W(i, a);
+      }
+    out[p] += volume_rate;
+  }
+
+ private:
+  const TermContext& c_;
+};
+
+// ---- Loads ---------------------------------------------------------------------
+
+// A force on one vertex, lambda F: dead (no tangent).
+class PointLoadTerm final : public EquilibriumTerm {
+ public:
+  PointLoadTerm(const TermContext& c, size_t index) : c_(c), index_(index) {}
+  const char* name() const override { return "point load"; }
+  bool is_load() const override { return true; }
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
+    const Load& load = c_.model.loads[index_];
+    for (int a = 0; a < c_.model.dim(); ++a)
+      R[c_.model.dof(load.vertex, a)] -= s.factors[index_] * load.force[a];
+  }
+  void add_tangent(const TermState&, Eigen::MatrixXd&) const override {}
+  void add_tangent_product(const TermState&, const Eigen::VectorXd&, const Eigen::MatrixXd&,
+                           Eigen::VectorXd&) const override {}
+
+ private:
+  const TermContext& c_;
+  size_t index_;
+};
+
+// The fluid's weight, q_i(x) S_i(x) outward (loads.hpp), a follower load:
+// q_i = lambda rho |a| h_i with h_i the depth of x_i below the highest
+// reference point, so dq_i/dx_i = lambda rho a (the same for every i).
+class HydrostaticLoadTerm final : public EquilibriumTerm {
+ public:
+  HydrostaticLoadTerm(const TermContext& c, size_t index)
+      : c_(c),
+        index_(index),
+        level_(hydrostatic_level(c.model.surface.V, c.model.loads[index].acceleration)) {}
+  const char* name() const override { return "hydrostatic load"; }
+  bool is_load() const override { return true; }
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
+    if (inactive(s)) return;
+    const Eigen::VectorXd q = pressures(s);
+    const int n = c_.model.num_vertices();
+    for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) -= q.cwiseProduct(s.S.col(a));
+  }
+  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+    if (inactive(s)) return;
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    add_area_vector_tangent(c_, s.X, -pressures(s), J);
+    const Eigen::Vector3d gradient = pressure_gradient(s);
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) J(a * n + i, b * n + i) -= s.S(i, a) * gradient[b];
+  }
+  void add_tangent_product(const TermState& s, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
+                           Eigen::VectorXd& out) const override {
+    if (inactive(s)) return;
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    const Eigen::MatrixXd geometric = area_vector_product(c_, s.X, -pressures(s), W);
+    const Eigen::Vector3d gradient = pressure_gradient(s);
+    for (int i = 0; i < n; ++i) {
+      const double along = gradient.head(dim).dot(W.row(i).transpose());
+      for (int a = 0; a < dim; ++a) out[a * n + i] += geometric(i, a) - s.S(i, a) * along;
+    }
+  }
+
+ private:
+  const Load& load() const { return c_.model.loads[index_]; }
+  bool inactive(const TermState& s) const {
+    return s.factors[index_] == 0.0 || load().acceleration.norm() == 0.0;
+  }
+  Eigen::VectorXd pressures(const TermState& s) const {
+    return hydrostatic_pressure_per_depth(load(), s.factors[index_]) *
+           hydrostatic_heads(s.X, load().acceleration, level_);
+  }
+  Eigen::Vector3d pressure_gradient(const TermState& s) const {
+    const Eigen::Vector3d direction = load().acceleration / load().acceleration.norm();
+    return hydrostatic_pressure_per_depth(load(), s.factors[index_]) * direction;
+  }
+
+  const TermContext& c_;
+  size_t index_;
+  double level_;
+};
+
+}  // namespace
+
+std::unique_ptr<EquilibriumTerm> make_load_term(const TermContext& c, size_t index) {
+  switch (c.model.loads[index].kind) {
+    case Load::Kind::Point: return std::make_unique<PointLoadTerm>(c, index);
+    case Load::Kind::Hydrostatic: return std::make_unique<HydrostaticLoadTerm>(c, index);
+  }
+  throw std::invalid_argument("load " + std::to_string(index) + " is of an unknown kind");
+}
+
+std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c) {
+  std::vector<std::unique_ptr<EquilibriumTerm>> terms;
+  terms.push_back(std::make_unique<SurfaceTensionTerm>(c));
+  terms.push_back(std::make_unique<PressureVolumeTerm>(c));
+  for (size_t l = 0; l < c.model.loads.size(); ++l) terms.push_back(make_load_term(c, l));
+  return terms;
+}
+
+// ---- Bulk fibers ---------------------------------------------------------------
+
+namespace {
+
+// The bulk fibers at X, U as the tiled kernels visit them.
+DeformedPairs deformed_pairs(const TermContext& c, const Eigen::MatrixXd& X,
+                             const Eigen::MatrixXd& U) {
+  return DeformedPairs(c.model.surface.V, X, U, c.area0, c.pair_factors, c.model.material.law,
+                       c.model.material.kinematics);
+}
+
+// Column pointers of the reference, current and displacement rows (three
+// each; the third is all zeros in 2D).
+struct Columns {
+  const double* s[3];
+  const double* x[3];
+  const double* u[3];
+  std::vector<double> zeros;
+
+  Columns(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X, const Eigen::MatrixXd& U)
+      : zeros(static_cast<size_t>(S.rows()), 0.0) {
+    for (int a = 0; a < 3; ++a) {
+      const bool has = a < S.cols();
+      s[a] = has ? S.col(a).data() : zeros.data();
+      x[a] = has ? X.col(a).data() : zeros.data();
+      u[a] = has ? U.col(a).data() : zeros.data();
+    }
+  }
+};
+
+// One row's pair state for dR/dtheta: h, L, r, strain, Y, Y' for every j.
+struct RowState {
+  std::vector<double> h, L, r, e, Y, Yp;
+  explicit RowState(size_t n) : h(n), L(n), r(n), e(n), Y(n), Yp(n) {}
+};
+
+void fill_row(const TermContext& c, int i, const Columns& col, RowState& row) {
+  const size_t n = static_cast<size_t>(c.model.num_vertices()), u = static_cast<size_t>(i);
+  c.pair_factors.row(i, row.h.data());
+  double *L = row.L.data(), *r = row.r.data(), *e = row.e.data();
+  const double *s0 = col.s[0], *s1 = col.s[1], *s2 = col.s[2];
+  const double *x0 = col.x[0], *x1 = col.x[1], *x2 = col.x[2];
+#pragma omp simd
+  for (size_t j = 0; j < n; ++j) {
+    // j == i: h = 0 makes the pair vanish; lengths 1 there only avoid 0/0.
+    L[j] = j == u ? 1.0 : pair_length(s0[u] - s0[j], s1[u] - s1[j], s2[u] - s2[j]);
+    r[j] = j == u ? 1.0 : pair_length(x0[u] - x0[j], x1[u] - x1[j], x2[u] - x2[j]);
+    e[j] = fiber_strain(r[j], L[j]);
+  }
+  c.model.material.law.evaluate(e, n, row.Y.data(), row.Yp.data());
+}
+
+}  // namespace
+
+Eigen::MatrixXd BulkFiberTerm::forces(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const {
+  return deformed_pairs(c_, X, U).forces();
+}
+
+void BulkFiberTerm::coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                 Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+  deformed_pairs(c_, X, U).coefficients(c1, c2);
+}
+
+void BulkFiberTerm::add_residual(const TermState& s, Eigen::VectorXd& R) const {
+  const int n = c_.model.num_vertices();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  const Eigen::MatrixXd bulk = forces(s.X, s.U);
+  for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) += m[a] * bulk.col(a);
+}
+
+void BulkFiberTerm::add_tangent_product(const TermState& s, const Eigen::VectorXd&,
+                                        const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
+  const int n = c_.model.num_vertices();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  const Eigen::MatrixXd bulk = deformed_pairs(c_, s.X, s.U).tangent_product(W);
+  for (int a = 0; a < c_.model.dim(); ++a) out.segment(a * n, n) += m[a] * bulk.col(a);
+}
+
+void BulkFiberTerm::add_tangent(const TermState& s, Eigen::MatrixXd& J) const {
+  Eigen::MatrixXd c1, c2;
+  coefficients(s.X, s.U, &c1, &c2);
+  add_dense_blocks(s.X, s.U, c1, c2, J);
+}
+
+void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                     const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2,
+                                     Eigen::MatrixXd& J) const {
+  const int n = c_.model.num_vertices(), dim = c_.model.dim();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  // Column by column (the pair coefficients are symmetric, so column j of
+  // the stored arrays runs over i): for j != i,
+  //   J(a i, b j) = -m_a T_ab(i, j)   (the stencil's pair_tangent_entry),
+  // and each diagonal block is minus the sum of its row's off-diagonal ones.
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+    // T_ab of the pair (i, j) with its coefficients c.
+    const auto block = [&](int i, int j, const PairCoefficients& c, int a, int b) {
+      return pair_tangent_entry<K>(c, a == b, X(i, a) - X(j, a), U(i, a) - U(j, a),
+                                   X(i, b) - X(j, b));
+    };
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int j = 0; j < n; ++j) {
+      const double* c1 = C1.col(j).data();
+      const double* c2 = C2.col(j).data();
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) {
+          double* column = J.col(b * n + j).data() + a * n;
+          for (int i = 0; i < n; ++i)
+            if (i != j) column[i] += -m[a] * block(i, j, {c1[i], c2[i]}, a, b);
+        }
+    }
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      const double* c1 = C1.col(i).data();
+      const double* c2 = C2.col(i).data();
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) {
+          double sum = 0.0;  // c1_ii = c2_ii = 0: the pair (i, i) adds nothing
+          for (int j = 0; j < n; ++j) sum += block(i, j, {c1[j], c2[j]}, a, b);
+          J(a * n + i, b * n + i) += m[a] * sum;
+        }
+    }
+  });
+}
+
+void BulkFiberTerm::add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                       const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2,
+                                       const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
+  const int n = c_.model.num_vertices(), dim = c_.model.dim();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  const std::vector<double> zeros(static_cast<size_t>(n), 0.0);
+  const double *x[3], *d[3], *w[3];
+  for (int a = 0; a < 3; ++a) {
+    x[a] = a < dim ? X.col(a).data() : zeros.data();
+    d[a] = a < dim ? U.col(a).data() : zeros.data();
+    w[a] = a < dim ? W.col(a).data() : zeros.data();
+  }
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      const double* c1 = C1.col(i).data();
+      const double* c2 = C2.col(i).data();
+      const auto u = static_cast<size_t>(i);
+      double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2)
+      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+        const PairCoefficients c{c1[j], c2[j]};
+        const double b0 = x[0][u] - x[0][j], b1 = x[1][u] - x[1][j], b2 = x[2][u] - x[2][j];
+        const double v0 = w[0][u] - w[0][j], v1 = w[1][u] - w[1][j], v2 = w[2][u] - w[2][j];
+        const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+        p0 += pair_tangent<K>(c, v0, b_dot_v, b0, d[0][u] - d[0][j]);
+        p1 += pair_tangent<K>(c, v1, b_dot_v, b1, d[1][u] - d[1][j]);
+        p2 += pair_tangent<K>(c, v2, b_dot_v, b2, d[2][u] - d[2][j]);
+      }
+      const double product[3] = {p0, p1, p2};
+      for (int a = 0; a < dim; ++a) out[a * n + i] += m[a] * product[a];
+    }
+  });
+}
+
+void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialParameter& p,
+                                             Eigen::Ref<Eigen::VectorXd> column) const {
+  if (p.kind == MaterialParameter::Kind::SurfaceTension) return;
+  const int n = c_.model.num_vertices(), dim = c_.model.dim();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  const FiberLaw& law = c_.model.material.law;
+  // factor_a: the fiber force of that axis over its factor; a law parameter:
+  // m_a times the force's derivative in it.
+  const int axis = p.kind == MaterialParameter::Kind::AxisFactor ? p.index : -1;
+  const Columns col(c_.model.surface.V, s.X, s.U);
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+#pragma omp parallel
+    {
+      RowState row(static_cast<size_t>(n));
+#pragma omp for schedule(dynamic, 16)
+      for (int i = 0; i < n; ++i) {
+        fill_row(c_, i, col, row);
+        const auto u = static_cast<size_t>(i);
+        double sum[3] = {0.0, 0.0, 0.0};
+        for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
+          if (row.h[j] == 0.0) continue;
+          const double a = bulk_weight(row.h[j], c_.area0[i], c_.area0[static_cast<Eigen::Index>(j)],
+                                       row.L[j]);
+          const PairCoefficients pc = K::coefficients(a, row.Y[j], row.Yp[j], row.r[j], row.L[j]);
+          const double dY = axis >= 0 ? 0.0 : law.modulus_derivative(p.index, row.e[j]);
+          for (int k = 0; k < 3; ++k) {
+            const double b = col.x[k][u] - col.x[k][j], d = col.u[k][u] - col.u[k][j];
+            sum[k] += axis >= 0 ? pair_force<K>(pc, b, d)
+                                : pair_parameter_force<K>(a, dY, row.r[j], row.L[j], b, d);
+          }
+        }
+        if (axis >= 0)
+          column[axis * n + i] += sum[axis];
+        else
+          for (int a = 0; a < dim; ++a) column[a * n + i] += m[a] * sum[a];
+      }
+    }
+  });
+}
+
+}  // namespace fiberfluid::model

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The terms of the equilibrium equations (model.md section 7). Equilibrium's
+// residual R(x), its tangent dR/dx (dense and as a product) and dR/dtheta are
+// sums over these terms:
+//
+//   bulk fibers       sum_j m_a f_a(i, j)           (the stencil's kinematics)
+//   surface tension   gamma sum_k b_ik (u_i - u_k)  (paper Eq. 7)
+//   pressure, volume  P S_i(x), and the row g = dim C0 (V(x) - V0)
+//   point load        -lambda F                     (one term per load)
+//   hydrostatic load  -q_i(x) S_i(x)                (one term per load)
+//
+// A new load kind is one new term and its case in make_load_term. Contact
+// with the paddles is not a term: contacts are held unknowns of the stepper's
+// active set (newton_stepper.cpp), and their reactions are the residual's rows.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "model/fiber_network.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::model {
+
+// What the terms read of the reference configuration (Equilibrium owns it).
+struct TermContext {
+  const Model& model;
+  const PairFactors& pair_factors;
+  const Eigen::VectorXd& area0;                // |S_i| at the reference
+  const Eigen::SparseMatrix<double>& surface;  // surface_tension_laplacian of the reference
+  double C0 = 0.0;                             // the reference area constant
+  double volume0 = 0.0;
+};
+
+// One state x = [u; P] with what several terms share, computed once.
+struct TermState {
+  TermState(const TermContext& context, const Eigen::VectorXd& x,
+            const std::vector<double>& factors);
+  const Eigen::VectorXd& x;
+  const std::vector<double>& factors;  // per load
+  Eigen::MatrixXd X, U;                // positions and displacements, #V by dim
+  Eigen::MatrixXd S;                   // S_i(x) = C0 sum_{f at i} A_f(x), #V by dim
+  double P = 0.0;
+};
+
+class EquilibriumTerm {
+ public:
+  virtual ~EquilibriumTerm() = default;
+  virtual const char* name() const = 0;
+  // A load's residual is minus the external force it applies (reactions,
+  // Equilibrium::external_forces).
+  virtual bool is_load() const { return false; }
+  // R += this term's part at the state (full layout [u; P]).
+  virtual void add_residual(const TermState& s, Eigen::VectorXd& R) const = 0;
+  // J += its dR/dx (dense, full layout).
+  virtual void add_tangent(const TermState& s, Eigen::MatrixXd& J) const = 0;
+  // out += its dR/dx v; W holds v's displacement rows (#V by dim).
+  virtual void add_tangent_product(const TermState& s, const Eigen::VectorXd& v,
+                                   const Eigen::MatrixXd& W, Eigen::VectorXd& out) const = 0;
+  // column += its dR/dtheta for a material parameter (most terms have none).
+  virtual void add_parameter_derivative(const TermState& /*s*/, const MaterialParameter& /*p*/,
+                                        Eigen::Ref<Eigen::VectorXd> /*column*/) const {}
+};
+
+// The bulk fibers: the one term whose pairs are O(N^2). Besides the term's
+// interface, it gives the pair coefficients for the stored-coefficient
+// tangent operator and applies them.
+class BulkFiberTerm final : public EquilibriumTerm {
+ public:
+  explicit BulkFiberTerm(const TermContext& context) : c_(context) {}
+  const char* name() const override { return "bulk fibers"; }
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override;
+  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override;
+  void add_tangent_product(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
+                           Eigen::VectorXd& out) const override;
+  void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
+                                Eigen::Ref<Eigen::VectorXd> column) const override;
+
+  // The fiber forces before the axis factors, #V by 3.
+  Eigen::MatrixXd forces(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const;
+  // c1 and c2 of every pair (N x N, symmetric, zero diagonal).
+  void coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U, Eigen::MatrixXd* c1,
+                    Eigen::MatrixXd* c2) const;
+  // out += the tangent times W from stored coefficients (one pass over memory).
+  void add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                          const Eigen::MatrixXd& c1, const Eigen::MatrixXd& c2,
+                          const Eigen::MatrixXd& W, Eigen::VectorXd& out) const;
+
+ private:
+  void add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                        const Eigen::MatrixXd& c1, const Eigen::MatrixXd& c2,
+                        Eigen::MatrixXd& J) const;
+  const TermContext& c_;
+};
+
+// The terms other than the bulk fibers, in the order they are summed:
+// surface tension, pressure and volume, then one per load of the model.
+// Throws std::invalid_argument for a load of an unknown kind.
+std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c);
+
+// The term of one load (the model's load `index`).
+std::unique_ptr<EquilibriumTerm> make_load_term(const TermContext& c, size_t index);
+
+}  // namespace fiberfluid::model
