@@ -14,6 +14,7 @@
 #include "app/runner.hpp"
 #include "fem/mesh_tools.hpp"
 #include "fit/calibration.hpp"
+#include "fit/golden_section.hpp"
 #include "metrics/metrics.hpp"
 
 namespace fiberfluid::app {
@@ -309,10 +310,16 @@ Experiment fiber_experiment(const fem::Scene& scene, const fem::Boundary& rest, 
   return ex;
 }
 
-FiberRun run_fiber_model(const fem::Scene& scene, const fem::Boundary& rest, double Y,
-                         double gamma, int steps, bool newton) {
+// The fiber model of a built experiment (fiber_experiment, read and built
+// once: the surface, its fibers) with Y and gamma set directly.
+FiberRun run_fiber_model(const Experiment& built, const fem::Boundary& rest, double Y,
+                         double gamma, int steps) {
   const auto start = std::chrono::steady_clock::now();
-  const Experiment ex = fiber_experiment(scene, rest, Y, gamma, steps, newton);
+  Experiment ex = built;
+  for (Case& c : ex.cases) {
+    c.model.material.law = model::FiberLaw::constant(Y);
+    c.model.material.surface_tension = gamma;
+  }
   FiberRun out;
   out.positions.assign(static_cast<size_t>(steps) + 1, rest.surface.V);
   const Case& c = ex.cases.front();
@@ -364,24 +371,17 @@ FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Sce
   const double E = scene.material.young;
   const Eigen::MatrixXd target_u = target - rest.surface.V;
   if (spec.scene == BenchmarkSpec::Scene::BlockNeedle) {
+    const Experiment built = fiber_experiment(scene, rest, E, 0.0, steps, spec.fiber.newton);
     auto error = [&](double gamma) {
-      const FiberRun run = run_fiber_model(scene, rest, E, gamma, steps, spec.fiber.newton);
+      const FiberRun run = run_fiber_model(built, rest, E, gamma, steps);
       if (!run.ok) return std::numeric_limits<double>::infinity();
       return metrics::relative_energy_norm(target_u, run.positions.back() - rest.surface.V);
     };
-    // gamma / (E L), L = 1 m: from 1e-4 to 10.
-    double lo = std::log(1e-4 * E), hi = std::log(10.0 * E);
-    const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-    double a = hi - ratio * (hi - lo), b = lo + ratio * (hi - lo);
-    double fa = error(std::exp(a)), fb = error(std::exp(b));
-    for (int k = 0; k < 30; ++k) {
-      if (fa < fb) {
-        hi = b, b = a, fb = fa, a = hi - ratio * (hi - lo), fa = error(std::exp(a));
-      } else {
-        lo = a, a = b, fa = fb, b = lo + ratio * (hi - lo), fb = error(std::exp(b));
-      }
-    }
-    const double best = fa < fb ? std::exp(a) : std::exp(b), best_error = std::min(fa, fb);
+    // gamma / (E L), L = 1 m: from 1e-4 to 10, in log scale.
+    const fit::LineMinimum m = fit::golden_section_minimum(
+        [&](double log_gamma) { return error(std::exp(log_gamma)); }, std::log(1e-4 * E),
+        std::log(10.0 * E), 30);
+    const double best = std::exp(m.x), best_error = m.value;
     const double zero_error = error(0.0);
     report.Y = E;
     report.gamma = zero_error <= best_error ? 0.0 : best;
@@ -553,8 +553,9 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
       report.gamma = spec.fiber.gamma;
       report.how = "given";
     }
-    const FiberRun run = run_fiber_model(scene, frames.rest, report.Y, report.gamma, fiber_steps,
-                                         spec.fiber.newton);
+    const FiberRun run = run_fiber_model(
+        fiber_experiment(scene, frames.rest, report.Y, report.gamma, fiber_steps, spec.fiber.newton),
+        frames.rest, report.Y, report.gamma, fiber_steps);
     MetricSeries s;
     s.label = "fiber-model";
     s.ok = run.ok;

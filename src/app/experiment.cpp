@@ -435,21 +435,14 @@ FiberSpec read_fibers(Fields& root) {
   return spec;
 }
 
-// The treecode approximates the linear bulk product inside PCG: anything that
-// needs the exact pair sums or a dense matrix is refused by name.
-void check_treecode(Fields& root, CaseSpec& c) {
-  const auto refuse = [&](const std::string& why) {
-    root.fail("fibers", "\"product\": \"treecode\" " + why);
-  };
-  if (c.stepping.scheme != solve::Scheme::Incremental)
-    refuse("approximates the incremental scheme's linear product; Newton's tangent is exact "
-           "(\"stepping\": {\"scheme\": \"incremental\"})");
-  if (!c.material.material.law.is_constant())
-    refuse("needs a linear material (a constant \"law\")");
-  if (c.stepping.solver == solve::SolverKind::Auto) c.stepping.solver = solve::SolverKind::PCG;
-  if (c.stepping.solver != solve::SolverKind::PCG)
-    refuse("is matrix-free: it goes with \"stepping\": {\"solver\": \"pcg\"}, not \"" +
-           std::string(solve::to_string(c.stepping.solver)) + "\"");
+// The treecode's rules are the library's (solve::treecode_problem): the
+// reader names the field.
+void check_treecode(Fields& root, const CaseSpec& c) {
+  model::Model probe;
+  probe.material = c.material.material;
+  probe.treecode_tolerance = c.fibers.treecode_tolerance;
+  const std::string why = solve::treecode_problem(probe, c.stepping);
+  if (!why.empty()) root.fail("fibers", "\"product\": \"treecode\": " + why);
 }
 
 // Parses one case from a complete simulation document; opens no file.

@@ -68,9 +68,10 @@ Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
   return b;
 }
 
-solve::SolverKind choose(const solve::SteppingOptions& o, const Blocks& b) {
+solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
+                         const Blocks& b) {
   if (o.solver != solve::SolverKind::Auto) return o.solver;
-  return solve::choose_solver(b.largest, b.factors, memory_budget_bytes());
+  return solve::automatic_solver(m, b.largest, b.factors, memory_budget_bytes());
 }
 
 std::string seconds_text(double s) {
@@ -127,7 +128,7 @@ ResourceEstimate estimate_resources(const model::Model& model,
   const bool dense_tangent =
       newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns) ==
                     solve::TangentSolver::Dense;
-  const solve::SolverKind kind = dense_tangent ? solve::SolverKind::DenseLU : choose(o, blocks);
+  const solve::SolverKind kind = dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)

@@ -110,38 +110,4 @@ DofPartition partition_dofs(const Model& model) {
   return p;
 }
 
-void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
-                   Eigen::MatrixXd& A, Eigen::VectorXd& B) {
-  for (size_t k = 0; k < partition.constrained.size(); ++k) {
-    const int d = partition.constrained[k];
-    A(d, d) = penalty;
-    B[d] = penalty * values[static_cast<Eigen::Index>(k)];
-  }
-}
-
-Eigen::VectorXd reduce_rhs(const DofPartition& partition, const Eigen::VectorXd& values,
-                           const Eigen::MatrixXd& A, const Eigen::VectorXd& B) {
-  const auto nf = static_cast<Eigen::Index>(partition.free.size());
-  Eigen::VectorXd B_free(nf);
-  for (Eigen::Index r = 0; r < nf; ++r) {
-    const int row = partition.free[static_cast<size_t>(r)];
-    double b = B[row];
-    for (size_t k = 0; k < partition.constrained.size(); ++k)
-      b -= A(row, partition.constrained[k]) * values[static_cast<Eigen::Index>(k)];
-    B_free[r] = b;
-  }
-  return B_free;
-}
-
-void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
-                   const Eigen::MatrixXd& A, const Eigen::VectorXd& B, Eigen::MatrixXd& A_free,
-                   Eigen::VectorXd& B_free) {
-  const auto nf = static_cast<Eigen::Index>(partition.free.size());
-  A_free.resize(nf, nf);
-  for (Eigen::Index c = 0; c < nf; ++c)
-    for (Eigen::Index r = 0; r < nf; ++r)
-      A_free(r, c) = A(partition.free[static_cast<size_t>(r)], partition.free[static_cast<size_t>(c)]);
-  B_free = reduce_rhs(partition, values, A, B);
-}
-
 }  // namespace fiberfluid::model

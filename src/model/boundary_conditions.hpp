@@ -46,16 +46,4 @@ struct DofPartition {
 };
 DofPartition partition_dofs(const Model& model);
 
-// The paper's penalty: A(d, d) = penalty and B(d) = penalty * value for each
-// constrained unknown d; the rest of the row is kept.
-void apply_penalty(const DofPartition& partition, const Eigen::VectorXd& values, double penalty,
-                   Eigen::MatrixXd& A, Eigen::VectorXd& B);
-
-// Elimination: A_ff x_f = B_f - A_fc values.
-void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
-                   const Eigen::MatrixXd& A, const Eigen::VectorXd& B, Eigen::MatrixXd& A_free,
-                   Eigen::VectorXd& B_free);
-Eigen::VectorXd reduce_rhs(const DofPartition& partition, const Eigen::VectorXd& values,
-                           const Eigen::MatrixXd& A, const Eigen::VectorXd& B);
-
 }  // namespace fiberfluid::model

@@ -10,13 +10,6 @@
 namespace fiberfluid::model {
 namespace {
 
-void add_fiber(Eigen::MatrixXd& L, int i, int j, double weight) {
-  L(i, i) += weight;
-  L(j, j) += weight;
-  L(i, j) -= weight;
-  L(j, i) -= weight;
-}
-
 double fiber_length(const Eigen::MatrixXd& X, int i, int j) {
   const double length = (X.row(i) - X.row(j)).norm();
   if (!(length > 0.0))
@@ -75,30 +68,6 @@ Eigen::SparseMatrix<double> surface_tension_laplacian(const Eigen::MatrixXd& X,
   Eigen::SparseMatrix<double> L(X.rows(), X.rows());
   L.setFromTriplets(entries.begin(), entries.end());
   return L;
-}
-
-FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
-                                 const Eigen::MatrixXi& edges, const geom::FiberMask* fibers,
-                                 ConnectionCount count) {
-  const int n = static_cast<int>(X.rows());
-  FiberLaplacians out;
-  out.bulk = Eigen::MatrixXd::Zero(n, n);
-  out.surface = Eigen::MatrixXd::Zero(n, n);
-  const PairFactors factors(fibers, count, n);
-  std::vector<double> h(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    factors.row(i, h.data());
-    for (int j = i + 1; j < n; ++j)
-      if (h[static_cast<size_t>(j)] != 0.0)
-        add_fiber(out.bulk, i, j, bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
-  }
-  out.surface = Eigen::MatrixXd(surface_tension_laplacian(X, area, edges));
-  return out;
-}
-
-Eigen::MatrixXd axis_block(const FiberLaplacians& laplacians, const Material& material, int axis) {
-  return material.young_modulus()[axis] * laplacians.bulk +
-         material.surface_tension * laplacians.surface;
 }
 
 }  // namespace fiberfluid::model

@@ -8,16 +8,6 @@
 
 namespace fiberfluid::model {
 
-// The two weighted graph Laplacians (positive diagonal, negative off-diagonal)
-// from which each axis block of the stiffness is made:
-//   bulk:    every pair i != j, weight (S_i + S_j) / (2 (N-1) |x_i - x_j|)   (paper Eq. 6)
-//   surface: every mesh edge,   weight (S_i + S_k) / (2 |x_i - x_k|^2)       (paper Eq. 7)
-// so that block(axis) = Y_axis * bulk + gamma * surface.
-struct FiberLaplacians {
-  Eigen::MatrixXd bulk;     // N x N, dense (all pairs)
-  Eigen::MatrixXd surface;  // N x N, nonzero on mesh edges only
-};
-
 // The factor h_ij = kept_ij / (2 c_ij) of every bulk fiber at one vertex, so
 // that w_ij = h_ij (|S_i| + |S_j|) / |x_i - x_j|; c_ij is N-1 when every pair
 // is kept, else the model's connection count. h_ii = 0.
@@ -47,16 +37,5 @@ class PairFactors {
 Eigen::SparseMatrix<double> surface_tension_laplacian(const Eigen::MatrixXd& X,
                                                       const Eigen::VectorXd& area,
                                                       const Eigen::MatrixXi& edges);
-
-// X: #V by dim positions giving the fiber lengths; area: #V vertex area
-// magnitudes |S_i|; edges: #E by 2 mesh edges; fibers and count as in the
-// Model. Throws InputError when two vertices coincide (a fiber of zero length).
-FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
-                                 const Eigen::MatrixXi& edges,
-                                 const geom::FiberMask* fibers = nullptr,
-                                 ConnectionCount count = ConnectionCount::Symmetric);
-
-// Y_axis * bulk + gamma * surface.
-Eigen::MatrixXd axis_block(const FiberLaplacians& laplacians, const Material& material, int axis);
 
 }  // namespace fiberfluid::model

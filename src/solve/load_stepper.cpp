@@ -103,9 +103,34 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
 }
 
 
+std::string treecode_problem(const model::Model& model, const SteppingOptions& options) {
+  if (!(model.treecode_tolerance > 0.0)) return {};
+  const std::string what = "the treecode product (treecode_tolerance) ";
+  if (!(model.treecode_tolerance >= 1e-10 && model.treecode_tolerance <= 1e-2))
+    return what + "takes a relative error from 1e-10 to 1e-2, got " +
+           std::to_string(model.treecode_tolerance);
+  if (options.scheme != Scheme::Incremental)
+    return what + "approximates the incremental scheme's linear product; Newton's tangent is "
+                  "exact (the incremental scheme)";
+  if (!model.material.law.is_constant())
+    return what + "needs a linear material (a constant law)";
+  if (options.solver != SolverKind::Auto && options.solver != SolverKind::PCG)
+    return what + "is matrix-free: it goes with the pcg solver, not " +
+           std::string(to_string(options.solver));
+  return {};
+}
+
+SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
+                            double budget_bytes) {
+  if (model.treecode_tolerance > 0.0) return SolverKind::PCG;  // the only matrix-free backend
+  return choose_solver(largest_block, factors, budget_bytes);
+}
+
 std::string setup_problem(const model::Model& model, const SteppingOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) return why;
+  why = treecode_problem(model, options);
+  if (!why.empty()) return why;
   return model::singular_setup_reason(model);
 }
 
@@ -225,8 +250,11 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
       }
       summary.assemble_seconds += seconds_since(t);
       if (!solver) {
-        summary.solver = options.solver == SolverKind::Auto ? choose_solver(*system)
-                                                            : options.solver;
+        summary.solver = options.solver == SolverKind::Auto
+                             ? automatic_solver(model, system->largest_block(),
+                                                system->blocks_equal() ? 1 : system->num_blocks(),
+                                                memory_budget_bytes())
+                             : options.solver;
         solver = make_linear_solver(summary.solver, options.pcg);
         const Status status = solver->analyze_pattern(*system);
         if (!status.ok) return fail(status.message);

@@ -70,7 +70,7 @@ struct SteppingOptions {
   bool update_load_geometry = true;  // loads from x_{k-1} (the paper) or from the reference
   model::BoundaryMethod boundary_method = model::BoundaryMethod::Elimination;
   double penalty = 1e9;           // the paper's diagonal value, for BoundaryMethod::Penalty
-  SolverKind solver = SolverKind::Auto;  // the linear backend; Auto chooses by size
+  SolverKind solver = SolverKind::Auto;  // the linear backend; Auto: automatic_solver()
   PcgOptions pcg;                 // for SolverKind::PCG
   // Runaway guards: a step that changes the enclosed volume by more than this
   // fraction of the reference volume, or turns a face over, ends the run.
@@ -168,6 +168,18 @@ using StepObserver = std::function<void(const StepRecord&, const Eigen::VectorXd
 // message naming the step and the cause.
 SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
                                  const StepObserver& observer = {});
+
+// "" when the model's treecode product (Model::treecode_tolerance) can run
+// with these options, else why not: it approximates the incremental scheme's
+// linear product, needs the constant law and the matrix-free pcg solver.
+// solve_load_steps checks it, so every entry point (JSON, C++, Python) gets
+// the same message.
+std::string treecode_problem(const model::Model& model, const SteppingOptions& options);
+
+// The backend SolverKind::Auto runs: pcg with the treecode, else
+// choose_solver's rule by size (the largest axis block, the distinct factors).
+SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
+                            double budget_bytes);
 
 // The Newton scheme (what solve_load_steps runs for Scheme::Newton).
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,

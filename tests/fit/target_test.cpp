@@ -116,3 +116,25 @@ TEST(DistanceStatistics, MeanRmsDeviationAndShare) {
 
 }  // namespace
 }  // namespace fiberfluid::fit
+
+#include "fit/golden_section.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+TEST(GoldenSection, FindsTheMinimumOfAUnimodalFunctionAndSkipsFailures) {
+  const LineMinimum m =
+      golden_section_minimum([](double x) { return (x - 2.0) * (x - 2.0) + 1.0; }, 0.0, 5.0, 40);
+  EXPECT_NEAR(m.x, 2.0, 1e-6);
+  EXPECT_NEAR(m.value, 1.0, 1e-12);
+  EXPECT_EQ(m.evaluations, 42);  // two to start, one per iteration
+  // A failed evaluation (NaN) is never taken for the minimum.
+  const LineMinimum guarded = golden_section_minimum(
+      [](double x) { return x < 1.0 ? std::nan("") : std::abs(x - 3.0); }, 0.0, 4.0, 40);
+  EXPECT_NEAR(guarded.x, 3.0, 1e-6);
+  EXPECT_THROW(golden_section_minimum([](double x) { return x; }, 1.0, 1.0, 5),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fiberfluid::fit

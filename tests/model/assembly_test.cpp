@@ -12,9 +12,12 @@
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 #include "test_support.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::model {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 TEST(Assembly, PaperRectangleMatrixEntryByEntry) {
   const Model m = testing::paper_rectangle_model();

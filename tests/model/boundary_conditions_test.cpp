@@ -5,9 +5,12 @@
 
 #include "geom/error.hpp"
 #include "model/model_fixtures.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::model {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 TEST(BoundaryConditions, ParsesHalfSpaces) {
   const HalfSpace h = parse_half_space("z >= 0.8", 3);

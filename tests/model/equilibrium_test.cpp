@@ -12,9 +12,12 @@
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::model {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 // A 42-vertex sphere with a cap held, gravity, a point load and surface tension.
 Model small_sphere(const FiberLaw& law) {

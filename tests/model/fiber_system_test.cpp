@@ -8,9 +8,12 @@
 #include "model/assembly.hpp"
 #include "model/model_fixtures.hpp"
 #include "test_support.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::model {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 // The structured system against the straightforward full assembly of
 // assembly.cpp with the boundary conditions applied there: two

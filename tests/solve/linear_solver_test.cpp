@@ -15,9 +15,12 @@
 #include "model/model_fixtures.hpp"
 #include "solve/load_stepper.hpp"
 #include "test_support.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::solve {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 using model::BoundaryMethod;
 
@@ -80,7 +83,7 @@ class EveryBackend : public ::testing::TestWithParam<Param> {};
 // with the boundary conditions of model/boundary_conditions.cpp and Eigen's LU.
 Eigen::VectorXd reference_steps(const model::Model& m, const SteppingOptions& options) {
   const model::DofPartition partition = model::partition_dofs(m);
-  const Eigen::MatrixXd A = model::system_matrix(m, m.surface.V);
+  const Eigen::MatrixXd A = model::reference::system_matrix(m, m.surface.V);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(m.num_unknowns());
   for (int k = 1; k <= options.steps; ++k) {
     std::vector<double> increment = model::load_factors(m, k, options.steps);
@@ -98,12 +101,12 @@ Eigen::VectorXd reference_steps(const model::Model& m, const SteppingOptions& op
     if (options.boundary_method == BoundaryMethod::Penalty) {
       Eigen::MatrixXd A_pen = A;
       Eigen::VectorXd B = dB;
-      model::apply_penalty(partition, values, options.penalty, A_pen, B);
+      model::reference::apply_penalty(partition, values, options.penalty, A_pen, B);
       dx = A_pen.partialPivLu().solve(B);
     } else {
       Eigen::MatrixXd A_free;
       Eigen::VectorXd B_free;
-      model::reduce_system(partition, values, A, dB, A_free, B_free);
+      model::reference::reduce_system(partition, values, A, dB, A_free, B_free);
       const Eigen::VectorXd free = A_free.partialPivLu().solve(B_free);
       for (size_t i = 0; i < partition.free.size(); ++i)
         dx[partition.free[i]] = free[static_cast<Eigen::Index>(i)];

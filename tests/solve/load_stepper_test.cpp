@@ -12,9 +12,12 @@
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 #include "solve/dense_lu.hpp"
+#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::solve {
 namespace {
+
+using namespace fiberfluid::model::reference;  // the oracle
 
 using model::BoundaryMethod;
 
@@ -27,6 +30,34 @@ SteppingOptions options(int steps, BoundaryMethod method = BoundaryMethod::Elimi
 
 double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).norm() / b.norm();
+}
+
+// The treecode's rules are the library's: a C++ caller who sets a tolerance
+// with Newton, a strain-dependent law or a factorising solver gets the same
+// refusal as an experiment file, not a silently exact run.
+TEST(LoadStepper, TheTreecodeRulesAreCheckedForEveryCaller) {
+  model::Model m = testing::paper_sphere_model();
+  m.treecode_tolerance = 1e-6;
+  SteppingOptions o;
+  o.steps = 1;
+  const SteppingSummary fine = solve_load_steps(m, o);
+  ASSERT_TRUE(fine.success) << fine.message;
+  EXPECT_EQ(fine.solver, SolverKind::PCG);  // Auto chose the matrix-free backend
+  const auto refused = [&](const model::Model& model, const SteppingOptions& options,
+                           const std::string& why) {
+    const SteppingSummary s = solve_load_steps(model, options);
+    EXPECT_FALSE(s.success);
+    EXPECT_NE(s.message.find(why), std::string::npos) << s.message;
+  };
+  SteppingOptions dense = o;
+  dense.solver = SolverKind::DenseLU;
+  refused(m, dense, "is matrix-free");
+  SteppingOptions newton = o;
+  newton.scheme = Scheme::Newton;
+  refused(m, newton, "Newton's tangent is exact");
+  model::Model nonlinear = m;
+  nonlinear.material.law = model::FiberLaw::exponential(3000.0, 5.0);
+  refused(nonlinear, o, "needs a linear material");
 }
 
 TEST(LoadStepper, PaperRectangleExactWithElimination) {
@@ -50,7 +81,7 @@ TEST(LoadStepper, PaperRectangleWithPenaltyAsInThePaper) {
 // An independent solve: the bordered system with its constrained rows and
 // columns removed, by Eigen's full-pivot LU instead of LAPACK.
 Eigen::VectorXd eigen_reference_solution(const model::Model& m, const std::vector<double>& f) {
-  const Eigen::MatrixXd A = model::system_matrix(m, m.surface.V);
+  const Eigen::MatrixXd A = model::reference::system_matrix(m, m.surface.V);
   const Eigen::VectorXd B = model::right_hand_side(m, m.surface.V, f);
   std::vector<char> fixed(static_cast<size_t>(m.num_unknowns()), 0);
   for (const model::Constraint& c : m.constraints) fixed[static_cast<size_t>(m.dof(c.vertex, c.axis))] = 1;
@@ -307,7 +338,7 @@ TEST(Reactions, AgreeWithTheDenseAssemblyRows) {
   o.update_load_geometry = false;
   const SteppingSummary s = solve_load_steps(m, o);
   ASSERT_TRUE(s.success) << s.message;
-  const Eigen::VectorXd residual = model::linear_residual(m, s.unknowns, {1.0, 1.0});
+  const Eigen::VectorXd residual = model::reference::linear_residual(m, s.unknowns, {1.0, 1.0});
   double largest = 0.0;
   for (const model::Constraint& c : m.constraints)
     largest = std::max(largest, std::abs(s.reaction_forces(c.vertex, c.axis) -
