@@ -18,9 +18,11 @@ int main() {
       {"supports", {{{"where", "z >= 0.04"}, {"label", "cap"}}}},
       {"loads", {{{"type", "gravity"}, {"acceleration", {0.0, 0.0, -9.81}}, {"density", 1000.0}}}},
       {"stepping", {{"steps", 5}}},
-      {"variants", {{{"name", "soft"}, {"material", {{"Y", 10000.0}}}},
-                    {{"name", "stiff"}, {"material", {{"Y", 40000.0}}}}}}};
-  const fiberfluid::app::Experiment ex = fiberfluid::app::parse_experiment(document, ".", "in code");
+      {"variants",
+       {{{"name", "soft"}, {"material", {{"Y", 10000.0}}}},
+        {{"name", "stiff"}, {"material", {{"Y", 40000.0}}}}}}};
+  const fiberfluid::app::Experiment ex =
+      fiberfluid::app::parse_experiment(document, ".", "in code");
   const fiberfluid::app::ExperimentResult result = fiberfluid::app::run_experiment(ex);
   for (size_t r = 0; r < result.runs.size(); ++r) {
     const auto& summary = result.runs[r].summary;
@@ -30,7 +32,8 @@ int main() {
     }
     const auto& surface = ex.cases[r].model.surface;
     std::printf("%s: largest displacement %.6g m, cap reaction z %.6g N, volume %.6g m^3\n",
-                result.runs[r].variant.c_str(), result.figures.at(result.runs[r].variant + ".max_displacement"),
+                result.runs[r].variant.c_str(),
+                result.figures.at(result.runs[r].variant + ".max_displacement"),
                 summary.steps.back().reactions.at(0).z(),
                 fiberfluid::geom::enclosed_volume(surface.V, surface.F));
   }

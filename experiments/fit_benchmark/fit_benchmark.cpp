@@ -32,9 +32,10 @@ int main(int argc, char** argv) {
   const ff::app::Case& c = ex.cases.front();
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-  std::printf("%s: %d vertices, %lld of %lld fibers kept, %d Newton steps; loaded and pruned in %.1f s\n",
-              ex.name.c_str(), c.model.num_vertices(), c.fibers.kept, c.fibers.pairs,
-              c.stepping.steps, load_seconds);
+  std::printf(
+      "%s: %d vertices, %lld of %lld fibers kept, %d Newton steps; loaded and pruned in %.1f s\n",
+      ex.name.c_str(), c.model.num_vertices(), c.fibers.kept, c.fibers.pairs, c.stepping.steps,
+      load_seconds);
   std::fflush(stdout);
 
   // The truth and its deformed surface at the last step: the target.
@@ -46,10 +47,12 @@ int main(int argc, char** argv) {
   }
   const double run_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - truth_start).count();
-  std::printf("one forward run: %.2f s, %d Newton iterations\n", run_seconds, truth.newton_iterations);
+  std::printf("one forward run: %.2f s, %d Newton iterations\n", run_seconds,
+              truth.newton_iterations);
   std::fflush(stdout);
   const std::vector<ff::fit::MeasuredStep> targets = {
-      {ff::fit::make_target("truth", ff::model::positions(c.model, truth.unknowns), c.model.surface.F),
+      {ff::fit::make_target("truth", ff::model::positions(c.model, truth.unknowns),
+                            c.model.surface.F),
        c.stepping.steps}};
 
   const ff::model::Material& truth_material = c.model.material;
@@ -71,7 +74,9 @@ int main(int argc, char** argv) {
   };
   std::vector<Setting> settings = {{false, 1e4}, {false, 10.0}};
   if (!skip_differences) settings.push_back({true, 1e4});
-  std::printf("\n| Jacobian | first trust region | iterations | forward runs | sensitivity solves | seconds | Y0 | beta | gamma |\n");
+  std::printf(
+      "\n| Jacobian | first trust region | iterations | forward runs | sensitivity solves | "
+      "seconds | Y0 | beta | gamma |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const Setting& setting : settings) {
     const bool differences = setting.differences;
@@ -85,15 +90,14 @@ int main(int argc, char** argv) {
     const ff::fit::Calibration calibration(c.model, c.stepping, targets, parameters, options);
     const ff::fit::FitResult r = calibration.run();
     std::printf("| %s | %g | %zu | %d | %d | %.1f | %.6g | %.6g | %.6g |%s\n",
-                differences ? "central differences" : "analytic (Newton sensitivities)", setting.radius,
-                r.iterations.empty() ? 0 : r.iterations.size() - 1, r.forward_runs,
+                differences ? "central differences" : "analytic (Newton sensitivities)",
+                setting.radius, r.iterations.empty() ? 0 : r.iterations.size() - 1, r.forward_runs,
                 r.sensitivity_solves, r.seconds, r.values[0], r.values[1], r.values[2],
                 r.success ? "" : (" " + r.message).c_str());
     std::fflush(stdout);
   }
   std::printf("\ntruth: Y0 %.6g, beta %.6g, gamma %.6g; start a factor 3 away\n",
-              truth_material.parameter("Y0"),
-              truth_material.parameter("beta"),
+              truth_material.parameter("Y0"), truth_material.parameter("beta"),
               truth_material.parameter("gamma"));
   return 0;
 }

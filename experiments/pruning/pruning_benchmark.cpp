@@ -56,8 +56,9 @@ int main(int argc, char** argv) {
   std::cout << "| mesh | vertices | fibers in all | kept | pruned | exact fallbacks | seconds |\n"
             << "|---|---|---|---|---|---|---|" << std::endl;
   for (const char* name : {"liver.obj", "torus.obj", "Bunny.stl"})
-    report_pruning(name, geom::remove_unused_vertices(
-                             geom::read_surface(meshes + "/" + name).surface).surface);
+    report_pruning(
+        name,
+        geom::remove_unused_vertices(geom::read_surface(meshes + "/" + name).surface).surface);
   if (!skip_large) report_pruning("torus R=2 r=0.7, 100 x 50", geom::torus(2.0, 0.7, 100, 50));
 
   std::cout << "\n| convexity check | vertices | faces | convex | seconds |\n"

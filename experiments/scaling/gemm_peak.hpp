@@ -10,8 +10,8 @@
 
 extern "C" void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k,
                        const double* alpha, const double* a, const int* lda, const double* b,
-                       const int* ldb, const double* beta, double* c, const int* ldc,
-                       std::size_t, std::size_t);
+                       const int* ldb, const double* beta, double* c, const int* ldc, std::size_t,
+                       std::size_t);
 
 inline double gemm_gflops(int n) {
   const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n), b = Eigen::MatrixXd::Random(n, n);

@@ -28,11 +28,11 @@
 
 #include "app/experiment.hpp"
 #include "gemm_peak.hpp"
-#include "geom/run_control.hpp"
 #include "model/equilibrium.hpp"
 #include "model/fiber_system.hpp"
 #include "model/loads.hpp"
 #include "model/vector_clones.hpp"
+#include "util/run_control.hpp"
 
 namespace {
 
@@ -62,7 +62,8 @@ double best_seconds(int repeat, const std::function<void()>& kernel) {
   for (int r = 0; r < repeat; ++r) {
     const auto start = std::chrono::steady_clock::now();
     kernel();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    best = std::min(
+        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return best;
 }
@@ -89,7 +90,8 @@ int main(int argc, char** argv) {
   const double ordered = static_cast<double>(n) * (n - 1), unordered = ordered / 2.0;
 
   const double peak = gemm_gflops(3000);
-  const fiberfluid::model::FiberSystem system(model, model.surface.V, BoundaryMethod::Elimination, 1e9);
+  const fiberfluid::model::FiberSystem system(model, model.surface.V, BoundaryMethod::Elimination,
+                                              1e9);
   const Eigen::MatrixXd V = Eigen::MatrixXd::Random(n, 3);
   const fiberfluid::model::Equilibrium equilibrium(model);
   Eigen::VectorXd x = 1e-3 * Eigen::VectorXd::Random(model.num_unknowns());
@@ -99,7 +101,7 @@ int main(int argc, char** argv) {
 
   struct Row {
     const char* name;
-    double pairs, flops_per_pair;     // nominal: ordered pairs (entries for the block)
+    double pairs, flops_per_pair;       // nominal: ordered pairs (entries for the block)
     double visits, executed_per_visit;  // executed: pairs visited
     std::function<void()> kernel;
   };
@@ -107,7 +109,8 @@ int main(int argc, char** argv) {
   Eigen::VectorXd vector_sink;
   double scalar_sink = 0.0;
   std::vector<double> squared_lengths(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) squared_lengths[static_cast<size_t>(i)] = 1.0 + model.surface.V.row(i).squaredNorm();
+  for (int i = 0; i < n; ++i)
+    squared_lengths[static_cast<size_t>(i)] = 1.0 + model.surface.V.row(i).squaredNorm();
   const std::vector<Row> rows = {
       {"bulk_product (3 columns)", ordered, 21, unordered, 27,
        [&] { sink = system.bulk_product(V); }},
@@ -117,8 +120,7 @@ int main(int argc, char** argv) {
                                                     BoundaryMethod::Elimination, 1e9);
          vector_sink = fresh.bulk_diagonal();
        }},
-      {"dense_block (one axis)", ordered, 13, unordered, 15,
-       [&] { sink = system.dense_block(0); }},
+      {"dense_block (one axis)", ordered, 13, unordered, 15, [&] { sink = system.dense_block(0); }},
       {"tangent_product (recomputed)", ordered, 50, unordered, 59,
        [&] { vector_sink = equilibrium.tangent_product(x, factors, w); }},
       {"tangent apply (stored)", ordered, 27, ordered, 27, [&] { vector_sink = stored.apply(w); }},

@@ -102,11 +102,10 @@ int main(int argc, char** argv) {
       {"run_s", s.total_seconds},
       {"slowest_step_s", slowest_step},
       {"peak_mib", peak_memory_mib()},
-      {"factorization_gflops",
-       s.solver_statistics.factorization_kernel_seconds > 0
-           ? s.solver_statistics.factorization_flops /
-                 s.solver_statistics.factorization_kernel_seconds / 1e9
-           : 0.0},
+      {"factorization_gflops", s.solver_statistics.factorization_kernel_seconds > 0
+                                   ? s.solver_statistics.factorization_flops /
+                                         s.solver_statistics.factorization_kernel_seconds / 1e9
+                                   : 0.0},
       {"pcg_iterations", s.solver_statistics.iterations},
       {"treecode_tolerance", treecode},
       {"scheme", fiberfluid::solve::to_string(s.scheme)},
@@ -115,8 +114,8 @@ int main(int argc, char** argv) {
       {"krylov_iterations", s.krylov_iterations},
       {"factorizations", s.factorizations},
       {"steps", s.steps.size()},
-      {"newton_iterations_per_step", s.steps.empty() ? 0.0
-                                     : double(s.newton_iterations) / double(s.steps.size())},
+      {"newton_iterations_per_step",
+       s.steps.empty() ? 0.0 : double(s.newton_iterations) / double(s.steps.size())},
       {"krylov_iterations_per_solve",
        s.newton_iterations > 0 ? double(s.krylov_iterations) / s.newton_iterations : 0.0},
       {"max_displacement", s.success ? result.figures.at("max_displacement") : 0.0}};

@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("--theta", theta, "override the tolerance's theta (tuning)");
   CLI11_PARSE(app, argc, argv);
 
-  std::cout << "| vertices | tolerance | degree | theta | relative error (2-norm) | max row error / max row "
+  std::cout << "| vertices | tolerance | degree | theta | relative error (2-norm) | max row error "
+               "/ max row "
                "| diagonal relative error | treecode s | exact s | speed-up |\n"
             << "|---|---|---|---|---|---|---|---|---|---|" << std::endl;
   for (int level : subdivisions) {
@@ -78,18 +79,21 @@ int main(int argc, char** argv) {
       double error = NAN, row_error = NAN, diagonal_error = NAN;
       if (exact.size() > 0) {
         error = (approximate - exact).norm() / exact.norm();
-        row_error = (approximate - exact).rowwise().norm().maxCoeff() /
-                    exact.rowwise().norm().maxCoeff();
+        row_error =
+            (approximate - exact).rowwise().norm().maxCoeff() / exact.rowwise().norm().maxCoeff();
         diagonal_error = (treecode.row_sums() - exact_diagonal).norm() / exact_diagonal.norm();
       }
       std::cout << "| " << n << " | " << tolerance << " | " << options.degree << " | "
-                << options.theta << " | " << error << " | " << row_error << " | "
-                << diagonal_error << " | " << seconds << " | " << exact_seconds << " | "
-                << exact_seconds / seconds << " |" << std::endl;
-      std::cerr << nlohmann::json{{"vertices", n},          {"tolerance", tolerance},
-                                  {"relative_error", error}, {"row_error", row_error},
+                << options.theta << " | " << error << " | " << row_error << " | " << diagonal_error
+                << " | " << seconds << " | " << exact_seconds << " | " << exact_seconds / seconds
+                << " |" << std::endl;
+      std::cerr << nlohmann::json{{"vertices", n},
+                                  {"tolerance", tolerance},
+                                  {"relative_error", error},
+                                  {"row_error", row_error},
                                   {"diagonal_error", diagonal_error},
-                                  {"treecode_seconds", seconds}, {"exact_seconds", exact_seconds},
+                                  {"treecode_seconds", seconds},
+                                  {"exact_seconds", exact_seconds},
                                   {"direct_terms", treecode.treecode().direct_terms()},
                                   {"proxy_terms", treecode.treecode().proxy_terms()}}
                        .dump()

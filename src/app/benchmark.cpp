@@ -41,7 +41,8 @@ std::vector<Integrator> read_solvers(Fields& f, const std::string& key, bool wit
     if (with_reference || kind != Integrator::ImplicitNewmark) allowed.push_back(name);
   std::string expected;
   for (const std::string& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
-  if (!list.is_array() || list.empty()) f.fail(key, "expected a non-empty list of solvers (" + expected + ")");
+  if (!list.is_array() || list.empty())
+    f.fail(key, "expected a non-empty list of solvers (" + expected + ")");
   for (const json& item : list) {
     const std::string name = item.is_string() ? item.get<std::string>() : excerpt(item);
     if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
@@ -62,8 +63,10 @@ fem::MaterialPreset read_material(Fields& f, const std::string& key, std::string
   if (value.is_string()) {
     const std::string name = value.get<std::string>();
     if (name != "MP1" && name != "MP2" && name != "MP3")
-      f.fail(key, "expected a preset (MP1, MP2, MP3) or an object {E, nu, density, alpha, beta}, "
-                  "got \"" + name + "\"");
+      f.fail(key,
+             "expected a preset (MP1, MP2, MP3) or an object {E, nu, density, alpha, beta}, "
+             "got \"" +
+                 name + "\"");
     *label = name;
     return fem::material_preset(name);
   }
@@ -103,8 +106,9 @@ BenchmarkSpec read_benchmark(Fields& root) {
       if (block) {
         spec.block.cells = cells.cast<int>();
         if (spec.block.cells[1] % 2 != 0)
-          m.fail("cells", "expected an even number of cells along y (the needle sits on the "
-                          "node in the middle of the right side)");
+          m.fail("cells",
+                 "expected an even number of cells along y (the needle sits on the "
+                 "node in the middle of the right side)");
       } else {
         spec.rod.cells = cells.cast<int>();
       }
@@ -118,7 +122,7 @@ BenchmarkSpec read_benchmark(Fields& root) {
     if (block) {
       spec.block.material.material.plane =
           m.choice("plane", "strain", {"strain", "stress"}) == "stress" ? fem::PlaneModel::Stress
-                                                                     : fem::PlaneModel::Strain;
+                                                                        : fem::PlaneModel::Strain;
     }
     m.finish();
   }
@@ -142,16 +146,17 @@ BenchmarkSpec read_benchmark(Fields& root) {
     t.finish();
   }
   spec.metrics_every = root.integer("metrics_every", 1, 1, 1000000);
-  spec.solvers = root.has("solvers") ? read_solvers(root, "solvers", false)
-                                     : std::vector<Integrator>{Integrator::ExplicitConsistent,
-                                                               Integrator::ExplicitLumped,
-                                                               Integrator::ImplicitLumped,
-                                                               Integrator::QuasiStatic};
+  spec.solvers =
+      root.has("solvers")
+          ? read_solvers(root, "solvers", false)
+          : std::vector<Integrator>{Integrator::ExplicitConsistent, Integrator::ExplicitLumped,
+                                    Integrator::ImplicitLumped, Integrator::QuasiStatic};
   if (root.has("linear_solver")) {
     Fields l = root.object("linear_solver");
-    spec.linear.linear = l.choice("method", "cholesky", {"cholesky", "gauss-seidel"}) == "gauss-seidel"
-                             ? fem::LinearMethod::GaussSeidel
-                             : fem::LinearMethod::Cholesky;
+    spec.linear.linear =
+        l.choice("method", "cholesky", {"cholesky", "gauss-seidel"}) == "gauss-seidel"
+            ? fem::LinearMethod::GaussSeidel
+            : fem::LinearMethod::Cholesky;
     spec.linear.tolerance = l.positive("tolerance", spec.linear.tolerance);
     spec.linear.max_sweeps = l.integer("max_sweeps", spec.linear.max_sweeps, 1, 100000000);
     l.finish();
@@ -233,7 +238,8 @@ void append_metrics(MetricSeries& s, double t, const Frame& frame, const Eigen::
     }
   }
   s.surface.push_back(es);
-  s.interior.push_back(metrics::interior_error(reference, approximation, *frame.weights, frame.measure, dim));
+  s.interior.push_back(
+      metrics::interior_error(reference, approximation, *frame.weights, frame.measure, dim));
 }
 
 bool metrics_step(size_t k, size_t count, int every) {
@@ -289,8 +295,8 @@ json fiber_document(const fem::Scene& scene, const fem::Boundary& rest, double Y
   }
   if (scene.gravity.size() > 0) {
     std::vector<double> g(scene.gravity.data(), scene.gravity.data() + scene.gravity.size());
-    doc["loads"] = json::array({{{"type", "gravity"}, {"acceleration", g},
-                                 {"density", scene.material.density}}});
+    doc["loads"] = json::array(
+        {{{"type", "gravity"}, {"acceleration", g}, {"density", scene.material.density}}});
   }
   return doc;
 }
@@ -312,8 +318,8 @@ Experiment fiber_experiment(const fem::Scene& scene, const fem::Boundary& rest, 
 
 // The fiber model of a built experiment (fiber_experiment, read and built
 // once: the surface, its fibers) with Y and gamma set directly.
-FiberRun run_fiber_model(const Experiment& built, const fem::Boundary& rest, double Y,
-                         double gamma, int steps) {
+FiberRun run_fiber_model(const Experiment& built, const fem::Boundary& rest, double Y, double gamma,
+                         int steps) {
   const auto start = std::chrono::steady_clock::now();
   Experiment ex = built;
   for (Case& c : ex.cases) {
@@ -323,8 +329,8 @@ FiberRun run_fiber_model(const Experiment& built, const fem::Boundary& rest, dou
   FiberRun out;
   out.positions.assign(static_cast<size_t>(steps) + 1, rest.surface.V);
   const Case& c = ex.cases.front();
-  const ExperimentResult r = run_experiment(
-      ex, [&](size_t, const solve::StepRecord& record, const Eigen::VectorXd& x) {
+  const ExperimentResult r =
+      run_experiment(ex, [&](size_t, const solve::StepRecord& record, const Eigen::VectorXd& x) {
         out.positions[static_cast<size_t>(record.step)] = input_positions(c, x);
       });
   out.ok = r.runs_succeeded();
@@ -344,8 +350,10 @@ Eigen::VectorXd static_state(const fem::Scene& scene) {
   fem::Constraints held;
   const double late = 1e9;
   const Eigen::VectorXd values =
-      d.held_values ? d.held_values(late) : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size()));
-  for (size_t k = 0; k < d.held.size(); ++k) held.hold(d.held[k], values[static_cast<Eigen::Index>(k)]);
+      d.held_values ? d.held_values(late)
+                    : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size()));
+  for (size_t k = 0; k < d.held.size(); ++k)
+    held.hold(d.held[k], values[static_cast<Eigen::Index>(k)]);
   Eigen::VectorXd u;
   const Eigen::VectorXd f = d.force ? d.force(late) : Eigen::VectorXd::Zero(d.K.rows());
   const solve::Status status = fem::solve_static(d.K, f, held, &u);
@@ -355,7 +363,8 @@ Eigen::VectorXd static_state(const fem::Scene& scene) {
 
 Eigen::MatrixXd boundary_rows(const fem::Boundary& b, const Eigen::MatrixXd& node_rows) {
   Eigen::MatrixXd out(static_cast<Eigen::Index>(b.nodes.size()), node_rows.cols());
-  for (size_t v = 0; v < b.nodes.size(); ++v) out.row(static_cast<Eigen::Index>(v)) = node_rows.row(b.nodes[v]);
+  for (size_t v = 0; v < b.nodes.size(); ++v)
+    out.row(static_cast<Eigen::Index>(v)) = node_rows.row(b.nodes[v]);
   return out;
 }
 
@@ -378,9 +387,9 @@ FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Sce
       return metrics::relative_energy_norm(target_u, run.positions.back() - rest.surface.V);
     };
     // gamma / (E L), L = 1 m: from 1e-4 to 10, in log scale.
-    const fit::LineMinimum m = fit::golden_section_minimum(
-        [&](double log_gamma) { return error(std::exp(log_gamma)); }, std::log(1e-4 * E),
-        std::log(10.0 * E), 30);
+    const fit::LineMinimum m =
+        fit::golden_section_minimum([&](double log_gamma) { return error(std::exp(log_gamma)); },
+                                    std::log(1e-4 * E), std::log(10.0 * E), 30);
     const double best = std::exp(m.x), best_error = m.value;
     const double zero_error = error(0.0);
     report.Y = E;
@@ -403,7 +412,8 @@ FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Sce
   options.symmetric = true;
   const fit::Calibration calibration(c.model, c.stepping, measured, parameters, options);
   const fit::FitResult fitted = calibration.run();
-  if (fitted.values.size() != 2) throw InputError("benchmark: the fiber model's fit failed: " + fitted.message);
+  if (fitted.values.size() != 2)
+    throw InputError("benchmark: the fiber model's fit failed: " + fitted.message);
   report.Y = fitted.values[0];
   report.gamma = fitted.values[1];
   std::ostringstream how;
@@ -441,7 +451,8 @@ void add_series_figures(const BenchmarkSpec& spec, const MetricSeries& s,
       return best;
     };
     for (double t : {1.0, 2.0, 5.0})
-      if (const auto v = at(t)) figures[L + "." + m.name + ".at_" + std::to_string(static_cast<int>(t)) + "s"] = *v;
+      if (const auto v = at(t))
+        figures[L + "." + m.name + ".at_" + std::to_string(static_cast<int>(t)) + "s"] = *v;
     if (s.ok && !s.times.empty())
       if (const auto v = at(s.times.back())) figures[L + "." + m.name + ".final"] = *v;
     double sum = 0.0;
@@ -511,7 +522,8 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
   const Eigen::VectorXd statics = static_state(scene);
   result.figures["reference.static_gap"] = (reference.u.back() - statics).norm() / statics.norm();
   result.figures["reference.seconds"] = result.reference_seconds;
-  result.reference_final = deformed_boundary(frames, scene.mesh.nodes + fem::displacement_rows(reference.u.back(), dim));
+  result.reference_final =
+      deformed_boundary(frames, scene.mesh.nodes + fem::displacement_rows(reference.u.back(), dim));
 
   // One solver on a scene (this one, or another material's) whose static state is given.
   auto run_one = [&](const fem::Scene& on, const Eigen::VectorXd& on_statics, Integrator kind,
@@ -526,7 +538,8 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
     s.seconds = seconds;
     s.sweeps = run.sweeps;
     if (run.ok)
-      result.figures[label + ".static_gap"] = (run.u.back() - on_statics).norm() / on_statics.norm();
+      result.figures[label + ".static_gap"] =
+          (run.u.back() - on_statics).norm() / on_statics.norm();
     result.series.push_back(std::move(s));
   };
   for (Integrator kind : spec.solvers) run_one(scene, statics, kind, fem::to_string(kind));
@@ -541,10 +554,12 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
     tell("fiber model");
     // The block: one load step per time step of the push, so that each time
     // step has its own quasi-static state; the rod: its gravity in steps.
-    const int fiber_steps = block ? std::max(1, static_cast<int>(std::lround(scene.push_time / spec.step)))
-                                  : spec.fiber.steps;
+    const int fiber_steps =
+        block ? std::max(1, static_cast<int>(std::lround(scene.push_time / spec.step)))
+              : spec.fiber.steps;
     const Eigen::MatrixXd X0 = scene.mesh.nodes;
-    const Eigen::MatrixXd target = boundary_rows(frames.rest, X0 + fem::displacement_rows(statics, dim));
+    const Eigen::MatrixXd target =
+        boundary_rows(frames.rest, X0 + fem::displacement_rows(statics, dim));
     FiberModelReport report;
     if (spec.fiber.fit) {
       report = choose_fiber_material(spec, scene, frames.rest, target, fiber_steps);
@@ -553,9 +568,10 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
       report.gamma = spec.fiber.gamma;
       report.how = "given";
     }
-    const FiberRun run = run_fiber_model(
-        fiber_experiment(scene, frames.rest, report.Y, report.gamma, fiber_steps, spec.fiber.newton),
-        frames.rest, report.Y, report.gamma, fiber_steps);
+    const FiberRun run =
+        run_fiber_model(fiber_experiment(scene, frames.rest, report.Y, report.gamma, fiber_steps,
+                                         spec.fiber.newton),
+                        frames.rest, report.Y, report.gamma, fiber_steps);
     MetricSeries s;
     s.label = "fiber-model";
     s.ok = run.ok;
@@ -570,13 +586,15 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
       geom::Surface reference_boundary = frames.rest.surface, fiber_boundary = frames.rest.surface;
       for (size_t k = 1; k < reference.u.size(); ++k) {
         const double t = reference.times[k];
-        reference_boundary.V = boundary_rows(frames.rest, X0 + fem::displacement_rows(reference.u[k], dim));
+        reference_boundary.V =
+            boundary_rows(frames.rest, X0 + fem::displacement_rows(reference.u[k], dim));
         fiber_boundary.V = run.positions[fiber_step(scene, t, fiber_steps)];
         const bool surface_step = metrics_step(k, reference.u.size(), spec.metrics_every);
         append_metrics(s, t, frame, reference_boundary.V, fiber_boundary.V,
                        surface_step ? &reference_boundary : nullptr, &fiber_boundary);
       }
-      report.static_energy_norm = metrics::relative_energy_norm(target - rest, run.positions.back() - rest);
+      report.static_energy_norm =
+          metrics::relative_energy_norm(target - rest, run.positions.back() - rest);
       result.fiber_final = frames.rest.surface;
       result.fiber_final.V = run.positions.back();
     }
@@ -599,7 +617,9 @@ std::string benchmark_report(const BenchmarkResult& result) {
     for (const char* when : {"at_1s", "at_2s", "at_5s", "final"}) {
       const auto figure = [&](const char* metric) {
         const auto it = result.figures.find(s.label + "." + metric + "." + when);
-        return it == result.figures.end() ? std::string("-") : (std::ostringstream() << std::setprecision(3) << it->second).str();
+        return it == result.figures.end()
+                   ? std::string("-")
+                   : (std::ostringstream() << std::setprecision(3) << it->second).str();
       };
       out << " " << (std::string(when) == "final" ? "end" : std::string(when).substr(3)) << " "
           << figure("E_n") << " / " << figure("E_s") << " / " << figure("E_i") << ";";
@@ -618,7 +638,10 @@ std::string benchmark_csv(const BenchmarkResult& result) {
   std::ostringstream out;
   out.precision(10);
   out << "time_s,series,E_n,E_s,E_i\n";
-  auto cell = [](double v) { return std::isfinite(v) ? (std::ostringstream() << std::setprecision(10) << v).str() : std::string(); };
+  auto cell = [](double v) {
+    return std::isfinite(v) ? (std::ostringstream() << std::setprecision(10) << v).str()
+                            : std::string();
+  };
   for (const MetricSeries& s : result.series)
     for (size_t k = 0; k < s.times.size(); ++k)
       out << s.times[k] << "," << s.label << "," << cell(s.energy_norm[k]) << ","
@@ -637,25 +660,28 @@ std::string benchmark_json(const BenchmarkSpec& spec, const BenchmarkResult& res
                       {"gauss_seidel_sweeps", s.sweeps},
                       {"steps", s.times.size()},
                       {"interior_weights", s.interior_weights}});
-  json doc = {
-      {"scene", scene.name},
-      {"material", {{"label", spec.material_label},
-                    {"E", scene.material.young},
-                    {"nu", scene.material.poisson},
-                    {"density", scene.material.density},
-                    {"alpha", scene.dynamics.alpha},
-                    {"beta", scene.dynamics.beta}}},
-      {"mesh", {{"nodes", scene.mesh.num_nodes()},
+  json doc = {{"scene", scene.name},
+              {"material",
+               {{"label", spec.material_label},
+                {"E", scene.material.young},
+                {"nu", scene.material.poisson},
+                {"density", scene.material.density},
+                {"alpha", scene.dynamics.alpha},
+                {"beta", scene.dynamics.beta}}},
+              {"mesh",
+               {{"nodes", scene.mesh.num_nodes()},
                 {"elements", scene.mesh.elements.rows()},
                 {"nodes_per_element", scene.mesh.elements.cols()},
-                {"plane", scene.mesh.dim == 3 ? "3D"
-                          : scene.material.plane == fem::PlaneModel::Strain ? "strain" : "stress"}}},
-      {"time", {{"step", spec.step}, {"duration", spec.duration}}},
-      {"linear_solver", fem::to_string(spec.linear.linear)},
-      {"reference", {{"solver", "implicit-newmark"},
-                     {"seconds", result.reference_seconds},
-                     {"gauss_seidel_sweeps", result.reference_sweeps}}},
-      {"series", series}};
+                {"plane", scene.mesh.dim == 3                               ? "3D"
+                          : scene.material.plane == fem::PlaneModel::Strain ? "strain"
+                                                                            : "stress"}}},
+              {"time", {{"step", spec.step}, {"duration", spec.duration}}},
+              {"linear_solver", fem::to_string(spec.linear.linear)},
+              {"reference",
+               {{"solver", "implicit-newmark"},
+                {"seconds", result.reference_seconds},
+                {"gauss_seidel_sweeps", result.reference_sweeps}}},
+              {"series", series}};
   if (result.fiber)
     doc["fiber_model"] = {{"Y", result.fiber->Y},
                           {"gamma", result.fiber->gamma},

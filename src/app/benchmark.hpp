@@ -30,12 +30,12 @@ struct BenchmarkSpec {
   Scene scene = Scene::BlockNeedle;
   fem::BlockOptions block;
   fem::RodOptions rod;
-  std::string material_label = "MP1";      // the preset's name, or "custom"
-  double step = 1.0 / 30.0;                // s, the paper's h
-  double duration = 10.0;                  // s
-  int metrics_every = 1;                   // compute E_s every k-th step (E_n, E_i every step)
-  std::vector<fem::Integrator> solvers;    // against the implicit Newmark reference
-  fem::IntegrationOptions linear;          // Cholesky, or the paper's Gauss-Seidel
+  std::string material_label = "MP1";    // the preset's name, or "custom"
+  double step = 1.0 / 30.0;              // s, the paper's h
+  double duration = 10.0;                // s
+  int metrics_every = 1;                 // compute E_s every k-th step (E_n, E_i every step)
+  std::vector<fem::Integrator> solvers;  // against the implicit Newmark reference
+  fem::IntegrationOptions linear;        // Cholesky, or the paper's Gauss-Seidel
   // The same scene with another material, each solver against the reference.
   struct OtherMaterial {
     std::string label;
@@ -46,10 +46,10 @@ struct BenchmarkSpec {
   // The fibers-and-fluid model on the scene's boundary (quasi-static).
   struct FiberModel {
     bool enabled = false;
-    bool fit = true;          // Y and gamma fitted to the FEM's static shape; else given
+    bool fit = true;  // Y and gamma fitted to the FEM's static shape; else given
     double Y = 0.0, gamma = 0.0;
-    int steps = 10;           // load steps of the rod's gravity (the block: one per time step of the push)
-    bool newton = false;      // the Newton scheme instead of the paper's incremental one
+    int steps = 10;  // load steps of the rod's gravity (the block: one per time step of the push)
+    bool newton = false;  // the Newton scheme instead of the paper's incremental one
   };
   FiberModel fiber;
 };
@@ -60,18 +60,18 @@ BenchmarkSpec read_benchmark(Fields& root);
 
 // One approximation against the reference, per time step.
 struct MetricSeries {
-  std::string label;      // e.g. "explicit", "MP1/quasi-static", "fiber-model"
+  std::string label;  // e.g. "explicit", "MP1/quasi-static", "fiber-model"
   bool ok = true;
-  std::string message;    // why it stopped (diverged) when not ok
-  double seconds = 0.0;   // wall time of its integration (or the fiber model's run)
-  long long sweeps = 0;   // Gauss-Seidel sweeps
+  std::string message;           // why it stopped (diverged) when not ok
+  double seconds = 0.0;          // wall time of its integration (or the fiber model's run)
+  long long sweeps = 0;          // Gauss-Seidel sweeps
   std::string interior_weights;  // "volume" (FEM nodes) or "surface" (|S_i|: a surface model)
   std::vector<double> times, energy_norm, surface, interior;  // E_s is NaN between metrics steps
 };
 
 struct FiberModelReport {
   double Y = 0.0, gamma = 0.0;
-  std::string how;           // "given" or how the fit went
+  std::string how;  // "given" or how the fit went
   int vertices = 0;
   double static_energy_norm = 0.0;  // E_n of its static state against the FEM's
 };

@@ -5,13 +5,13 @@
 #include <string>
 
 #include "app/case_spec.hpp"
-#include "geom/error.hpp"
 #include "geom/fiber_pruning.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
 #include "model/boundary_conditions.hpp"
+#include "util/error.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::app {
 
@@ -35,8 +35,9 @@ geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
 
 geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* warnings) {
   if (spec.empty())
-    spec.field.fail("", "missing (required): the document names no surface and the program "
-                        "gave none");
+    spec.field.fail("",
+                    "missing (required): the document names no surface and the program "
+                    "gave none");
   geom::Surface surface;
   if (!spec.file.empty()) {
     try {
@@ -56,9 +57,11 @@ geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* w
   // past what squares and cross products of them can hold (or to nothing).
   const double size = geom::bounding_box_diagonal(surface.V);
   if (!(size > 1e-100 && size < 1e100))
-    spec.field.fail("scale", (std::ostringstream() << "scaled by " << spec.scale << " the surface is "
-                                                    << size << " m across; expected a size from "
-                                                    "1e-100 to 1e100 m").str());
+    spec.field.fail(
+        "scale", (std::ostringstream() << "scaled by " << spec.scale << " the surface is " << size
+                                       << " m across; expected a size from "
+                                          "1e-100 to 1e100 m")
+                     .str());
   return surface;
 }
 
@@ -109,11 +112,12 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
                                        per_vertex.begin()) +
                         " keeps no fiber: is the mesh self-intersecting?");
   if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Symmetric)
-    spec.field.fail("product", "\"treecode\" needs one connection count for every fiber: this "
-                               "concave body prunes " +
-                                   std::to_string(report.pairs - report.kept) +
-                                   " fibers; set \"connection_count\": \"global\" (pruned "
-                                   "fibers are then exact corrections) or \"product\": \"exact\"");
+    spec.field.fail("product",
+                    "\"treecode\" needs one connection count for every fiber: this "
+                    "concave body prunes " +
+                        std::to_string(report.pairs - report.kept) +
+                        " fibers; set \"connection_count\": \"global\" (pruned "
+                        "fibers are then exact corrections) or \"product\": \"exact\"");
   m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
   return report;
 }
@@ -154,7 +158,9 @@ void add_fibers(const CaseSpec& spec, Case& c) {
 class ModelBuilder {
  public:
   ModelBuilder(const CaseSpec& spec, Case& c)
-      : spec_(spec), c_(c), dim_(c.model.dim()),
+      : spec_(spec),
+        c_(c),
+        dim_(c.model.dim()),
         input_to_model_(static_cast<size_t>(c.input_surface.num_vertices()), -1) {
     for (size_t m = 0; m < c.model_to_input.size(); ++m)
       input_to_model_[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
@@ -213,9 +219,7 @@ class ModelBuilder {
     spec.field.fail("type", "a load of an unknown kind");
   }
 
-  std::vector<int> select(const SelectionSpec& spec) const {
-    return resolve_selection(spec, c_);
-  }
+  std::vector<int> select(const SelectionSpec& spec) const { return resolve_selection(spec, c_); }
 
   void add_group(const ConstraintSpec& spec) {
     model::Model& m = c_.model;
@@ -286,10 +290,12 @@ std::vector<int> resolve_selection(const SelectionSpec& spec, const Case& c) {
       input_to_model[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
     for (int input : spec.vertices) {
       if (input >= static_cast<int>(input_to_model.size()))
-        spec.field.fail("vertices", "vertex " + std::to_string(input) + " does not exist (the mesh has " +
-                                        std::to_string(input_to_model.size()) + " vertices, from 0)");
+        spec.field.fail("vertices",
+                        "vertex " + std::to_string(input) + " does not exist (the mesh has " +
+                            std::to_string(input_to_model.size()) + " vertices, from 0)");
       const int m = input_to_model[static_cast<size_t>(input)];
-      if (m < 0) spec.field.fail("vertices", "vertex " + std::to_string(input) + " belongs to no face");
+      if (m < 0)
+        spec.field.fail("vertices", "vertex " + std::to_string(input) + " belongs to no face");
       selected.push_back(m);
     }
   } else if (!spec.where.empty()) {
@@ -319,8 +325,9 @@ Case build_case(const CaseSpec& spec, std::vector<std::string>* warnings) {
 Case build_case(const CaseSpec& spec, const geom::Surface& surface,
                 std::vector<std::string>* warnings) {
   if (!spec.surface.empty())
-    spec.surface.field.fail("", "the program gives the surface; the document must not name "
-                                "one too");
+    spec.surface.field.fail("",
+                            "the program gives the surface; the document must not name "
+                            "one too");
   const std::string label = spec.surface.field.file + ": the given surface";
   const geom::MeshReport report = geom::inspect(surface);
   geom::require_usable(report, label);

@@ -35,8 +35,8 @@ struct FieldName {
 // Where the rest surface comes from: a mesh file or a generator, then a scale.
 struct SurfaceSpec {
   FieldName field;
-  std::filesystem::path file;               // a mesh file (made absolute against the experiment's folder)
-  bool flip = false;                        // the file's faces point inward: flip them
+  std::filesystem::path file;  // a mesh file (made absolute against the experiment's folder)
+  bool flip = false;           // the file's faces point inward: flip them
   std::function<geom::Surface()> generate;  // a generator whose parameters were checked
   std::string generator;                    // its name, for messages
   double scale = 1.0;
@@ -53,9 +53,9 @@ struct SelectionSpec {
 
 struct LoadSpec {
   FieldName field;
-  model::Load load;         // everything but the vertex and the vector
-  int input_vertex = 0;     // a point load's vertex, in input order
-  Eigen::VectorXd vector;   // the acceleration (gravity) or the force (point): one entry per axis
+  model::Load load;        // everything but the vertex and the vector
+  int input_vertex = 0;    // a point load's vertex, in input order
+  Eigen::VectorXd vector;  // the acceleration (gravity) or the force (point): one entry per axis
 };
 
 // A "supports" entry (held axes) or a "prescribed" one (a displacement).
@@ -71,9 +71,9 @@ struct ConstraintSpec {
 
 struct PaddleSpec {
   FieldName field;
-  model::Paddle paddle;                      // label, axis, side, schedule, contact
-  std::optional<double> position;            // default: touching the body
-  std::optional<double> travel, compression; // exactly one
+  model::Paddle paddle;                       // label, axis, side, schedule, contact
+  std::optional<double> position;             // default: touching the body
+  std::optional<double> travel, compression;  // exactly one
 };
 
 struct MaterialSpec {
@@ -86,18 +86,18 @@ struct MaterialSpec {
 };
 
 struct FiberSpec {
-  bool pruning = true;                    // "auto": prune the fibers that leave a concave body
+  bool pruning = true;  // "auto": prune the fibers that leave a concave body
   model::ConnectionCount count = model::ConnectionCount::Symmetric;
-  std::string write = "none";             // "kept" or "pruned": DIR/fibers.vtu
-  double treecode_tolerance = 0.0;        // "product": "treecode": its relative error
+  std::string write = "none";       // "kept" or "pruned": DIR/fibers.vtu
+  double treecode_tolerance = 0.0;  // "product": "treecode": its relative error
   FieldName field;
 };
 
 // One simulation as parsed: the whole experiment, or one variant of a sweep.
 struct CaseSpec {
-  std::string variant;     // "" unless the experiment sweeps
-  nlohmann::json patch;    // the variant's merge patch (null without a sweep)
-  SurfaceSpec surface;     // empty when the document has no "surface" (a program gives one)
+  std::string variant;   // "" unless the experiment sweeps
+  nlohmann::json patch;  // the variant's merge patch (null without a sweep)
+  SurfaceSpec surface;   // empty when the document has no "surface" (a program gives one)
   FiberSpec fibers;
   // Variants whose "surface" and "fibers" read the same share one built
   // surface and one pruning.
@@ -112,9 +112,9 @@ struct CaseSpec {
 
 // What the fiber pruning did (issue 4), for the summary.
 struct FiberReport {
-  bool pruning = true;         // "fibers.pruning": "auto" (prune a concave body) or "off"
-  bool convex = false;         // the fast path: nothing to prune
-  long long pairs = 0;         // fibers in all, N (N-1) / 2
+  bool pruning = true;  // "fibers.pruning": "auto" (prune a concave body) or "off"
+  bool convex = false;  // the fast path: nothing to prune
+  long long pairs = 0;  // fibers in all, N (N-1) / 2
   long long kept = 0;
   int min_per_vertex = 0, max_per_vertex = 0;
   double mean_per_vertex = 0.0;

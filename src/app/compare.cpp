@@ -3,9 +3,9 @@
 
 #include <sstream>
 
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "metrics/metrics.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 
@@ -38,20 +38,20 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
                        std::to_string(reference.num_vertices()) + " vertices, " +
                        approximation_label + " " + std::to_string(approximation.num_vertices()) +
                        ", " + undeformed_label + " " + std::to_string(n));
-    c.energy_norm = metrics::relative_energy_norm(reference.V - undeformed->V,
-                                                  approximation.V - undeformed->V);
-    c.interior_error = metrics::interior_error(
-        reference.V, approximation.V, metrics::boundary_node_measures(*undeformed),
-        metrics::enclosed_measure(*undeformed), c.dim);
+    c.energy_norm =
+        metrics::relative_energy_norm(reference.V - undeformed->V, approximation.V - undeformed->V);
+    c.interior_error = metrics::interior_error(reference.V, approximation.V,
+                                               metrics::boundary_node_measures(*undeformed),
+                                               metrics::enclosed_measure(*undeformed), c.dim);
   }
   if (c.dim == 3) {
     if (!approximation.V.allFinite())
       throw InputError(approximation_label + ": a vertex coordinate is not finite");
-    const fit::TargetDistance distance(
-        fit::make_target(reference_label, reference.V, reference.F));
+    const fit::TargetDistance distance(fit::make_target(reference_label, reference.V, reference.F));
     const std::vector<fit::TargetDistance::Closest> closest = distance.closest(approximation.V);
     Eigen::VectorXd d(static_cast<Eigen::Index>(closest.size()));
-    for (size_t i = 0; i < closest.size(); ++i) d[static_cast<Eigen::Index>(i)] = closest[i].distance;
+    for (size_t i = 0; i < closest.size(); ++i)
+      d[static_cast<Eigen::Index>(i)] = closest[i].distance;
     const Eigen::RowVectorXd extent =
         reference.V.colwise().maxCoeff() - reference.V.colwise().minCoeff();
     c.distances = fit::distance_statistics(d, extent.maxCoeff());
@@ -96,12 +96,15 @@ std::string comparison_text(const Comparison& c) {
 }
 
 nlohmann::json comparison_json(const Comparison& c) {
-  nlohmann::json j = {{"reference", c.reference},
-                      {"approximation", c.approximation},
-                      {"dim", c.dim},
-                      {"reference_measure", c.reference_measure ? nlohmann::json(*c.reference_measure) : nlohmann::json()},
-                      {"symmetric_difference", c.symmetric_difference ? nlohmann::json(*c.symmetric_difference) : nlohmann::json()},
-                      {"E_s", c.surface_error ? nlohmann::json(*c.surface_error) : nlohmann::json()}};
+  nlohmann::json j = {
+      {"reference", c.reference},
+      {"approximation", c.approximation},
+      {"dim", c.dim},
+      {"reference_measure",
+       c.reference_measure ? nlohmann::json(*c.reference_measure) : nlohmann::json()},
+      {"symmetric_difference",
+       c.symmetric_difference ? nlohmann::json(*c.symmetric_difference) : nlohmann::json()},
+      {"E_s", c.surface_error ? nlohmann::json(*c.surface_error) : nlohmann::json()}};
   if (!c.surface_error) j["E_s_missing"] = c.surface_error_missing;
   if (!c.undeformed.empty()) j["undeformed"] = c.undeformed;
   if (c.energy_norm) j["E_n"] = *c.energy_norm;
@@ -111,9 +114,12 @@ nlohmann::json comparison_json(const Comparison& c) {
   }
   if (c.distances) {
     const fit::DistanceStatistics& d = *c.distances;
-    j["distance"] = {{"count", d.count},         {"mean", d.mean},
-                     {"rms", d.rms},             {"standard_deviation", d.standard_deviation},
-                     {"largest", d.largest},     {"length", d.length},
+    j["distance"] = {{"count", d.count},
+                     {"mean", d.mean},
+                     {"rms", d.rms},
+                     {"standard_deviation", d.standard_deviation},
+                     {"largest", d.largest},
+                     {"length", d.length},
                      {"standard_deviation_share", d.share(d.standard_deviation)}};
   }
   return j;

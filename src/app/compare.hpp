@@ -24,8 +24,8 @@ struct Comparison {
   std::optional<double> surface_error;         // E_s
   std::string surface_error_missing;           // why E_s is not there
   // With the undeformed mesh and the same vertices in all three:
-  std::optional<double> energy_norm;    // E_n
-  std::optional<double> interior_error; // E_i, over the surface nodes weighted by |S_i|
+  std::optional<double> energy_norm;     // E_n
+  std::optional<double> interior_error;  // E_i, over the surface nodes weighted by |S_i|
   // 3D: each vertex of M' to the surface of M.
   std::optional<fit::DistanceStatistics> distances;
 };

@@ -9,13 +9,13 @@
 #include <fstream>
 #include <functional>
 #include <istream>
-#include <utility>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <utility>
 
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "model/boundary_conditions.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -25,9 +25,9 @@ using nlohmann::json;
 // ------------------------------------------------------------ surfaces
 // A generator's parameters, checked now; the surface is made when the case is built.
 std::function<geom::Surface()> read_generator(Fields& f) {
-  const std::string kind =
-      f.choice("generator", "", {"icosphere", "tetrahedron", "octahedron", "icosahedron", "cube",
-                                 "box", "dome", "torus", "rectangle", "polygon"});
+  const std::string kind = f.choice("generator", "",
+                                    {"icosphere", "tetrahedron", "octahedron", "icosahedron",
+                                     "cube", "box", "dome", "torus", "rectangle", "polygon"});
   if (kind == "icosphere") {
     const int subdivisions = f.integer("subdivisions", 2, 0, 7);
     const double radius = f.positive("radius", 1.0);
@@ -57,7 +57,8 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   }
   if (kind == "torus") {
     const double major = f.positive("major_radius", 2.0), minor = f.positive("minor_radius", 0.7);
-    if (minor >= major) f.fail("minor_radius", "must be below major_radius (a ring, not a spindle)");
+    if (minor >= major)
+      f.fail("minor_radius", "must be below major_radius (a ring, not a spindle)");
     Eigen::Vector2i segments(40, 20);
     if (f.has("segments")) segments = f.counts("segments", 2, 3, 1000);
     return [=] { return geom::torus(major, minor, segments.x(), segments.y()); };
@@ -167,9 +168,7 @@ double required_positive(Fields& f, const std::string& key) {
 }
 
 model::FiberLaw read_law(Fields f) {
-  std::vector<std::string> types = {"constant", "exponential", "bilinear", "tabulated"};
-  for (const std::string& name : model::registered_law_names()) types.push_back(name);
-  const std::string type = f.choice("type", "constant", types);
+  const std::string type = f.choice("type", "constant", model::law_type_names());
   model::FiberLaw law = model::FiberLaw::constant(1.0);
   if (type == "constant") {
     const double Y = f.number("Y");
@@ -302,8 +301,9 @@ std::vector<PaddleSpec> read_paddles(Fields& root) {
     p.above = f.choice("side", "", {"above", "below"}) == "above";
     if (f.has("position")) spec.position = f.number("position");
     if (f.has("travel") == f.has("compression"))
-      f.fail("travel", "give either travel (m, along the axis) or compression (a share of "
-                       "the body's extent), one of them");
+      f.fail("travel",
+             "give either travel (m, along the axis) or compression (a share of "
+             "the body's extent), one of them");
     if (f.has("travel")) {
       spec.travel = f.number("travel");
     } else {
@@ -350,14 +350,13 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   options.steps = f.integer("steps", options.steps, 1, 100000);
   options.rebuild_matrix = f.boolean("rebuild_matrix", options.rebuild_matrix);
   options.update_load_geometry = f.boolean("update_load_geometry", options.update_load_geometry);
-  const std::string method = f.choice("boundary_method",
-                                      model::to_string(options.boundary_method),
+  const std::string method = f.choice("boundary_method", model::to_string(options.boundary_method),
                                       {"elimination", "penalty"});
-  options.boundary_method = method == "penalty" ? model::BoundaryMethod::Penalty
-                                                : model::BoundaryMethod::Elimination;
+  options.boundary_method =
+      method == "penalty" ? model::BoundaryMethod::Penalty : model::BoundaryMethod::Elimination;
   options.penalty = f.positive("penalty", options.penalty);
-  const std::string solver = f.choice("solver", solve::to_string(options.solver),
-                                      {"auto", "dense-lu", "block-cholesky", "cholmod", "pcg"});
+  const std::string solver =
+      f.choice("solver", solve::to_string(options.solver), solve::solver_kind_names());
   options.solver = *solve::solver_kind_from_string(solver);
   options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
   options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
@@ -464,17 +463,18 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
   c.constraints = read_constraints(root);
   c.paddles = read_paddles(root);
   c.paddles_field = {root.file(), root.name("paddles")};
-  c.stepping = root.has("stepping") ? read_stepping(root.object("stepping"), {})
-                                    : solve::SteppingOptions{};
+  c.stepping =
+      root.has("stepping") ? read_stepping(root.object("stepping"), {}) : solve::SteppingOptions{};
   if (!c.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
-    root.fail("paddles", "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
-                         "an active set inside the equilibrium iterations)");
-  if (!c.material.material.law.is_constant() &&
-      c.stepping.scheme == solve::Scheme::Incremental && !c.stepping.rebuild_matrix &&
-      warnings != nullptr)
-    warnings->push_back("material.law: the incremental scheme without stepping.rebuild_matrix "
-                        "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
-                        "scheme \"newton\" for the strain-dependent law");
+    root.fail("paddles",
+              "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
+              "an active set inside the equilibrium iterations)");
+  if (!c.material.material.law.is_constant() && c.stepping.scheme == solve::Scheme::Incremental &&
+      !c.stepping.rebuild_matrix && warnings != nullptr)
+    warnings->push_back(
+        "material.law: the incremental scheme without stepping.rebuild_matrix "
+        "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
+        "scheme \"newton\" for the strain-dependent law");
   if (c.fibers.treecode_tolerance > 0.0) check_treecode(root, c);
   check_tables(root, c);
   root.finish();
@@ -573,8 +573,8 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
 }
 
 // Fields of the experiment that a variant may not patch.
-const char* const kExperimentFields[] = {"name", "description", "kind", "variants", "expected",
-                                         "output", "fit", "fem_reference"};
+const char* const kExperimentFields[] = {"name",     "description", "kind", "variants",
+                                         "expected", "output",      "fit",  "fem_reference"};
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
@@ -653,8 +653,9 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   if (root.has("fit")) {
     if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
     if (root.has("variants"))
-      root.fail("fit", "a fit calibrates one simulation: remove \"variants\" (fit several loads "
-                       "with several targets, each tied to its step)");
+      root.fail("fit",
+                "a fit calibrates one simulation: remove \"variants\" (fit several loads "
+                "with several targets, each tied to its step)");
     ex.fit = read_fit(root.object("fit"), folder);
   }
   if (root.has("fem_reference")) {

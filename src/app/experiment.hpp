@@ -19,18 +19,18 @@ namespace fiberfluid::app {
 // A figure the experiment expects, checked after the run: either a value
 // with an absolute tolerance, or bounds.
 struct ExpectedFigure {
-  std::string figure;                     // e.g. "max_displacement", "position.0.x"
+  std::string figure;  // e.g. "max_displacement", "position.0.x"
   std::optional<double> value;
-  double tolerance = 0.0;                 // |actual - value| <= tolerance
+  double tolerance = 0.0;  // |actual - value| <= tolerance
   std::optional<double> at_most, at_least;
-  Eigen::MatrixXd matrix;                 // for matrix figures ("system_matrix")
-  std::string note;                       // where the number comes from
+  Eigen::MatrixXd matrix;  // for matrix figures ("system_matrix")
+  std::string note;        // where the number comes from
 };
 
 struct OutputOptions {
-  bool vtk = true;   // one .vtu per load step and a .pvd series
-  bool obj = true;   // final.obj, the deformed surface in input vertex order
-  int every = 1;     // write every k-th step's .vtu (the last always)
+  bool vtk = true;  // one .vtu per load step and a .pvd series
+  bool obj = true;  // final.obj, the deformed surface in input vertex order
+  int every = 1;    // write every k-th step's .vtu (the last always)
 };
 
 // A named surface for an "areas" experiment (the paper's Table 1).
@@ -53,7 +53,7 @@ struct Experiment {
   std::filesystem::path source;  // the JSON file ("" for a document built in a program)
 
   // As parsed (read_experiment), and as built (build_experiment):
-  std::vector<CaseSpec> specs;   // Simulate: one, or one per variant
+  std::vector<CaseSpec> specs;  // Simulate: one, or one per variant
   std::vector<Case> cases;
   OutputOptions output;
 
@@ -66,7 +66,8 @@ struct Experiment {
   std::optional<FitSpec> fit;
   // "fem_reference": also solve the simulation by linear FEM on tetrahedra
   // and write its deformed boundary (fem_reference.obj) as a target.
-  std::optional<FemReferenceSpec> fem_reference;   // the "fit" section: what `fiberfluid fit` calibrates
+  std::optional<FemReferenceSpec>
+      fem_reference;  // the "fit" section: what `fiberfluid fit` calibrates
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader

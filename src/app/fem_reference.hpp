@@ -29,15 +29,15 @@ struct RunResult;
 class Fields;
 
 struct FemReferenceSpec {
-  double young = 0.0;   // E (Pa)
-  double poisson = 0.3; // nu
+  double young = 0.0;    // E (Pa)
+  double poisson = 0.3;  // nu
   fem::TetMeshOptions mesh;
 };
 FemReferenceSpec read_fem_reference(Fields& f);
 
 struct FemReferenceResult {
-  fem::Mesh mesh;                  // the tetrahedra at rest
-  Eigen::MatrixXd displacement;    // per node
+  fem::Mesh mesh;                // the tetrahedra at rest
+  Eigen::MatrixXd displacement;  // per node
   geom::Surface rest_boundary, deformed_boundary;
   std::map<std::string, double> figures;  // "fem_reference.*"
 };

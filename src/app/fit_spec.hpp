@@ -15,7 +15,7 @@ namespace fiberfluid::app {
 struct FitTargetSpec {
   FieldName field;
   std::filesystem::path file;
-  int step = 0;  // the load step it was measured at; 0: the last
+  int step = 0;        // the load step it was measured at; 0: the last
   double scale = 1.0;  // the scan's coordinates times this are in m ("units": "mm" is 1e-3)
 };
 
@@ -31,8 +31,8 @@ struct FitSpec {
   // A fit.json whose parameters' values are the starts (an interrupted or
   // earlier fit, continued).
   std::optional<std::filesystem::path> start_from;
-  fit::FitOptions options;                // all but counted_vertices and progress
-  std::optional<SelectionSpec> exclude;   // vertices whose distances do not count
+  fit::FitOptions options;               // all but counted_vertices and progress
+  std::optional<SelectionSpec> exclude;  // vertices whose distances do not count
 };
 
 }  // namespace fiberfluid::app

@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/fitting.hpp"
 
-#include <cmath>
-#include <limits>
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/vtk_writer.hpp"
 #include "model/assembly.hpp"
 #include "model/equilibrium.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -37,10 +37,11 @@ json statistics_json(const fit::DistanceStatistics& s) {
 
 json iteration_json(const fit::IterationRecord& it, const std::vector<std::string>& names) {
   json values = json::object();
-  for (size_t k = 0; k < names.size(); ++k) values[names[k]] = it.values[static_cast<Eigen::Index>(k)];
+  for (size_t k = 0; k < names.size(); ++k)
+    values[names[k]] = it.values[static_cast<Eigen::Index>(k)];
   json out = {{"iteration", it.iteration}, {"cost", number(it.cost)},
-              {"accepted", it.accepted}, {"trial_cost", number(it.trial_cost)},
-              {"values", values}, {"forward_runs", it.forward_runs},
+              {"accepted", it.accepted},   {"trial_cost", number(it.trial_cost)},
+              {"values", values},          {"forward_runs", it.forward_runs},
               {"seconds", it.seconds}};
   if (!it.trial_failure.empty()) out["trial_failure"] = it.trial_failure;
   return out;
@@ -50,7 +51,9 @@ json iteration_json(const fit::IterationRecord& it, const std::vector<std::strin
 
 std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file) {
   std::ifstream in(fit_json_file);
-  if (!in) throw InputError(fit_json_file.string() + ": cannot open (expected the fit.json of an earlier fit)");
+  if (!in)
+    throw InputError(fit_json_file.string() +
+                     ": cannot open (expected the fit.json of an earlier fit)");
   const json doc = parse_json(in, fit_json_file.string());
   std::map<std::string, double> values;
   if (doc.is_object() && doc.contains("parameters") && doc["parameters"].is_array())
@@ -59,30 +62,37 @@ std::map<std::string, double> fitted_values(const std::filesystem::path& fit_jso
           p["value"].is_number() && std::isfinite(p["value"].get<double>()))
         values[p["name"].get<std::string>()] = p["value"].get<double>();
   if (values.empty())
-    throw InputError(fit_json_file.string() + ": expected a fit.json with parameters[].name and "
+    throw InputError(fit_json_file.string() +
+                     ": expected a fit.json with parameters[].name and "
                      "parameters[].value");
   return values;
 }
 
 int fit_exit_status(fit::FitStatus status) {
   switch (status) {
-    case fit::FitStatus::Converged: return 0;
-    case fit::FitStatus::ConvergedAtBounds: return 4;
-    case fit::FitStatus::Interrupted: return 130;
+    case fit::FitStatus::Converged:
+      return 0;
+    case fit::FitStatus::ConvergedAtBounds:
+      return 4;
+    case fit::FitStatus::Interrupted:
+      return 130;
     case fit::FitStatus::NotIdentifiable:
     case fit::FitStatus::IterationLimit:
     case fit::FitStatus::ForwardRunsFailed:
     case fit::FitStatus::StartFailed:
-    case fit::FitStatus::OptimizerFailed: break;
+    case fit::FitStatus::OptimizerFailed:
+      break;
   }
   return 2;
 }
 
 bool fit_result_kept(fit::FitStatus status) { return fit::converged(status); }
 
-FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::IterationRecord&)> progress) {
+FitSetup setup_fit(const Experiment& ex,
+                   std::function<void(const fit::IterationRecord&)> progress) {
   if (!ex.fit) throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");
-  if (ex.cases.size() != 1) throw InputError(ex.source.string() + ": a fit calibrates one simulation");
+  if (ex.cases.size() != 1)
+    throw InputError(ex.source.string() + ": a fit calibrates one simulation");
   const FitSpec& spec = *ex.fit;
   const Case& c = ex.cases.front();
   FitSetup setup;
@@ -107,8 +117,8 @@ FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::Iteration
     fit::ParameterRequest request = p.request;
     if (spec.start_from) {
       if (!earlier.count(request.name))
-        spec.field.fail("start_from", spec.start_from->string() + " has no value for \"" +
-                                          request.name + "\"");
+        spec.field.fail("start_from",
+                        spec.start_from->string() + " has no value for \"" + request.name + "\"");
       request.start = earlier.at(request.name);
     }
     try {
@@ -134,8 +144,8 @@ FitSetup setup_fit(const Experiment& ex, std::function<void(const fit::Iteration
       spec.exclude->field.fail("", "excludes every vertex: no distance would count");
   }
   try {
-    setup.calibration = std::make_unique<fit::Calibration>(c.model, c.stepping, setup.targets,
-                                                           parameters, options);
+    setup.calibration =
+        std::make_unique<fit::Calibration>(c.model, c.stepping, setup.targets, parameters, options);
   } catch (const InputError& e) {
     spec.field.fail("", e.what());
   }
@@ -186,11 +196,13 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
   json correlation = json::array();
   for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
     json row = json::array();
-    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b) row.push_back(number(r.correlation(a, b)));
+    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b)
+      row.push_back(number(r.correlation(a, b)));
     correlation.push_back(row);
   }
   json iterations = json::array();
-  for (const fit::IterationRecord& it : r.iterations) iterations.push_back(iteration_json(it, r.names));
+  for (const fit::IterationRecord& it : r.iterations)
+    iterations.push_back(iteration_json(it, r.names));
   json targets = json::array();
   for (size_t t = 0; t < setup.targets.size(); ++t) {
     json target = {{"file", setup.targets[t].target.label},
@@ -202,19 +214,23 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
   }
   json checks = json::array();
   for (const FigureCheck& check : run.checks)
-    checks.push_back({{"figure", check.expected.figure}, {"passed", check.passed},
-                      {"actual", number(check.actual)}, {"text", check.Describe()}});
+    checks.push_back({{"figure", check.expected.figure},
+                      {"passed", check.passed},
+                      {"actual", number(check.actual)},
+                      {"text", check.Describe()}});
   json failures = json::object();
   for (const auto& [cause, count] : r.failures_by_cause) failures[cause] = count;
   json examples = json::array();
   for (const fit::FailedRun& f : r.failed_examples) {
     json values = json::object();
-    for (size_t k = 0; k < r.names.size(); ++k) values[r.names[k]] = f.values[static_cast<Eigen::Index>(k)];
+    for (size_t k = 0; k < r.names.size(); ++k)
+      values[r.names[k]] = f.values[static_cast<Eigen::Index>(k)];
     examples.push_back({{"values", values}, {"message", f.message}});
   }
   const int counted = c.num_counted_vertices();
   int target_points = 0;
-  for (const fit::MeasuredStep& t : setup.targets) target_points += static_cast<int>(t.target.points.rows());
+  for (const fit::MeasuredStep& t : setup.targets)
+    target_points += static_cast<int>(t.target.points.rows());
   json doc = {
       {"experiment", ex.name},
       {"status", fit::to_string(r.status)},
@@ -298,7 +314,8 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
     geom::Surface scan;
     scan.V = setup.targets[t].target.points;
     scan.F = setup.targets[t].target.triangles;
-    if (scan.F.rows() > 0) geom::write_obj(folder / ("fit_target_" + std::to_string(t) + "_scan.obj"), scan);
+    if (scan.F.rows() > 0)
+      geom::write_obj(folder / ("fit_target_" + std::to_string(t) + "_scan.obj"), scan);
   }
   geom::write_text_file(folder / "fit_distances.csv", distances.str());
 }

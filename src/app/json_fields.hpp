@@ -2,16 +2,16 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "app/case_spec.hpp"
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 
@@ -20,7 +20,8 @@ namespace fiberfluid::app {
 inline std::string excerpt(const nlohmann::json& value) {
   constexpr size_t kLongest = 80;
   std::string text = value.dump();
-  if (text.size() > kLongest) text = text.substr(0, kLongest) + "... (" + std::to_string(text.size()) + " characters)";
+  if (text.size() > kLongest)
+    text = text.substr(0, kLongest) + "... (" + std::to_string(text.size()) + " characters)";
   return text;
 }
 
@@ -72,8 +73,10 @@ class Fields {
   int integer(const std::string& key, int fallback, int min, int max) {
     if (!has(key)) return seen_.insert(key), fallback;
     const nlohmann::json& v = raw(key);
-    const std::string range = "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
-    if (!v.is_number_integer() || !fits(v, min, max)) fail(key, "expected " + range + ", got " + excerpt(v));
+    const std::string range =
+        "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
+    if (!v.is_number_integer() || !fits(v, min, max))
+      fail(key, "expected " + range + ", got " + excerpt(v));
     return static_cast<int>(v.get<long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
@@ -100,8 +103,8 @@ class Fields {
   // A list of `size` numbers (any size when size < 0).
   Eigen::VectorXd vector(const std::string& key, int size) {
     const nlohmann::json& v = raw(key);
-    const std::string want = size < 0 ? "a list of numbers"
-                                      : "a list of " + std::to_string(size) + " numbers";
+    const std::string want =
+        size < 0 ? "a list of numbers" : "a list of " + std::to_string(size) + " numbers";
     if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size))
       fail(key, "expected " + want + ", got " + excerpt(v));
     Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
@@ -117,11 +120,13 @@ class Fields {
     const nlohmann::json& v = raw(key);
     const std::string want = "a list of " + std::to_string(size) + " whole numbers from " +
                              std::to_string(min) + " to " + std::to_string(max);
-    if (!v.is_array() || static_cast<int>(v.size()) != size) fail(key, "expected " + want + ", got " + excerpt(v));
+    if (!v.is_array() || static_cast<int>(v.size()) != size)
+      fail(key, "expected " + want + ", got " + excerpt(v));
     Eigen::VectorXi out(size);
     for (int k = 0; k < size; ++k) {
       const nlohmann::json& item = v[static_cast<size_t>(k)];
-      if (!item.is_number_integer() || !fits(item, min, max)) fail(key, "expected " + want + ", got " + excerpt(v));
+      if (!item.is_number_integer() || !fits(item, min, max))
+        fail(key, "expected " + want + ", got " + excerpt(v));
       out[k] = static_cast<int>(item.get<long long>());
     }
     return out;
@@ -181,6 +186,5 @@ class Fields {
   std::string path_, file_;
   std::set<std::string> seen_;
 };
-
 
 }  // namespace fiberfluid::app

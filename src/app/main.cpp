@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // fiberfluid: command-line tool. It only parses, loads and dispatches.
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <csignal>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -11,8 +11,8 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "app/compare.hpp"
@@ -21,18 +21,22 @@
 #include "app/output_folder.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
+#include "util/error.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace {
 
 namespace app = fiberfluid::app;
 
 enum ExitCode {
-  kOk = 0, kBadInput = 1, kSolverFailed = 2, kChecksFailed = 3, kUsage = 64,
+  kOk = 0,
+  kBadInput = 1,
+  kSolverFailed = 2,
+  kChecksFailed = 3,
+  kUsage = 64,
   kInterrupted = 130,  // 128 + SIGINT, as a shell reports a process ended by Ctrl-C
 };
 
@@ -134,8 +138,10 @@ class ProgressPrinter {
       std::snprintf(buffer, sizeof buffer, ", %.1f s", elapsed);
       line += buffer;
     }
-    if (tty_) std::fprintf(stderr, "\r\033[K%s", line.c_str());
-    else std::fprintf(stderr, "%s\n", line.c_str());
+    if (tty_)
+      std::fprintf(stderr, "\r\033[K%s", line.c_str());
+    else
+      std::fprintf(stderr, "%s\n", line.c_str());
     std::fflush(stderr);
     line_open_ = tty_;
   }
@@ -174,12 +180,12 @@ struct RunFlags {
 // Loads an experiment (throwing before anything is written), drawing the
 // progress of long phases such as pruning unless quiet; the sink stays set.
 // Estimates of long runs are printed before they start (as notes).
-app::Experiment load_showing_progress(const std::string& path, bool quiet, ProgressPrinter& printer) {
+app::Experiment load_showing_progress(const std::string& path, bool quiet,
+                                      ProgressPrinter& printer) {
   if (!quiet) {
     fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
-                                             double done, double total) {
-      printer(label, phase, done, total);
-    });
+                                             double done,
+                                             double total) { printer(label, phase, done, total); });
     fiberfluid::set_note_sink([&printer](const std::string& label, const std::string& text) {
       printer.close();
       std::cerr << "note: " << (label.empty() ? "" : "[" + label + "] ") << text << "\n";
@@ -220,7 +226,9 @@ int run_command(const std::string& path, const RunFlags& flags) {
   if (ex.kind == app::Experiment::Kind::Simulate) {
     const app::FiberReport& f = ex.cases.front().fibers;
     std::cout << "  fibers: " << f.kept << " kept of " << f.pairs << " ("
-              << (!f.pruning ? "pruning off" : f.convex ? "convex" : "pruned exactly")
+              << (!f.pruning ? "pruning off"
+                  : f.convex ? "convex"
+                             : "pruned exactly")
               << "; per vertex " << f.min_per_vertex << " / " << f.mean_per_vertex << " / "
               << f.max_per_vertex << "; " << f.seconds << " s)\n";
   }
@@ -253,7 +261,8 @@ int run_command(const std::string& path, const RunFlags& flags) {
 
 // Prints one line per iteration of a fit: its cost and point, and for a
 // rejected step why (its cost, or its forward run's failure).
-void print_iteration(const fiberfluid::fit::IterationRecord& r, const std::vector<std::string>& names) {
+void print_iteration(const fiberfluid::fit::IterationRecord& r,
+                     const std::vector<std::string>& names) {
   std::cerr << "fit: iteration " << r.iteration << ": cost " << r.cost << " m^2";
   if (!r.accepted && !r.trial_failure.empty())
     std::cerr << " (step rejected: its forward run failed: " << r.trial_failure << ")";
@@ -291,14 +300,16 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
   }
   std::cout << "  " << fitted.forward_runs << " forward runs";
   if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed)";
-  std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds << " s\n";
+  std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds
+            << " s\n";
   for (const auto& [cause, count] : fitted.failures_by_cause)
     std::cout << "  failed forward runs: " << count << " x " << cause << "\n";
   if (!fitted.failed_examples.empty()) {
     const fit::FailedRun& f = fitted.failed_examples.front();
     std::cout << "  first failure at";
     for (size_t k = 0; k < fitted.names.size(); ++k)
-      std::cout << (k ? ", " : " ") << fitted.names[k] << " = " << f.values[static_cast<Eigen::Index>(k)];
+      std::cout << (k ? ", " : " ") << fitted.names[k] << " = "
+                << f.values[static_cast<Eigen::Index>(k)];
     std::cout << ": " << f.message << "\n";
   }
 }
@@ -315,7 +326,8 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   ProgressPrinter printer;
   const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
-  const std::filesystem::path folder = app::output_folder(flags.output, ex.name);  // refused now, not after the fit
+  const std::filesystem::path folder =
+      app::output_folder(flags.output, ex.name);  // refused now, not after the fit
   std::vector<std::string> names;
   if (ex.fit)
     for (const auto& p : ex.fit->parameters) names.push_back(p.request.name);
@@ -343,30 +355,32 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   writer.begin();
   if (fitted.status == fit::FitStatus::Interrupted) {
     const app::ExperimentResult none;
-    writer.keep_interrupted("the fit was interrupted after " + std::to_string(fitted.iterations.size()) +
+    writer.keep_interrupted("the fit was interrupted after " +
+                                std::to_string(fitted.iterations.size()) +
                                 " iterations; fit.json holds the best point so far (continue "
                                 "with \"start_from\" in the fit section)",
                             [&](const std::filesystem::path& dir) {
                               app::write_fit_files(dir, at_fit, setup, fitted, none);
                             });
-    std::cerr << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
-              << (writer.folder() / "fit.json").string() << " (continue with \"start_from\": \""
-              << (writer.folder() / "fit.json").string() << "\" in the fit section)\n";
+    std::cerr
+        << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
+        << (writer.folder() / "fit.json").string() << " (continue with \"start_from\": \""
+        << (writer.folder() / "fit.json").string() << "\" in the fit section)\n";
     return app::fit_exit_status(fitted.status);
   }
   app::ExperimentResult result;
   if (fitted.status != fit::FitStatus::StartFailed) {
-    result = app::run_experiment(
-        at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
-          writer.on_step(run, r, x);
-        });
+    result =
+        app::run_experiment(at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r,
+                                        const Eigen::VectorXd& x) { writer.on_step(run, r, x); });
     stop_if_interrupted("the run at the fitted values");
     for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
     result.checks = app::check_expected(at_fit, result);
   }
   if (!app::fit_result_kept(fitted.status))
     result.failure = std::string("the fit ended ") + fit::to_string(fitted.status) + ": " +
-                     fitted.message + (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
+                     fitted.message +
+                     (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
   writer.finish(result, [&](const std::filesystem::path& dir) {
     app::write_fit_files(dir, at_fit, setup, fitted, result);
   });
@@ -400,8 +414,10 @@ int compare_command(const std::string& reference, const std::string& approximati
   const app::Comparison c = app::compare_files(
       reference, approximation,
       undeformed.empty() ? std::nullopt : std::optional<std::filesystem::path>(undeformed));
-  if (as_json) std::cout << app::comparison_json(c).dump(2) << "\n";
-  else std::cout << app::comparison_text(c);
+  if (as_json)
+    std::cout << app::comparison_json(c).dump(2) << "\n";
+  else
+    std::cout << app::comparison_text(c);
   return kOk;
 }
 
@@ -422,8 +438,9 @@ int check_command(const std::string& path, bool flip) {
 // dense factor is checked against before it is allocated; --max-time: the
 // longest estimate that may start.
 void add_resource_limits(CLI::App* command, RunFlags& flags) {
-  command->add_option("--max-time", flags.max_time,
-                      "Refuse a case whose estimated time exceeds this many seconds")
+  command
+      ->add_option("--max-time", flags.max_time,
+                   "Refuse a case whose estimated time exceeds this many seconds")
       ->check(CLI::PositiveNumber);
   command
       ->add_option_function<std::string>(
@@ -464,10 +481,13 @@ int main(int argc, char** argv) {
 
   RunFlags fit_flags;
   CLI::App* fit = cli.add_subcommand(
-      "fit", "Calibrate the material of an experiment to its \"fit\" targets, then run it at the "
-             "fitted values");
-  fit->add_option("experiment", experiment, "Experiment file (JSON) with a \"fit\" section")->required();
-  fit->add_option("-o,--output", fit_flags.output, "Output folder (default: out/<experiment name>)");
+      "fit",
+      "Calibrate the material of an experiment to its \"fit\" targets, then run it at the "
+      "fitted values");
+  fit->add_option("experiment", experiment, "Experiment file (JSON) with a \"fit\" section")
+      ->required();
+  fit->add_option("-o,--output", fit_flags.output,
+                  "Output folder (default: out/<experiment name>)");
   fit->add_flag("--check", fit_flags.check_expected,
                 "Exit with status 3 when an expected figure of the file is not met");
   fit->add_flag("-q,--quiet", fit_flags.quiet, "No progress lines");
@@ -480,8 +500,9 @@ int main(int argc, char** argv) {
   std::string compared_reference, compared, undeformed;
   bool as_json = false;
   CLI::App* compare = cli.add_subcommand(
-      "compare", "The benchmarks paper's metrics (E_s; E_n and E_i with --reference) and the "
-                 "surface distances between a reference deformed surface M and another M'");
+      "compare",
+      "The benchmarks paper's metrics (E_s; E_n and E_i with --reference) and the "
+      "surface distances between a reference deformed surface M and another M'");
   compare->add_option("M", compared_reference, "The reference deformed surface")->required();
   compare->add_option("M_prime", compared, "The deformed surface to compare with it")->required();
   compare->add_option("--reference", undeformed,
@@ -501,7 +522,8 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(experiment, flags);
     if (fit->parsed()) return fit_command(experiment, fit_flags);
-    if (compare->parsed()) return compare_command(compared_reference, compared, undeformed, as_json);
+    if (compare->parsed())
+      return compare_command(compared_reference, compared, undeformed, as_json);
     return check_command(mesh, flip);
   } catch (const fiberfluid::Interrupted& e) {
     std::cerr << "\nerror: " << e.what() << " (Ctrl-C): nothing was written; an earlier "

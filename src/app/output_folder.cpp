@@ -14,8 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 
@@ -33,7 +33,9 @@ constexpr int kMarkerVersion = 1;
 constexpr size_t kLongestTypedName = 190;
 constexpr size_t kLongestHost = 32;
 
-bool safe_character(unsigned char ch) { return std::isalnum(ch) || ch == '_' || ch == '-' || ch == '.'; }
+bool safe_character(unsigned char ch) {
+  return std::isalnum(ch) || ch == '_' || ch == '-' || ch == '.';
+}
 
 // This host's name in the folder-name alphabet: staging folders of two hosts
 // sharing a volume never collide, and only this host's are cleaned up here.
@@ -79,14 +81,16 @@ std::string replace_problem(const fs::path& folder) {
   std::ifstream summary(folder / "summary.json");
   const nlohmann::json old = nlohmann::json::parse(summary, nullptr, /*allow_exceptions=*/false);
   if (old.is_object() && old.contains("fiberfluid_version"))  // before the marker existed
-    return "holds results of an older fiberfluid (it has no " + marker + "), and only folders "
+    return "holds results of an older fiberfluid (it has no " + marker +
+           "), and only folders "
            "with it are replaced: remove it by hand, or choose another output folder with -o";
   return "exists and was not written by fiberfluid (it has no " + marker +
          "), so it is never replaced; choose another output folder with -o";
 }
 
 // Removes the previous result that a swap left at `old`; a failure is a warning.
-void remove_previous(const fs::path& old, const fs::path& target, std::vector<std::string>* warnings) {
+void remove_previous(const fs::path& old, const fs::path& target,
+                     std::vector<std::string>* warnings) {
   std::error_code error;
   fs::remove_all(old, error);
   if (error && warnings != nullptr)
@@ -97,9 +101,11 @@ void remove_previous(const fs::path& old, const fs::path& target, std::vector<st
 
 // Without renameat2's flags (some network file systems): the earlier folder
 // is renamed aside first (atomic), then the new one takes its name.
-void move_by_two_renames(const fs::path& from, const fs::path& to, std::vector<std::string>* warnings) {
+void move_by_two_renames(const fs::path& from, const fs::path& to,
+                         std::vector<std::string>* warnings) {
   const std::string problem = replace_problem(to);
-  if (!problem.empty()) throw InputError(to.string() + ": " + problem + "; the results are in " + from.string());
+  if (!problem.empty())
+    throw InputError(to.string() + ": " + problem + "; the results are in " + from.string());
   fs::path old = to;
   old += ".old-" + random_hex();
   const bool had_old = ::rename(to.c_str(), old.c_str()) == 0;
@@ -123,8 +129,10 @@ std::string folder_name_problem(const std::string& name) {
     return "a name of letters, digits, '_', '-' or '.' (it names an output folder), got \"" +
            (name.size() > 60 ? name.substr(0, 60) + "..." : name) + "\"";
   if (name.size() > kLongestName)
-    return "a name of at most " + std::to_string(kLongestName) + " characters (it names an output "
-           "folder), got one of " + std::to_string(name.size());
+    return "a name of at most " + std::to_string(kLongestName) +
+           " characters (it names an output "
+           "folder), got one of " +
+           std::to_string(name.size());
   return "";
 }
 
@@ -149,8 +157,10 @@ fs::path output_folder(const std::string& flag, const std::string& experiment_na
   }
   const std::string name = folder.filename().string();
   if (folder.empty() || name.empty() || name == "." || name == ".." || !folder.has_relative_path())
-    throw InputError("-o " + flag + ": expected a folder of its own for the results (it is "
-                     "replaced as a whole), not \"" + folder.string() + "\"");
+    throw InputError("-o " + flag +
+                     ": expected a folder of its own for the results (it is "
+                     "replaced as a whole), not \"" +
+                     folder.string() + "\"");
   if (name.size() > kLongestTypedName)
     throw InputError("-o " + flag + ": expected a folder name of at most " +
                      std::to_string(kLongestTypedName) + " characters");
@@ -212,8 +222,10 @@ void move_into_place(const fs::path& from, const fs::path& to, std::vector<std::
   const std::string problem = replace_problem(from);
   if (!problem.empty()) {
     renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_EXCHANGE);
-    throw InputError(to.string() + ": " + problem + " (it appeared while this run went on); the "
-                     "results are in " + from.string());
+    throw InputError(to.string() + ": " + problem +
+                     " (it appeared while this run went on); the "
+                     "results are in " +
+                     from.string());
   }
   remove_previous(from, to, warnings);
 }

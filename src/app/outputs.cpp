@@ -8,10 +8,10 @@
 
 #include "app/output_folder.hpp"
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/vtk_writer.hpp"
 #include "model/assembly.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -43,16 +43,16 @@ json newton_options_json(const solve::NewtonOptions& n) {
 
 json stepping_json(const solve::SteppingOptions& s) {
   json out = {{"scheme", solve::to_string(s.scheme)},
-             {"steps", s.steps},
-             {"rebuild_matrix", s.rebuild_matrix},
-             {"update_load_geometry", s.update_load_geometry},
-             {"boundary_method", model::to_string(s.boundary_method)},
-             {"penalty", s.penalty},
-             {"solver", solve::to_string(s.solver)},
-             {"tolerance", s.pcg.tolerance},
-             {"max_iterations", s.pcg.max_iterations},
-             {"max_volume_change", s.max_volume_change},
-             {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
+              {"steps", s.steps},
+              {"rebuild_matrix", s.rebuild_matrix},
+              {"update_load_geometry", s.update_load_geometry},
+              {"boundary_method", model::to_string(s.boundary_method)},
+              {"penalty", s.penalty},
+              {"solver", solve::to_string(s.solver)},
+              {"tolerance", s.pcg.tolerance},
+              {"max_iterations", s.pcg.max_iterations},
+              {"max_volume_change", s.max_volume_change},
+              {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
   if (s.scheme == solve::Scheme::Newton) out["newton"] = newton_options_json(s.newton);
   return out;
 }
@@ -100,8 +100,8 @@ json estimate_json(const ResourceEstimate& e) {
   json parts = json::array();
   for (const ResourcePart& p : e.parts)
     parts.push_back({{"name", p.name}, {"bytes", p.bytes}, {"seconds", p.seconds}});
-  return {{"peak_bytes", e.peak_bytes}, {"seconds", e.seconds}, {"solver", e.solver},
-          {"parts", parts}};
+  return {
+      {"peak_bytes", e.peak_bytes}, {"seconds", e.seconds}, {"solver", e.solver}, {"parts", parts}};
 }
 
 json run_json(const Case& c, const ExperimentResult& result, const RunResult& run) {
@@ -141,10 +141,11 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"success", run.summary.success},
           {"message", run.summary.message},
           {"factorizations", run.summary.factorizations},
-          {"seconds", {{"assemble", run.summary.assemble_seconds},
-                       {"factorize", run.summary.factorize_seconds},
-                       {"solve", run.summary.solve_seconds},
-                       {"total", run.summary.total_seconds}}},
+          {"seconds",
+           {{"assemble", run.summary.assemble_seconds},
+            {"factorize", run.summary.factorize_seconds},
+            {"solve", run.summary.solve_seconds},
+            {"total", run.summary.total_seconds}}},
           {"estimate", estimate_json(c.estimate)},
           {"steps", steps},
           {"final", final_figures}};
@@ -160,9 +161,8 @@ json fibers_json(const Case& c) {
           {"in_all", f.pairs},
           {"kept", f.kept},
           {"pruned", f.pairs - f.kept},
-          {"kept_per_vertex", {{"min", f.min_per_vertex},
-                               {"mean", f.mean_per_vertex},
-                               {"max", f.max_per_vertex}}},
+          {"kept_per_vertex",
+           {{"min", f.min_per_vertex}, {"mean", f.mean_per_vertex}, {"max", f.max_per_vertex}}},
           {"pruning_seconds", f.seconds},
           {"exact_fallbacks", f.exact_fallbacks}};
 }
@@ -209,9 +209,14 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
                 : ex.kind == Experiment::Kind::Benchmark ? "benchmark"
                                                          : "simulate";
   if (!result.failure.empty()) doc["failure"] = result.failure;
-  doc["units"] = {{"length", "m"},        {"displacement", "m"}, {"force", "N"},
-                  {"pressure", "Pa"},     {"volume", "m^3 (m^2 in 2D)"},
-                  {"Y", "Pa"},            {"gamma", "N/m"},      {"time", "s"}};
+  doc["units"] = {{"length", "m"},
+                  {"displacement", "m"},
+                  {"force", "N"},
+                  {"pressure", "Pa"},
+                  {"volume", "m^3 (m^2 in 2D)"},
+                  {"Y", "Pa"},
+                  {"gamma", "N/m"},
+                  {"time", "s"}};
   doc["success"] = result.runs_succeeded();
   if (ex.kind == Experiment::Kind::Simulate) {
     const Case& first = ex.cases.front();
@@ -245,8 +250,7 @@ static void paddle_headers(CsvTable& t, const model::Paddle& p, int dim, bool fu
   t.header("paddle_" + p.label + "_travel_m");
   if (full) {
     t.header("paddle_" + p.label + "_plane_m");
-    for (int a = 0; a < dim; ++a)
-      t.header("paddle_" + p.label + "_force_" + kAxes[a] + "_N");
+    for (int a = 0; a < dim; ++a) t.header("paddle_" + p.label + "_force_" + kAxes[a] + "_N");
     t.header("paddle_" + p.label + "_contacts");
   } else {
     t.header("paddle_" + p.label + "_force_N");
@@ -254,7 +258,7 @@ static void paddle_headers(CsvTable& t, const model::Paddle& p, int dim, bool fu
 }
 
 static void paddle_numbers(CsvTable& t, const model::Model& m, const solve::StepRecord& r, int dim,
-                    bool full) {
+                           bool full) {
   for (size_t p = 0; p < m.paddles.size(); ++p) {
     const solve::StepRecord::PaddleState s =
         p < r.paddles.size() ? r.paddles[p] : solve::StepRecord::PaddleState{};
@@ -281,8 +285,7 @@ std::string steps_csv(const Case& c, const RunResult& run) {
   t.header("max_displacement_m");
   for (int a = 0; a < dim; ++a) t.header(std::string("applied_force_") + kAxes[a] + "_N");
   for (size_t g = 0; g < groups; ++g)
-    for (int a = 0; a < dim; ++a)
-      t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
+    for (int a = 0; a < dim; ++a) t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
   for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, true);
   const bool newton = run.summary.scheme == solve::Scheme::Newton;
   if (newton)
@@ -394,14 +397,18 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
     t.number(static_cast<double>(s.steps.size()));
     for (const char* f : figures) {  // as the runner computed them; none for a failed run
       const auto value = result.figures.find(run.variant + "." + f);
-      if (value != result.figures.end()) t.number(value->second);
-      else t.text("");
+      if (value != result.figures.end())
+        t.number(value->second);
+      else
+        t.text("");
     }
     const bool same_groups = ex.cases[r].model.constraint_groups == first.constraint_groups;
     for (size_t g = 0; g < groups; ++g)
       for (int a = 0; a < first.dim(); ++a) {
-        if (s.success && same_groups && !s.steps.empty()) t.number(s.steps.back().reactions[g][a]);
-        else t.text("");
+        if (s.success && same_groups && !s.steps.empty())
+          t.number(s.steps.back().reactions[g][a]);
+        else
+          t.text("");
       }
     t.number(s.total_seconds);
     t.text(s.message);
@@ -475,10 +482,9 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
     S.row(c.model_to_input[k]) = model_S.row(static_cast<Eigen::Index>(k));
   char name[32];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
-  geom::write_vtu(run_folder(run) / "vtk" / name, deformed,
-                  {{"displacement", U},
-                   {"displacement_magnitude", U.rowwise().norm()},
-                   {"area_vector", S}});
+  geom::write_vtu(
+      run_folder(run) / "vtk" / name, deformed,
+      {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}, {"area_vector", S}});
   series_[run].emplace_back(step, std::string("vtk/") + name);
 }
 

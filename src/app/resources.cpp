@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "app/case_spec.hpp"
-#include "geom/error.hpp"
-#include "geom/run_control.hpp"
 #include "model/treecode.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -20,8 +20,10 @@ namespace {
 // interpolation degree, measured at 163,842 vertices (README, treecode table).
 double treecode_product_seconds(double N, double tolerance) {
   const int degree = model::TreecodeOptions::for_tolerance(tolerance).degree;
-  const double per_unit = degree <= 3 ? 2.6e-7 : degree <= 4 ? 4.1e-7 : degree <= 6 ? 9.3e-7
-                                                                                    : 2.1e-6;
+  const double per_unit = degree <= 3   ? 2.6e-7
+                          : degree <= 4 ? 4.1e-7
+                          : degree <= 6 ? 9.3e-7
+                                        : 2.1e-6;
   return N * std::log2(std::max(N, 2.0)) * per_unit;
 }
 
@@ -68,18 +70,21 @@ Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
   return b;
 }
 
-solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
-                         const Blocks& b) {
+solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o, const Blocks& b) {
   if (o.solver != solve::SolverKind::Auto) return o.solver;
   return solve::automatic_solver(m, b.largest, b.factors, memory_budget_bytes());
 }
 
 std::string seconds_text(double s) {
   char buffer[32];
-  if (s < 1.0) std::snprintf(buffer, sizeof buffer, "%.2g s", s);
-  else if (s < 120.0) std::snprintf(buffer, sizeof buffer, "%.0f s", s);
-  else if (s < 7200.0) std::snprintf(buffer, sizeof buffer, "%.0f min", s / 60.0);
-  else std::snprintf(buffer, sizeof buffer, "%.1f h", s / 3600.0);
+  if (s < 1.0)
+    std::snprintf(buffer, sizeof buffer, "%.2g s", s);
+  else if (s < 120.0)
+    std::snprintf(buffer, sizeof buffer, "%.0f s", s);
+  else if (s < 7200.0)
+    std::snprintf(buffer, sizeof buffer, "%.0f min", s / 60.0);
+  else
+    std::snprintf(buffer, sizeof buffer, "%.1f h", s / 3600.0);
   return buffer;
 }
 
@@ -99,9 +104,8 @@ std::string ResourceEstimate::describe() const {
   return out.str();
 }
 
-ResourceEstimate estimate_resources(const model::Model& model,
-                                    const solve::SteppingOptions& o, PruningWork pruning,
-                                    const KernelSpeed& speed) {
+ResourceEstimate estimate_resources(const model::Model& model, const solve::SteppingOptions& o,
+                                    PruningWork pruning, const KernelSpeed& speed) {
   ResourceEstimate e;
   const geom::Surface& surface = model.surface;
   const double N = surface.num_vertices(), d = surface.dim;
@@ -110,8 +114,8 @@ ResourceEstimate estimate_resources(const model::Model& model,
 
   e.parts.push_back({"model", kProcessBytes + kBytesPerVertex * N, 0.0, true});
   if (pruning != PruningWork::None)  // N x F tests when convex; a concave body stops early
-    e.parts.push_back({"convexity check", 0.0,
-                       N * surface.num_faces() / speed.orientation_tests_per_second});
+    e.parts.push_back(
+        {"convexity check", 0.0, N * surface.num_faces() / speed.orientation_tests_per_second});
   // An N x N byte table, kept for the solvers, and per thread an AABB tree and
   // the exact solid (about 12 kB a face in all: the bunny's peak).
   if (pruning == PruningWork::Prune)
@@ -128,7 +132,8 @@ ResourceEstimate estimate_resources(const model::Model& model,
   const bool dense_tangent =
       newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns) ==
                     solve::TangentSolver::Dense;
-  const solve::SolverKind kind = dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
+  const solve::SolverKind kind =
+      dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)
@@ -182,15 +187,17 @@ ResourceEstimate estimate_resources(const model::Model& model,
     if (o.rebuild_matrix) factor.name = std::to_string(o.steps) + " factorisations";
     e.parts.push_back(factor);
     const double per_step = solve_seconds + (o.measure_residual ? residual : 0.0);
-    e.parts.push_back({std::to_string(o.steps) + " load steps", 8.0 * unknowns * 8.0,
-                       steps * per_step});
+    e.parts.push_back(
+        {std::to_string(o.steps) + " load steps", 8.0 * unknowns * 8.0, steps * per_step});
   }
 
   double kept = 0.0, largest = 0.0;
   for (const ResourcePart& p : e.parts) {
     e.seconds += p.seconds;
-    if (p.kept) kept += p.bytes;
-    else largest = std::max(largest, p.bytes);
+    if (p.kept)
+      kept += p.bytes;
+    else
+      largest = std::max(largest, p.bytes);
   }
   e.peak_bytes = kept + largest;
   return e;
@@ -202,8 +209,10 @@ void require_within_budget(const ResourceEstimate& estimate, const CaseSpec& spe
   if (estimate.peak_bytes > budget) {
     why << "this case needs " << estimate.describe() << ", more than the memory budget of "
         << format_bytes(budget);
-    if (memory_budget_is_set()) why << " set by --max-memory; raise --max-memory";
-    else why << " (80% of this machine's memory); --max-memory sets another budget";
+    if (memory_budget_is_set())
+      why << " set by --max-memory; raise --max-memory";
+    else
+      why << " (80% of this machine's memory); --max-memory sets another budget";
     why << ", or use a coarser mesh";
     if (estimate.solver != "pcg") why << " or \"stepping\": {\"solver\": \"pcg\"} (memory O(N))";
   } else if (estimate.seconds > time_budget) {

@@ -19,29 +19,29 @@ struct CaseSpec;  // case_spec.hpp, which keeps an estimate in each Case
 // both cores), from scripts/resources.sh on this 2-core machine: rerun it
 // and put the figures here on another machine.
 struct KernelSpeed {
-  double prune_pairs_per_second = 6e5;         // pruning: 5,000-vertex torus, 12.5M pairs in 21 s
-                                               // (the bunny's 930k: 0.75 s)
-  double orientation_tests_per_second = 4e9;   // the convexity check, counted as N x F tests
-                                               // (clusters culled: 10,242 vertices in 0.054 s)
-  double factor_flops_per_second = 6.5e10;     // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
-  double triangular_flops_per_second = 1e10;   // solves with a dense factor (memory-bound)
-  double pair_updates_per_second = 4.5e9;      // one fiber pair in one axis block's product (tiled)
-  double residual_pairs_per_second = 8e8;      // one ordered pair of the Newton residual (tiled)
-  double sparse_flops_per_second = 3e9;        // CHOLMOD on dense bulk blocks
+  double prune_pairs_per_second = 6e5;        // pruning: 5,000-vertex torus, 12.5M pairs in 21 s
+                                              // (the bunny's 930k: 0.75 s)
+  double orientation_tests_per_second = 4e9;  // the convexity check, counted as N x F tests
+                                              // (clusters culled: 10,242 vertices in 0.054 s)
+  double factor_flops_per_second = 6.5e10;    // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
+  double triangular_flops_per_second = 1e10;  // solves with a dense factor (memory-bound)
+  double pair_updates_per_second = 4.5e9;     // one fiber pair in one axis block's product (tiled)
+  double residual_pairs_per_second = 8e8;     // one ordered pair of the Newton residual (tiled)
+  double sparse_flops_per_second = 3e9;       // CHOLMOD on dense bulk blocks
 };
 
 struct ResourcePart {
-  std::string name;     // "pruning", "factorisation", "10 load steps" ...
-  double bytes = 0.0;   // held while this part runs (and after, for the kept parts)
+  std::string name;    // "pruning", "factorisation", "10 load steps" ...
+  double bytes = 0.0;  // held while this part runs (and after, for the kept parts)
   double seconds = 0.0;
-  bool kept = false;    // still held by the later parts (the model, the fiber table)
+  bool kept = false;  // still held by the later parts (the model, the fiber table)
 };
 
 struct ResourceEstimate {
   std::vector<ResourcePart> parts;
-  std::string solver;        // the backend assumed ("block-cholesky", ...)
-  double peak_bytes = 0.0;   // the largest part plus what the kept parts hold
-  double seconds = 0.0;      // all parts
+  std::string solver;       // the backend assumed ("block-cholesky", ...)
+  double peak_bytes = 0.0;  // the largest part plus what the kept parts hold
+  double seconds = 0.0;     // all parts
   // "about 1.2 GiB and 40 s (pruning 30 s, factorisation 8 s / 1.1 GiB, ...; block-cholesky)".
   std::string describe() const;
 };

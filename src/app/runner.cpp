@@ -1,27 +1,27 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/runner.hpp"
 
+#include <omp.h>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <omp.h>
 #include <exception>
 #include <functional>
-#include <thread>
 #include <sstream>
+#include <thread>
 
 #include "geom/area_vectors.hpp"
-#include "geom/progress.hpp"
 #include "model/assembly.hpp"
 #include "model/boundary_conditions.hpp"
+#include "util/progress.hpp"
 
 namespace fiberfluid::app {
 namespace {
 
-const char* kRunFigures[] = {"max_displacement",  "final_pressure",
-                             "final_volume",      "initial_volume",
+const char* kRunFigures[] = {"max_displacement",       "final_pressure",
+                             "final_volume",           "initial_volume",
                              "volume_change_relative", "mean_displacement_over_diagonal",
-                             "surface_area",      "steps",
+                             "surface_area",           "steps",
                              "factorizations"};
 
 // "position.12.y" -> (12, 1); nothing when the form does not match.
@@ -45,8 +45,8 @@ void add_area_figures(const Experiment& ex, ExperimentResult& result) {
     const geom::VertexAreaVectors areas = geom::vertex_area_vectors(s.surface.V, s.surface.F);
     result.figures[s.name + ".vertices"] = s.surface.num_vertices();
     result.figures[s.name + ".faces"] = s.surface.num_faces();
-    result.figures[s.name + ".area_faces"] = areas.surface_area;         // sum |A_f|
-    result.figures[s.name + ".area_vertices"] = areas.magnitude.sum();   // sum |S_i|
+    result.figures[s.name + ".area_faces"] = areas.surface_area;        // sum |A_f|
+    result.figures[s.name + ".area_vertices"] = areas.magnitude.sum();  // sum |S_i|
     result.figures[s.name + ".volume"] = geom::enclosed_volume(s.surface.V, s.surface.F);
   }
 }
@@ -86,9 +86,11 @@ FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
   }
   std::optional<double> value;
   auto it = result.figures.find(expected.figure);
-  if (it != result.figures.end()) value = it->second;
+  if (it != result.figures.end())
+    value = it->second;
   else if (r >= 0)
-    value = run_figure(ex.cases[static_cast<size_t>(r)], result.runs[static_cast<size_t>(r)], figure);
+    value =
+        run_figure(ex.cases[static_cast<size_t>(r)], result.runs[static_cast<size_t>(r)], figure);
   if (!value) return check;
   check.found = true;
   check.actual = *value;
@@ -186,13 +188,14 @@ std::optional<double> run_figure(const Case& ex, const RunResult& run, const std
     if (!va || va->first >= ex.input_surface.num_vertices()) return std::nullopt;
     const Eigen::MatrixXd P = input_positions(ex, x);
     const double position = P(va->first, va->second);
-    return prefix == "position." ? position
-                                 : position - ex.input_surface.V(va->first, va->second);
+    return prefix == "position." ? position : position - ex.input_surface.V(va->first, va->second);
   }
   return std::nullopt;
 }
 
-static int core_count() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+static int core_count() {
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 static int effective_jobs(const RunOptions& options, size_t cases) {
   const int wanted = options.jobs > 0 ? options.jobs : core_count();
@@ -237,8 +240,10 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
   } else if (ex.kind == Experiment::Kind::Benchmark) {
-    auto benchmark = std::make_shared<BenchmarkResult>(run_benchmark(
-        *ex.benchmark, [](int done, int total) { report_progress("benchmark runs", done, total); }));
+    auto benchmark =
+        std::make_shared<BenchmarkResult>(run_benchmark(*ex.benchmark, [](int done, int total) {
+          report_progress("benchmark runs", done, total);
+        }));
     result.figures = benchmark->figures;
     if (!benchmark->ok) result.failure = benchmark->message;
     result.benchmark = benchmark;
@@ -251,8 +256,9 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
       run.variant = ex.cases[r].variant;
       solve::StepObserver step_observer;
       if (observer)
-        step_observer = [&observer, r](const solve::StepRecord& record,
-                                       const Eigen::VectorXd& x) { observer(r, record, x); };
+        step_observer = [&observer, r](const solve::StepRecord& record, const Eigen::VectorXd& x) {
+          observer(r, record, x);
+        };
       run.summary = solve::solve_load_steps(ex.cases[r].model, ex.cases[r].stepping, step_observer);
       if (ex.cases.size() > 1)
         report_progress("variants", static_cast<double>(++finished),
@@ -286,7 +292,8 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
 
 std::vector<FigureCheck> check_expected(const Experiment& ex, const ExperimentResult& result) {
   std::vector<FigureCheck> checks;
-  for (const ExpectedFigure& expected : ex.expected) checks.push_back(check_figure(ex, result, expected));
+  for (const ExpectedFigure& expected : ex.expected)
+    checks.push_back(check_figure(ex, result, expected));
   return checks;
 }
 

@@ -32,7 +32,7 @@ struct ExperimentResult {
   std::map<std::string, double> figures;  // headline figures, "variant.figure" for sweeps,
                                           // and fibers.in_all / kept / pruned
   std::vector<FigureCheck> checks;
-  std::shared_ptr<const BenchmarkResult> benchmark;  // a benchmark's series
+  std::shared_ptr<const BenchmarkResult> benchmark;         // a benchmark's series
   std::shared_ptr<const FemReferenceResult> fem_reference;  // when the experiment asks for one
   std::string failure;  // what failed besides the runs (a benchmark's reference)
   bool runs_succeeded() const;
@@ -45,7 +45,8 @@ using RunObserver =
     std::function<void(size_t run, const solve::StepRecord&, const Eigen::VectorXd&)>;
 
 // Checks the experiment's expected figures against a result's figures and runs.
-std::vector<FigureCheck> check_expected(const Experiment& experiment, const ExperimentResult& result);
+std::vector<FigureCheck> check_expected(const Experiment& experiment,
+                                        const ExperimentResult& result);
 
 struct RunOptions {
   // Cases run at once. Each job's OpenMP loops get cores / jobs threads, so a

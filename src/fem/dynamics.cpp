@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "fem/free_unknowns.hpp"
-#include "geom/run_control.hpp"
 #include "solve/sparse_cholesky.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -31,8 +31,10 @@ int gauss_seidel(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const Ei
     for (Eigen::Index r = 0; r < A.outerSize(); ++r) {
       double sum = b[r], diagonal = 0.0;
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(A, r); it; ++it) {
-        if (it.col() == r) diagonal = it.value();
-        else sum -= it.value() * x[it.col()];
+        if (it.col() == r)
+          diagonal = it.value();
+        else
+          sum -= it.value() * x[it.col()];
       }
       x[r] = sum / diagonal;
     }
@@ -96,11 +98,16 @@ const char* to_string(LinearMethod method) {
 
 const char* to_string(Integrator integrator) {
   switch (integrator) {
-    case Integrator::ImplicitNewmark: return "implicit-newmark";
-    case Integrator::ExplicitConsistent: return "explicit";
-    case Integrator::ExplicitLumped: return "explicit-lumped";
-    case Integrator::ImplicitLumped: return "implicit-lumped";
-    case Integrator::QuasiStatic: return "quasi-static";
+    case Integrator::ImplicitNewmark:
+      return "implicit-newmark";
+    case Integrator::ExplicitConsistent:
+      return "explicit";
+    case Integrator::ExplicitLumped:
+      return "explicit-lumped";
+    case Integrator::ImplicitLumped:
+      return "implicit-lumped";
+    case Integrator::QuasiStatic:
+      return "quasi-static";
   }
   return "?";
 }
@@ -130,10 +137,14 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
       return out;
     }
   const FreeUnknowns split(n, d.held);
-  auto force = [&](double t) { return d.force ? d.force(t) : Eigen::VectorXd(Eigen::VectorXd::Zero(n)); };
+  auto force = [&](double t) {
+    return d.force ? d.force(t) : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
+  };
   auto held_at = [&](double t) {
-    Eigen::VectorXd values = d.held_values ? d.held_values(t)
-                                           : Eigen::VectorXd(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size())));
+    Eigen::VectorXd values =
+        d.held_values
+            ? d.held_values(t)
+            : Eigen::VectorXd(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size())));
     return values;
   };
   auto fail = [&](double t, const std::string& why) {
@@ -160,7 +171,8 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
       if (cancel_requested()) return fail(t, "interrupted");
       const Eigen::VectorXd previous = u, target = held_at(t);
       Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
-      for (size_t k = 0; k < d.held.size(); ++k) fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
+      for (size_t k = 0; k < d.held.size(); ++k)
+        fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
       if (!stiffness_solve.solve(split.restrict(force(t) - d.K * fixed), &free_u))
         return fail(t, no_convergence);
       u = fixed;
@@ -173,8 +185,10 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
     return out;
   }
 
-  const bool lumped = integrator == Integrator::ExplicitLumped || integrator == Integrator::ImplicitLumped;
-  const bool implicit = integrator == Integrator::ImplicitNewmark || integrator == Integrator::ImplicitLumped;
+  const bool lumped =
+      integrator == Integrator::ExplicitLumped || integrator == Integrator::ImplicitLumped;
+  const bool implicit =
+      integrator == Integrator::ImplicitNewmark || integrator == Integrator::ImplicitLumped;
   const double b = implicit ? 0.5 : 0.0, g = 0.5;  // the paper's Newmark parameters
   const Sparse M = lumped ? diagonal(d.lumped) : d.M;
   const Sparse C = d.alpha * M + d.beta * d.K;
@@ -186,7 +200,8 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
                        : Sparse(M + (g * h) * C + (b * h * h / 2.0) * d.K);
   FreeSolve step_solve(A, split, integrator == Integrator::ExplicitLumped, options);
   FreeSolve mass_solve(M, split, lumped, options);
-  if (!step_solve.ok() || !mass_solve.ok()) return fail(0.0, "the step matrix is not positive definite");
+  if (!step_solve.ok() || !mass_solve.ok())
+    return fail(0.0, "the step matrix is not positive definite");
 
   // a at rest: M a = f(0) on the free unknowns; the held ones start at rest.
   Eigen::VectorXd a = Eigen::VectorXd::Zero(n), free_a;
@@ -203,8 +218,9 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
     const Eigen::VectorXd target = held_at(t);
     for (size_t k = 0; k < d.held.size(); ++k) {
       const int dof = d.held[k];
-      a_next[dof] = b > 0.0 ? (target[static_cast<Eigen::Index>(k)] - u_pred[dof]) / (b * h * h / 2.0)
-                            : 2.0 * (target[static_cast<Eigen::Index>(k)] - u[dof] - h * v[dof]) / (h * h);
+      a_next[dof] =
+          b > 0.0 ? (target[static_cast<Eigen::Index>(k)] - u_pred[dof]) / (b * h * h / 2.0)
+                  : 2.0 * (target[static_cast<Eigen::Index>(k)] - u[dof] - h * v[dof]) / (h * h);
     }
     const Eigen::VectorXd rhs = force(t) - C * v_pred - d.K * u_pred - A * a_next;
     if (!step_solve.solve(split.restrict(rhs), &free_a)) return fail(t, no_convergence);
@@ -213,7 +229,8 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
     u = u_pred + (b * h * h / 2.0) * a;
     v = v_pred + (g * h) * a;
     for (size_t k = 0; k < d.held.size(); ++k) u[d.held[k]] = target[static_cast<Eigen::Index>(k)];
-    if (!u.allFinite() || !v.allFinite()) return fail(t, "the state is no longer finite (diverged)");
+    if (!u.allFinite() || !v.allFinite())
+      return fail(t, "the state is no longer finite (diverged)");
     if (u.cwiseAbs().maxCoeff() > d.divergence_scale)
       return fail(t, "a displacement exceeds the divergence scale (diverged)");
     out.times.push_back(t);

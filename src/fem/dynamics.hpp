@@ -28,15 +28,21 @@
 
 namespace fiberfluid::fem {
 
-enum class Integrator { ImplicitNewmark, ExplicitConsistent, ExplicitLumped, ImplicitLumped, QuasiStatic };
+enum class Integrator {
+  ImplicitNewmark,
+  ExplicitConsistent,
+  ExplicitLumped,
+  ImplicitLumped,
+  QuasiStatic
+};
 const char* to_string(Integrator integrator);
 
 struct Dynamics {
-  Eigen::SparseMatrix<double> K, M;  // stiffness and consistent mass
-  Eigen::VectorXd lumped;            // the lumped mass (row sums of M)
-  double alpha = 0.0, beta = 0.0;    // Rayleigh damping
-  std::function<Eigen::VectorXd(double)> force;  // f(t), #dofs; empty: none
-  std::vector<int> held;                         // prescribed unknowns
+  Eigen::SparseMatrix<double> K, M;                    // stiffness and consistent mass
+  Eigen::VectorXd lumped;                              // the lumped mass (row sums of M)
+  double alpha = 0.0, beta = 0.0;                      // Rayleigh damping
+  std::function<Eigen::VectorXd(double)> force;        // f(t), #dofs; empty: none
+  std::vector<int> held;                               // prescribed unknowns
   std::function<Eigen::VectorXd(double)> held_values;  // u at the held unknowns at t; empty: 0
   // A displacement larger than this (e.g. ten times the body's size) means
   // the integration diverged.
@@ -58,10 +64,10 @@ struct IntegrationOptions {
 
 struct Trajectory {
   bool ok = true;
-  std::string message;          // why it stopped (diverged, singular)
-  std::vector<double> times;    // 0, h, 2h, ...
+  std::string message;                // why it stopped (diverged, singular)
+  std::vector<double> times;          // 0, h, 2h, ...
   std::vector<Eigen::VectorXd> u, v;  // per time
-  long long sweeps = 0;         // Gauss-Seidel sweeps in all (0 with Cholesky)
+  long long sweeps = 0;               // Gauss-Seidel sweeps in all (0 with Cholesky)
 };
 
 // The matrices of a mesh and material with Rayleigh damping; no loads, no

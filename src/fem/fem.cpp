@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "fem/free_unknowns.hpp"
-#include "geom/error.hpp"
 #include "solve/sparse_cholesky.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -75,9 +75,9 @@ Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& dN, int dim) {
       for (int i = 0; i < 3; ++i) B(i, c + i) = dN(a, i);
       B(3, c + 1) = dN(a, 2);  // 2 eyz
       B(3, c + 2) = dN(a, 1);
-      B(4, c) = dN(a, 2);      // 2 exz
+      B(4, c) = dN(a, 2);  // 2 exz
       B(4, c + 2) = dN(a, 0);
-      B(5, c) = dN(a, 1);      // 2 exy
+      B(5, c) = dN(a, 1);  // 2 exy
       B(5, c + 1) = dN(a, 0);
     }
   }
@@ -88,8 +88,9 @@ Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& dN, int dim) {
 bool is_simplex(const Eigen::MatrixXd& corners) {
   const int dim = static_cast<int>(corners.cols());
   if ((dim != 2 && dim != 3) || (corners.rows() != (1 << dim) && corners.rows() != dim + 1))
-    throw InputError("fem: an element needs 4 corners (a quadrilateral) or 3 (a triangle) in "
-                     "2D, 8 (a hexahedron) or 4 (a tetrahedron) in 3D");
+    throw InputError(
+        "fem: an element needs 4 corners (a quadrilateral) or 3 (a triangle) in "
+        "2D, 8 (a hexahedron) or 4 (a tetrahedron) in 3D");
   return corners.rows() == dim + 1;
 }
 
@@ -153,7 +154,8 @@ Mesh structured_grid(const Eigen::VectorXd& size, const Eigen::VectorXi& cells) 
                                            id(i, j + 1, k)};
         for (int a = 0; a < 4; ++a) mesh.elements(e, a) = bottom[static_cast<size_t>(a)];
         if (dim == 3)
-          for (int a = 0; a < 4; ++a) mesh.elements(e, 4 + a) = bottom[static_cast<size_t>(a)] + (nx + 1) * (ny + 1);
+          for (int a = 0; a < 4; ++a)
+            mesh.elements(e, 4 + a) = bottom[static_cast<size_t>(a)] + (nx + 1) * (ny + 1);
       }
   return mesh;
 }
@@ -263,8 +265,10 @@ solve::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::Ve
   cholesky.analyze_pattern(Kff);
   const solve::Status status = cholesky.factorize(Kff);
   if (!status.ok)
-    return solve::Status::failure("fem: the stiffness is singular on the free unknowns (too few "
-                                  "supports?): " + status.message);
+    return solve::Status::failure(
+        "fem: the stiffness is singular on the free unknowns (too few "
+        "supports?): " +
+        status.message);
   *u = fixed;
   split.scatter(cholesky.solve(rhs), *u);
   return {};

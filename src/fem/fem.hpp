@@ -38,9 +38,9 @@ Mesh structured_grid(const Eigen::VectorXd& size, const Eigen::VectorXi& cells);
 enum class PlaneModel { Strain, Stress };
 
 struct Material {
-  double young = 1.0;      // Pa
+  double young = 1.0;  // Pa
   double poisson = 0.3;
-  double density = 1.0;    // kg/m^3 (per unit thickness in 2D)
+  double density = 1.0;  // kg/m^3 (per unit thickness in 2D)
   PlaneModel plane = PlaneModel::Strain;
 };
 

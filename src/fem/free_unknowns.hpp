@@ -23,7 +23,8 @@ struct FreeUnknowns {
     std::vector<Eigen::Triplet<double>> entries;
     for (int c = 0; c < A.outerSize(); ++c)
       for (Eigen::SparseMatrix<double>::InnerIterator it(A, c); it; ++it) {
-        const int r = index[static_cast<size_t>(it.row())], k = index[static_cast<size_t>(it.col())];
+        const int r = index[static_cast<size_t>(it.row())],
+                  k = index[static_cast<size_t>(it.col())];
         if (r >= 0 && k >= 0) entries.emplace_back(r, k, it.value());
       }
     Eigen::SparseMatrix<double> B(free, free);

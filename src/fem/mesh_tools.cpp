@@ -6,7 +6,7 @@
 #include <array>
 #include <map>
 
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -52,7 +52,8 @@ Mesh to_simplices(const Mesh& mesh) {
   Mesh out;
   out.dim = mesh.dim;
   out.nodes = mesh.nodes;
-  out.elements.resize(mesh.elements.rows() * static_cast<Eigen::Index>(pieces.size()), mesh.dim + 1);
+  out.elements.resize(mesh.elements.rows() * static_cast<Eigen::Index>(pieces.size()),
+                      mesh.dim + 1);
   Eigen::Index e = 0;
   for (Eigen::Index cell = 0; cell < mesh.elements.rows(); ++cell)
     for (const std::vector<int>& piece : pieces) {
@@ -107,7 +108,8 @@ Boundary boundary(const Mesh& mesh, const Eigen::MatrixXd& positions) {
   } else {
     for (const std::vector<int>& f : kept)
       for (int node : f)
-        if (vertex_of.emplace(node, static_cast<int>(b.nodes.size())).second) b.nodes.push_back(node);
+        if (vertex_of.emplace(node, static_cast<int>(b.nodes.size())).second)
+          b.nodes.push_back(node);
   }
   if (mesh.dim == 2 && b.nodes.size() != kept.size())
     throw InputError("fem: the mesh's boundary is not one closed polygon");
@@ -122,7 +124,8 @@ Boundary boundary(const Mesh& mesh, const Eigen::MatrixXd& positions) {
   } else {
     for (size_t f = 0; f < kept.size(); ++f)
       for (int k = 0; k < 3; ++k)
-        b.surface.F(static_cast<Eigen::Index>(f), k) = vertex_of.at(kept[f][static_cast<size_t>(k)]);
+        b.surface.F(static_cast<Eigen::Index>(f), k) =
+            vertex_of.at(kept[f][static_cast<size_t>(k)]);
   }
   return b;
 }

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "fem/mesh_tools.hpp"
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 
@@ -36,8 +36,9 @@ double Scene::load_factor(double t) const {
 
 Scene needle_block(const BlockOptions& o) {
   if (o.cells.minCoeff() < 1 || o.cells[1] % 2 != 0)
-    throw InputError("block: expected at least one cell per axis and an even number along y "
-                     "(the needle sits on the node in the middle of the right side)");
+    throw InputError(
+        "block: expected at least one cell per axis and an even number along y "
+        "(the needle sits on the node in the middle of the right side)");
   if (!(o.needle_speed > 0.0) || !(o.push_time > 0.0))
     throw InputError("block: the needle's speed and push time must be positive");
   Scene s;

@@ -37,11 +37,11 @@ struct Scene {
   Material material;
   Dynamics dynamics;  // matrices, damping, loads, held unknowns and their path
   // The same problem for a surface model:
-  std::vector<int> fixed_nodes;               // held in every axis
-  int needle = -1;                            // the block's needle node
-  double needle_travel = 0.0;                 // its displacement along -x at the end of the push
-  double push_time = 0.0;                     // s
-  Eigen::VectorXd gravity;                    // the rod's acceleration (m/s^2); empty for the block
+  std::vector<int> fixed_nodes;  // held in every axis
+  int needle = -1;               // the block's needle node
+  double needle_travel = 0.0;    // its displacement along -x at the end of the push
+  double push_time = 0.0;        // s
+  Eigen::VectorXd gravity;       // the rod's acceleration (m/s^2); empty for the block
   // Where each scene's load reaches its final value: the quasi-static path.
   double load_factor(double t) const;
 };
@@ -52,9 +52,9 @@ struct Scene {
 struct BlockOptions {
   Eigen::Vector2i cells{8, 8};  // cells along y must be even: the needle sits on a node
   MaterialPreset material = material_preset("MP1");
-  double needle_speed = 0.08;   // m/s
-  double push_time = 2.0;       // s
-  bool simplices = false;       // triangles instead of quadrilaterals
+  double needle_speed = 0.08;  // m/s
+  double push_time = 2.0;      // s
+  bool simplices = false;      // triangles instead of quadrilaterals
 };
 Scene needle_block(const BlockOptions& options);
 
@@ -63,8 +63,8 @@ Scene needle_block(const BlockOptions& options);
 struct RodOptions {
   Eigen::Vector3i cells{4, 2, 2};  // along the rod, then across it
   MaterialPreset material = material_preset("MP3");
-  double gravity = 0.05;           // m/s^2, along -z
-  bool simplices = false;          // tetrahedra instead of hexahedra
+  double gravity = 0.05;   // m/s^2, along -z
+  bool simplices = false;  // tetrahedra instead of hexahedra
 };
 Scene bending_rod(const RodOptions& options);
 

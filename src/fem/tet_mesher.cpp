@@ -14,7 +14,7 @@
 #include <map>
 #include <vector>
 
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -24,7 +24,7 @@ using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using Domain = CGAL::Polyhedral_mesh_domain_with_features_3<Kernel, SurfaceMesh>;
 using Triangulation = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using Complex = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation, Domain::Corner_index,
-                                                          Domain::Curve_index>;
+                                                        Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
 
 }  // namespace
@@ -37,7 +37,8 @@ Mesh tetrahedralize(const geom::Surface& s, const TetMeshOptions& options) {
   for (int v = 0; v < s.num_vertices(); ++v)
     vertex.push_back(mesh.add_vertex(Kernel::Point_3(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
   for (int f = 0; f < s.num_faces(); ++f)
-    if (mesh.add_face(vertex[static_cast<size_t>(s.F(f, 0))], vertex[static_cast<size_t>(s.F(f, 1))],
+    if (mesh.add_face(vertex[static_cast<size_t>(s.F(f, 0))],
+                      vertex[static_cast<size_t>(s.F(f, 1))],
                       vertex[static_cast<size_t>(s.F(f, 2))]) == SurfaceMesh::null_face())
       throw InputError("tetrahedralize: the surface is not a manifold triangle mesh (face " +
                        std::to_string(f) + ")");
@@ -78,15 +79,21 @@ Mesh tetrahedralize(const geom::Surface& s, const TetMeshOptions& options) {
       t[k] = it->second;
     }
     Eigen::Matrix3d edges;
-    for (int k = 0; k < 3; ++k) edges.col(k) = nodes[static_cast<size_t>(t[k + 1])] - nodes[static_cast<size_t>(t[0])];
+    for (int k = 0; k < 3; ++k)
+      edges.col(k) = nodes[static_cast<size_t>(t[k + 1])] - nodes[static_cast<size_t>(t[0])];
     if (edges.determinant() < 0.0) std::swap(t[1], t[2]);
     tets.push_back(t);
   }
-  if (tets.empty()) throw InputError("tetrahedralize: the mesher produced no tetrahedra (is the surface outward and free of self-intersections?)");
+  if (tets.empty())
+    throw InputError(
+        "tetrahedralize: the mesher produced no tetrahedra (is the surface outward and free of "
+        "self-intersections?)");
   out.nodes.resize(static_cast<Eigen::Index>(nodes.size()), 3);
-  for (size_t v = 0; v < nodes.size(); ++v) out.nodes.row(static_cast<Eigen::Index>(v)) = nodes[v].transpose();
+  for (size_t v = 0; v < nodes.size(); ++v)
+    out.nodes.row(static_cast<Eigen::Index>(v)) = nodes[v].transpose();
   out.elements.resize(static_cast<Eigen::Index>(tets.size()), 4);
-  for (size_t e = 0; e < tets.size(); ++e) out.elements.row(static_cast<Eigen::Index>(e)) = tets[e].transpose();
+  for (size_t e = 0; e < tets.size(); ++e)
+    out.elements.row(static_cast<Eigen::Index>(e)) = tets[e].transpose();
   return out;
 }
 

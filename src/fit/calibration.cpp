@@ -4,19 +4,19 @@
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <sstream>
-#include <Eigen/SVD>
-#include <cctype>
 
 #include "fit/optimizers.hpp"
-#include "geom/error.hpp"
-#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -93,26 +93,37 @@ Eigen::Vector3d barycentric(const Eigen::Vector3d& c, const Eigen::Vector3d& a,
   return {1.0 - s - t, s, t};
 }
 
-Eigen::Vector3d bounding_low(const Eigen::MatrixXd& P) { return P.colwise().minCoeff().transpose(); }
-Eigen::Vector3d bounding_high(const Eigen::MatrixXd& P) { return P.colwise().maxCoeff().transpose(); }
+Eigen::Vector3d bounding_low(const Eigen::MatrixXd& P) {
+  return P.colwise().minCoeff().transpose();
+}
+Eigen::Vector3d bounding_high(const Eigen::MatrixXd& P) {
+  return P.colwise().maxCoeff().transpose();
+}
 
 }  // namespace
 
 const char* to_string(Method method) {
   switch (method) {
-    case Method::LevenbergMarquardt: return "levenberg-marquardt";
-    case Method::Bobyqa: return "bobyqa";
-    case Method::DirectL: return "direct-l";
-    case Method::Crs2: return "crs2";
+    case Method::LevenbergMarquardt:
+      return "levenberg-marquardt";
+    case Method::Bobyqa:
+      return "bobyqa";
+    case Method::DirectL:
+      return "direct-l";
+    case Method::Crs2:
+      return "crs2";
   }
   return "?";
 }
 
 const char* to_string(Loss loss) {
   switch (loss) {
-    case Loss::Squared: return "squared";
-    case Loss::Huber: return "huber";
-    case Loss::Cauchy: return "cauchy";
+    case Loss::Squared:
+      return "squared";
+    case Loss::Huber:
+      return "huber";
+    case Loss::Cauchy:
+      return "cauchy";
   }
   return "?";
 }
@@ -148,7 +159,8 @@ void check_options(const FitOptions& o) {
   positive("initial_trust_region_radius", o.initial_trust_region_radius,
            std::numeric_limits<double>::max(), "a positive finite number");
   if (o.max_iterations < 1 || o.max_iterations > 100000)
-    throw InputError("max_iterations: expected 1 to 100000, got " + std::to_string(o.max_iterations));
+    throw InputError("max_iterations: expected 1 to 100000, got " +
+                     std::to_string(o.max_iterations));
   if (o.max_evaluations < 1 || o.max_evaluations > 10000000)
     throw InputError("max_evaluations: expected 1 to 10000000, got " +
                      std::to_string(o.max_evaluations));
@@ -161,8 +173,8 @@ struct Calibration::Impl {
   std::vector<TargetDistance> distances;  // one per target
   ParameterMap map;
   FitOptions options;
-  std::vector<int> counted;               // model vertices whose distances count
-  std::vector<int> target_steps;          // the distinct steps, ascending
+  std::vector<int> counted;       // model vertices whose distances count
+  std::vector<int> target_steps;  // the distinct steps, ascending
   bool analytic = true;
   double length = 0.0;
   int residuals = 0;
@@ -194,9 +206,10 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
     std::sort(m.counted.begin(), m.counted.end());
     m.counted.erase(std::unique(m.counted.begin(), m.counted.end()), m.counted.end());
     if (m.counted.front() < 0 || m.counted.back() >= n)
-      throw InputError("counted vertices: vertex " +
-                       std::to_string(m.counted.front() < 0 ? m.counted.front() : m.counted.back()) +
-                       " does not exist (the model has " + std::to_string(n) + ")");
+      throw InputError(
+          "counted vertices: vertex " +
+          std::to_string(m.counted.front() < 0 ? m.counted.front() : m.counted.back()) +
+          " does not exist (the model has " + std::to_string(n) + ")");
   }
   const Eigen::MatrixXd& V = m.model.surface.V;
   const Eigen::Vector3d low = bounding_low(V), high = bounding_high(V);
@@ -207,9 +220,12 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
                        ", but the run has steps 1.." + std::to_string(m.stepping.steps));
     // A scan may be unregistered, but it must be near the body to be fitted.
     const Eigen::Vector3d margin = Eigen::Vector3d::Constant(0.5 * m.length);
-    const Eigen::Vector3d t_low = bounding_low(t.target.points), t_high = bounding_high(t.target.points);
-    if (((t_low.array() > (high + margin).array()) || (t_high.array() < (low - margin).array())).any())
-      throw InputError(t.target.label + ": the target does not overlap the body (its bounding box "
+    const Eigen::Vector3d t_low = bounding_low(t.target.points),
+                          t_high = bounding_high(t.target.points);
+    if (((t_low.array() > (high + margin).array()) || (t_high.array() < (low - margin).array()))
+            .any())
+      throw InputError(t.target.label +
+                       ": the target does not overlap the body (its bounding box "
                        "lies more than half the body's length away): wrong units or another "
                        "specimen?");
     // Nor of another size altogether: a scan in mm against a body in m.
@@ -254,9 +270,15 @@ double Calibration::cost(const Eigen::VectorXd& r) const {
   for (Eigen::Index i = 0; i < r.size(); ++i) {
     const double s = r[i] * r[i];
     switch (impl_->options.loss) {
-      case Loss::Squared: sum += s; break;
-      case Loss::Huber: sum += s <= d2 ? s : 2.0 * d * std::sqrt(s) - d2; break;  // Ceres' HuberLoss
-      case Loss::Cauchy: sum += d2 * std::log1p(s / d2); break;                    // Ceres' CauchyLoss
+      case Loss::Squared:
+        sum += s;
+        break;
+      case Loss::Huber:
+        sum += s <= d2 ? s : 2.0 * d * std::sqrt(s) - d2;
+        break;  // Ceres' HuberLoss
+      case Loss::Cauchy:
+        sum += d2 * std::log1p(s / d2);
+        break;  // Ceres' CauchyLoss
     }
   }
   return 0.5 * sum;
@@ -284,12 +306,11 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   std::map<int, Eigen::VectorXd> states;
   auto run = [&](const model::Model& model, const solve::SteppingOptions& options,
                  std::map<int, Eigen::VectorXd>& at) {
-    return solve::solve_load_steps(model, options,
-                                   [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
-                                     if (std::binary_search(m.target_steps.begin(),
-                                                            m.target_steps.end(), r.step))
-                                       at[r.step] = x;
-                                   });
+    return solve::solve_load_steps(
+        model, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+          if (std::binary_search(m.target_steps.begin(), m.target_steps.end(), r.step))
+            at[r.step] = x;
+        });
   };
   e.summary = run(changed, stepping, states);
   e.forward_runs = 1;
@@ -339,14 +360,16 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     Eigen::Matrix<double, 3, Eigen::Dynamic> dx = Eigen::MatrixXd::Zero(3, P);
     for (size_t j = 0; j < map.material_indices().size(); ++j) {
       const int k = map.material_indices()[j];
-      for (int a = 0; a < 3; ++a) dx(a, k) = S(a * nv + i, static_cast<Eigen::Index>(j)) * dvalue[k];
+      for (int a = 0; a < 3; ++a)
+        dx(a, k) = S(a * nv + i, static_cast<Eigen::Index>(j)) * dvalue[k];
     }
     return dx;
   };
   // Adds the alignment's columns: d residual / d (rotation, translation) =
   // n . dq (dq in the body's frame), and d residual / d scale.
-  auto add_alignment = [&](Eigen::Index row, const Eigen::Vector3d& n, const Eigen::Matrix3d& dq_domega,
-                           const Eigen::Matrix3d& dq_dt, double d_scale) {
+  auto add_alignment = [&](Eigen::Index row, const Eigen::Vector3d& n,
+                           const Eigen::Matrix3d& dq_domega, const Eigen::Matrix3d& dq_dt,
+                           double d_scale) {
     for (int a = 0; a < 3; ++a) {
       const int r = map.alignment_index(a), t = map.alignment_index(3 + a);
       if (r >= 0) e.jacobian(row, r) += n.dot(dq_domega.col(a)) * dvalue[r];
@@ -377,7 +400,8 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
       e.residuals[row] = align.scale * hits[c].distance;
       if (!with_jacobian) continue;
       const Eigen::Vector3d n = direction(q, hits[c].point, target, hits[c].primitive);
-      if (S) e.jacobian.row(row) += n.transpose() * R_inverse * vertex_sensitivity(*S, m.counted[c]);
+      if (S)
+        e.jacobian.row(row) += n.transpose() * R_inverse * vertex_sensitivity(*S, m.counted[c]);
       add_alignment(row, n, align.scale * dq_domega[c], -R_inverse, hits[c].distance - n.dot(q));
     }
     if (!m.options.symmetric) continue;
@@ -392,7 +416,9 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     Eigen::MatrixXd moved(np, 3);
     std::vector<Eigen::Matrix3d> dp_domega(static_cast<size_t>(np));
     for (Eigen::Index j = 0; j < np; ++j)
-      moved.row(j) = align.apply(target.points.row(j).transpose(), &dp_domega[static_cast<size_t>(j)]).transpose();
+      moved.row(j) =
+          align.apply(target.points.row(j).transpose(), &dp_domega[static_cast<size_t>(j)])
+              .transpose();
     const std::vector<TargetDistance::Closest> back = to_simulated.closest(moved);
     for (Eigen::Index j = 0; j < np; ++j, ++row) {
       const TargetDistance::Closest& hit = back[static_cast<size_t>(j)];
@@ -403,8 +429,9 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
       // make_target keeps every vertex of a closed surface in order, so the
       // simulated triangle's corners are model vertices.
       const Eigen::Vector3i corners = simulated.triangles.row(hit.primitive).transpose();
-      const Eigen::Vector3d b = barycentric(hit.point, X.row(corners[0]).transpose(),
-                                            X.row(corners[1]).transpose(), X.row(corners[2]).transpose());
+      const Eigen::Vector3d b =
+          barycentric(hit.point, X.row(corners[0]).transpose(), X.row(corners[1]).transpose(),
+                      X.row(corners[2]).transpose());
       if (S)
         for (int k = 0; k < 3; ++k)
           e.jacobian.row(row) -= b[k] * n.transpose() * vertex_sensitivity(*S, corners[k]);
@@ -428,11 +455,14 @@ std::string failure_cause(const std::string& message) {
   for (size_t i = 0; i < message.size(); ++i) {
     const char ch = message[i];
     const bool digit = std::isdigit(static_cast<unsigned char>(ch)) != 0;
-    const bool in_number = digit || ((ch == '.' || ch == 'e' || ch == '-' || ch == '+') &&
-                                     !cause.empty() && cause.back() == '#' && i + 1 < message.size() &&
-                                     std::isdigit(static_cast<unsigned char>(message[i + 1])));
-    if (!in_number) cause += ch;
-    else if (cause.empty() || cause.back() != '#') cause += '#';
+    const bool in_number =
+        digit || ((ch == '.' || ch == 'e' || ch == '-' || ch == '+') && !cause.empty() &&
+                  cause.back() == '#' && i + 1 < message.size() &&
+                  std::isdigit(static_cast<unsigned char>(message[i + 1])));
+    if (!in_number)
+      cause += ch;
+    else if (cause.empty() || cause.back() != '#')
+      cause += '#';
   }
   return cause;
 }
@@ -478,14 +508,22 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
 
 const char* to_string(FitStatus status) {
   switch (status) {
-    case FitStatus::Converged: return "converged";
-    case FitStatus::ConvergedAtBounds: return "converged_at_bounds";
-    case FitStatus::IterationLimit: return "iteration_limit";
-    case FitStatus::NotIdentifiable: return "not_identifiable";
-    case FitStatus::ForwardRunsFailed: return "forward_runs_failed";
-    case FitStatus::StartFailed: return "start_failed";
-    case FitStatus::OptimizerFailed: return "optimizer_failed";
-    case FitStatus::Interrupted: return "interrupted";
+    case FitStatus::Converged:
+      return "converged";
+    case FitStatus::ConvergedAtBounds:
+      return "converged_at_bounds";
+    case FitStatus::IterationLimit:
+      return "iteration_limit";
+    case FitStatus::NotIdentifiable:
+      return "not_identifiable";
+    case FitStatus::ForwardRunsFailed:
+      return "forward_runs_failed";
+    case FitStatus::StartFailed:
+      return "start_failed";
+    case FitStatus::OptimizerFailed:
+      return "optimizer_failed";
+    case FitStatus::Interrupted:
+      return "interrupted";
   }
   return "?";
 }
@@ -495,10 +533,12 @@ namespace {
 // Why a Jacobian cannot separate its parameters: a column that is zero or
 // not finite (no distance changes with that parameter), else the
 // combination its smallest singular value leaves unseen.
-std::string unidentifiable_because(const Eigen::MatrixXd& J, const std::vector<std::string>& names) {
+std::string unidentifiable_because(const Eigen::MatrixXd& J,
+                                   const std::vector<std::string>& names) {
   for (Eigen::Index k = 0; k < J.cols(); ++k) {
     if (!J.col(k).allFinite())
-      return "the derivatives of the distances by \"" + names[static_cast<size_t>(k)] + "\" are not finite";
+      return "the derivatives of the distances by \"" + names[static_cast<size_t>(k)] +
+             "\" are not finite";
     if (J.col(k).norm() == 0.0)
       return "no distance changes with \"" + names[static_cast<size_t>(k)] +
              "\" (does the load act? is difference_step large enough to move the result?)";
@@ -508,8 +548,10 @@ std::string unidentifiable_because(const Eigen::MatrixXd& J, const std::vector<s
   const Eigen::VectorXd v = svd.matrixV().col(J.cols() - 1);
   std::string which;
   for (Eigen::Index k = 0; k < v.size(); ++k)
-    if (std::abs(v[k]) >= 0.3) which += (which.empty() ? "\"" : ", \"") + names[static_cast<size_t>(k)] + "\"";
-  return "the distances cannot tell " + which + " apart (the Jacobian is rank deficient): fix "
+    if (std::abs(v[k]) >= 0.3)
+      which += (which.empty() ? "\"" : ", \"") + names[static_cast<size_t>(k)] + "\"";
+  return "the distances cannot tell " + which +
+         " apart (the Jacobian is rank deficient): fix "
          "one of them, or add targets that separate them";
 }
 
@@ -548,7 +590,8 @@ FitResult Calibration::run() const {
     result.failed_runs = evaluations.failed_runs;
     result.failures_by_cause = evaluations.failures_by_cause;
     result.failed_examples = evaluations.failed_examples;
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
   // The start, as Levenberg-Marquardt will ask for it (with analytic
@@ -564,8 +607,9 @@ FitResult Calibration::run() const {
   if (!std::isfinite(result.initial_cost))
     return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
-  const OptimizerOutcome outcome = levenberg_marquardt ? fit_levenberg_marquardt(evaluations, m.options)
-                                                       : fit_nlopt(evaluations, m.options);
+  const OptimizerOutcome outcome = levenberg_marquardt
+                                       ? fit_levenberg_marquardt(evaluations, m.options)
+                                       : fit_nlopt(evaluations, m.options);
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.values = m.map.values(outcome.phi);
@@ -576,7 +620,8 @@ FitResult Calibration::run() const {
   const Evaluation* kept = evaluations.kept(outcome.phi, false);
   if (outcome.status == FitStatus::Interrupted && (kept == nullptr || !kept->ok))
     return finish(FitStatus::Interrupted, "");
-  const Evaluation best = kept != nullptr ? *kept : evaluations.at(outcome.phi, false);  // a copy: entries move
+  const Evaluation best =
+      kept != nullptr ? *kept : evaluations.at(outcome.phi, false);  // a copy: entries move
   if (!best.ok) {
     if (cancel_requested()) return finish(FitStatus::Interrupted, "");
     return finish(FitStatus::ForwardRunsFailed,
@@ -600,7 +645,9 @@ FitResult Calibration::run() const {
     result.vertex_distances.push_back(per_vertex);
     result.statistics.push_back(distance_statistics(counted, m.length));
   }
-  result.overall = distance_statistics(Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())), m.length);
+  result.overall = distance_statistics(
+      Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())),
+      m.length);
   // The parameters on a bound, said whatever the ending (a fit that ran out
   // of iterations against a bound is the usual sign of a wrong model).
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
@@ -617,7 +664,8 @@ FitResult Calibration::run() const {
           << (phi - lower[k] <= upper[k] - phi ? "lower" : "upper") << " bound";
       int partner = -1;
       for (int j = 0; j < P && with_correlation; ++j)
-        if (j != k && (partner < 0 || std::abs(result.correlation(k, j)) > std::abs(result.correlation(k, partner))))
+        if (j != k && (partner < 0 || std::abs(result.correlation(k, j)) >
+                                          std::abs(result.correlation(k, partner))))
           partner = j;
       if (partner >= 0)
         why << " (its correlation with " << result.names[static_cast<size_t>(partner)] << " is "
@@ -634,10 +682,10 @@ FitResult Calibration::run() const {
   if (cancel_requested()) return finish(FitStatus::Interrupted, "");
   if (!result.covariance_ok) {
     const Evaluation* with_jacobian = evaluations.kept(outcome.phi, true);
-    result.status_detail = with_jacobian != nullptr && with_jacobian->ok
-                               ? unidentifiable_because(with_jacobian->jacobian, result.names)
-                               : "the Jacobian at the optimum could not be evaluated: " +
-                                     evaluations.last_failure;
+    result.status_detail =
+        with_jacobian != nullptr && with_jacobian->ok
+            ? unidentifiable_because(with_jacobian->jacobian, result.names)
+            : "the Jacobian at the optimum could not be evaluated: " + evaluations.last_failure;
     return finish(FitStatus::NotIdentifiable, "");
   }
   const int dof = m.residuals - P;
@@ -650,7 +698,8 @@ FitResult Calibration::run() const {
     }
   describe_bounds(true);
   for (int k = 0; k < P; ++k) {
-    if (on_bound(outcome.phi[k], lower[k], upper[k])) continue;  // a bound is no estimate: no standard error
+    if (on_bound(outcome.phi[k], lower[k], upper[k]))
+      continue;  // a bound is no estimate: no standard error
     const double sigma = std::sqrt(std::max(0.0, scaled(k, k)));
     const bool log = m.map.parameters()[static_cast<size_t>(k)].log_scale;
     const double phi = outcome.phi[k];

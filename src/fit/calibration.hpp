@@ -69,7 +69,7 @@ struct FailedRun {
 
 struct IterationRecord {
   int iteration = 0;
-  double cost = 0.0;          // 1/2 sum rho(r^2), m^2, at the current point
+  double cost = 0.0;  // 1/2 sum rho(r^2), m^2, at the current point
   // Levenberg-Marquardt: whether this iteration's trial point was accepted,
   // and its cost (a rejected one costs more than `cost`).
   bool accepted = true;
@@ -77,9 +77,9 @@ struct IterationRecord {
   // Why the forward run of a trial point tried in this iteration failed, if
   // one did (the step is then rejected, or a smaller one accepted).
   std::string trial_failure;
-  Eigen::VectorXd values;     // the parameters' values at the current point
-  int forward_runs = 0;       // so far
-  double seconds = 0.0;       // since the start
+  Eigen::VectorXd values;  // the parameters' values at the current point
+  int forward_runs = 0;    // so far
+  double seconds = 0.0;    // since the start
 };
 
 struct FitOptions {
@@ -87,16 +87,16 @@ struct FitOptions {
   // Analytic Jacobians need the Newton scheme; with the incremental scheme
   // (or when asked) they are central differences of whole runs.
   bool finite_differences = false;
-  double difference_step = 1e-5;   // in the fitted variable (log or linear)
+  double difference_step = 1e-5;  // in the fitted variable (log or linear)
   // Also the distances from each target's points to the simulated surface:
   // catches a simulated surface that covers only part of the target.
   bool symmetric = false;
   Loss loss = Loss::Squared;
-  double loss_scale = 1e-3;        // m: where Huber and Cauchy start to discount
+  double loss_scale = 1e-3;  // m: where Huber and Cauchy start to discount
   // The model vertices whose distances count (empty: all), e.g. without the clamped region.
   std::vector<int> counted_vertices;
-  int max_iterations = 50;         // Levenberg-Marquardt iterations
-  int max_evaluations = 400;       // NLopt objective evaluations (each a forward run)
+  int max_iterations = 50;            // Levenberg-Marquardt iterations
+  int max_evaluations = 400;          // NLopt objective evaluations (each a forward run)
   double function_tolerance = 1e-12;  // relative change of the cost that ends the fit
   double parameter_tolerance = 1e-8;  // relative change of the parameters
   // Levenberg-Marquardt's first trust region (Ceres' radius: the damping
@@ -117,9 +117,9 @@ void check_options(const FitOptions& options);
 // The residuals at one point of the parameter space, and their Jacobian.
 struct Evaluation {
   bool ok = false;
-  std::string message;                 // why the forward run failed
-  Eigen::VectorXd residuals;           // m: the forward distances, then the symmetric ones
-  Eigen::MatrixXd jacobian;            // d residual / d phi (phi: the fitted variables)
+  std::string message;        // why the forward run failed
+  Eigen::VectorXd residuals;  // m: the forward distances, then the symmetric ones
+  Eigen::MatrixXd jacobian;   // d residual / d phi (phi: the fitted variables)
   solve::SteppingSummary summary;
   std::vector<Eigen::MatrixXd> positions;  // per target: the model's positions at its step
   int forward_runs = 0;

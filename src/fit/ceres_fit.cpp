@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "fit/optimizers.hpp"
-#include "geom/run_control.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -56,9 +56,12 @@ class DistanceResidual final : public ceres::CostFunction {
 
 std::unique_ptr<ceres::LossFunction> make_loss(const FitOptions& options) {
   switch (options.loss) {
-    case Loss::Huber: return std::make_unique<ceres::HuberLoss>(options.loss_scale);
-    case Loss::Cauchy: return std::make_unique<ceres::CauchyLoss>(options.loss_scale);
-    case Loss::Squared: break;
+    case Loss::Huber:
+      return std::make_unique<ceres::HuberLoss>(options.loss_scale);
+    case Loss::Cauchy:
+      return std::make_unique<ceres::CauchyLoss>(options.loss_scale);
+    case Loss::Squared:
+      break;
   }
   return nullptr;
 }
@@ -74,7 +77,8 @@ struct CeresProblem {
     const Calibration& calibration = cache.calibration();
     const ParameterMap& map = calibration.parameters();
     for (int i = 0; i < calibration.num_residuals(); ++i)
-      problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(), phi.data());
+      problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(),
+                               phi.data());
     const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
     for (int k = 0; k < map.size(); ++k) {
       if (std::isfinite(lower[k])) problem.SetParameterLowerBound(phi.data(), k, lower[k]);
@@ -92,8 +96,12 @@ class Recorder final : public ceres::IterationCallback {
  public:
   Recorder(const Calibration& calibration, const FitOptions& options, const Eigen::VectorXd& phi,
            const SharedEvaluation& shared, OptimizerOutcome& outcome)
-      : calibration_(calibration), options_(options), phi_(phi), shared_(shared),
-        outcome_(outcome), start_(std::chrono::steady_clock::now()) {}
+      : calibration_(calibration),
+        options_(options),
+        phi_(phi),
+        shared_(shared),
+        outcome_(outcome),
+        start_(std::chrono::steady_clock::now()) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     IterationRecord r;
     r.iteration = s.iteration;
@@ -167,9 +175,8 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
       // Ceres fails when a point it must have (the Jacobian at an accepted
       // point, a finite-difference run) cannot be evaluated.
       outcome.status = p.shared.cache().failed_runs > 0 ? FitStatus::ForwardRunsFailed
-                                                         : FitStatus::OptimizerFailed;
-      if (p.shared.cache().failed_runs > 0)
-        outcome.message += ": " + p.shared.cache().last_failure;
+                                                        : FitStatus::OptimizerFailed;
+      if (p.shared.cache().failed_runs > 0) outcome.message += ": " + p.shared.cache().last_failure;
       break;
   }
   // A stop asked for ends Ceres in whichever way the runs it cut short lead to.

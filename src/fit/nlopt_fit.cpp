@@ -8,8 +8,8 @@
 #include <limits>
 
 #include "fit/optimizers.hpp"
-#include "geom/error.hpp"
-#include "geom/run_control.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -61,18 +61,30 @@ struct Objective {
 
 std::string describe(nlopt_result r) {
   switch (r) {
-    case NLOPT_SUCCESS: return "success";
-    case NLOPT_STOPVAL_REACHED: return "the cost reached its target";
-    case NLOPT_FTOL_REACHED: return "converged: the cost changes less than function_tolerance";
-    case NLOPT_XTOL_REACHED: return "converged: the parameters change less than parameter_tolerance";
-    case NLOPT_MAXEVAL_REACHED: return "stopped at max_evaluations";
-    case NLOPT_MAXTIME_REACHED: return "stopped at the time limit";
-    case NLOPT_FAILURE: return "failure";
-    case NLOPT_INVALID_ARGS: return "invalid arguments (bounds?)";
-    case NLOPT_OUT_OF_MEMORY: return "out of memory";
-    case NLOPT_ROUNDOFF_LIMITED: return "limited by rounding";
-    case NLOPT_FORCED_STOP: return "stopped";
-    default: break;
+    case NLOPT_SUCCESS:
+      return "success";
+    case NLOPT_STOPVAL_REACHED:
+      return "the cost reached its target";
+    case NLOPT_FTOL_REACHED:
+      return "converged: the cost changes less than function_tolerance";
+    case NLOPT_XTOL_REACHED:
+      return "converged: the parameters change less than parameter_tolerance";
+    case NLOPT_MAXEVAL_REACHED:
+      return "stopped at max_evaluations";
+    case NLOPT_MAXTIME_REACHED:
+      return "stopped at the time limit";
+    case NLOPT_FAILURE:
+      return "failure";
+    case NLOPT_INVALID_ARGS:
+      return "invalid arguments (bounds?)";
+    case NLOPT_OUT_OF_MEMORY:
+      return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "limited by rounding";
+    case NLOPT_FORCED_STOP:
+      return "stopped";
+    default:
+      break;
   }
   return "unknown result";
 }
@@ -97,7 +109,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
   Eigen::VectorXd step(P);
   for (int k = 0; k < P; ++k) {
     const Parameter& p = map.parameters()[static_cast<size_t>(k)];
-    step[k] = p.log_scale                          ? 0.3
+    step[k] = p.log_scale                            ? 0.3
               : p.name.rfind("rotation_", 0) == 0    ? 0.05
               : p.name.rfind("translation_", 0) == 0 ? 0.05 * calibration.body_length()
                                                      : 0.1 * std::max(std::abs(phi[k]), 1e-3);
@@ -124,7 +136,8 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& optio
   Objective objective(evaluations, options, outcome);
   nlopt_result result;
   if (options.method == Method::Bobyqa) {
-    result = minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi, options.max_evaluations);
+    result =
+        minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi, options.max_evaluations);
   } else {
     const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
     for (int k = 0; k < map.size(); ++k)
@@ -140,11 +153,16 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& optio
                                            options.max_evaluations - objective.calls);
   }
   outcome.phi = phi;
-  if (cancel_requested()) outcome.status = FitStatus::Interrupted;
-  else if (!(objective.best < kFailedCost)) outcome.status = FitStatus::ForwardRunsFailed;
-  else if (result == NLOPT_MAXEVAL_REACHED) outcome.status = FitStatus::IterationLimit;
-  else if (result > 0) outcome.status = FitStatus::Converged;
-  else outcome.status = FitStatus::OptimizerFailed;
+  if (cancel_requested())
+    outcome.status = FitStatus::Interrupted;
+  else if (!(objective.best < kFailedCost))
+    outcome.status = FitStatus::ForwardRunsFailed;
+  else if (result == NLOPT_MAXEVAL_REACHED)
+    outcome.status = FitStatus::IterationLimit;
+  else if (result > 0)
+    outcome.status = FitStatus::Converged;
+  else
+    outcome.status = FitStatus::OptimizerFailed;
   outcome.message = std::string(to_string(options.method)) + ": " + describe(result) + " after " +
                     std::to_string(objective.calls) + " evaluations";
   return outcome;

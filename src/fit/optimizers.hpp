@@ -52,7 +52,7 @@ struct OptimizerOutcome {
   // Converged, IterationLimit, ForwardRunsFailed, OptimizerFailed or Interrupted.
   FitStatus status = FitStatus::OptimizerFailed;
   std::string message;
-  Eigen::VectorXd phi;                    // the best point found
+  Eigen::VectorXd phi;  // the best point found
   std::vector<IterationRecord> iterations;
 };
 

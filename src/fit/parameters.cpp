@@ -5,15 +5,14 @@
 #include <cmath>
 #include <sstream>
 
-#include "geom/error.hpp"
 #include "model/equilibrium.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {
 
-const char* const kAlignment[7] = {"rotation_x",    "rotation_y",    "rotation_z",
-                                   "translation_x", "translation_y", "translation_z",
-                                   "scale"};
+const char* const kAlignment[7] = {"rotation_x",    "rotation_y",    "rotation_z", "translation_x",
+                                   "translation_y", "translation_z", "scale"};
 
 std::string number(double x) {
   std::ostringstream out;
@@ -38,8 +37,9 @@ Parameter make_parameter(const ParameterRequest& request, const model::Material&
     throw InputError("\"" + p.name + "\" is not a parameter of this material (" + known +
                      ") or of the alignment (rotation_x..z, translation_x..z, scale)");
   }
-  p.initial = request.start ? *request.start : alignment ? (p.name == "scale" ? 1.0 : 0.0)
-                                                         : material.parameter(p.name);
+  p.initial = request.start ? *request.start
+              : alignment   ? (p.name == "scale" ? 1.0 : 0.0)
+                            : material.parameter(p.name);
   if (request.lower) p.lower = *request.lower;
   if (request.upper) p.upper = *request.upper;
   p.log_scale = request.log_scale.value_or(log_scale_by_default(p.name, material));
@@ -62,8 +62,8 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
     for (size_t j = 0; j < k; ++j)
       if (parameters_[j].name == p.name) throw InputError(who + " is given twice");
     if (is_alignment_parameter(p.name)) {
-      const int a = static_cast<int>(std::find(std::begin(kAlignment), std::end(kAlignment),
-                                               p.name) - std::begin(kAlignment));
+      const int a = static_cast<int>(
+          std::find(std::begin(kAlignment), std::end(kAlignment), p.name) - std::begin(kAlignment));
       alignment_index_[a] = static_cast<int>(k);
       has_alignment_ = true;
     } else if (std::find(known.begin(), known.end(), p.name) != known.end()) {
@@ -73,8 +73,10 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
     } else {
       std::string list;
       for (const std::string& n : known) list += (list.empty() ? "" : ", ") + n;
-      throw InputError(who + " is not a parameter of this material or of the alignment "
-                       "(expected one of " + list + ", rotation_x..z, translation_x..z)");
+      throw InputError(who +
+                       " is not a parameter of this material or of the alignment "
+                       "(expected one of " +
+                       list + ", rotation_x..z, translation_x..z)");
     }
     if (!std::isfinite(p.initial)) throw InputError(who + ": the start is not finite");
     if (std::isnan(p.lower) || std::isnan(p.upper) || (std::isinf(p.lower) && p.lower > 0) ||
@@ -83,13 +85,15 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
                        number(p.upper) + "]");
     if (!(p.lower < p.upper))
       throw InputError(who + ": expected a lower bound below the upper one, got [" +
-                       number(p.lower) + ", " + number(p.upper) + "] (to hold a parameter at a "
+                       number(p.lower) + ", " + number(p.upper) +
+                       "] (to hold a parameter at a "
                        "value, leave it out of the fit and set it in the material)");
     if (p.initial < p.lower || p.initial > p.upper)
       throw InputError(who + ": the start " + number(p.initial) + " lies outside the bounds [" +
                        number(p.lower) + ", " + number(p.upper) + "]");
     if (p.log_scale && (!(p.initial > 0.0) || (std::isfinite(p.lower) && p.lower < 0.0)))
-      throw InputError(who + ": fitted in log scale, so its start must be positive and its lower "
+      throw InputError(who +
+                       ": fitted in log scale, so its start must be positive and its lower "
                        "bound at least 0 (or set log_scale false)");
   }
 }

@@ -14,7 +14,7 @@
 #include <optional>
 
 #include "fit/target.hpp"
-#include "geom/run_control.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -63,7 +63,8 @@ TargetDistance::TargetDistance(const Target& target) : impl_(std::make_unique<Im
                                m.points[static_cast<size_t>(target.triangles(f, 2))]);
     m.aabb.emplace(m.triangles.cbegin(), m.triangles.cend());
     m.aabb->accelerate_distance_queries();
-    m.aabb->closest_point(m.points.front());  // builds what is built lazily, before parallel queries
+    m.aabb->closest_point(
+        m.points.front());  // builds what is built lazily, before parallel queries
   }
 }
 
@@ -78,8 +79,7 @@ TargetDistance::Closest TargetDistance::closest(const Eigen::Vector3d& query) co
   const Point q = to_point(query);
   Closest out;
   if (m.kd) {
-    NeighborSearch search(*m.kd, q, 1, 0, true,
-                          NeighborSearch::Distance(m.point_map()));
+    NeighborSearch search(*m.kd, q, 1, 0, true, NeighborSearch::Distance(m.point_map()));
     out.primitive = static_cast<int>(search.begin()->first);
     const Point& p = m.points[static_cast<size_t>(out.primitive)];
     out.point = {p.x(), p.y(), p.z()};

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 
@@ -24,11 +24,14 @@ Target make_target(std::string label, const Eigen::MatrixXd& points,
   for (Eigen::Index f = 0; f < triangles.rows(); ++f) {
     const Eigen::Vector3i c = triangles.row(f).transpose();
     if ((c.array() < 0).any() || (c.array() >= points.rows()).any())
-      throw InputError(t.label + ": triangle " + std::to_string(f) + " refers to a point that "
+      throw InputError(t.label + ": triangle " + std::to_string(f) +
+                       " refers to a point that "
                        "does not exist");
     const Eigen::Vector3d a = points.row(c[0]), b = points.row(c[1]), d = points.row(c[2]);
-    if ((b - a).cross(d - a).norm() > 0.0) kept.push_back(c);
-    else ++degenerate;
+    if ((b - a).cross(d - a).norm() > 0.0)
+      kept.push_back(c);
+    else
+      ++degenerate;
   }
   std::vector<int> new_index(static_cast<size_t>(points.rows()), triangles.rows() > 0 ? -1 : 0);
   if (triangles.rows() > 0)
@@ -40,7 +43,8 @@ Target make_target(std::string label, const Eigen::MatrixXd& points,
   if (used == 0) throw InputError(t.label + ": no point to fit to");
   t.points.resize(used, 3);
   for (Eigen::Index i = 0; i < points.rows(); ++i)
-    if (new_index[static_cast<size_t>(i)] >= 0) t.points.row(new_index[static_cast<size_t>(i)]) = points.row(i);
+    if (new_index[static_cast<size_t>(i)] >= 0)
+      t.points.row(new_index[static_cast<size_t>(i)]) = points.row(i);
   t.triangles.resize(static_cast<Eigen::Index>(kept.size()), 3);
   for (size_t f = 0; f < kept.size(); ++f)
     for (int k = 0; k < 3; ++k)

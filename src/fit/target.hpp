@@ -14,10 +14,10 @@ namespace fiberfluid::fit {
 // triangle soup (open, non-manifold, with holes) is kept as it is, and a file
 // with vertices only is a point cloud.
 struct Target {
-  std::string label;           // for messages: the file, or a name given by the program
-  Eigen::MatrixXd points;      // #P x 3: the vertices (a point cloud) or the triangles' corners
-  Eigen::MatrixXi triangles;   // #T x 3 indices into points; empty for a point cloud
-  std::string description;     // what was read, e.g. "a triangle soup: 5,012 triangles ..."
+  std::string label;          // for messages: the file, or a name given by the program
+  Eigen::MatrixXd points;     // #P x 3: the vertices (a point cloud) or the triangles' corners
+  Eigen::MatrixXi triangles;  // #T x 3 indices into points; empty for a point cloud
+  std::string description;    // what was read, e.g. "a triangle soup: 5,012 triangles ..."
 
   bool is_point_cloud() const { return triangles.rows() == 0; }
 };
@@ -43,8 +43,8 @@ class TargetDistance {
   TargetDistance& operator=(TargetDistance&&) noexcept;
 
   struct Closest {
-    Eigen::Vector3d point;     // the closest point of the target
-    int primitive = -1;        // its triangle (or its point, for a cloud)
+    Eigen::Vector3d point;  // the closest point of the target
+    int primitive = -1;     // its triangle (or its point, for a cloud)
     double distance = 0.0;
   };
   Closest closest(const Eigen::Vector3d& query) const;

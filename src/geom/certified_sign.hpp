@@ -64,8 +64,8 @@ inline void orientation_2d_with_bound(const double* a, const double* b, const do
 inline int certified_mean_sign(double first, double first_bound, double second,
                                double second_bound) {
   const double sum = first + second;
-  return certified(sum, first_bound + second_bound +
-                            0x1p-52 * (std::abs(first) + std::abs(second)));
+  return certified(sum,
+                   first_bound + second_bound + 0x1p-52 * (std::abs(first) + std::abs(second)));
 }
 
 }  // namespace fiberfluid::geom

@@ -9,8 +9,8 @@
 #include <numeric>
 
 #include "geom/certified_sign.hpp"
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::geom {
 

@@ -14,8 +14,8 @@
 namespace fiberfluid::geom {
 
 struct ConvexityScreen {
-  bool vertex_in_front = false;               // certified: the body is not convex
-  std::vector<std::pair<int, int>> unsure;    // (face, vertex) to test exactly
+  bool vertex_in_front = false;             // certified: the body is not convex
+  std::vector<std::pair<int, int>> unsure;  // (face, vertex) to test exactly
 };
 
 // A 3D surface with outward faces; nothing when its coordinates are outside

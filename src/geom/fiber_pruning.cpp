@@ -7,20 +7,20 @@
 
 #include <atomic>
 
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
 #include "geom/convexity_filter.hpp"
 #include "geom/segment_filter.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/intersections.h>
-#include <CGAL/Polygon_2_algorithms.h>
 
 #include <algorithm>
 #include <chrono>
@@ -118,8 +118,9 @@ struct ExactSolid {
     for (size_t k = 0; k + 1 < breaks.size(); ++k) {
       const Epeck::FT& a = breaks[k];
       const Epeck::FT& b = breaks[k + 1];
-      const bool covered = std::any_of(on_surface.begin(), on_surface.end(),
-                                       [&](const auto& s) { return s.first <= a && b <= s.second; });
+      const bool covered = std::any_of(on_surface.begin(), on_surface.end(), [&](const auto& s) {
+        return s.first <= a && b <= s.second;
+      });
       if (!covered && outside(p + ((a + b) / 2) * d)) return false;
     }
     return true;
@@ -133,8 +134,8 @@ struct VertexStars {
   std::vector<Star> star;
   std::vector<std::vector<int>> faces;  // incident faces per vertex
 
-  explicit VertexStars(const Surface& s) : star(static_cast<size_t>(s.num_vertices())),
-                                           faces(static_cast<size_t>(s.num_vertices())) {
+  explicit VertexStars(const Surface& s)
+      : star(static_cast<size_t>(s.num_vertices())), faces(static_cast<size_t>(s.num_vertices())) {
     for (int f = 0; f < s.num_faces(); ++f)
       for (int k = 0; k < 3; ++k) faces[static_cast<size_t>(s.F(f, k))].push_back(f);
     for (int v = 0; v < s.num_vertices(); ++v) {
@@ -142,9 +143,9 @@ struct VertexStars {
       for (int f : faces[static_cast<size_t>(v)])
         for (int g : faces[static_cast<size_t>(v)])
           for (int k = 0; k < 3; ++k) {
-            const CGAL::Orientation o = CGAL::orientation(
-                point3(s.V, s.F(f, 0)), point3(s.V, s.F(f, 1)), point3(s.V, s.F(f, 2)),
-                point3(s.V, s.F(g, k)));
+            const CGAL::Orientation o =
+                CGAL::orientation(point3(s.V, s.F(f, 0)), point3(s.V, s.F(f, 1)),
+                                  point3(s.V, s.F(f, 2)), point3(s.V, s.F(g, k)));
             front |= o == CGAL::POSITIVE;
             behind |= o == CGAL::NEGATIVE;
           }
@@ -261,8 +262,11 @@ PruningResult prune_3d(const Surface& s) {
           filtered += verdict != SegmentVerdict::Clear && verdict != SegmentVerdict::Unsure;
           switch (verdict) {
             case SegmentVerdict::Crosses:
-            case SegmentVerdict::Outside: keep = false; break;
-            case SegmentVerdict::Inside: break;
+            case SegmentVerdict::Outside:
+              keep = false;
+              break;
+            case SegmentVerdict::Inside:
+              break;
             case SegmentVerdict::Clear:  // the open segment is wholly inside or outside
               ++clear;
               keep = !exact.outside(CGAL::midpoint(exact_point(s.V, i), exact_point(s.V, j)));
@@ -326,22 +330,26 @@ PruningResult prune_2d(const Surface& s) {
         const int a = s.F(f, 0), b = s.F(f, 1);
         const Epick::Point_2 &u = point[static_cast<size_t>(a)], &v = point[static_cast<size_t>(b)];
         const bool at_i = a == i || b == i, at_j = a == j || b == j;
-        if (at_i && at_j) { degenerate = true; continue; }  // ij is an edge
+        if (at_i && at_j) {
+          degenerate = true;
+          continue;
+        }  // ij is an edge
         if (at_i || at_j) {
           if (CGAL::orientation(u, v, at_i ? q : p) == CGAL::COLLINEAR) degenerate = true;
           continue;
         }
         const CGAL::Orientation op = CGAL::orientation(u, v, p), oq = CGAL::orientation(u, v, q);
         const CGAL::Orientation ou = CGAL::orientation(p, q, u), ov = CGAL::orientation(p, q, v);
-        if (op != CGAL::COLLINEAR && oq != CGAL::COLLINEAR && op != oq &&
-            ou != CGAL::COLLINEAR && ov != CGAL::COLLINEAR && ou != ov)
+        if (op != CGAL::COLLINEAR && oq != CGAL::COLLINEAR && op != oq && ou != CGAL::COLLINEAR &&
+            ov != CGAL::COLLINEAR && ou != ov)
           crossed = true;  // a proper crossing of an edge's interior
         else if (CGAL::do_intersect(Epick::Segment_2(p, q), Epick::Segment_2(u, v)))
           degenerate = true;
       }
       bool keep = !crossed;
       if (keep && !degenerate) {
-        keep = !outside(CGAL::midpoint(exact[static_cast<size_t>(i)], exact[static_cast<size_t>(j)]));
+        keep =
+            !outside(CGAL::midpoint(exact[static_cast<size_t>(i)], exact[static_cast<size_t>(j)]));
       } else if (keep) {
         ++fallbacks;
         // Split at every contact with the outline; classify each open piece.
@@ -352,9 +360,9 @@ PruningResult prune_2d(const Surface& s) {
         std::vector<std::pair<Epeck::FT, Epeck::FT>> on_surface;
         const Epeck::Segment_2 segment(pe, qe);
         for (int f = 0; f < s.num_faces(); ++f) {
-          const auto hit = CGAL::intersection(
-              segment, Epeck::Segment_2(exact[static_cast<size_t>(s.F(f, 0))],
-                                        exact[static_cast<size_t>(s.F(f, 1))]));
+          const auto hit =
+              CGAL::intersection(segment, Epeck::Segment_2(exact[static_cast<size_t>(s.F(f, 0))],
+                                                           exact[static_cast<size_t>(s.F(f, 1))]));
           if (!hit) continue;
           if (const auto* x = boost::get<ExactPoint2>(&*hit)) {
             breaks.push_back(((*x - pe) * d) / dd);
@@ -410,10 +418,10 @@ bool is_convex(const Surface& s) {
         // Outward faces: POSITIVE is in front of the plane, outside the body.
         if (o == CGAL::POSITIVE) return false;
       } else {
-        const CGAL::Orientation o = CGAL::orientation(
-            Epick::Point_2(s.V(s.F(f, 0), 0), s.V(s.F(f, 0), 1)),
-            Epick::Point_2(s.V(s.F(f, 1), 0), s.V(s.F(f, 1), 1)),
-            Epick::Point_2(s.V(v, 0), s.V(v, 1)));
+        const CGAL::Orientation o =
+            CGAL::orientation(Epick::Point_2(s.V(s.F(f, 0), 0), s.V(s.F(f, 0), 1)),
+                              Epick::Point_2(s.V(s.F(f, 1), 0), s.V(s.F(f, 1), 1)),
+                              Epick::Point_2(s.V(v, 0), s.V(v, 1)));
         if (o == CGAL::RIGHT_TURN) return false;  // right of a CCW edge: outside
       }
     }
@@ -430,8 +438,7 @@ PruningResult prune_fibers(const Surface& surface, bool convex_fast_path) {
   } else {
     result = surface.dim == 3 ? prune_3d(surface) : prune_2d(surface);
   }
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -30,9 +30,9 @@ class FiberMask {
 
 struct PruningResult {
   FiberMask mask;
-  bool convex = false;           // the fast path: nothing to prune
+  bool convex = false;  // the fast path: nothing to prune
   double seconds = 0.0;
-  long long exact_fallbacks = 0; // pairs decided by exact constructions
+  long long exact_fallbacks = 0;     // pairs decided by exact constructions
   long long decided_in_doubles = 0;  // pairs the float pre-filter certified (3D)
 };
 

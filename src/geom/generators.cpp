@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {
@@ -49,9 +49,9 @@ Surface tetrahedron(double radius) {
 
 Surface octahedron(double radius) {
   require_positive(radius, "octahedron radius");
-  Surface s = from_lists({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
-                         {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                          {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+  Surface s = from_lists(
+      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
   scale_to_radius(s, radius);
   return s;
 }
@@ -60,11 +60,21 @@ Surface icosahedron(double radius) {
   require_positive(radius, "icosahedron radius");
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   Surface s = from_lists(
-      {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}},
-      {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-       {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-       {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}});
+      {{-1, t, 0},
+       {1, t, 0},
+       {-1, -t, 0},
+       {1, -t, 0},
+       {0, -1, t},
+       {0, 1, t},
+       {0, -1, -t},
+       {0, 1, -t},
+       {t, 0, -1},
+       {t, 0, 1},
+       {-t, 0, -1},
+       {-t, 0, 1}},
+      {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+       {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}});
   scale_to_radius(s, radius);
   return s;
 }
@@ -132,8 +142,10 @@ Surface box(const Eigen::Vector3d& min, const Eigen::Vector3d& max,
             return vertex(lattice);
           };
           const int p00 = corner(0, 0), p10 = corner(1, 0), p11 = corner(1, 1), p01 = corner(0, 1);
-          if (side > 0) faces.insert(faces.end(), {{p00, p10, p11}, {p00, p11, p01}});
-          else faces.insert(faces.end(), {{p00, p11, p10}, {p00, p01, p11}});
+          if (side > 0)
+            faces.insert(faces.end(), {{p00, p10, p11}, {p00, p11, p01}});
+          else
+            faces.insert(faces.end(), {{p00, p11, p10}, {p00, p01, p11}});
         }
     }
   }
@@ -156,8 +168,8 @@ Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions) {
       const double below = std::asin(std::min(1.0, -p.z()));
       const double rho = 1.0 - below / (M_PI / 2.0);
       const double planar = p.head<2>().norm();
-      p.head<2>() = planar > 0.0 ? Eigen::Vector2d(p.head<2>() * (rho / planar))
-                                 : Eigen::Vector2d::Zero();
+      p.head<2>() =
+          planar > 0.0 ? Eigen::Vector2d(p.head<2>() * (rho / planar)) : Eigen::Vector2d::Zero();
       p.z() = 0.0;
     }
     s.V.row(i) = p.cwiseProduct(semi_axes).transpose();
@@ -175,8 +187,8 @@ Surface torus(double R, double r, int around, int tube) {
   for (int u = 0; u < around; ++u)
     for (int v = 0; v < tube; ++v) {
       const double a = 2 * M_PI * u / around, b = 2 * M_PI * v / tube;
-      vertices.emplace_back((R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a),
-                            r * std::sin(b));
+      vertices.emplace_back((R + r * std::cos(b)) * std::cos(a),
+                            (R + r * std::cos(b)) * std::sin(a), r * std::sin(b));
     }
   for (int u = 0; u < around; ++u)
     for (int v = 0; v < tube; ++v) {

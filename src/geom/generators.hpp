@@ -39,7 +39,6 @@ Surface polygon(const Eigen::MatrixXd& points);
 
 // 2D: axis-aligned rectangle from `min` to `max`, with nx and ny segments on
 // its horizontal and vertical sides, counter-clockwise from the lower left.
-Surface rectangle(const Eigen::Vector2d& min, const Eigen::Vector2d& max, int nx = 1,
-                  int ny = 1);
+Surface rectangle(const Eigen::Vector2d& min, const Eigen::Vector2d& max, int nx = 1, int ny = 1);
 
 }  // namespace fiberfluid::geom

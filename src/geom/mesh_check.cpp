@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {
@@ -114,8 +114,8 @@ void check_triangle_topology(const Surface& s, MeshReport& r) {
     const int faces = count.first + count.second;
     if (faces == 1 && boundary++ == 0) first_boundary = edge_name(edge.first, edge.second);
     if (faces > 2 && nonmanifold++ == 0)
-      first_nonmanifold = edge_name(edge.first, edge.second) + " is shared by " +
-                          std::to_string(faces) + " faces";
+      first_nonmanifold =
+          edge_name(edge.first, edge.second) + " is shared by " + std::to_string(faces) + " faces";
     if (faces == 2 && count.first != 1 && misoriented++ == 0)
       first_misoriented = edge_name(edge.first, edge.second);
   }
@@ -223,9 +223,10 @@ MeshReport inspect(const Surface& s) {
   // fluid's) and the exact pruning's inside test mean nothing there.
   if (r.ok())
     if (const auto crossing = find_self_intersection(s))
-      r.problems.push_back("the surface intersects itself: " + std::string(s.dim == 3 ? "triangles " : "segments ") +
-                           std::to_string(crossing->first) + " and " + std::to_string(crossing->second) +
-                           " cross (it bounds no solid, so its volume and the fiber pruning are meaningless)");
+      r.problems.push_back(
+          "the surface intersects itself: " + std::string(s.dim == 3 ? "triangles " : "segments ") +
+          std::to_string(crossing->first) + " and " + std::to_string(crossing->second) +
+          " cross (it bounds no solid, so its volume and the fiber pruning are meaningless)");
   if (r.ok() && !r.outward)
     r.problems.push_back(std::string("inverted: the faces point inward (enclosed ") +
                          (s.dim == 3 ? "volume " : "area ") + std::to_string(r.volume) +
@@ -244,8 +245,9 @@ std::string format_report(const MeshReport& r, const std::string& source) {
       << "  closed:        " << (r.closed ? "yes" : "no") << "\n"
       << "  manifold:      " << (r.manifold ? "yes" : "no") << "\n"
       << "  orientation:   "
-      << (!r.consistently_oriented ? "inconsistent" : r.outward ? "consistent, outward"
-                                                                : "consistent, inward")
+      << (!r.consistently_oriented ? "inconsistent"
+          : r.outward              ? "consistent, outward"
+                                   : "consistent, inward")
       << "\n";
   if (r.dim == 3) out << "  genus:         " << r.genus << "\n";
   out << "  " << (r.dim == 3 ? "area:          " : "perimeter:     ") << r.area << "\n"

@@ -12,19 +12,19 @@ namespace fiberfluid::geom {
 // problems is empty (warnings are informational).
 struct MeshReport {
   int dim = 3;
-  int vertices = 0;          // as listed in the input
-  int used_vertices = 0;     // referenced by a face
+  int vertices = 0;       // as listed in the input
+  int used_vertices = 0;  // referenced by a face
   int faces = 0;
   int edges = 0;
-  int components = 0;        // connected components of the used vertices
+  int components = 0;  // connected components of the used vertices
   int euler_characteristic = 0;
-  int genus = 0;             // 3D, closed, one component: (2 - chi) / 2
-  bool closed = false;       // every edge has exactly two faces (2D: every vertex two edges)
-  bool manifold = false;     // no edge with more than two faces, no pinched vertex
+  int genus = 0;          // 3D, closed, one component: (2 - chi) / 2
+  bool closed = false;    // every edge has exactly two faces (2D: every vertex two edges)
+  bool manifold = false;  // no edge with more than two faces, no pinched vertex
   bool consistently_oriented = false;
-  bool outward = false;      // enclosed volume (area in 2D) is positive
-  double area = 0.0;         // surface area (perimeter in 2D)
-  double volume = 0.0;       // signed enclosed volume (area in 2D)
+  bool outward = false;               // enclosed volume (area in 2D) is positive
+  double area = 0.0;                  // surface area (perimeter in 2D)
+  double volume = 0.0;                // signed enclosed volume (area in 2D)
   std::vector<std::string> problems;  // each a full sentence; empty when usable
   std::vector<std::string> warnings;  // e.g. unused vertices
   bool ok() const { return problems.empty(); }

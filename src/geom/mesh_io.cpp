@@ -2,18 +2,18 @@
 #include "geom/mesh_io.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
 #include <cctype>
-#include <cstdint>
 #include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <map>
 #include <sstream>
 
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {
@@ -42,11 +42,9 @@ struct MeshBuilder {
     if (split_polygons > 0)
       out.warnings.push_back(name + ": " + std::to_string(split_polygons) +
                              " polygons with more than 3 corners were split into triangles");
-    const bool polygon_2d =
-        triangles.empty() && !segments.empty() &&
-        std::all_of(vertices.begin(), vertices.end(), [](const Eigen::Vector3d& v) {
-          return v.z() == 0.0;
-        });
+    const bool polygon_2d = triangles.empty() && !segments.empty() &&
+                            std::all_of(vertices.begin(), vertices.end(),
+                                        [](const Eigen::Vector3d& v) { return v.z() == 0.0; });
     Surface& s = out.surface;
     s.dim = polygon_2d ? 2 : 3;
     s.V.resize(static_cast<Eigen::Index>(vertices.size()), s.dim);
@@ -94,8 +92,8 @@ double parse_number(const std::string& token, const std::filesystem::path& path,
 }
 
 // ---------------------------------------------------------------- OBJ
-int resolve_obj_index(const std::string& token, int vertex_count,
-                      const std::filesystem::path& path, int line) {
+int resolve_obj_index(const std::string& token, int vertex_count, const std::filesystem::path& path,
+                      int line) {
   const std::string head = token.substr(0, token.find('/'));
   long index = 0;
   try {
@@ -176,9 +174,10 @@ ReadResult read_off(std::istream& in, const std::filesystem::path& path) {
     const auto& [token, l] = next(what);
     const long long value = whole_number(parse_number(token, path, l, what), most);
     if (value < 0)
-      throw InputError(where(path, l) + "expected a count for " + what + " (a whole number no "
-                       "larger than the file's " + std::to_string(tokens.size()) + " values), got '" +
-                       token + "'");
+      throw InputError(where(path, l) + "expected a count for " + what +
+                       " (a whole number no "
+                       "larger than the file's " +
+                       std::to_string(tokens.size()) + " values), got '" + token + "'");
     return static_cast<int>(value);
   };
   if (tokens.empty() || tokens[0].first != "OFF")
@@ -207,8 +206,8 @@ ReadResult read_off(std::istream& in, const std::filesystem::path& path) {
                          std::to_string(nv - 1));
       face.push_back(static_cast<int>(index));
     }
-    if (corners < 3) throw InputError(path.string() + ": face " + std::to_string(f) +
-                                      " has fewer than 3 corners");
+    if (corners < 3)
+      throw InputError(path.string() + ": face " + std::to_string(f) + " has fewer than 3 corners");
     mesh.add_polygon(face);
     // Optional per-face colour values run to the end of the line.
     const int face_line = tokens[at - 1].second;
@@ -320,8 +319,8 @@ struct PlyElement {
 
 int ply_type_size(const std::string& type, const std::filesystem::path& path) {
   static const std::map<std::string, int> sizes = {
-      {"char", 1},  {"uchar", 1},  {"int8", 1},   {"uint8", 1},  {"short", 2},   {"ushort", 2},
-      {"int16", 2}, {"uint16", 2}, {"int", 4},    {"uint", 4},   {"int32", 4},   {"uint32", 4},
+      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
       {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
   auto it = sizes.find(type);
   if (it == sizes.end()) throw InputError(path.string() + ": unknown PLY type '" + type + "'");
@@ -391,28 +390,36 @@ ReadResult read_ply(const std::string& bytes, const std::filesystem::path& path)
     if (keyword == "format") {
       std::string name;
       tokens >> name;
-      if (name == "ascii") format = PlyFormat::Ascii;
-      else if (name == "binary_little_endian") format = PlyFormat::LittleEndian;
-      else if (name == "binary_big_endian") format = PlyFormat::BigEndian;
-      else throw InputError(where(path, line) + "unknown PLY format '" + name + "'");
+      if (name == "ascii")
+        format = PlyFormat::Ascii;
+      else if (name == "binary_little_endian")
+        format = PlyFormat::LittleEndian;
+      else if (name == "binary_big_endian")
+        format = PlyFormat::BigEndian;
+      else
+        throw InputError(where(path, line) + "unknown PLY format '" + name + "'");
     } else if (keyword == "element") {
       PlyElement element;
       std::string count;
       tokens >> element.name >> count;
       // Each item takes at least a byte: no count can exceed the file's size.
-      element.count = static_cast<long>(whole_number(parse_number(count, path, line, "an element count"),
-                                                     static_cast<double>(bytes.size())));
+      element.count = static_cast<long>(whole_number(
+          parse_number(count, path, line, "an element count"), static_cast<double>(bytes.size())));
       if (element.count < 0)
-        throw InputError(where(path, line) + "expected an element count no larger than the "
-                         "file's " + std::to_string(bytes.size()) + " bytes, got '" + count + "'");
+        throw InputError(where(path, line) +
+                         "expected an element count no larger than the "
+                         "file's " +
+                         std::to_string(bytes.size()) + " bytes, got '" + count + "'");
       elements.push_back(element);
     } else if (keyword == "property") {
       if (elements.empty()) throw InputError(where(path, line) + "property before any element");
       PlyProperty property;
       std::string type;
       tokens >> type;
-      if (type == "list") tokens >> property.count_type >> property.type;
-      else property.type = type;
+      if (type == "list")
+        tokens >> property.count_type >> property.type;
+      else
+        property.type = type;
       tokens >> property.name;
       elements.back().properties.push_back(property);
     }
@@ -433,7 +440,8 @@ ReadResult read_ply(const std::string& bytes, const std::filesystem::path& path)
             position[p.name[0] - 'x'] = value;
           continue;
         }
-        const long long n = whole_number(reader.read(p.count_type), static_cast<double>(bytes.size()));
+        const long long n =
+            whole_number(reader.read(p.count_type), static_cast<double>(bytes.size()));
         if (n < 0)
           throw InputError(path.string() + ": " + element.name + " " + std::to_string(item) +
                            ": a list length that is not a count the file could hold");
@@ -474,14 +482,18 @@ std::optional<MeshFormat> mesh_format_of(const std::filesystem::path& path) {
   return std::nullopt;
 }
 
-ReadResult read_surface_bytes(const std::string& bytes, MeshFormat format, const std::string& name) {
+ReadResult read_surface_bytes(const std::string& bytes, MeshFormat format,
+                              const std::string& name) {
   if (bytes.empty()) throw InputError(name + ": the file is empty");
   const std::filesystem::path path = name;
   switch (format) {
-    case MeshFormat::Stl: return read_stl(bytes, path);
-    case MeshFormat::Ply: return read_ply(bytes, path);
+    case MeshFormat::Stl:
+      return read_stl(bytes, path);
+    case MeshFormat::Ply:
+      return read_ply(bytes, path);
     case MeshFormat::Obj:
-    case MeshFormat::Off: break;
+    case MeshFormat::Off:
+      break;
   }
   std::istringstream in(bytes);
   return format == MeshFormat::Obj ? read_obj(in, path) : read_off(in, path);
@@ -526,8 +538,7 @@ void write_obj(const std::filesystem::path& path, const Surface& s) {
   std::ostringstream out;
   out << std::setprecision(17) << "# written by fiberfluid\n";
   for (int i = 0; i < s.num_vertices(); ++i)
-    out << "v " << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << (s.dim == 3 ? s.V(i, 2) : 0.0)
-        << '\n';
+    out << "v " << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << (s.dim == 3 ? s.V(i, 2) : 0.0) << '\n';
   for (int f = 0; f < s.num_faces(); ++f) {
     out << (s.dim == 3 ? "f" : "l");
     for (int k = 0; k < s.F.cols(); ++k) out << ' ' << s.F(f, k) + 1;

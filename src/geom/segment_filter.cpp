@@ -22,8 +22,7 @@ bool has_vertex(const int* v, int i) { return v[0] == i || v[1] == i || v[2] == 
 enum class LineAtTriangle { Beside, Through, Unsure };
 
 LineAtTriangle line_at_triangle(int e0, int e1, int e2) {
-  const bool seen_positive = e0 > 0 || e1 > 0 || e2 > 0,
-             seen_negative = e0 < 0 || e1 < 0 || e2 < 0;
+  const bool seen_positive = e0 > 0 || e1 > 0 || e2 > 0, seen_negative = e0 < 0 || e1 < 0 || e2 < 0;
   if (seen_positive && seen_negative) return LineAtTriangle::Beside;
   if (e0 == 0 || e1 == 0 || e2 == 0) return LineAtTriangle::Unsure;
   return LineAtTriangle::Through;
@@ -60,16 +59,18 @@ SegmentFilter::SegmentFilter(const Surface& s, std::vector<Star> stars)
   faces_.reserve(order.size());
   for (int f : order) faces_.push_back(faces[static_cast<size_t>(f)]);
   for (size_t position = 0; position < faces_.size(); ++position)
-    for (int v : faces_[position].v) incident_[static_cast<size_t>(v)].push_back(static_cast<int>(position));
+    for (int v : faces_[position].v)
+      incident_[static_cast<size_t>(v)].push_back(static_cast<int>(position));
 }
 
 // Median split along the longest axis of the face centroids' box.
 void SegmentFilter::build(std::vector<int>& order, const std::vector<Face>& faces, int begin,
                           int end) {
   const size_t at = nodes_.size();
-  nodes_.push_back(Node{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, begin,
-                        begin, 0});
-  double centre_lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, centre_hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  nodes_.push_back(
+      Node{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, begin, begin, 0});
+  double centre_lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         centre_hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (int k = begin; k < end; ++k) {
     const Face& f = faces[static_cast<size_t>(order[static_cast<size_t>(k)])];
     for (int x = 0; x < 3; ++x) {
@@ -158,9 +159,12 @@ int SegmentFilter::starts_inside(int v, const double* x) const {
   // A convex cone is the intersection of its faces' half-spaces; a concave
   // star's outside is the intersection of the opposite ones.
   switch (stars_[static_cast<size_t>(v)]) {
-    case Star::Convex: return any_front ? -1 : 1;
-    case Star::Concave: return all_front ? -1 : 1;
-    case Star::Saddle: return 0;
+    case Star::Convex:
+      return any_front ? -1 : 1;
+    case Star::Concave:
+      return all_front ? -1 : 1;
+    case Star::Saddle:
+      return 0;
   }
   return 0;
 }
@@ -181,10 +185,9 @@ SegmentVerdict SegmentFilter::classify(int i, int j) const {
     const int sp = certified_orientation(face.a, face.b, face.c, p);
     const int sq = certified_orientation(face.a, face.b, face.c, q);
     if (sp != 0 && sp == sq) return true;  // both ends on one side of the face's plane
-    const LineAtTriangle line =
-        line_at_triangle(certified_orientation(p, q, face.a, face.b),
-                         certified_orientation(p, q, face.b, face.c),
-                         certified_orientation(p, q, face.c, face.a));
+    const LineAtTriangle line = line_at_triangle(certified_orientation(p, q, face.a, face.b),
+                                                 certified_orientation(p, q, face.b, face.c),
+                                                 certified_orientation(p, q, face.c, face.a));
     if (line == LineAtTriangle::Beside) return true;
     if (line == LineAtTriangle::Through && sp != 0 && sq != 0) {
       decided = SegmentVerdict::Crosses;  // wherever else it touches, part of it is outside
@@ -203,8 +206,9 @@ SegmentVerdict SegmentFilter::classify(int i, int j) const {
   if (from_i != 0) return from_i > 0 ? SegmentVerdict::Inside : SegmentVerdict::Outside;
   if (from_j != 0) return from_j > 0 ? SegmentVerdict::Inside : SegmentVerdict::Outside;
   const int inside = midpoint_inside(p, q);
-  return inside > 0 ? SegmentVerdict::Inside : inside < 0 ? SegmentVerdict::Outside
-                                                          : SegmentVerdict::Clear;
+  return inside > 0   ? SegmentVerdict::Inside
+         : inside < 0 ? SegmentVerdict::Outside
+                      : SegmentVerdict::Clear;
 }
 
 int SegmentFilter::midpoint_inside(const double* p, const double* q) const {

@@ -70,12 +70,12 @@ class SegmentFilter {
 
   const Surface& surface_;
   std::vector<Star> stars_;
-  std::vector<Face> faces_;  // leaf order
+  std::vector<Face> faces_;                 // leaf order
   std::vector<std::vector<int>> incident_;  // each vertex's faces, as positions in faces_
   std::vector<Node> nodes_;
-  double reach_ = 0.0;       // a ray's length that leaves every box
-  double margin_ = 0.0;      // box inflation covering the slab test's rounding
-  bool usable_ = true;       // coordinates within the certified range
+  double reach_ = 0.0;   // a ray's length that leaves every box
+  double margin_ = 0.0;  // box inflation covering the slab test's rounding
+  bool usable_ = true;   // coordinates within the certified range
 };
 
 }  // namespace fiberfluid::geom

@@ -4,8 +4,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 
@@ -23,8 +23,8 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
     if (field.values.rows() != n)
       throw std::invalid_argument("write_vtu: field " + field.name + " has the wrong row count");
     const int components = field.values.cols() == 1 ? 1 : 3;
-    out << "        <DataArray type=\"Float64\" Name=\"" << field.name
-        << "\" NumberOfComponents=\"" << components << "\" format=\"ascii\">\n";
+    out << "        <DataArray type=\"Float64\" Name=\"" << field.name << "\" NumberOfComponents=\""
+        << components << "\" format=\"ascii\">\n";
     for (int i = 0; i < n; ++i) {
       out << "         ";
       for (int k = 0; k < components; ++k)
@@ -37,8 +37,8 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
       << "      <Points>\n"
       << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (int i = 0; i < n; ++i)
-    out << "          " << s.V(i, 0) << ' ' << s.V(i, 1) << ' ' << (s.V.cols() == 3 ? s.V(i, 2) : 0.0)
-        << '\n';
+    out << "          " << s.V(i, 0) << ' ' << s.V(i, 1) << ' '
+        << (s.V.cols() == 3 ? s.V(i, 2) : 0.0) << '\n';
   out << "        </DataArray>\n"
       << "      </Points>\n"
       << "      <Cells>\n"

@@ -4,16 +4,16 @@
 #include <cmath>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::metrics {
 
 double relative_energy_norm(const Eigen::MatrixXd& u_reference, const Eigen::MatrixXd& u) {
   if (u.rows() != u_reference.rows() || u.cols() != u_reference.cols())
     throw InputError("E_n needs the same nodes: the reference has " +
-                     std::to_string(u_reference.rows()) + " by " + std::to_string(u_reference.cols()) +
-                     " displacements, the approximation " + std::to_string(u.rows()) + " by " +
-                     std::to_string(u.cols()));
+                     std::to_string(u_reference.rows()) + " by " +
+                     std::to_string(u_reference.cols()) + " displacements, the approximation " +
+                     std::to_string(u.rows()) + " by " + std::to_string(u.cols()));
   const double reference = u_reference.norm();
   if (!(reference > 0.0)) throw InputError("E_n: the reference does not move (|u| = 0)");
   return (u - u_reference).norm() / reference;

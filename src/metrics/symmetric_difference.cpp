@@ -18,8 +18,8 @@
 #include <iterator>
 #include <vector>
 
-#include "geom/error.hpp"
 #include "metrics/metrics.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::metrics {
 namespace {
@@ -33,7 +33,6 @@ using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using CheckKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CheckMesh = CGAL::Surface_mesh<CheckKernel::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
-
 
 // The 2D surface's segments as one closed loop, counterclockwise.
 Polygon polygon(const geom::Surface& s, const std::string& what) {
@@ -90,7 +89,8 @@ MeshType build_mesh(const geom::Surface& s, const std::string& what) {
     for (int k = 0; k < 3; ++k)
       if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices())
         throw InputError(what + ": face " + std::to_string(f) + " refers to a missing vertex");
-    if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))], vertices[static_cast<size_t>(s.F(f, 1))],
+    if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))],
+                      vertices[static_cast<size_t>(s.F(f, 1))],
                       vertices[static_cast<size_t>(s.F(f, 2))]) == MeshType::null_face())
       throw InputError(what + ": face " + std::to_string(f) + " makes the mesh non-manifold");
   }
@@ -122,7 +122,8 @@ double volume(const Mesh& mesh) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(HUGE_VAL), high = -low;
   for (const auto v : mesh.vertices()) {
     const Kernel::Point_3& point = mesh.point(v);
-    const Eigen::Vector3d x(CGAL::to_double(point.x()), CGAL::to_double(point.y()), CGAL::to_double(point.z()));
+    const Eigen::Vector3d x(CGAL::to_double(point.x()), CGAL::to_double(point.y()),
+                            CGAL::to_double(point.z()));
     low = low.cwiseMin(x);
     high = high.cwiseMax(x);
   }
@@ -134,7 +135,8 @@ double volume(const Mesh& mesh) {
     for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
       const Kernel::Point_3& point = mesh.point(v);
       corner[k++] = Eigen::Vector3d(CGAL::to_double(point.x()), CGAL::to_double(point.y()),
-                                    CGAL::to_double(point.z())) - centre;
+                                    CGAL::to_double(point.z())) -
+                    centre;
     }
     sum += corner[0].dot(corner[1].cross(corner[2]));
   }
@@ -166,14 +168,19 @@ void require_representable(const geom::Surface& s, const std::string& what) {
       const double x = s.V(i, a);
       if (!std::isfinite(x) || std::abs(x) > kLargest)
         throw InputError(what + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " +
-                         std::to_string(x) + ": expected a finite coordinate of magnitude at most "
+                         std::to_string(x) +
+                         ": expected a finite coordinate of magnitude at most "
                          "1e50 (rescale the meshes, e.g. to m)");
       largest = std::max(largest, std::abs(x));
     }
-  const double extent = s.V.rows() > 0 ? (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).maxCoeff() : 0.0;
+  const double extent =
+      s.V.rows() > 0 ? (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).maxCoeff() : 0.0;
   if (!(extent > 0.0) || largest / extent > kDigits)
-    throw InputError(what + ": the body (extent " + std::to_string(extent) + ") is too small for "
-                     "its distance from the origin (" + std::to_string(largest) + ") to keep six "
+    throw InputError(what + ": the body (extent " + std::to_string(extent) +
+                     ") is too small for "
+                     "its distance from the origin (" +
+                     std::to_string(largest) +
+                     ") to keep six "
                      "digits in doubles: move it nearer the origin");
 }
 

@@ -25,7 +25,8 @@ class BorderedSystem {
   virtual const std::vector<int>& block_offsets() const = 0;
   int num_unknowns() const { return block_offsets().back() + 1; }  // with P
   int block_size(int block) const {
-    return block_offsets()[static_cast<size_t>(block) + 1] - block_offsets()[static_cast<size_t>(block)];
+    return block_offsets()[static_cast<size_t>(block) + 1] -
+           block_offsets()[static_cast<size_t>(block)];
   }
   int largest_block() const;
   // All blocks are the same matrix, so one factor serves them all.
@@ -57,7 +58,9 @@ class DenseBorderedSystem final : public BorderedSystem {
   const std::vector<int>& block_offsets() const override { return offsets_; }
   bool blocks_equal() const override;
   bool dense_blocks() const override { return true; }
-  Eigen::MatrixXd dense_block(int block) const override { return blocks_[static_cast<size_t>(block)]; }
+  Eigen::MatrixXd dense_block(int block) const override {
+    return blocks_[static_cast<size_t>(block)];
+  }
   Eigen::SparseMatrix<double> sparse_block(int block) const override;
   Eigen::SparseMatrix<double> preconditioner_block(int block) const override {
     return sparse_block(block);

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
-#include <set>
 #include <regex>
+#include <set>
 
-#include "geom/error.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 
@@ -25,15 +25,16 @@ HalfSpace parse_half_space(const std::string& text, int dim) {
   HalfSpace h;
   h.axis = match[1].str()[0] - 'x';
   if (h.axis >= dim)
-    throw InputError("'" + text + "' uses axis " + match[1].str() + " in a " +
-                     std::to_string(dim) + "D problem");
+    throw InputError("'" + text + "' uses axis " + match[1].str() + " in a " + std::to_string(dim) +
+                     "D problem");
   const std::string op = match[2].str();
   h.greater = op[0] == '>';
   h.inclusive = op.size() == 2;
   // strtod, not stod: a threshold beyond a double (1e999) is an input error, not an exception.
   h.threshold = std::strtod(match[3].str().c_str(), nullptr);
   if (!std::isfinite(h.threshold))
-    throw InputError("'" + text + "': the threshold " + match[3].str() + " is beyond a double's range");
+    throw InputError("'" + text + "': the threshold " + match[3].str() +
+                     " is beyond a double's range");
   return h;
 }
 
@@ -53,8 +54,7 @@ std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min
   std::vector<int> selected;
   for (int i = 0; i < X.rows(); ++i) {
     const Eigen::VectorXd p = X.row(i).transpose();
-    if ((p.array() >= min.array()).all() && (p.array() <= max.array()).all())
-      selected.push_back(i);
+    if ((p.array() >= min.array()).all() && (p.array() <= max.array()).all()) selected.push_back(i);
   }
   return selected;
 }

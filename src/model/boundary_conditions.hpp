@@ -19,8 +19,8 @@ const char* to_string(BoundaryMethod method);
 // A half-space written as "z >= 0.8", "x < 0", "y<=1.5".
 struct HalfSpace {
   int axis = 0;
-  bool greater = true;     // >= (or >) versus <= (or <)
-  bool inclusive = true;   // >= or <= versus > or <
+  bool greater = true;    // >= (or >) versus <= (or <)
+  bool inclusive = true;  // >= or <= versus > or <
   double threshold = 0.0;
 };
 // Throws InputError quoting `text` when it is not of that form.
@@ -40,8 +40,8 @@ std::string singular_setup_reason(const Model& model);
 // The constrained and free unknowns of the paper's layout (P is always free).
 // Throws InputError when one unknown is given two different displacements.
 struct DofPartition {
-  std::vector<int> free;         // ascending
-  std::vector<int> constrained;  // ascending
+  std::vector<int> free;           // ascending
+  std::vector<int> constrained;    // ascending
   std::vector<int> constraint_of;  // per constrained unknown: an index into model.constraints
 };
 DofPartition partition_dofs(const Model& model);

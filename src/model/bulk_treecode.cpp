@@ -39,7 +39,8 @@ BulkTreecode::BulkTreecode(const Eigen::MatrixXd& X, const Eigen::VectorXd& area
       const uint8_t* kept = mask->row(i);
       for (int j = i + 1; j < mask->num_vertices(); ++j)
         if (kept[j] == 0)
-          pruned_.push_back({i, j, bulk_weight(h_, area[i], area[j], (X.row(i) - X.row(j)).norm())});
+          pruned_.push_back(
+              {i, j, bulk_weight(h_, area[i], area[j], (X.row(i) - X.row(j)).norm())});
     }
   Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(X.rows(), 1);
   row_sums_ = weighted_sums(ones).col(0);
@@ -55,8 +56,8 @@ Eigen::MatrixXd BulkTreecode::weighted_sums(const Eigen::MatrixXd& V) const {
   charges.leftCols(k) = V;
   charges.rightCols(k) = V.array().colwise() * area_.array();
   const Eigen::MatrixXd phi = treecode_.potentials(charges);
-  return h_ * ((phi.leftCols(k).array().colwise() * area_.array()) + phi.rightCols(k).array())
-                  .matrix();
+  return h_ *
+         ((phi.leftCols(k).array().colwise() * area_.array()) + phi.rightCols(k).array()).matrix();
 }
 
 Eigen::MatrixXd BulkTreecode::laplacian_product(const Eigen::MatrixXd& V) const {

@@ -7,8 +7,8 @@
 #include <stdexcept>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "model/assembly.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -153,7 +153,8 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
                                                    const std::vector<std::string>& names) const {
   const std::vector<double> no_load(model_.loads.size(), 0.0);  // loads do not depend on theta
   const TermState s(context_, x, no_load);
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(num_unknowns(), static_cast<Eigen::Index>(names.size()));
+  Eigen::MatrixXd D =
+      Eigen::MatrixXd::Zero(num_unknowns(), static_cast<Eigen::Index>(names.size()));
   for (size_t k = 0; k < names.size(); ++k) {
     // Resolved once (throws for an unknown name), not per pair.
     const MaterialParameter p = model_.material.resolve(names[k], model_.dim());
@@ -173,8 +174,7 @@ double Equilibrium::relative_norm(const Eigen::VectorXd& reduced, double force_s
 
 std::shared_ptr<const FiberSystem> Equilibrium::linear_system(const Eigen::MatrixXd& X,
                                                               const DofMap& dofs,
-                                                              BoundaryMethod method,
-                                                              double penalty,
+                                                              BoundaryMethod method, double penalty,
                                                               bool strained) const {
   return std::make_shared<const FiberSystem>(model_, X, dofs, method, penalty,
                                              strained ? &X : nullptr);

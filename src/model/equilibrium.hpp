@@ -117,10 +117,10 @@ class Equilibrium {
 
   const Model& model_;
   PairFactors factors_;
-  Eigen::VectorXd area0_;                 // |S_i| at the reference
-  Eigen::SparseMatrix<double> surface_;   // gamma-free surface Laplacian of the reference
+  Eigen::VectorXd area0_;                // |S_i| at the reference
+  Eigen::SparseMatrix<double> surface_;  // gamma-free surface Laplacian of the reference
   double C0_ = 0.0, volume0_ = 0.0;
-  TermContext context_;                   // refers to the members above
+  TermContext context_;  // refers to the members above
   BulkFiberTerm bulk_;
   std::vector<std::unique_ptr<EquilibriumTerm>> terms_;  // the others, in order
 };

@@ -199,9 +199,9 @@ class TabulatedLaw final : public LawModel {
     // A table without a segment (check() names it) gives NaN, never a read past it.
     if (strain_.size() < 2 || stress_.size() != strain_.size()) return {std::nan(""), 0.0};
     const auto it = std::upper_bound(strain_.begin(), strain_.end(), e);
-    const auto k = std::min(
-        static_cast<size_t>(std::max<std::ptrdiff_t>(1, it - strain_.begin()) - 1),
-        strain_.size() - 2);
+    const auto k =
+        std::min(static_cast<size_t>(std::max<std::ptrdiff_t>(1, it - strain_.begin()) - 1),
+                 strain_.size() - 2);
     const double m = (stress_[k + 1] - stress_[k]) / (strain_[k + 1] - strain_[k]);
     const bool through_origin = strain_[k] == 0.0 || strain_[k + 1] == 0.0;
     return {m, through_origin ? 0.0 : stress_[k] - m * strain_[k]};
@@ -269,8 +269,15 @@ Registry& registry() {
   return r;
 }
 
+const std::vector<std::string>& builtin_law_names() {
+  static const std::vector<std::string> names = {"constant", "exponential", "bilinear",
+                                                 "tabulated"};
+  return names;
+}
+
 bool is_builtin(const std::string& name) {
-  return name == "constant" || name == "exponential" || name == "bilinear" || name == "tabulated";
+  const std::vector<std::string>& names = builtin_law_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 }  // namespace
@@ -291,6 +298,12 @@ std::shared_ptr<const LawModel> find_registered_law(const std::string& name) {
   const std::lock_guard<std::mutex> lock(r.mutex);
   const auto it = r.laws.find(name);
   return it == r.laws.end() ? nullptr : it->second;
+}
+
+std::vector<std::string> law_type_names() {
+  std::vector<std::string> names = builtin_law_names();
+  for (const std::string& name : registered_law_names()) names.push_back(name);
+  return names;
 }
 
 std::vector<std::string> registered_law_names() {

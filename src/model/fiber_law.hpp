@@ -121,5 +121,7 @@ void register_law(std::shared_ptr<const LawModel> model);
 // The registered law of that name, or null.
 std::shared_ptr<const LawModel> find_registered_law(const std::string& name);
 std::vector<std::string> registered_law_names();
+// Every "type" an experiment file may give a law: the built-ins, then the registered.
+std::vector<std::string> law_type_names();
 
 }  // namespace fiberfluid::model

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <string>
 
-#include "geom/error.hpp"
 #include "model/pair_stencil.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

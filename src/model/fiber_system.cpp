@@ -5,10 +5,10 @@
 #include <cmath>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
-#include "geom/run_control.hpp"
 #include "model/fiber_network.hpp"
 #include "model/pair_stencil.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -118,10 +118,12 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   }
   if (gamma_ != 0.0) {
     std::vector<int> position(static_cast<size_t>(n_), -1);
-    for (size_t k = 0; k < act.size(); ++k) position[static_cast<size_t>(act[k])] = static_cast<int>(k);
+    for (size_t k = 0; k < act.size(); ++k)
+      position[static_cast<size_t>(act[k])] = static_cast<int>(k);
     for (int col = 0; col < surface_.outerSize(); ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it) {
-        const int r = position[static_cast<size_t>(it.row())], c = position[static_cast<size_t>(it.col())];
+        const int r = position[static_cast<size_t>(it.row())],
+                  c = position[static_cast<size_t>(it.col())];
         if (r >= 0 && c >= 0) K(r, c) += gamma_ * it.value();
       }
   }
@@ -178,11 +180,13 @@ Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,
 Eigen::SparseMatrix<double> FiberSystem::sparse_block(int axis, bool include_bulk) const {
   const std::vector<int>& act = active(axis);
   std::vector<int> position(static_cast<size_t>(n_), -1);
-  for (size_t k = 0; k < act.size(); ++k) position[static_cast<size_t>(act[k])] = static_cast<int>(k);
+  for (size_t k = 0; k < act.size(); ++k)
+    position[static_cast<size_t>(act[k])] = static_cast<int>(k);
   std::vector<Eigen::Triplet<double>> entries;
   for (int col = 0; col < surface_.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it) {
-      const int r = position[static_cast<size_t>(it.row())], c = position[static_cast<size_t>(it.col())];
+      const int r = position[static_cast<size_t>(it.row())],
+                c = position[static_cast<size_t>(it.col())];
       if (r >= 0 && c >= 0) entries.emplace_back(r, c, gamma_ * it.value());
     }
   const auto m = static_cast<Eigen::Index>(act.size());
@@ -248,7 +252,8 @@ Eigen::VectorXd FiberSystem::apply_K(const Eigen::VectorXd& u) const {
   return out;
 }
 
-Eigen::VectorXd FiberSystem::reduce_rhs(const Eigen::VectorXd& F, const Eigen::VectorXd& U_c) const {
+Eigen::VectorXd FiberSystem::reduce_rhs(const Eigen::VectorXd& F,
+                                        const Eigen::VectorXd& U_c) const {
   Eigen::VectorXd rhs(num_unknowns());
   Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n_, dim_);
   for (int a = 0; a < dim_; ++a) U.col(a) = U_c.segment(a * n_, n_);
@@ -256,7 +261,8 @@ Eigen::VectorXd FiberSystem::reduce_rhs(const Eigen::VectorXd& F, const Eigen::V
   if (method_ == BoundaryMethod::Penalty) {
     for (int a = 0; a < dim_; ++a) {
       rhs.segment(offset(a), n_) = F.segment(a * n_, n_);
-      for (int k : penalised(a)) rhs[offset(a) + k] = penalty_ * U(active(a)[static_cast<size_t>(k)], a);
+      for (int k : penalised(a))
+        rhs[offset(a) + k] = penalty_ * U(active(a)[static_cast<size_t>(k)], a);
     }
     rhs[num_unknowns() - 1] = 0.0;
     return rhs;

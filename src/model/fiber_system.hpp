@@ -7,10 +7,10 @@
 
 #include "model/bordered_system.hpp"
 #include "model/boundary_conditions.hpp"
+#include "model/bulk_treecode.hpp"
 #include "model/dof_map.hpp"
 #include "model/fiber_network.hpp"
 #include "model/model.hpp"
-#include "model/bulk_treecode.hpp"
 #include "model/pair_kernels.hpp"
 
 namespace fiberfluid::model {
@@ -30,8 +30,7 @@ namespace fiberfluid::model {
 class FiberSystem final : public BorderedSystem {
  public:
   // The supports and prescribed values of the model held.
-  FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method,
-              double penalty);
+  FiberSystem(const Model& model, const Eigen::MatrixXd& X, BoundaryMethod method, double penalty);
   // The unknowns that `dofs` holds (e.g. with a contact active set). With a
   // strain-dependent law, each bulk weight is multiplied by the secant modulus
   // Y(e_ij) at the strains of `strained` (positions #V by dim, against the

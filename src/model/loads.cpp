@@ -47,8 +47,8 @@ double hydrostatic_pressure_per_depth(const Load& load, double factor) {
   return factor * load.density * load.acceleration.norm();
 }
 
-Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X,
-                            const Eigen::MatrixXd& S, const std::vector<double>& factors) {
+Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X, const Eigen::MatrixXd& S,
+                            const std::vector<double>& factors) {
   const int n = model.num_vertices(), dim = model.dim();
   Eigen::VectorXd B = Eigen::VectorXd::Zero(model.num_unknowns());
   for (size_t l = 0; l < model.loads.size(); ++l) {

@@ -28,8 +28,8 @@ double hydrostatic_pressure_per_depth(const Load& load, double factor);
 // The load part of the right-hand side B (paper Eq. 4) at positions X with
 // vertex area vectors S (#V by dim), each load scaled by factors[l]. Length
 // dim * N + 1; the last (volume) entry is 0.
-Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X,
-                            const Eigen::MatrixXd& S, const std::vector<double>& factors);
+Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X, const Eigen::MatrixXd& S,
+                            const std::vector<double>& factors);
 
 // Factors of every load after step k of n.
 std::vector<double> load_factors(const Model& model, int step, int steps);

@@ -34,9 +34,12 @@ bool Material::has_parameter(const std::string& name, int dim) const {
 
 double Material::parameter(const MaterialParameter& p) const {
   switch (p.kind) {
-    case MaterialParameter::Kind::Law: return law.parameters()[static_cast<size_t>(p.index)];
-    case MaterialParameter::Kind::SurfaceTension: return surface_tension;
-    case MaterialParameter::Kind::AxisFactor: return axis_factors[p.index];
+    case MaterialParameter::Kind::Law:
+      return law.parameters()[static_cast<size_t>(p.index)];
+    case MaterialParameter::Kind::SurfaceTension:
+      return surface_tension;
+    case MaterialParameter::Kind::AxisFactor:
+      return axis_factors[p.index];
   }
   return 0.0;
 }
@@ -46,8 +49,12 @@ void Material::set_parameter(const MaterialParameter& p, double value) {
     case MaterialParameter::Kind::Law:
       law.set_parameter(law.parameter_names()[static_cast<size_t>(p.index)], value);
       return;
-    case MaterialParameter::Kind::SurfaceTension: surface_tension = value; return;
-    case MaterialParameter::Kind::AxisFactor: axis_factors[p.index] = value; return;
+    case MaterialParameter::Kind::SurfaceTension:
+      surface_tension = value;
+      return;
+    case MaterialParameter::Kind::AxisFactor:
+      axis_factors[p.index] = value;
+      return;
   }
 }
 

@@ -85,20 +85,20 @@ struct Load {
   };
   Kind kind = Kind::Point;
   std::string label;
-  int vertex = -1;                                 // Point: the vertex (model index)
-  Eigen::Vector3d force = Eigen::Vector3d::Zero(); // Point: force at full load (N)
-  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero(); // Hydrostatic, at full load (m/s^2)
-  double density = 0.0;                            // Hydrostatic: fluid density (kg/m^3)
+  int vertex = -1;                                         // Point: the vertex (model index)
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();         // Point: force at full load (N)
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  // Hydrostatic, at full load (m/s^2)
+  double density = 0.0;                                    // Hydrostatic: fluid density (kg/m^3)
   Schedule schedule;
 };
 
 // One degree of freedom held at a displacement (0 for a support).
 struct Constraint {
-  int vertex = -1;    // model index
-  int axis = 0;       // 0, 1, 2 = x, y, z
-  double value = 0.0; // displacement at full load
-  Schedule schedule;  // how the displacement is reached
-  int group = 0;      // index into Model::constraint_groups: whose reaction this adds to
+  int vertex = -1;     // model index
+  int axis = 0;        // 0, 1, 2 = x, y, z
+  double value = 0.0;  // displacement at full load
+  Schedule schedule;   // how the displacement is reached
+  int group = 0;       // index into Model::constraint_groups: whose reaction this adds to
 };
 
 // A rigid paddle (the paper's liver validation): a plane normal to a
@@ -106,12 +106,12 @@ struct Constraint {
 // an active set in the Newton scheme (model.md section 7).
 struct Paddle {
   std::string label;
-  int axis = 2;            // 0, 1, 2 = x, y, z: the plane's normal
-  bool above = true;       // on the high side of the body (it keeps x_axis <= plane), or below
-  double position = 0.0;   // the plane's coordinate before the first step (m)
-  double travel = 0.0;     // its displacement along the axis at full schedule (m)
+  int axis = 2;           // 0, 1, 2 = x, y, z: the plane's normal
+  bool above = true;      // on the high side of the body (it keeps x_axis <= plane), or below
+  double position = 0.0;  // the plane's coordinate before the first step (m)
+  double travel = 0.0;    // its displacement along the axis at full schedule (m)
   Schedule schedule;
-  bool sticking = false;   // hold every component of a vertex in contact, not only the normal
+  bool sticking = false;  // hold every component of a vertex in contact, not only the normal
 
   double plane(double factor) const { return position + factor * travel; }
   // How far a coordinate is past the plane (> 0: penetrating).

@@ -8,9 +8,9 @@
 #include <cmath>
 
 #include "geom/fiber_pruning.hpp"
-#include "geom/run_control.hpp"
 #include "model/pair_stencil.hpp"
 #include "model/vector_clones.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -178,8 +178,8 @@ struct RowArrays {
 
 // The pair's coefficients from the row arrays at q (stencil: weight, then policy).
 template <class K>
-inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i,
-                                         double area_j, double count_i, double count_j) {
+inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i, double area_j,
+                                         double count_i, double count_j) {
   const double a = counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q]);
   return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q]);
 }
@@ -290,7 +290,8 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
     for (int q = 0; q < t.nj; ++q) {
       const double length = (reference_->row(vi) - reference_->row(vj[q])).norm();
       strain[static_cast<size_t>(q)] =
-          vj[q] == vi ? 0.0 : fiber_strain((strained_->row(vi) - strained_->row(vj[q])).norm(), length);
+          vj[q] == vi ? 0.0
+                      : fiber_strain((strained_->row(vi) - strained_->row(vj[q])).norm(), length);
     }
     law_->evaluate(strain.data(), static_cast<size_t>(t.nj), modulus.data(), slope.data());
     for (int q = 0; q < t.nj; ++q)
@@ -373,8 +374,12 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
 struct DeformedPairs::RowScratch {
   std::vector<double> m, L, r, e, Y, Yp;
   RowScratch()
-      : m(BulkPairs::kTile, 1.0), L(BulkPairs::kTile), r(BulkPairs::kTile),
-        e(BulkPairs::kTile), Y(BulkPairs::kTile), Yp(BulkPairs::kTile) {}
+      : m(BulkPairs::kTile, 1.0),
+        L(BulkPairs::kTile),
+        r(BulkPairs::kTile),
+        e(BulkPairs::kTile),
+        Y(BulkPairs::kTile),
+        Yp(BulkPairs::kTile) {}
   RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
 };
 
@@ -407,8 +412,7 @@ Eigen::MatrixXd DeformedPairs::forces() const {
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      forces_row<K>(p, area_.data(), count_.data(), i, j0, first, end, row,
-                    forces.columns(thread));
+      forces_row<K>(p, area_.data(), count_.data(), i, j0, first, end, row, forces.columns(thread));
     });
   });
   return forces.sum();
@@ -448,8 +452,8 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
       double* k1 = c1->col(i).data();
       double* k2 = c2->col(i).data();
       for (int j = first; j < end; ++j) {
-        const PairCoefficients c = row_coefficients<K>(row, j - j0, area[i], area[j], count[i],
-                                                       count[j]);
+        const PairCoefficients c =
+            row_coefficients<K>(row, j - j0, area[i], area[j], count[i], count[j]);
         k1[j] = (*c1)(i, j) = c.c1;
         k2[j] = (*c2)(i, j) = c.c2;
       }

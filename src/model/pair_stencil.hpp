@@ -94,7 +94,8 @@ enum class FiberKinematics {
 
 inline const char* kinematics_name(FiberKinematics k) {
   switch (k) {
-    case FiberKinematics::VectorSpring: return VectorSpring::name;
+    case FiberKinematics::VectorSpring:
+      return VectorSpring::name;
   }
   return "?";
 }
@@ -103,7 +104,8 @@ inline const char* kinematics_name(FiberKinematics k) {
 template <class Body>
 decltype(auto) with_kinematics(FiberKinematics k, Body&& body) {
   switch (k) {
-    case FiberKinematics::VectorSpring: return body(VectorSpring{});
+    case FiberKinematics::VectorSpring:
+      return body(VectorSpring{});
   }
   throw std::logic_error("unknown fiber kinematics");
 }
@@ -126,15 +128,14 @@ inline double pair_tangent(const PairCoefficients& c, double v, double b_dot_v, 
 
 // The entry (a, b) of the 3x3 tangent block df_a/dx_i,b: c1 delta_ab + c2 g_a b_b.
 template <class K>
-inline double pair_tangent_entry(const PairCoefficients& c, bool same_axis, double b_a,
-                                 double d_a, double b_b) {
+inline double pair_tangent_entry(const PairCoefficients& c, bool same_axis, double b_a, double d_a,
+                                 double b_b) {
   return c.c1 * (same_axis ? 1.0 : 0.0) + c.c2 * K::along(b_a, d_a) * b_b;
 }
 
 // The component a of df/dtheta for a law parameter theta: p g_a.
 template <class K>
-inline double pair_parameter_force(double a, double dY, double r, double L, double b,
-                                   double d) {
+inline double pair_parameter_force(double a, double dY, double r, double L, double b, double d) {
   return K::parameter_coefficient(a, dY, r, L) * K::along(b, d);
 }
 

@@ -244,8 +244,10 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
 
 std::unique_ptr<EquilibriumTerm> make_load_term(const TermContext& c, size_t index) {
   switch (c.model.loads[index].kind) {
-    case Load::Kind::Point: return std::make_unique<PointLoadTerm>(c, index);
-    case Load::Kind::Hydrostatic: return std::make_unique<HydrostaticLoadTerm>(c, index);
+    case Load::Kind::Point:
+      return std::make_unique<PointLoadTerm>(c, index);
+    case Load::Kind::Hydrostatic:
+      return std::make_unique<HydrostaticLoadTerm>(c, index);
   }
   throw std::invalid_argument("load " + std::to_string(index) + " is of an unknown kind");
 }
@@ -441,8 +443,8 @@ void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialP
         double sum[3] = {0.0, 0.0, 0.0};
         for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
           if (row.h[j] == 0.0) continue;
-          const double a = bulk_weight(row.h[j], c_.area0[i], c_.area0[static_cast<Eigen::Index>(j)],
-                                       row.L[j]);
+          const double a =
+              bulk_weight(row.h[j], c_.area0[i], c_.area0[static_cast<Eigen::Index>(j)], row.L[j]);
           const PairCoefficients pc = K::coefficients(a, row.Y[j], row.Yp[j], row.r[j], row.L[j]);
           const double dY = axis >= 0 ? 0.0 : law.modulus_derivative(p.index, row.e[j]);
           for (int k = 0; k < 3; ++k) {

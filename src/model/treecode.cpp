@@ -49,14 +49,22 @@ using BlockSum = void (*)(const double*, const double*, const double*, int, cons
 
 BlockSum block_sum_for(int k) {
   switch (k) {
-    case 1: return block_sum<1>;
-    case 2: return block_sum<2>;
-    case 3: return block_sum<3>;
-    case 4: return block_sum<4>;
-    case 5: return block_sum<5>;
-    case 6: return block_sum<6>;
-    case 7: return block_sum<7>;
-    default: return block_sum<8>;
+    case 1:
+      return block_sum<1>;
+    case 2:
+      return block_sum<2>;
+    case 3:
+      return block_sum<3>;
+    case 4:
+      return block_sum<4>;
+    case 5:
+      return block_sum<5>;
+    case 6:
+      return block_sum<6>;
+    case 7:
+      return block_sum<7>;
+    default:
+      return block_sum<8>;
   }
 }
 
@@ -123,7 +131,8 @@ Treecode::Treecode(const Eigen::MatrixXd& X, TreecodeOptions options)
   if (X.cols() != 3) throw std::invalid_argument("the treecode sums over 3D points");
   if (options_.degree < 1 || !(options_.theta > 0.0 && options_.theta < 1.0) ||
       options_.leaf_size < 1)
-    throw std::invalid_argument("treecode options: expected degree >= 1, 0 < theta < 1, leaves >= 1");
+    throw std::invalid_argument(
+        "treecode options: expected degree >= 1, 0 < theta < 1, leaves >= 1");
   const int p = options_.degree + 1;
   proxies_per_node_ = p * p * p;
   for (int m = 0; m < p; ++m) chebyshev_.push_back(std::cos(M_PI * m / options_.degree));
@@ -138,7 +147,8 @@ Treecode::Treecode(const Eigen::MatrixXd& X, TreecodeOptions options)
   // Positions in tree order, and the proxy points of the nodes that have them.
   for (int a = 0; a < 3; ++a) {
     std::vector<double> sorted(static_cast<size_t>(n_));
-    for (int t = 0; t < n_; ++t) sorted[static_cast<size_t>(t)] = X(order_[static_cast<size_t>(t)], a);
+    for (int t = 0; t < n_; ++t)
+      sorted[static_cast<size_t>(t)] = X(order_[static_cast<size_t>(t)], a);
     x_[a] = std::move(sorted);
   }
   for (Node& node : nodes_) {
@@ -175,17 +185,16 @@ int Treecode::build(int begin, int end) {
     }
     node.centre[a] = 0.5 * (node.lo[a] + node.hi[a]);
   }
-  node.radius = 0.5 * std::sqrt(std::pow(node.hi[0] - node.lo[0], 2) +
-                                std::pow(node.hi[1] - node.lo[1], 2) +
-                                std::pow(node.hi[2] - node.lo[2], 2));
+  node.radius =
+      0.5 * std::sqrt(std::pow(node.hi[0] - node.lo[0], 2) + std::pow(node.hi[1] - node.lo[1], 2) +
+                      std::pow(node.hi[2] - node.lo[2], 2));
   if (end - begin > options_.leaf_size) {
     int axis = 0;
     for (int a = 1; a < 3; ++a)
       if (node.hi[a] - node.lo[a] > node.hi[axis] - node.lo[axis]) axis = a;
     const auto first = order_.begin() + begin, last = order_.begin() + end;
-    auto middle = std::partition(first, last, [&](int i) {
-      return x_[axis][static_cast<size_t>(i)] < node.centre[axis];
-    });
+    auto middle = std::partition(
+        first, last, [&](int i) { return x_[axis][static_cast<size_t>(i)] < node.centre[axis]; });
     if (middle == first || middle == last) {  // all on one side: split by count
       middle = first + (end - begin) / 2;
       std::nth_element(first, middle, last, [&](int i, int j) {
@@ -259,7 +268,8 @@ void Treecode::evaluate_leaf(const Node& leaf, const std::vector<double>& charge
     const double dx = leaf.centre[0] - node.centre[0], dy = leaf.centre[1] - node.centre[1],
                  dz = leaf.centre[2] - node.centre[2];
     const double reach = node.radius + leaf.radius;
-    if (node.proxy >= 0 && reach * reach < options_.theta * options_.theta * (dx * dx + dy * dy + dz * dz)) {
+    if (node.proxy >= 0 &&
+        reach * reach < options_.theta * options_.theta * (dx * dx + dy * dy + dz * dz)) {
       const size_t base = static_cast<size_t>(node.proxy) * static_cast<size_t>(P);
       sum(tx, ty, tz, targets, proxy_x_[0].data() + base, proxy_x_[1].data() + base,
           proxy_x_[2].data() + base, P,
@@ -297,7 +307,8 @@ Eigen::MatrixXd Treecode::potentials(const Eigen::MatrixXd& Q) const {
 #pragma omp parallel reduction(+ : direct, proxy)
   {
     std::vector<double> sums(static_cast<size_t>(options_.leaf_size * k));
-    std::vector<double> scratch(static_cast<size_t>(std::max(proxies_per_node_, options_.leaf_size)));
+    std::vector<double> scratch(
+        static_cast<size_t>(std::max(proxies_per_node_, options_.leaf_size)));
     std::vector<int> stack;
 #pragma omp for schedule(dynamic, 4)
     for (size_t l = 0; l < leaves_.size(); ++l) {
@@ -305,7 +316,8 @@ Eigen::MatrixXd Treecode::potentials(const Eigen::MatrixXd& Q) const {
       evaluate_leaf(leaf, charges, proxy_charges, k, sums.data(), scratch, stack, direct, proxy);
       for (int t = leaf.begin; t < leaf.end; ++t)
         for (int c = 0; c < k; ++c)
-          out(order_[static_cast<size_t>(t)], c) = sums[static_cast<size_t>((t - leaf.begin) * k + c)];
+          out(order_[static_cast<size_t>(t)], c) =
+              sums[static_cast<size_t>((t - leaf.begin) * k + c)];
     }
   }
   direct_terms_ = direct;

@@ -19,9 +19,9 @@
 namespace fiberfluid::model {
 
 struct TreecodeOptions {
-  int degree = 4;         // interpolation degree per axis
-  double theta = 0.5;     // the far-field criterion: radius < theta * distance
-  int leaf_size = 64;     // boxes of at most this many points are not split
+  int degree = 4;      // interpolation degree per axis
+  double theta = 0.5;  // the far-field criterion: radius < theta * distance
+  int leaf_size = 64;  // boxes of at most this many points are not split
 
   // The degree and theta measured to keep the relative error of the bulk
   // product below `tolerance` (1e-2 to 1e-10) on surface meshes
@@ -45,10 +45,10 @@ class Treecode {
  private:
   struct Node {
     double lo[3], hi[3], centre[3];
-    double radius;      // half the box diagonal
-    int begin, end;     // points [begin, end) in tree order
+    double radius;   // half the box diagonal
+    int begin, end;  // points [begin, end) in tree order
     int left = -1, right = -1;
-    int proxy = -1;     // index among the nodes with proxies, or -1 (summed directly)
+    int proxy = -1;  // index among the nodes with proxies, or -1 (summed directly)
   };
 
   int build(int begin, int end);
@@ -62,12 +62,12 @@ class Treecode {
   TreecodeOptions options_;
   int n_ = 0, proxies_per_node_ = 0;
   std::vector<double> chebyshev_;  // cos(m pi / degree), m = 0..degree
-  std::vector<int> order_;       // tree position -> input row
-  std::vector<double> x_[3];     // positions in tree order
+  std::vector<int> order_;         // tree position -> input row
+  std::vector<double> x_[3];       // positions in tree order
   std::vector<Node> nodes_;
-  std::vector<int> leaves_;               // the target batches
-  std::vector<int> proxy_nodes_;          // the nodes with proxies
-  std::vector<double> proxy_x_[3];        // their proxy points, proxies_per_node_ each
+  std::vector<int> leaves_;         // the target batches
+  std::vector<int> proxy_nodes_;    // the nodes with proxies
+  std::vector<double> proxy_x_[3];  // their proxy points, proxies_per_node_ each
   mutable long long direct_terms_ = 0, proxy_terms_ = 0;
 };
 

@@ -16,11 +16,11 @@
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
 #include "fit/calibration.hpp"
-#include "model/equilibrium.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
-#include "geom/run_control.hpp"
+#include "model/equilibrium.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace py = pybind11;
 namespace ff = fiberfluid;
@@ -70,7 +70,8 @@ py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s)
   out["applied_force"] = applied;
   py::dict load_factors;
   for (size_t l = 0; l < c.model.loads.size(); ++l)
-    load_factors[py::str(c.model.loads[l].label)] = Eigen::VectorXd(factors.col(static_cast<Eigen::Index>(l)));
+    load_factors[py::str(c.model.loads[l].label)] =
+        Eigen::VectorXd(factors.col(static_cast<Eigen::Index>(l)));
   out["load_factors"] = load_factors;
   py::dict reaction_dict;
   for (size_t g = 0; g < groups; ++g)
@@ -167,7 +168,8 @@ py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
     if (!(scale > 0.0) || !std::isfinite(scale))
       throw ff::InputError(label + ": scale: expected a positive finite number");
     const Eigen::MatrixXd V = scale * t["vertices"].cast<Eigen::MatrixXd>();
-    const Eigen::MatrixXi F = t.contains("faces") ? t["faces"].cast<Eigen::MatrixXi>() : Eigen::MatrixXi();
+    const Eigen::MatrixXi F =
+        t.contains("faces") ? t["faces"].cast<Eigen::MatrixXi>() : Eigen::MatrixXi();
     const int step = t.contains("step") ? t["step"].cast<int>() : c.stepping.steps;
     measured.push_back({ff::fit::make_target(label, V, F), step});
   }
@@ -188,7 +190,8 @@ py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
   ff::fit::FitOptions options;
   options.method = ff::fit::method_from_string(method);
   if (jacobian != "analytic" && jacobian != "finite-differences")
-    throw ff::InputError("jacobian: expected analytic or finite-differences, got \"" + jacobian + "\"");
+    throw ff::InputError("jacobian: expected analytic or finite-differences, got \"" + jacobian +
+                         "\"");
   options.finite_differences = jacobian == "finite-differences";
   options.symmetric = symmetric;
   options.loss = ff::fit::loss_from_string(loss);
@@ -239,8 +242,9 @@ py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
 }
 
 PYBIND11_MODULE(fiberfluid, m) {
-  m.doc() = "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
-            "SI units throughout: m, N, Pa.";
+  m.doc() =
+      "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
+      "SI units throughout: m, N, Pa.";
   py::register_exception<ff::InputError>(m, "InputError", PyExc_ValueError);
   // Every other exception that reaches Python becomes a Python exception
   // too: an interruption a KeyboardInterrupt, bad JSON a ValueError (the
@@ -297,8 +301,9 @@ PYBIND11_MODULE(fiberfluid, m) {
             ff::geom::Surface surface;
             surface.dim = static_cast<int>(vertices->cols());
             if ((surface.dim != 2 && surface.dim != 3) || faces->cols() != surface.dim)
-              throw ff::InputError("<dict>: vertices must be #V x 3 with faces #F x 3 (or "
-                                   "#V x 2 with segments #F x 2)");
+              throw ff::InputError(
+                  "<dict>: vertices must be #V x 3 with faces #F x 3 (or "
+                  "#V x 2 with segments #F x 2)");
             surface.V = *vertices;
             surface.F = *faces;
             ff::app::build_experiment(ex, &surface);
@@ -328,20 +333,22 @@ PYBIND11_MODULE(fiberfluid, m) {
            "with positions, displacements, pressure, steps as numpy arrays, figures), figures "
            "and checks.");
 
-  m.def("fit", &fit_experiment, py::arg("experiment"), py::arg("targets"), py::arg("parameters"),
-        py::arg("method") = "levenberg-marquardt", py::arg("jacobian") = "analytic",
-        py::arg("symmetric") = false, py::arg("loss") = "squared", py::arg("loss_scale") = 1e-3,
-        py::arg("max_iterations") = 50,
-        "Fits the material (and optionally a rigid alignment) of a one-run experiment to measured "
-        "surfaces. targets: a list of dicts with vertices (#P x 3), faces (#T x 3, omit for a point "
-        "cloud), step (default: the last) and scale (the vertices times it are in m); parameters: "
-        "dicts with name (Y0, beta, gamma, factor_x, rotation_y, scale, ...), and optionally start, "
-        "lower, upper, log_scale. Options are checked as a file's fit section is (ValueError naming "
-        "the option). Returns a dict: status (converged, converged_at_bounds, iteration_limit, "
-        "not_identifiable, forward_runs_failed, start_failed, interrupted), status_detail, "
-        "success, message, failed_runs, values, standard_errors, interval_95, correlation, cost_per_iteration, "
-        "distance (mean, rms, standard_deviation, largest, share_of_length), forward_runs, "
-        "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
+  m.def(
+      "fit", &fit_experiment, py::arg("experiment"), py::arg("targets"), py::arg("parameters"),
+      py::arg("method") = "levenberg-marquardt", py::arg("jacobian") = "analytic",
+      py::arg("symmetric") = false, py::arg("loss") = "squared", py::arg("loss_scale") = 1e-3,
+      py::arg("max_iterations") = 50,
+      "Fits the material (and optionally a rigid alignment) of a one-run experiment to measured "
+      "surfaces. targets: a list of dicts with vertices (#P x 3), faces (#T x 3, omit for a point "
+      "cloud), step (default: the last) and scale (the vertices times it are in m); parameters: "
+      "dicts with name (Y0, beta, gamma, factor_x, rotation_y, scale, ...), and optionally start, "
+      "lower, upper, log_scale. Options are checked as a file's fit section is (ValueError naming "
+      "the option). Returns a dict: status (converged, converged_at_bounds, iteration_limit, "
+      "not_identifiable, forward_runs_failed, start_failed, interrupted), status_detail, "
+      "success, message, failed_runs, values, standard_errors, interval_95, correlation, "
+      "cost_per_iteration, "
+      "distance (mean, rms, standard_deviation, largest, share_of_length), forward_runs, "
+      "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
 
   m.def(
       "summary",

@@ -44,8 +44,8 @@ class BlockCholeskySolver final : public SchurSolver {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (info > 0)
         return Status::failure("block-cholesky: " + system.block_name(a) +
-                               " is not positive definite (leading minor " +
-                               std::to_string(info) + ")");
+                               " is not positive definite (leading minor " + std::to_string(info) +
+                               ")");
       statistics_.factorization_flops += static_cast<double>(n) * n * n / 3.0;
       factors_.push_back(std::move(K));
     }
@@ -61,8 +61,7 @@ class BlockCholeskySolver final : public SchurSolver {
       // multi-right-hand-side solve, a single pass over the factor.
       const int n = offsets_[1] - offsets_[0];
       const int nrhs = static_cast<int>(offsets_.size()) - 1;
-      if (n > 0)
-        dpotrs_(&lower, &n, &nrhs, factors_[0].data(), &n, w->data(), &n, &info, 1);
+      if (n > 0) dpotrs_(&lower, &n, &nrhs, factors_[0].data(), &n, w->data(), &n, &info, 1);
       return {};
     }
     const int nrhs = 1;

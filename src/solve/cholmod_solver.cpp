@@ -33,7 +33,8 @@ class CholmodSolver final : public SchurSolver {
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
       const Status status = factors_[static_cast<size_t>(a)].factorize(system.sparse_block(a));
-      if (!status.ok) return Status::failure("cholmod: " + system.block_name(a) + ": " + status.message);
+      if (!status.ok)
+        return Status::failure("cholmod: " + system.block_name(a) + ": " + status.message);
     }
     return {};
   }

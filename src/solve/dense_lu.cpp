@@ -40,7 +40,8 @@ Status DenseLU::factorize(const Eigen::MatrixXd& A) {
     char rcond[32];
     std::snprintf(rcond, sizeof rcond, "%.3g", rcond_);
     return Status::failure(std::string("the system matrix is numerically singular (reciprocal "
-                                       "condition ") + rcond + ")");
+                                       "condition ") +
+                           rcond + ")");
   }
   factored_ = true;
   return {};

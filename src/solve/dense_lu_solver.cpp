@@ -15,9 +15,8 @@ class DenseLUSolver final : public LinearSolver {
   Status analyze_pattern(const model::BorderedSystem& system) override {
     const double n = system.num_unknowns();
     // The assembled matrix and its LU factors.
-    return require_memory(2.0 * 8.0 * n * n, "the dense LU of " +
-                                                 std::to_string(system.num_unknowns()) +
-                                                 " unknowns");
+    return require_memory(2.0 * 8.0 * n * n,
+                          "the dense LU of " + std::to_string(system.num_unknowns()) + " unknowns");
   }
 
   Status factorize(const model::BorderedSystem& system) override {

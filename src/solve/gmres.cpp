@@ -6,7 +6,7 @@
 #include <sstream>
 #include <vector>
 
-#include "geom/run_control.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::solve {
 
@@ -70,8 +70,9 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
       }
       const double rho = std::hypot(H(k, k), H(k + 1, k));
       if (!(rho > 0.0) || !std::isfinite(rho)) {
-        result.status = Status::failure("gmres: breakdown (the operator or preconditioner "
-                                        "gave a zero or non-finite vector)");
+        result.status = Status::failure(
+            "gmres: breakdown (the operator or preconditioner "
+            "gave a zero or non-finite vector)");
         return result;
       }
       cs[k] = H(k, k) / rho;
@@ -87,8 +88,7 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& preconditioner,
       V.push_back(w / w.norm());  // w != 0 here: else g[k + 1] = 0 ended the loop
     }
     // x += Z y with H(0:k, 0:k) y = g(0:k).
-    const Eigen::VectorXd y =
-        H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+    const Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
     for (int i = 0; i < k; ++i) x += y[i] * Z[static_cast<size_t>(i)];
   }
   std::ostringstream out;

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "model/bordered_system.hpp"
 #include "solve/status.hpp"
@@ -22,6 +23,8 @@ enum class SolverKind {
 };
 const char* to_string(SolverKind kind);
 std::optional<SolverKind> solver_kind_from_string(const std::string& name);
+// Every name solver_kind_from_string reads, for the readers' lists and messages.
+std::vector<std::string> solver_kind_names();
 
 struct PcgOptions {
   double tolerance = 1e-10;   // stop at |r| <= tolerance |b| (relative residual)
@@ -30,9 +33,9 @@ struct PcgOptions {
 
 // What a backend did, for the summaries.
 struct SolverStatistics {
-  double factorization_flops = 0.0;  // dense paths: the LAPACK factorisation's flop count
+  double factorization_flops = 0.0;           // dense paths: the LAPACK factorisation's flop count
   double factorization_kernel_seconds = 0.0;  // time inside that LAPACK routine
-  int iterations = 0;                // pcg: iterations over all solves
+  int iterations = 0;                         // pcg: iterations over all solves
   int solves = 0;
 };
 

@@ -44,9 +44,9 @@ struct NewtonOptions {
   // than increment_tolerance times the body's bounding-box diagonal.
   double residual_tolerance = 1e-10;
   double increment_tolerance = 1e-12;
-  int max_iterations = 25;      // per load step (or cut piece of one)
-  int max_step_cuts = 6;        // halvings of a failing step before giving up
-  bool line_search = true;      // backtracking on the residual norm
+  int max_iterations = 25;  // per load step (or cut piece of one)
+  int max_step_cuts = 6;    // halvings of a failing step before giving up
+  bool line_search = true;  // backtracking on the residual norm
   TangentSolver tangent = TangentSolver::Auto;
   // GMRES stops at a relative residual of max(krylov_tolerance, 0.1 r) for a
   // Newton residual r (inexact Newton: no sharper than the step needs).
@@ -65,13 +65,13 @@ struct NewtonOptions {
 struct SteppingOptions {
   Scheme scheme = Scheme::Incremental;
   NewtonOptions newton;
-  int steps = 1;                  // number of load steps n
-  bool rebuild_matrix = false;    // rebuild A (lengths, area vectors) from x_{k-1} each step
+  int steps = 1;                     // number of load steps n
+  bool rebuild_matrix = false;       // rebuild A (lengths, area vectors) from x_{k-1} each step
   bool update_load_geometry = true;  // loads from x_{k-1} (the paper) or from the reference
   model::BoundaryMethod boundary_method = model::BoundaryMethod::Elimination;
-  double penalty = 1e9;           // the paper's diagonal value, for BoundaryMethod::Penalty
+  double penalty = 1e9;                  // the paper's diagonal value, for BoundaryMethod::Penalty
   SolverKind solver = SolverKind::Auto;  // the linear backend; Auto: automatic_solver()
-  PcgOptions pcg;                 // for SolverKind::PCG
+  PcgOptions pcg;                        // for SolverKind::PCG
   // Runaway guards: a step that changes the enclosed volume by more than this
   // fraction of the reference volume, or turns a face over, ends the run.
   double max_volume_change = 0.5;
@@ -94,36 +94,36 @@ struct SteppingOptions {
 };
 
 struct StepRecord {
-  int step = 0;                       // 1..n
-  std::vector<double> load_factors;   // one per load, after this step
-  double pressure = 0.0;              // P after this step
-  double volume = 0.0;                // enclosed volume (area in 2D) after this step
-  double max_displacement = 0.0;      // max_i |u_i|
+  int step = 0;                      // 1..n
+  std::vector<double> load_factors;  // one per load, after this step
+  double pressure = 0.0;             // P after this step
+  double volume = 0.0;               // enclosed volume (area in 2D) after this step
+  double max_displacement = 0.0;     // max_i |u_i|
   // How far the state reached is from equilibrium: the relative |R| of
   // model.md section 7 (Equilibrium::relative_norm). Newton drives it below
   // its tolerance; the incremental scheme leaves what its linearisation
   // misses (with SteppingOptions::measure_residual).
   double residual = 0.0;
-  double seconds = 0.0;               // wall time of this step
+  double seconds = 0.0;  // wall time of this step
   // Force that each constraint group (Model::constraint_groups) exerts on the
   // body, and the sum of the external loads; they sum to zero at equilibrium.
   std::vector<Eigen::Vector3d> reactions;
   Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();
 
   // Newton scheme only.
-  int newton_iterations = 0;            // over the step's pieces
-  std::vector<double> residual_norms;   // relative, at every iteration (before its correction)
+  int newton_iterations = 0;           // over the step's pieces
+  std::vector<double> residual_norms;  // relative, at every iteration (before its correction)
   int line_search_halvings = 0;
   int krylov_iterations = 0;
-  int step_cuts = 0;                    // halvings of this step
-  double volume_drift = 0.0;            // (V - V0) / V0 after the step
+  int step_cuts = 0;          // halvings of this step
+  double volume_drift = 0.0;  // (V - V0) / V0 after the step
   struct PaddleState {
-    double plane = 0.0;                 // the plane's coordinate
-    double travel = 0.0;                // how far it has moved
+    double plane = 0.0;                               // the plane's coordinate
+    double travel = 0.0;                              // how far it has moved
     Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the body
-    int contacts = 0;                   // vertices held on it
+    int contacts = 0;                                 // vertices held on it
   };
-  std::vector<PaddleState> paddles;     // one per Model::paddles
+  std::vector<PaddleState> paddles;  // one per Model::paddles
   // At the steps SteppingOptions::sensitivities lists: du/dtheta, full
   // layout (zero at held unknowns), one column per parameter.
   Eigen::MatrixXd sensitivities;
@@ -131,15 +131,15 @@ struct StepRecord {
 
 struct SteppingSummary {
   bool success = false;
-  std::string message;                // why it failed, or "" on success
+  std::string message;  // why it failed, or "" on success
   std::vector<StepRecord> steps;
-  Eigen::VectorXd unknowns;           // final [u_x.. u_y.. (u_z..) P]
-  Eigen::MatrixXd reaction_forces;    // #V by dim: the support force on each vertex at the end
+  Eigen::VectorXd unknowns;         // final [u_x.. u_y.. (u_z..) P]
+  Eigen::MatrixXd reaction_forces;  // #V by dim: the support force on each vertex at the end
   Scheme scheme = Scheme::Incremental;
   SolverKind solver = SolverKind::Auto;  // the backend that ran (newton: the preconditioner's)
   TangentSolver tangent = TangentSolver::Auto;  // newton: how the tangent was solved
-  int newton_iterations = 0;              // newton: over all steps
-  int krylov_iterations = 0;              // newton with krylov: over all solves
+  int newton_iterations = 0;                    // newton: over all steps
+  int krylov_iterations = 0;                    // newton with krylov: over all solves
   // The bordered system the backend factored last (reduced, boundary
   // conditions applied): what was actually solved.
   std::shared_ptr<const model::FiberSystem> system;

@@ -10,9 +10,6 @@
 #include <sstream>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 #include "model/dof_map.hpp"
 #include "model/equilibrium.hpp"
@@ -21,6 +18,9 @@
 #include "solve/load_stepper.hpp"
 #include "solve/stepping_common.hpp"
 #include "solve/tangent_solve.hpp"
+#include "util/error.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -205,8 +205,7 @@ class NewtonSolver {
   bool release_pulling() { return release_pulling(residual_); }
   bool contact_would_change(const PathPoint& at, const Eigen::VectorXd& x,
                             const Eigen::VectorXd& R) {
-    return !model_.paddles.empty() &&
-           (release_pulling(R, false) || add_penetrating(at, x, false));
+    return !model_.paddles.empty() && (release_pulling(R, false) || add_penetrating(at, x, false));
   }
 
   // The relative residual (the gauge's force scale: the largest load or reaction seen).
@@ -299,9 +298,9 @@ class NewtonSolver {
   const NewtonOptions& newton_;
   SteppingSummary& summary_;
   std::shared_ptr<const model::Equilibrium> equilibrium_;
-  DofMap supports_;                    // supports and prescribed values
-  std::vector<int> contact_paddle_;    // per vertex: its paddle, or -1
-  Eigen::MatrixXd stuck_;              // sticking contact: displacement at first touch
+  DofMap supports_;                  // supports and prescribed values
+  std::vector<int> contact_paddle_;  // per vertex: its paddle, or -1
+  Eigen::MatrixXd stuck_;            // sticking contact: displacement at first touch
   Eigen::VectorXd residual_;
   double diagonal_ = 1.0;
   ResidualGauge gauge_;
@@ -496,7 +495,8 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     report_progress("step", k, n);
     if (observer) observer(record, x);
   }
-  if (options.keep_final_tangent) summary.final_tangent = solver->final_tangent(path_point(model, n, n), x);
+  if (options.keep_final_tangent)
+    summary.final_tangent = solver->final_tangent(path_point(model, n, n), x);
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;

@@ -7,11 +7,11 @@
 #include <sstream>
 #include <vector>
 
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
 #include "solve/backends.hpp"
 #include "solve/schur_solver.hpp"
 #include "solve/sparse_cholesky.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -57,8 +57,8 @@ class PcgSolver final : public SchurSolver {
         return Status::failure("pcg: a product with the matrix is not finite at iteration " +
                                std::to_string(it));
       if (!(pq > 0.0))
-        return Status::failure("pcg: the system is not positive definite (p.Kp = " +
-                               std::to_string(pq) + ")");
+        return Status::failure(
+            "pcg: the system is not positive definite (p.Kp = " + std::to_string(pq) + ")");
       const double alpha = rz / pq;
       *w += alpha * p;
       r -= alpha * q;
@@ -67,7 +67,8 @@ class PcgSolver final : public SchurSolver {
       const double residual = r.stableNorm();
       if (residual <= options_.tolerance * norm_f) return {};
       if (!std::isfinite(residual))
-        return Status::failure("pcg: the residual is not finite at iteration " + std::to_string(it));
+        return Status::failure("pcg: the residual is not finite at iteration " +
+                               std::to_string(it));
       if (cancel_requested())
         return Status::failure("pcg: interrupted at iteration " + std::to_string(it));
       z = precondition(r);
@@ -76,9 +77,8 @@ class PcgSolver final : public SchurSolver {
       rz = rz_next;
     }
     std::ostringstream out;
-    out << "pcg: no convergence in " << options_.max_iterations
-        << " iterations (relative residual " << r.norm() / norm_f << " > tolerance "
-        << options_.tolerance << ")";
+    out << "pcg: no convergence in " << options_.max_iterations << " iterations (relative residual "
+        << r.norm() / norm_f << " > tolerance " << options_.tolerance << ")";
     return Status::failure(out.str());
   }
 

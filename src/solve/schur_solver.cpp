@@ -15,8 +15,9 @@ Status SchurSolver::factorize(const model::BorderedSystem& system) {
   // K is positive definite, so s.z > 0 unless the border vanishes on every
   // free unknown: then nothing determines P.
   if (!(s_dot_z_ > 1e-300) || !std::isfinite(s_dot_z_))
-    return Status::failure("the pressure is undetermined: the area vectors vanish on every free "
-                           "unknown (too many supports?)");
+    return Status::failure(
+        "the pressure is undetermined: the area vectors vanish on every free "
+        "unknown (too many supports?)");
   return {};
 }
 

@@ -46,9 +46,8 @@ std::string setup_problem(const model::Model& model, const SteppingOptions& opti
 // "": non-finite unknowns, a face turned over, a volume change beyond
 // options.max_volume_change.
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
-                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X,
-                           double volume, double reference_volume,
-                           const Eigen::MatrixXd& reference_face_areas);
+                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
+                           double reference_volume, const Eigen::MatrixXd& reference_face_areas);
 
 // How far a state is from equilibrium, relative (Equilibrium::relative_norm):
 // the free rows of R over the largest force seen so far along the path (the

@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "geom/run_control.hpp"
 #include "model/assembly.hpp"
 #include "solve/dense_lu.hpp"
 #include "solve/gmres.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::solve {
 
@@ -17,8 +17,7 @@ TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium
   const model::Model& model = equilibrium_->model();
   // The pair coefficients are stored when two N x N arrays fit in a
   // quarter of the memory budget; else each product recomputes them.
-  store_ = model::TangentOperator::bytes_for(model.num_vertices()) <
-           0.25 * memory_budget_bytes();
+  store_ = model::TangentOperator::bytes_for(model.num_vertices()) < 0.25 * memory_budget_bytes();
   preconditioner_kind_ = kind_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
 }
 
@@ -63,8 +62,7 @@ Eigen::VectorXd TangentSolve::precondition(const Eigen::VectorXd& reduced) const
     in = preconditioner_dofs_.reduce(full);
   }
   Eigen::VectorXd out;
-  if (!preconditioner_->solve(in, &out).ok)
-    return Eigen::VectorXd::Constant(reduced.size(), NAN);
+  if (!preconditioner_->solve(in, &out).ok) return Eigen::VectorXd::Constant(reduced.size(), NAN);
   if (same_layout) return out;
   Eigen::VectorXd full = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
   preconditioner_dofs_.scatter(out, full);
@@ -93,8 +91,10 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   // clearly more iterations per decade of residual reduction than it did
   // just after the last factorisation.
   const double rate = result.iterations / std::max(1.0, -std::log10(tolerance));
-  if (baseline_rate_ < 0.0) baseline_rate_ = rate;
-  else if (rate > 2.0 * baseline_rate_ + 1.0) refactor_ = true;
+  if (baseline_rate_ < 0.0)
+    baseline_rate_ = rate;
+  else if (rate > 2.0 * baseline_rate_ + 1.0)
+    refactor_ = true;
   if (!result.status.ok && !just_factored_) {
     const Status status = factor_preconditioner();
     if (!status.ok) return status;
@@ -124,8 +124,8 @@ Status TangentSolve::factor_preconditioner() {
   if (!preconditioner_ || !(preconditioner_dofs_.held_flags() == preconditioned_held_)) {
     // By size as for the linear scheme, but never the dense LU of the whole
     // bordered system: block Cholesky does the same job in a fraction of the flops.
-    SolverKind kind = options_.solver == SolverKind::Auto ? choose_solver(*secant_)
-                                                          : options_.solver;
+    SolverKind kind =
+        options_.solver == SolverKind::Auto ? choose_solver(*secant_) : options_.solver;
     if (options_.solver == SolverKind::Auto && kind == SolverKind::DenseLU)
       kind = SolverKind::BlockCholesky;
     preconditioner_ = make_linear_solver(kind, options_.pcg);

@@ -13,10 +13,10 @@
 #include "app/experiment.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "metrics/metrics.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -60,17 +60,21 @@ TEST(Benchmark, BadFieldsAreNamed) {
   expect_error(with("scene", "cube"), "scene: expected one of block-needle, bending-rod");
   expect_error(with("solvers", {"explicit", "leapfrog"}), "solvers: unknown solver \"leapfrog\"");
   expect_error(with("solvers", {"explicit", "explicit"}), "listed twice");
-  expect_error(with("solvers", {"implicit-newmark"}), "unknown solver \"implicit-newmark\"");  // the reference
+  expect_error(with("solvers", {"implicit-newmark"}),
+               "unknown solver \"implicit-newmark\"");  // the reference
   expect_error(with("mesh", {{"cells", {4, 3}}}), "mesh.cells: expected an even number");
   expect_error(with("mesh", {{"cells", {4, 4}}, {"elements", "hexahedron"}}), "mesh.elements");
   expect_error(with("mesh", {{"cells", {4.5, 4}}}), "mesh.cells: expected whole numbers");
   expect_error(with("material", "MP4"), "material: expected a preset");
   expect_error(with("material", {{"E", 100}, {"nu", 0.5}}), "material.nu");
   expect_error(with("gravity", 9.81), "gravity: only the bending-rod scene");
-  expect_error(with("time", {{"step", 0.1}, {"duration", 0.01}}), "time.duration: shorter than one step");
-  expect_error(with("fiber_model", {{"fit", true}, {"Y", 5}}), "fiber_model.fit: give Y and gamma, or fit");
+  expect_error(with("time", {{"step", 0.1}, {"duration", 0.01}}),
+               "time.duration: shorter than one step");
+  expect_error(with("fiber_model", {{"fit", true}, {"Y", 5}}),
+               "fiber_model.fit: give Y and gamma, or fit");
   expect_error(with("linear_solver", {{"method", "jacobi"}}), "linear_solver.method");
-  expect_error(with("compare_materials", {{{"material", "MP2"}}}), "compare_materials[0].solvers: missing");
+  expect_error(with("compare_materials", {{{"material", "MP2"}}}),
+               "compare_materials[0].solvers: missing");
   expect_error(with("surface", {{"generator", "cube"}}), "surface: unknown field");
   nlohmann::json rod = small_block();
   rod["scene"] = "bending-rod";
@@ -97,7 +101,8 @@ TEST(Benchmark, SeriesFollowTheReferenceStepByStep) {
   }
   // Quasi-static is the static state under the needle's position at each time.
   EXPECT_EQ(r.figures.at("quasi-static.static_gap"), 0.0);
-  EXPECT_GT(r.figures.at("quasi-static.E_n.mean_to_2s"), 3.0 * r.figures.at("explicit.E_n.mean_to_2s"));
+  EXPECT_GT(r.figures.at("quasi-static.E_n.mean_to_2s"),
+            3.0 * r.figures.at("explicit.E_n.mean_to_2s"));
   const std::string csv = benchmark_csv(r);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 90);
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "time_s,series,E_n,E_s,E_i");
@@ -113,15 +118,18 @@ TEST(Benchmark, GaussSeidelAndTrianglesAgreeWithTheDefaults) {
   ASSERT_TRUE(direct.ok && swept.ok);
   EXPECT_GT(swept.reference_sweeps, 90);
   EXPECT_EQ(direct.reference_sweeps, 0);
-  for (const char* figure : {"explicit.E_n.at_2s", "quasi-static.E_i.final", "quasi-static.E_s.at_1s"})
-    EXPECT_NEAR(swept.figures.at(figure), direct.figures.at(figure), 1e-6 * direct.figures.at(figure))
+  for (const char* figure :
+       {"explicit.E_n.at_2s", "quasi-static.E_i.final", "quasi-static.E_s.at_1s"})
+    EXPECT_NEAR(swept.figures.at(figure), direct.figures.at(figure),
+                1e-6 * direct.figures.at(figure))
         << figure;
   d.erase("linear_solver");
   d["mesh"]["elements"] = "triangle";
   const BenchmarkResult triangles = run_benchmark(*parse(d).benchmark);
   ASSERT_TRUE(triangles.ok);
   EXPECT_EQ(triangles.scene.mesh.elements.cols(), 3);
-  const double a = direct.figures.at("quasi-static.E_n.at_1s"), b = triangles.figures.at("quasi-static.E_n.at_1s");
+  const double a = direct.figures.at("quasi-static.E_n.at_1s"),
+               b = triangles.figures.at("quasi-static.E_n.at_1s");
   EXPECT_NEAR(b / a, 1.0, 0.2);  // the same physics on another mesh of the same nodes
 }
 
@@ -152,7 +160,8 @@ TEST(Benchmark, TheFiberModelRunsOnTheScenesBoundary) {
         (final_surface.V.row(v) - Eigen::RowVector2d(0.84, 0.5)).norm() < 1e-9)
       needle_x = final_surface.V(v, 0);
   EXPECT_NEAR(needle_x, 0.84, 1e-9);
-  EXPECT_NEAR(metrics::surface_error(r.reference_final, final_surface), fiber.surface.back(), 1e-12);
+  EXPECT_NEAR(metrics::surface_error(r.reference_final, final_surface), fiber.surface.back(),
+              1e-12);
 }
 
 // The fiber model fitted to the block's static shape beats the neighbouring
@@ -206,7 +215,8 @@ TEST(Benchmark, WritesItsFiles) {
   const ExperimentResult failed = run_experiment(bad);
   bad_writer.finish(failed);
   EXPECT_FALSE(failed.runs_succeeded());
-  EXPECT_NE(failed.failure.find("Gauss-Seidel did not converge"), std::string::npos) << failed.failure;
+  EXPECT_NE(failed.failure.find("Gauss-Seidel did not converge"), std::string::npos)
+      << failed.failure;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "bad"));
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "bad.failed" / "FAILED"));
 }

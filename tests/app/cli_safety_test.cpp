@@ -30,9 +30,10 @@ const char kSmall[] = R"({"name": "small",
   "stepping": {"steps": 2}})";
 
 // `fiberfluid ARGUMENTS` run from `folder` (for the default output folder out/NAME).
-Outcome run_in(const fs::path& folder, const std::string& arguments, const std::string& shell_prefix = "") {
-  return run_cli_command("cd '" + folder.string() + "' && " + shell_prefix + std::string(FIBERFLUID_CLI) +
-                         " " + arguments);
+Outcome run_in(const fs::path& folder, const std::string& arguments,
+               const std::string& shell_prefix = "") {
+  return run_cli_command("cd '" + folder.string() + "' && " + shell_prefix +
+                         std::string(FIBERFLUID_CLI) + " " + arguments);
 }
 
 json fit_sphere() {
@@ -52,7 +53,8 @@ TEST(CliSafety, ANameFromAFileNeverWritesOutsideTheOutputRoot) {
   const auto file = dir.write("shared.json", config.dump());
   const Outcome o = run_in(dir.path(), "run shared.json -q");
   EXPECT_EQ(o.status, 1) << o.output;
-  EXPECT_NE(o.output.find("shared.json: name: expected a name of letters, digits"), std::string::npos)
+  EXPECT_NE(o.output.find("shared.json: name: expected a name of letters, digits"),
+            std::string::npos)
       << o.output;
   EXPECT_EQ(read_file(dir.path() / "victim" / "thesis.tex"), "years of work");
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
@@ -74,11 +76,13 @@ TEST(CliSafety, AFolderFiberfluidDidNotWriteIsNeverReplacedAndTheRunNeverStarts)
   const Outcome o = run_cli("run " + file.string() + " -q -o " + data.string());
   EXPECT_EQ(o.status, 1) << o.output;
   EXPECT_NE(o.output.find(data.string() + ": exists and was not written by fiberfluid"),
-            std::string::npos) << o.output;
+            std::string::npos)
+      << o.output;
   EXPECT_EQ(o.output.find("results in"), std::string::npos) << o.output;  // refused before the run
   EXPECT_TRUE(fs::exists(data / "scan_0001.ply"));
   // The same for a fit, before its forward runs.
-  const Outcome fit = run_cli("fit " + dir.write("fit.json", fit_sphere().dump()).string() + " -o " + data.string());
+  const Outcome fit = run_cli("fit " + dir.write("fit.json", fit_sphere().dump()).string() +
+                              " -o " + data.string());
   EXPECT_EQ(fit.status, 1) << fit.output;
   EXPECT_EQ(fit.output.find("fit: iteration"), std::string::npos) << fit.output;
 }
@@ -86,11 +90,15 @@ TEST(CliSafety, AFolderFiberfluidDidNotWriteIsNeverReplacedAndTheRunNeverStarts)
 TEST(CliSafety, AnOutputPathWithATrailingSlashIsTheFolder) {
   ScratchDir dir;
   const auto file = dir.write("small.json", kSmall);
-  const Outcome o = run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/");
+  const Outcome o =
+      run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/");
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_TRUE(fs::exists(dir.path() / "out" / "small" / "summary.json"));
   // And again: the folder it wrote is replaced, nothing is left beside it.
-  EXPECT_EQ(run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/").status, 0);
+  EXPECT_EQ(
+      run_cli("run " + file.string() + " -q -o " + (dir.path() / "out" / "small").string() + "/")
+          .status,
+      0);
   for (const auto& entry : fs::directory_iterator(dir.path() / "out"))
     EXPECT_EQ(entry.path().filename(), "small") << entry.path();
 }
@@ -112,7 +120,8 @@ TEST(CliSafety, AFailedWriteIsANamedErrorAndTheEarlierResultStays) {
   EXPECT_EQ(o.output.find("terminate called"), std::string::npos) << o.output;
   EXPECT_EQ(read_file(out / "summary.json"), earlier);
   for (const auto& entry : fs::directory_iterator(dir.path()))
-    EXPECT_EQ(entry.path().filename().string().find(".running-"), std::string::npos) << entry.path();
+    EXPECT_EQ(entry.path().filename().string().find(".running-"), std::string::npos)
+        << entry.path();
 }
 
 TEST(CliSafety, FitOptionsThatCrashedAreNamedErrorsAndNothingIsWritten) {
@@ -122,31 +131,45 @@ TEST(CliSafety, FitOptionsThatCrashedAreNamedErrorsAndNothingIsWritten) {
     std::function<void(json&)> change;
     const char* message;
   } cases[] = {
-      {"difference_step 5", [](json& d) { d["fit"]["jacobian"] = "finite-differences"; d["fit"]["difference_step"] = 5; },
+      {"difference_step 5",
+       [](json& d) {
+         d["fit"]["jacobian"] = "finite-differences";
+         d["fit"]["difference_step"] = 5;
+       },
        "fit.difference_step: expected a step in the fitted variable above 0 and at most 0.5"},
-      {"lower == upper", [](json& d) { d["fit"]["parameters"][0]["lower"] = 1000; d["fit"]["parameters"][0]["upper"] = 1000; },
+      {"lower == upper",
+       [](json& d) {
+         d["fit"]["parameters"][0]["lower"] = 1000;
+         d["fit"]["parameters"][0]["upper"] = 1000;
+       },
        "fit.parameters[0]: parameter \"Y\": expected a lower bound below the upper one"},
-      {"variant name of 300", [](json& d) { d.erase("fit"); d["variants"] = {{{"name", std::string(300, 'v')}}}; },
+      {"variant name of 300",
+       [](json& d) {
+         d.erase("fit");
+         d["variants"] = {{{"name", std::string(300, 'v')}}};
+       },
        "variants[0].name: expected a name of at most 100 characters"},
   };
   for (const auto& c : cases) {
     json d = fit_sphere();
     c.change(d);
     const auto file = dir.write("case.json", d.dump());
-    const Outcome o = run_cli(std::string(d.contains("fit") ? "fit " : "run ") + file.string() + " -o " +
-                              (dir.path() / "out").string());
+    const Outcome o = run_cli(std::string(d.contains("fit") ? "fit " : "run ") + file.string() +
+                              " -o " + (dir.path() / "out").string());
     EXPECT_EQ(o.status, 1) << c.what << "\n" << o.output;
     EXPECT_NE(o.output.find(c.message), std::string::npos) << c.what << "\n" << o.output;
     EXPECT_FALSE(fs::exists(dir.path() / "out")) << c.what;
     EXPECT_FALSE(fs::exists(dir.path() / "out.failed")) << c.what;
   }
   // An experiment nested 100,000 deep (valid JSON, 200 KB): refused with a short message.
-  const auto deep = dir.write("deep.json", "{\"stepping\": {\"steps\": " + std::string(100000, '[') +
-                                               std::string(100000, ']') + "}}");
+  const auto deep =
+      dir.write("deep.json", "{\"stepping\": {\"steps\": " + std::string(100000, '[') +
+                                 std::string(100000, ']') + "}}");
   for (const char* command : {"run ", "fit "}) {
     const Outcome o = run_cli(command + deep.string());
     EXPECT_EQ(o.status, 1) << o.output.substr(0, 300);
-    EXPECT_NE(o.output.find("nested more than 64 levels deep"), std::string::npos) << o.output.substr(0, 300);
+    EXPECT_NE(o.output.find("nested more than 64 levels deep"), std::string::npos)
+        << o.output.substr(0, 300);
     EXPECT_LT(o.output.size(), 400u);
   }
 }
@@ -161,14 +184,16 @@ TEST(CliSafety, AFitOnItsBoundsSaysSoAndExitsWith4) {
   const auto file = dir.write("bounds.json", d.dump());
   const Outcome o = run_cli("fit " + file.string() + " -q -o " + (dir.path() / "out").string());
   EXPECT_EQ(o.status, 4) << o.output;
-  for (const char* part : {"converged_at_bounds", "Y = 10 is on its lower bound (its correlation with gamma is",
-                           "Y = 10 (on its bound: no standard error", "warning: the fit converged on bounds"})
+  for (const char* part :
+       {"converged_at_bounds", "Y = 10 is on its lower bound (its correlation with gamma is",
+        "Y = 10 (on its bound: no standard error", "warning: the fit converged on bounds"})
     EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
   const json report = json::parse(read_file(dir.path() / "out" / "fit.json"));
   EXPECT_EQ(report["status"], "converged_at_bounds");
   EXPECT_TRUE(report["parameters"][0]["at_bound"].get<bool>());
   EXPECT_TRUE(report["parameters"][0]["standard_error"].is_null());
-  EXPECT_EQ(report["counts"]["model_vertices_counted"].get<int>(), report["distance"]["count"].get<int>());
+  EXPECT_EQ(report["counts"]["model_vertices_counted"].get<int>(),
+            report["distance"]["count"].get<int>());
 }
 
 // A fit that cannot see its parameters (no load) is "not identifiable", its
@@ -201,11 +226,13 @@ TEST(CliSafety, AFailedDifferenceRunEndsTheFitWithItsCause) {
   json d = fit_sphere();
   d["fit"]["difference_step"] = 0.5;
   const fs::path out = dir.path() / "out";
-  const Outcome o = run_cli("fit " + dir.write("steep.json", d.dump()).string() + " -q -o " + out.string());
+  const Outcome o =
+      run_cli("fit " + dir.write("steep.json", d.dump()).string() + " -q -o " + out.string());
   EXPECT_EQ(o.status, 2) << o.output;
-  for (const char* part : {"forward_runs_failed", "a finite-difference run failed: step 2: runaway",
-                           "failed forward runs: 1 x a finite-difference run failed: step #: runaway",
-                           "first failure at Y = 1000, gamma = 9000"})
+  for (const char* part :
+       {"forward_runs_failed", "a finite-difference run failed: step 2: runaway",
+        "failed forward runs: 1 x a finite-difference run failed: step #: runaway",
+        "first failure at Y = 1000, gamma = 9000"})
     EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
   fs::path failed = out;
   failed += ".failed";
@@ -224,7 +251,8 @@ TEST(CliSafety, AnInterruptedFitKeepsItsBestPointAndCanBeContinued) {
   const auto file = dir.write("slow.json", slow.dump());
   const fs::path out = dir.path() / "out", log = dir.path() / "fit.log";
   const pid_t pid = testing::start_cli({"fit", file.string(), "-o", out.string()}, log);
-  for (int wait = 0; wait < 1200 && read_file(log).find("fit: iteration 0:") == std::string::npos; ++wait)
+  for (int wait = 0; wait < 1200 && read_file(log).find("fit: iteration 0:") == std::string::npos;
+       ++wait)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_NE(read_file(log).find("fit: iteration 0:"), std::string::npos) << read_file(log);
   kill(pid, SIGINT);
@@ -236,14 +264,16 @@ TEST(CliSafety, AnInterruptedFitKeepsItsBestPointAndCanBeContinued) {
   EXPECT_FALSE(fs::exists(out));
   const json report = json::parse(read_file(interrupted / "fit.json"));
   EXPECT_EQ(report["status"], "interrupted");
-  EXPECT_NEAR(report["parameters"][0]["value"].get<double>(), 1000.0, 1e-9);  // the start: iteration 0's point
+  EXPECT_NEAR(report["parameters"][0]["value"].get<double>(), 1000.0,
+              1e-9);  // the start: iteration 0's point
   EXPECT_NE(read_file(log).find("start_from"), std::string::npos) << read_file(log);
 
   // Continued (on the quicker mesh) from that point: it starts there and converges.
   json next = fit_sphere();
   next["fit"]["start_from"] = (interrupted / "fit.json").string();
   next["fit"]["parameters"][0].erase("start");
-  const Outcome o = run_cli("fit " + dir.write("next.json", next.dump()).string() + " -o " + out.string());
+  const Outcome o =
+      run_cli("fit " + dir.write("next.json", next.dump()).string() + " -o " + out.string());
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("Y = 1000, gamma = 9000"), std::string::npos) << o.output;
   EXPECT_EQ(json::parse(read_file(out / "fit.json"))["status"], "converged");

@@ -39,7 +39,8 @@ inline Outcome run_cli(const std::string& arguments) {
   return run_cli_command(std::string(FIBERFLUID_CLI) + " " + arguments);
 }
 
-inline pid_t start_cli(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
+inline pid_t start_cli(const std::vector<std::string>& arguments,
+                       const std::filesystem::path& log) {
   const pid_t pid = fork();
   if (pid == 0) {
     std::FILE* out = std::freopen(log.c_str(), "w", stdout);
@@ -56,7 +57,8 @@ inline pid_t start_cli(const std::vector<std::string>& arguments, const std::fil
 inline int count_files(const std::filesystem::path& folder) {
   if (!std::filesystem::exists(folder)) return 0;
   int n = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) n += entry.is_regular_file();
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    n += entry.is_regular_file();
   return n;
 }
 
@@ -79,7 +81,8 @@ inline int wait_for(pid_t pid, double* seconds = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   int status = 0;
   waitpid(pid, &status, 0);
-  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (seconds)
+    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

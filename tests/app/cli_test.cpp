@@ -5,45 +5,44 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <chrono>
 #include <fstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "app/cli_support.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
-#include "app/cli_support.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {
 namespace {
 
-using testing::ScratchDir;
-using testing::Outcome;
-using testing::run_cli;
-using testing::start_cli;
 using testing::count_files;
-using testing::staging_of;
-using testing::wait_for;
+using testing::Outcome;
 using testing::read_file;
-
-
+using testing::run_cli;
+using testing::ScratchDir;
+using testing::staging_of;
+using testing::start_cli;
+using testing::wait_for;
 
 TEST(Cli, CheckReportsAGoodMesh) {
   const Outcome o = run_cli("check " + testing::data_mesh("torus.obj").string());
   EXPECT_EQ(o.status, 0) << o.output;
-  for (const char* part : {"vertices:      800", "closed:        yes", "genus:         1",
-                           "consistent, outward"})
+  for (const char* part :
+       {"vertices:      800", "closed:        yes", "genus:         1", "consistent, outward"})
     EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
 }
 
 TEST(Cli, CheckRejectsABadMesh) {
   ScratchDir dir;
-  const auto open_mesh = dir.write("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
-                                               "f 1 3 2\nf 1 2 4\nf 1 4 3\n");
+  const auto open_mesh = dir.write("open.obj",
+                                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                   "f 1 3 2\nf 1 2 4\nf 1 4 3\n");
   const Outcome o = run_cli("check " + open_mesh.string());
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.output.find("open.obj: not closed"), std::string::npos) << o.output;
@@ -51,8 +50,8 @@ TEST(Cli, CheckRejectsABadMesh) {
 
 TEST(Cli, RunWritesItsOutputsAndChecksTheExpectedFigures) {
   ScratchDir dir;
-  const Outcome o = run_cli("run " + testing::experiment_file("rectangle.json").string() +
-                            " -o " + (dir.path() / "rect").string() + " --check");
+  const Outcome o = run_cli("run " + testing::experiment_file("rectangle.json").string() + " -o " +
+                            (dir.path() / "rect").string() + " --check");
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("pass  final_pressure = 32"), std::string::npos) << o.output;
   for (const char* file : {"summary.json", "final.obj", "series.pvd", "vtk/step_0001.vtu"})
@@ -61,12 +60,12 @@ TEST(Cli, RunWritesItsOutputsAndChecksTheExpectedFigures) {
 
 TEST(Cli, FitCalibratesThenWritesTheRunAndTheFitFiles) {
   ScratchDir dir;
-  const Outcome o = run_cli("fit " + testing::experiment_file("fit_sphere.json").string() +
-                            " -o " + (dir.path() / "fit").string() + " --check");
+  const Outcome o = run_cli("fit " + testing::experiment_file("fit_sphere.json").string() + " -o " +
+                            (dir.path() / "fit").string() + " --check");
   EXPECT_EQ(o.status, 0) << o.output;
-  for (const char* part : {"sphere_final.obj (step 10): a triangle soup of 320 triangles",
-                           "finite differences", "fit: iteration 1:", "pass  fit.Y = ",
-                           "% of the body's length"})
+  for (const char* part :
+       {"sphere_final.obj (step 10): a triangle soup of 320 triangles", "finite differences",
+        "fit: iteration 1:", "pass  fit.Y = ", "% of the body's length"})
     EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
   for (const char* file : {"summary.json", "fit.json", "fit_iterations.csv", "fit_target_0.vtu"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "fit" / file)) << file;
@@ -74,7 +73,8 @@ TEST(Cli, FitCalibratesThenWritesTheRunAndTheFitFiles) {
   const Outcome none = run_cli("fit " + testing::experiment_file("rectangle.json").string() +
                                " -o " + (dir.path() / "none").string());
   EXPECT_EQ(none.status, 1);
-  EXPECT_NE(none.output.find("rectangle.json: no \"fit\" section"), std::string::npos) << none.output;
+  EXPECT_NE(none.output.find("rectangle.json: no \"fit\" section"), std::string::npos)
+      << none.output;
 }
 
 TEST(Cli, BadExperimentWritesNothing) {
@@ -128,7 +128,6 @@ TEST(Cli, SupportsOnEveryVertexAreNamed) {
 
 // Starts the tool in the background; its standard output and error go to a file.
 
-
 // A run long enough to be stopped part way: 642 vertices, A rebuilt every
 // step (about 10 ms each), a .vtu per step.
 nlohmann::json many_steps(int steps) {
@@ -142,7 +141,6 @@ nlohmann::json many_steps(int steps) {
   return config;
 }
 
-
 TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
   ScratchDir dir;
   const std::filesystem::path out = dir.path() / "out";
@@ -152,8 +150,8 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
   const auto short_run = dir.write("short.json", config.dump());
 
   auto kill_part_way = [&](const std::string& name) {
-    const pid_t pid = start_cli({"run", long_run.string(), "-o", out.string()},
-                                dir.path() / (name + ".log"));
+    const pid_t pid =
+        start_cli({"run", long_run.string(), "-o", out.string()}, dir.path() / (name + ".log"));
     std::filesystem::path staging;
     for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -186,24 +184,25 @@ TEST(Cli, AKilledRunAndARerunNeverMixTheirFiles) {
   kill_part_way("second");
   EXPECT_EQ(count_files(out / "vtk"), 4);
   std::ifstream again_in(out / "summary.json");
-  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again_in)),
-                        std::istreambuf_iterator<char>()),
-            summary);
+  EXPECT_EQ(
+      std::string((std::istreambuf_iterator<char>(again_in)), std::istreambuf_iterator<char>()),
+      summary);
 }
-
-
 
 TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
   ScratchDir dir;
   const std::filesystem::path out = dir.path() / "out";
   nlohmann::json config = many_steps(3);
-  ASSERT_EQ(run_cli("run " + dir.write("short.json", config.dump()).string() + " -q -o " +
-                    out.string()).status, 0);
+  ASSERT_EQ(
+      run_cli("run " + dir.write("short.json", config.dump()).string() + " -q -o " + out.string())
+          .status,
+      0);
   const std::string earlier = read_file(out / "summary.json");
 
   config["stepping"]["steps"] = 4000;
-  const pid_t pid = start_cli({"run", dir.write("long.json", config.dump()).string(), "-o",
-                               out.string()}, dir.path() / "run.log");
+  const pid_t pid =
+      start_cli({"run", dir.write("long.json", config.dump()).string(), "-o", out.string()},
+                dir.path() / "run.log");
   std::filesystem::path staging;
   for (int wait = 0; wait < 600 && count_files(staging / "vtk") < 5; ++wait) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -214,8 +213,10 @@ TEST(Cli, CtrlCDuringTheLoadStepsWritesNothingAndKeepsTheEarlierResult) {
   double seconds = 0.0;
   EXPECT_EQ(wait_for(pid, &seconds), 130) << read_file(dir.path() / "run.log");
   EXPECT_LT(seconds, 10.0);  // at the next load step
-  EXPECT_NE(read_file(dir.path() / "run.log").find("interrupted during the run (Ctrl-C): nothing was written"),
-            std::string::npos) << read_file(dir.path() / "run.log");
+  EXPECT_NE(read_file(dir.path() / "run.log")
+                .find("interrupted during the run (Ctrl-C): nothing was written"),
+            std::string::npos)
+      << read_file(dir.path() / "run.log");
   EXPECT_FALSE(std::filesystem::exists(staging));
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out.failed"));
   EXPECT_EQ(read_file(out / "summary.json"), earlier);
@@ -235,7 +236,9 @@ TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
   const pid_t pid = start_cli({"run", config.string(), "-o", (dir.path() / "out").string()},
                               dir.path() / "run.log");
   // Progress lines start after 2 s: "pruning 1234/930,000 (...)".
-  auto pruning = [&] { return ("\n" + read_file(dir.path() / "run.log")).find("\npruning ") != std::string::npos; };
+  auto pruning = [&] {
+    return ("\n" + read_file(dir.path() / "run.log")).find("\npruning ") != std::string::npos;
+  };
   for (int wait = 0; wait < 1200 && !pruning(); ++wait)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   kill(pid, SIGINT);
@@ -243,9 +246,11 @@ TEST(Cli, CtrlCDuringPruningStopsAtOnce) {
   EXPECT_EQ(wait_for(pid, &seconds), 130) << read_file(dir.path() / "run.log");
   EXPECT_LT(seconds, 10.0);
   EXPECT_NE(read_file(dir.path() / "run.log").find("interrupted during the fiber pruning"),
-            std::string::npos) << read_file(dir.path() / "run.log");
+            std::string::npos)
+      << read_file(dir.path() / "run.log");
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
-                          std::filesystem::directory_iterator()), 2);  // the config and the log
+                          std::filesystem::directory_iterator()),
+            2);  // the config and the log
 }
 
 TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {
@@ -259,7 +264,9 @@ TEST(Cli, MaxMemoryRefusesARunBeforeItStarts) {
   EXPECT_NE(o.output.find("dense.json: this case needs about "), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("; dense-lu), more than"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("more than the memory budget of 20 MiB set by --max-memory; raise "
-                          "--max-memory"), std::string::npos) << o.output;
+                          "--max-memory"),
+            std::string::npos)
+      << o.output;
   EXPECT_FALSE(std::filesystem::exists(out));
   o = run_cli("run " + config.string() + " --max-memory 100M -q -o " + out.string());
   EXPECT_EQ(o.status, 0) << o.output;
@@ -325,29 +332,34 @@ TEST(Cli, CompareGivesTheMetricsAsTextAndJson) {
   // u = (0, 0, -0.2 z), u' = u + (0.1, 0, 0) at every node.
   double u2 = 0.0;
   for (Eigen::Index v = 0; v < cube.V.rows(); ++v) u2 += std::pow(0.2 * cube.V(v, 2) / 0.8, 2);
-  EXPECT_NEAR(j["E_n"].get<double>(), 0.1 * std::sqrt(static_cast<double>(cube.V.rows()) / u2), 1e-12);
+  EXPECT_NEAR(j["E_n"].get<double>(), 0.1 * std::sqrt(static_cast<double>(cube.V.rows()) / u2),
+              1e-12);
   EXPECT_GT(j["E_i"].get<double>(), 0.0);
   EXPECT_NEAR(j["distance"]["largest"].get<double>(), 0.1, 1e-12);
   // An open scan bounds no solid: E_s says so, naming the file, and the
   // distances are still given (a scan is rarely closed).
-  std::ofstream(dir.path() / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\n";
+  std::ofstream(dir.path() / "open.obj")
+      << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\n";
   const Outcome open = run_cli("compare " + m.string() + " " + (dir.path() / "open.obj").string());
   EXPECT_EQ(open.status, 0) << open.output;
-  for (const char* part : {"E_s: not computed: it needs two closed solids", "open.obj: the mesh is not closed",
-                           "distance from M' to M"})
+  for (const char* part : {"E_s: not computed: it needs two closed solids",
+                           "open.obj: the mesh is not closed", "distance from M' to M"})
     EXPECT_NE(open.output.find(part), std::string::npos) << part << "\n" << open.output;
   // A point cloud (vertices only) against the reference: the distances.
   std::ofstream(dir.path() / "cloud.obj") << "v 0.5 0.5 1.0\nv 0.5 0.5 0.0\nv 0.25 0.5 0.8\n";
-  const Outcome cloud = run_cli("compare " + m.string() + " " + (dir.path() / "cloud.obj").string() + " --json");
+  const Outcome cloud =
+      run_cli("compare " + m.string() + " " + (dir.path() / "cloud.obj").string() + " --json");
   ASSERT_EQ(cloud.status, 0) << cloud.output;
   const nlohmann::json c = nlohmann::json::parse(cloud.output.substr(cloud.output.find('{')));
   EXPECT_TRUE(c["E_s"].is_null());
   EXPECT_EQ(c["distance"]["count"].get<int>(), 3);
-  EXPECT_NEAR(c["distance"]["largest"].get<double>(), 0.2, 1e-12);  // (0.5, 0.5, 1) to the top at 0.8
+  EXPECT_NEAR(c["distance"]["largest"].get<double>(), 0.2,
+              1e-12);  // (0.5, 0.5, 1) to the top at 0.8
   // 2D polygons have nothing but E_s: an open one is still an error, naming the file.
   std::ofstream(dir.path() / "a.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\nl 3 1\n";
   std::ofstream(dir.path() / "b.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n";
-  const Outcome flat = run_cli("compare " + (dir.path() / "a.obj").string() + " " + (dir.path() / "b.obj").string());
+  const Outcome flat =
+      run_cli("compare " + (dir.path() / "a.obj").string() + " " + (dir.path() / "b.obj").string());
   EXPECT_EQ(flat.status, 1) << flat.output;
   EXPECT_NE(flat.output.find("b.obj"), std::string::npos) << flat.output;
 }

@@ -21,7 +21,8 @@ struct Outcome {
 Outcome run_with(const char* experiment, int threads) {
   const int before = omp_get_max_threads();
   omp_set_num_threads(threads);
-  const Experiment ex = load_experiment(testing::experiment_file(experiment));  // prunes in parallel
+  const Experiment ex =
+      load_experiment(testing::experiment_file(experiment));  // prunes in parallel
   RunOptions options;
   options.jobs = 1;
   const ExperimentResult result = run_experiment(ex, {}, options);

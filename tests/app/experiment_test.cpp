@@ -8,10 +8,10 @@
 
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -110,10 +110,12 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   // silently did something else.
   c = base_config();
   c["supports"][0]["where"] = "z >= 1e999";
-  expect_config_error(dir, c, "supports[0].where: 'z >= 1e999': the threshold 1e999 is beyond a double's range");
+  expect_config_error(
+      dir, c, "supports[0].where: 'z >= 1e999': the threshold 1e999 is beyond a double's range");
   c = base_config();
   c["supports"][0] = {{"vertices", {2147483648LL}}};
-  expect_config_error(dir, c, "supports[0].vertices: expected vertex indices (whole numbers from 0 to 2147483647)");
+  expect_config_error(
+      dir, c, "supports[0].vertices: expected vertex indices (whole numbers from 0 to 2147483647)");
   c = base_config();
   c["supports"][0] = {{"vertices", {4294967296ULL}}};
   expect_config_error(dir, c, "supports[0].vertices: expected vertex indices");
@@ -121,7 +123,8 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   c["loads"] = {{{"type", "point"}, {"force", {0, 0, -1}}}};
   expect_config_error(dir, c, "loads[0].vertex: missing (required)");
   c = base_config();
-  c["surface"] = {{"generator", "box"}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"segments", {1.9, 2, 2}}};
+  c["surface"] = {
+      {"generator", "box"}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"segments", {1.9, 2, 2}}};
   expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers from 1 to 200");
   c["surface"]["segments"] = {1e300, 2, 2};
   expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers");
@@ -141,7 +144,8 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
     load_experiment(overflow);
     ADD_FAILURE() << "no error for 1e999";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("overflow.json: not valid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("overflow.json: not valid JSON"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("1e999"), std::string::npos) << e.what();
   }
 
@@ -184,9 +188,13 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 5000}, {"beta", 4}}},
                    {"axis_factors", {1, 1, 0.5}},
                    {"gamma", 3}};
-  c["paddles"] = {{{"label", "press"}, {"axis", "z"}, {"side", "below"}, {"compression", 0.2},
+  c["paddles"] = {{{"label", "press"},
+                   {"axis", "z"},
+                   {"side", "below"},
+                   {"compression", 0.2},
                    {"contact", "sticking"}}};
-  c["stepping"] = {{"steps", 4}, {"scheme", "newton"},
+  c["stepping"] = {{"steps", 4},
+                   {"scheme", "newton"},
                    {"newton", {{"tangent", "krylov"}, {"max_step_cuts", 3}}}};
   const Experiment ex = load_experiment(write_config(dir, c));
   const model::Model& m = ex.cases[0].model;
@@ -198,7 +206,7 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   EXPECT_FALSE(m.paddles[0].above);
   EXPECT_TRUE(m.paddles[0].sticking);
   const double bottom = m.surface.V.col(2).minCoeff(), top = m.surface.V.col(2).maxCoeff();
-  EXPECT_EQ(m.paddles[0].position, bottom);  // touching by default
+  EXPECT_EQ(m.paddles[0].position, bottom);                       // touching by default
   EXPECT_NEAR(m.paddles[0].travel, 0.2 * (top - bottom), 1e-15);  // upwards, into the body
   EXPECT_EQ(ex.cases[0].stepping.scheme, solve::Scheme::Newton);
   EXPECT_EQ(ex.cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
@@ -216,8 +224,8 @@ TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   expect_config_error(dir, c, "material.law.Y0: missing");
 
   c = base_config();
-  c["material"] = {{"law", {{"type", "tabulated"}, {"strain", {0, 0.1, 0.2}},
-                            {"stress", {0, 200, 150}}}}};
+  c["material"] = {
+      {"law", {{"type", "tabulated"}, {"strain", {0, 0.1, 0.2}}, {"stress", {0, 200, 150}}}}};
   expect_config_error(dir, c, "material.law.stress: the stresses must be strictly increasing");
 
   c = base_config();
@@ -251,8 +259,7 @@ TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   c["paddles"][0]["compression"] = 0.3;
   expect_config_error(dir, c, "paddles[0].travel: give either travel");
 
-  c["paddles"] = {paddle, {{"label", "floor"}, {"axis", "z"}, {"side", "below"},
-                           {"travel", 2.0}}};
+  c["paddles"] = {paddle, {{"label", "floor"}, {"axis", "z"}, {"side", "below"}, {"travel", 2.0}}};
   expect_config_error(dir, c, "paddles: paddles paddle_0 and floor meet or pass each other");
 
   c = base_config();
@@ -294,13 +301,16 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
 
   c = base_config();
   c["fibers"] = {{"treecode_tolerance", 1e-6}};
-  expect_config_error(dir, c, "fibers.treecode_tolerance: applies to \"product\": \"treecode\" only");
+  expect_config_error(dir, c,
+                      "fibers.treecode_tolerance: applies to \"product\": \"treecode\" only");
   c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 0.5}};
-  expect_config_error(dir, c, "fibers.treecode_tolerance: expected a relative error from 1e-10 to 1e-2");
+  expect_config_error(dir, c,
+                      "fibers.treecode_tolerance: expected a relative error from 1e-10 to 1e-2");
   c["fibers"] = {{"product", "treecode"}};
   c["stepping"]["solver"] = "dense-lu";
-  expect_config_error(dir, c, "fibers: \"product\": \"treecode\": the treecode product "
-                              "(treecode_tolerance) is matrix-free");
+  expect_config_error(dir, c,
+                      "fibers: \"product\": \"treecode\": the treecode product "
+                      "(treecode_tolerance) is matrix-free");
   c["stepping"] = {{"scheme", "newton"}};
   expect_config_error(dir, c, "Newton's tangent is exact");
   // A concave body pruned with the symmetric count has no single pair factor.
@@ -317,8 +327,8 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
 TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  c["surface"] = {{"generator", "torus"}, {"major_radius", 2.0}, {"minor_radius", 0.5},
-                  {"segments", {24, 12}}};
+  c["surface"] = {
+      {"generator", "torus"}, {"major_radius", 2.0}, {"minor_radius", 0.5}, {"segments", {24, 12}}};
   c["supports"][0] = {{"where", "z >= 0.4"}};
   const Experiment ex = load_experiment(write_config(dir, c));
   EXPECT_EQ(ex.cases[0].model.num_vertices(), 24 * 12);
@@ -327,7 +337,8 @@ TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
   expect_config_error(dir, c, "surface.minor_radius: must be below major_radius");
   c["surface"]["minor_radius"] = 0.5;
   c["surface"]["segments"] = {2, 12};
-  expect_config_error(dir, c, "surface.segments: expected a list of 2 whole numbers from 3 to 1000");
+  expect_config_error(dir, c,
+                      "surface.segments: expected a list of 2 whole numbers from 3 to 1000");
 }
 
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
@@ -443,7 +454,8 @@ TEST(ExperimentPhases, ReadingOpensNoFileAndBuildingNamesTheField) {
   Experiment ex = read_experiment(c, "/nonexistent_folder", "doc");
   ASSERT_EQ(ex.specs.size(), 1u);
   EXPECT_TRUE(ex.cases.empty());
-  EXPECT_EQ(ex.specs[0].surface.file, std::filesystem::path("/nonexistent_folder/no_such_mesh.obj"));
+  EXPECT_EQ(ex.specs[0].surface.file,
+            std::filesystem::path("/nonexistent_folder/no_such_mesh.obj"));
   try {
     build_experiment(ex);
     ADD_FAILURE() << "built a case on a missing mesh";

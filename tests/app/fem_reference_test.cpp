@@ -9,10 +9,10 @@
 
 #include "app/experiment.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
 #include "fit/target.hpp"
 #include "metrics/metrics.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -20,8 +20,11 @@ namespace {
 // A 0.1 x 0.1 x 0.2 m box: its bottom held, its top moved by `top` (m).
 nlohmann::json column(double poisson, const nlohmann::json& top) {
   return {{"name", "column"},
-          {"surface", {{"generator", "box"}, {"min", {0, 0, 0}}, {"max", {0.1, 0.1, 0.2}},
-                       {"segments", {2, 2, 4}}}},
+          {"surface",
+           {{"generator", "box"},
+            {"min", {0, 0, 0}},
+            {"max", {0.1, 0.1, 0.2}},
+            {"segments", {2, 2, 4}}}},
           {"material", {{"Y", 1000}, {"gamma", 0}}},
           {"supports", {{{"where", "z <= 0"}, {"axes", "xyz"}}}},
           {"prescribed", {{{"where", "z >= 0.2"}, {"displacement", top}}}},
@@ -88,7 +91,8 @@ TEST(FemReference, WhatItCannotPoseIsAnError) {
     parse_experiment(d, ".", "column.json");
     ADD_FAILURE();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("column.json: fem_reference.E"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("column.json: fem_reference.E"), std::string::npos)
+        << e.what();
   }
   d = column(0.3, {0, 0, 0.01});
   d["variants"] = {{{"name", "a"}}};
@@ -123,7 +127,8 @@ TEST(FemReference, TheCommittedLiverTargetIsCurrent) {
   double largest = 0.0;
   for (const auto& c : to_committed.closest(fresh.V)) largest = std::max(largest, c.distance);
   for (const auto& c : to_fresh.closest(committed.points)) largest = std::max(largest, c.distance);
-  EXPECT_LT(largest, 1e-4) << "regenerate data/targets/liver_fem_reference.obj (SOURCES.md says how)";
+  EXPECT_LT(largest, 1e-4)
+      << "regenerate data/targets/liver_fem_reference.obj (SOURCES.md says how)";
 }
 
 }  // namespace

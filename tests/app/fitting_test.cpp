@@ -7,9 +7,9 @@
 #include <fstream>
 
 #include "app/outputs.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -53,7 +53,8 @@ nlohmann::json sphere_fit_document() {
 
 void expect_fit_error(const nlohmann::json& document, const std::string& part) {
   try {
-    const Experiment ex = parse_experiment(document, testing::experiment_file("").parent_path(), "doc");
+    const Experiment ex =
+        parse_experiment(document, testing::experiment_file("").parent_path(), "doc");
     setup_fit(ex);
     ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
   } catch (const InputError& e) {
@@ -97,14 +98,19 @@ TEST(FitConfig, OptionsAreCheckedOnceForEveryFrontEnd) {
   nlohmann::json d = sphere_fit_document();
   d["fit"]["parameters"][0]["lower"] = 1000;  // lower == upper: Ceres' "infeasible bound"
   d["fit"]["parameters"][0]["upper"] = 1000;
-  expect_fit_error(d, "doc: fit.parameters[0]: parameter \"Y\": expected a lower bound below the upper "
-                      "one, got [1000, 1000]");
+  expect_fit_error(
+      d,
+      "doc: fit.parameters[0]: parameter \"Y\": expected a lower bound below the upper "
+      "one, got [1000, 1000]");
   d = sphere_fit_document();
   d["fit"]["difference_step"] = 5;  // a central-difference run at e^5 times the value: SIGSEGV
-  expect_fit_error(d, "doc: fit.difference_step: expected a step in the fitted variable above 0 and at most 0.5");
+  expect_fit_error(
+      d,
+      "doc: fit.difference_step: expected a step in the fitted variable above 0 and at most 0.5");
   d = sphere_fit_document();
   d["fit"]["objective"] = {{"loss", "huber"}, {"loss_scale", 0}};
-  expect_fit_error(d, "doc: fit.objective.loss_scale: expected a positive finite length in m, got 0");
+  expect_fit_error(d,
+                   "doc: fit.objective.loss_scale: expected a positive finite length in m, got 0");
   d = sphere_fit_document();
   d["fit"]["max_iterations"] = 0;
   expect_fit_error(d, "doc: fit.max_iterations: expected 1 to 100000, got 0");
@@ -188,8 +194,10 @@ TEST(FitStatus, ParametersOnTheirBoundsAreNamedWithTheirCorrelation) {
   EXPECT_NEAR(r.values[0], 10.0, 1e-4);
   EXPECT_NEAR(r.values[1], 3500.0, 1e-4);
   EXPECT_TRUE(std::isnan(r.standard_errors[0]));  // a bound is no estimate
-  EXPECT_NE(r.status_detail.find("Y = 10 is on its lower bound (its correlation with gamma is -0.9"),
-            std::string::npos) << r.status_detail;
+  EXPECT_NE(
+      r.status_detail.find("Y = 10 is on its lower bound (its correlation with gamma is -0.9"),
+      std::string::npos)
+      << r.status_detail;
   EXPECT_EQ(fit_exit_status(r.status), 4);
   EXPECT_TRUE(fit_result_kept(r.status));
 
@@ -198,7 +206,8 @@ TEST(FitStatus, ParametersOnTheirBoundsAreNamedWithTheirCorrelation) {
   d = sphere_fit_document();
   d["fit"]["parameters"][0]["upper"] = 2000;
   const fit::FitResult limited =
-      setup_fit(parse_experiment(d, testing::experiment_file("").parent_path(), "doc")).calibration->run();
+      setup_fit(parse_experiment(d, testing::experiment_file("").parent_path(), "doc"))
+          .calibration->run();
   EXPECT_EQ(limited.status, fit::FitStatus::IterationLimit) << limited.message;
   EXPECT_EQ(limited.at_bounds, std::vector<std::string>{"Y"});
   EXPECT_NE(limited.status_detail.find("Y = 2000 is on its upper bound"), std::string::npos);
@@ -212,7 +221,8 @@ TEST(FitStatus, ALoadThatMovesNothingIsNotIdentifiable) {
   const fit::FitResult r = setup_fit(ex).calibration->run();
   EXPECT_EQ(r.status, fit::FitStatus::NotIdentifiable) << r.message;
   EXPECT_FALSE(r.success);
-  EXPECT_NE(r.status_detail.find("no distance changes with \"Y\""), std::string::npos) << r.status_detail;
+  EXPECT_NE(r.status_detail.find("no distance changes with \"Y\""), std::string::npos)
+      << r.status_detail;
   EXPECT_EQ(fit_exit_status(r.status), 2);
   EXPECT_FALSE(fit_result_kept(r.status));
   // The report reads every figure without a crash; errors are null.
@@ -229,9 +239,11 @@ TEST(FitStatus, ALoadThatMovesNothingIsNotIdentifiable) {
   tiny["fit"]["jacobian"] = "finite-differences";
   tiny["fit"]["difference_step"] = 1e-300;
   const fit::FitResult t =
-      setup_fit(parse_experiment(tiny, testing::experiment_file("").parent_path(), "doc")).calibration->run();
+      setup_fit(parse_experiment(tiny, testing::experiment_file("").parent_path(), "doc"))
+          .calibration->run();
   EXPECT_EQ(t.status, fit::FitStatus::NotIdentifiable) << t.message;
-  EXPECT_NE(t.status_detail.find("no distance changes with \"Y\""), std::string::npos) << t.status_detail;
+  EXPECT_NE(t.status_detail.find("no distance changes with \"Y\""), std::string::npos)
+      << t.status_detail;
 }
 
 TEST(FitStatus, TheIterationLimitAndFailedRunsAreCountedByCause) {
@@ -245,8 +257,8 @@ TEST(FitStatus, TheIterationLimitAndFailedRunsAreCountedByCause) {
   EXPECT_NE(r.message.find("max_iterations 3"), std::string::npos) << r.message;
   // The full fit meets a runaway trial point on its way (fit_sphere's log):
   // counted under its cause, with its parameters.
-  const fit::FitResult full = setup_fit(load_experiment(testing::experiment_file("fit_sphere.json")))
-                                  .calibration->run();
+  const fit::FitResult full =
+      setup_fit(load_experiment(testing::experiment_file("fit_sphere.json"))).calibration->run();
   ASSERT_EQ(full.status, fit::FitStatus::Converged) << full.message;
   ASSERT_GE(full.failed_runs, 1);
   int counted = 0;
@@ -273,7 +285,8 @@ TEST(FitStatus, StartFromTakesTheValuesOfAnEarlierFit) {
   const FitSetup setup = setup_fit(ex);
   EXPECT_EQ(setup.calibration->parameters().parameters()[0].initial, 2900.5);
   EXPECT_EQ(setup.calibration->parameters().parameters()[1].initial, 3100.25);
-  const auto partial = dir.write("partial.json", R"({"parameters": [{"name": "Y", "value": 2900.5}]})");
+  const auto partial =
+      dir.write("partial.json", R"({"parameters": [{"name": "Y", "value": 2900.5}]})");
   d["fit"]["start_from"] = partial.string();
   expect_fit_error(d, "fit.start_from: " + partial.string() + " has no value for \"gamma\"");
   d["fit"]["start_from"] = (dir.path() / "none.json").string();

@@ -16,9 +16,9 @@
 #include "app/experiment.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
-#include "geom/run_control.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -54,20 +54,23 @@ TEST(OutputFolder, NamesFromAFileStayOneFolderName) {
   EXPECT_EQ(folder_name_problem("liver-2026_a.b"), "");
   for (const char* bad : {"../victim", "..", ".", "", "a/b", "/etc", "a b", "x\\y"})
     EXPECT_NE(folder_name_problem(bad), "") << bad;
-  EXPECT_NE(folder_name_problem(std::string(300, 'a')).find("at most 100 characters"), std::string::npos);
+  EXPECT_NE(folder_name_problem(std::string(300, 'a')).find("at most 100 characters"),
+            std::string::npos);
   EXPECT_EQ(folder_name_from("my scan (2)"), "my_scan__2_");
   EXPECT_EQ(folder_name_from(".."), "experiment");
 
   // The experiment's name and a variant's, as a file gives them.
   json c = small_config();
   c["name"] = "../victim";
-  EXPECT_NE(error_of([&] { read_experiment(c, ".", "shared.json"); })
-                .find("shared.json: name: expected a name of letters, digits"),
+  EXPECT_NE(error_of([&] {
+              read_experiment(c, ".", "shared.json");
+            }).find("shared.json: name: expected a name of letters, digits"),
             std::string::npos);
   c = small_config();
   c["variants"] = {{{"name", std::string(300, 'v')}}};
-  EXPECT_NE(error_of([&] { read_experiment(c, ".", "shared.json"); })
-                .find("variants[0].name: expected a name of at most 100 characters"),
+  EXPECT_NE(error_of([&] {
+              read_experiment(c, ".", "shared.json");
+            }).find("variants[0].name: expected a name of at most 100 characters"),
             std::string::npos);
   // Without -o the output is out/NAME, and a bad name never makes a path.
   EXPECT_EQ(output_folder("", "small"), fs::path("out/small"));
@@ -78,9 +81,12 @@ TEST(OutputFolder, NamesFromAFileStayOneFolderName) {
 TEST(OutputFolder, PathsAsUsersTypeThemAreNormalisedBeforeTheRun) {
   ScratchDir dir;
   EXPECT_EQ(output_folder((dir.path() / "out/small/").string(), "x"), dir.path() / "out/small");
-  EXPECT_EQ(output_folder((dir.path() / "out/./a/../small").string(), "x"), dir.path() / "out/small");
-  for (const std::string& bad : std::vector<std::string>{".", "./", "/", "..", "a/..", std::string(200, 'o')})
-    EXPECT_NE(error_of([&] { output_folder(bad, "x"); }).find("-o " + bad), std::string::npos) << bad;
+  EXPECT_EQ(output_folder((dir.path() / "out/./a/../small").string(), "x"),
+            dir.path() / "out/small");
+  for (const std::string& bad :
+       std::vector<std::string>{".", "./", "/", "..", "a/..", std::string(200, 'o')})
+    EXPECT_NE(error_of([&] { output_folder(bad, "x"); }).find("-o " + bad), std::string::npos)
+        << bad;
 }
 
 TEST(OutputFolder, OnlyFoldersFiberfluidWroteAreReplaced) {
@@ -90,7 +96,9 @@ TEST(OutputFolder, OnlyFoldersFiberfluidWroteAreReplaced) {
   fs::create_directories(data);
   std::ofstream(data / "summary.json") << "{}";
   std::ofstream(data / "scan.obj") << "v 0 0 0\n";
-  EXPECT_NE(error_of([&] { check_replaceable(data); }).find("data: exists and was not written by fiberfluid"),
+  EXPECT_NE(error_of([&] {
+              check_replaceable(data);
+            }).find("data: exists and was not written by fiberfluid"),
             std::string::npos);
   // An older fiberfluid's folder (before the marker) is named as such, and kept.
   const fs::path old = dir.path() / "old";
@@ -103,9 +111,11 @@ TEST(OutputFolder, OnlyFoldersFiberfluidWroteAreReplaced) {
   EXPECT_THROW(check_replaceable(data), InputError);
   // A file, a symbolic link.
   std::ofstream(dir.path() / "file") << "x";
-  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "file"); }).find("is not a folder"), std::string::npos);
+  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "file"); }).find("is not a folder"),
+            std::string::npos);
   fs::create_directory_symlink(data, dir.path() / "link");
-  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "link"); }).find("symbolic link"), std::string::npos);
+  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "link"); }).find("symbolic link"),
+            std::string::npos);
   // Absent, empty, and written by fiberfluid: replaceable.
   EXPECT_NO_THROW(check_replaceable(dir.path() / "absent"));
   fs::create_directories(dir.path() / "empty");
@@ -146,7 +156,8 @@ TEST(OutputFolder, StagingNamesAreUniqueAndOnlyDeadRunsOfThisHostAreCleaned) {
   EXPECT_NE(a, b);  // the same process twice (two threads, two writers)
   EXPECT_TRUE(fs::exists(a / kOutputMarker));
   // Another host's folder with our PID, and this host's folder of a process that is gone.
-  const fs::path other_host = dir.path() / ("out.running-elsewhere-" + std::to_string(getpid()) + "-00000000");
+  const fs::path other_host =
+      dir.path() / ("out.running-elsewhere-" + std::to_string(getpid()) + "-00000000");
   fs::create_directories(other_host);
   std::string mine = a.filename().string();
   mine = mine.substr(0, mine.rfind('-', mine.rfind('-') - 1));  // out.running-HOST
@@ -163,7 +174,8 @@ TEST(OutputFolder, WritersRacingForOneFolderNeverMixOrLoseAResult) {
   const fs::path out = dir.path() / "out";
   json soft = small_config(), stiff = small_config();
   stiff["material"]["Y"] = 30000;
-  const Experiment a = parse_experiment(soft, ".", "a.json"), b = parse_experiment(stiff, ".", "b.json");
+  const Experiment a = parse_experiment(soft, ".", "a.json"),
+                   b = parse_experiment(stiff, ".", "b.json");
   const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
   std::atomic<int> failures{0};
   auto write = [&](const Experiment& ex, const ExperimentResult& r) {
@@ -186,9 +198,11 @@ TEST(OutputFolder, WritersRacingForOneFolderNeverMixOrLoseAResult) {
   const double Y = summary["runs"][0]["material"]["Y"].get<double>();
   EXPECT_TRUE(Y == 3000 || Y == 30000) << Y;
   const ExperimentResult& r = Y == 3000 ? ra : rb;
-  EXPECT_NEAR(summary["figures"]["max_displacement"].get<double>(), r.figures.at("max_displacement"), 0.0);
+  EXPECT_NEAR(summary["figures"]["max_displacement"].get<double>(),
+              r.figures.at("max_displacement"), 0.0);
   for (const auto& entry : fs::directory_iterator(dir.path()))
-    EXPECT_EQ(entry.path().filename(), "out") << entry.path();  // no staging or previous result left
+    EXPECT_EQ(entry.path().filename(), "out")
+        << entry.path();  // no staging or previous result left
 }
 
 // Issue 30: an exception in a worker of a sweep (a write that failed) ended

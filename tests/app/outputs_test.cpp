@@ -10,8 +10,8 @@
 
 #include "app/experiment.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -72,14 +72,14 @@ TEST(Sweep, EachVariantIsTheBaseWithItsMergePatch) {
   ASSERT_EQ(ex.cases.size(), 3u);
   EXPECT_TRUE(ex.sweeps());
   EXPECT_EQ(ex.cases[0].model.material.young_modulus().x(), 10000.0);
-  EXPECT_EQ(ex.cases[0].model.material.surface_tension, 1.0);   // kept from the base
+  EXPECT_EQ(ex.cases[0].model.material.surface_tension, 1.0);  // kept from the base
   EXPECT_EQ(ex.cases[0].stepping.steps, 3);
-  EXPECT_EQ(ex.cases[1].model.loads.size(), 1u);                // a list is replaced whole
+  EXPECT_EQ(ex.cases[1].model.loads.size(), 1u);  // a list is replaced whole
   EXPECT_EQ(ex.cases[1].model.loads[0].kind, model::Load::Kind::Point);
   EXPECT_EQ(ex.cases[1].model.constraint_groups, std::vector<std::string>{"bottom"});
   EXPECT_EQ(ex.cases[1].stepping.steps, 5);
   EXPECT_EQ(ex.cases[1].model.material.young_modulus().x(), 20000.0);
-  EXPECT_EQ(ex.cases[2].model.material.surface_tension, 0.0);   // null removes the field
+  EXPECT_EQ(ex.cases[2].model.material.surface_tension, 0.0);  // null removes the field
   EXPECT_EQ(ex.cases[1].patch["stepping"]["steps"], 5);
 }
 
@@ -136,11 +136,19 @@ TEST(Outputs, CsvTablesOpenAsTables) {
 
   const auto steps = read_csv(dir.path() / "out" / "stiff" / "steps.csv");
   ASSERT_EQ(steps.size(), 4u);  // header and 3 steps
-  const std::vector<std::string> header = {
-      "step", "load_factor_g", "pressure_Pa", "volume_m3", "max_displacement_m",
-      "applied_force_x_N", "applied_force_y_N", "applied_force_z_N",
-      "reaction_top_x_N", "reaction_top_y_N", "reaction_top_z_N", "equilibrium_residual",
-      "seconds"};
+  const std::vector<std::string> header = {"step",
+                                           "load_factor_g",
+                                           "pressure_Pa",
+                                           "volume_m3",
+                                           "max_displacement_m",
+                                           "applied_force_x_N",
+                                           "applied_force_y_N",
+                                           "applied_force_z_N",
+                                           "reaction_top_x_N",
+                                           "reaction_top_y_N",
+                                           "reaction_top_z_N",
+                                           "equilibrium_residual",
+                                           "seconds"};
   EXPECT_EQ(steps[0], header);
   for (size_t r = 1; r < steps.size(); ++r) {
     ASSERT_EQ(steps[r].size(), header.size());

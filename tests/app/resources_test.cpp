@@ -11,11 +11,11 @@
 #include "app/experiment.hpp"
 #include "app/outputs.hpp"
 #include "app/runner.hpp"
-#include "geom/error.hpp"
-#include "geom/progress.hpp"
-#include "geom/run_control.hpp"
 #include "solve/gmres.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::app {
 namespace {
@@ -35,12 +35,13 @@ class ResourceGuards : public ::testing::Test {
 };
 
 json sphere(int subdivisions, const std::string& solver = "auto") {
-  return {{"name", "sphere"},
-          {"surface", {{"generator", "icosphere"}, {"subdivisions", subdivisions}, {"radius", 0.05}}},
-          {"material", {{"Y", 20000}, {"gamma", 1}}},
-          {"supports", {{{"where", "z >= 0.04"}}}},
-          {"loads", {{{"type", "gravity"}, {"acceleration", {0, 0, -9.81}}}}},
-          {"stepping", {{"steps", 3}, {"solver", solver}}}};
+  return {
+      {"name", "sphere"},
+      {"surface", {{"generator", "icosphere"}, {"subdivisions", subdivisions}, {"radius", 0.05}}},
+      {"material", {{"Y", 20000}, {"gamma", 1}}},
+      {"supports", {{{"where", "z >= 0.04"}}}},
+      {"loads", {{{"type", "gravity"}, {"acceleration", {0, 0, -9.81}}}}},
+      {"stepping", {{"steps", 3}, {"solver", solver}}}};
 }
 
 json liver() {
@@ -92,7 +93,8 @@ TEST_F(ResourceGuards, TheEstimateCountsTheBackendsDenseBlocks) {
   const ResourceEstimate lu = estimate_resources(c.model, lu_options, PruningWork::ConvexityCheck);
   EXPECT_DOUBLE_EQ(part(lu, "factorisation")->bytes, 1.2 * 8 * (3 * n + 1) * (3 * n + 1));
   EXPECT_GT(part(lu, "factorisation")->seconds, 30 * part(e, "factorisation")->seconds)
-      << lu.describe() << "\n" << e.describe();
+      << lu.describe() << "\n"
+      << e.describe();
   // A concave body adds its N x N table of kept fibers and the pair tests.
   const ResourceEstimate pruned = estimate_resources(c.model, c.stepping, PruningWork::Prune);
   ASSERT_NE(part(pruned, "pruning"), nullptr);
@@ -125,7 +127,8 @@ TEST_F(ResourceGuards, ACaseBeyondTheMemoryBudgetIsRefusedBeforeItStarts) {
     const std::string what = e.what();
     EXPECT_NE(what.find("test.json: this case needs about"), std::string::npos) << what;
     EXPECT_NE(what.find("more than the memory budget of 40 MiB set by --max-memory"),
-              std::string::npos) << what;
+              std::string::npos)
+        << what;
     EXPECT_NE(what.find("raise --max-memory"), std::string::npos) << what;
     EXPECT_NE(what.find("\"solver\": \"pcg\""), std::string::npos) << what;
   }
@@ -154,7 +157,8 @@ TEST_F(ResourceGuards, ATimeBudgetRefusesALongEstimate) {
     build_experiment(ex);
     FAIL() << "expected a refusal";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("more than --max-time 1 s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than --max-time 1 s"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -204,10 +208,10 @@ TEST_F(ResourceGuards, EverySolverLoopStopsWhenInterrupted) {
   options.restart = 1;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(4);
   request_cancel();
-  const solve::GmresResult g = solve::gmres(
-      [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return A * v; },
-      [](const Eigen::VectorXd& v) -> Eigen::VectorXd { return v; }, Eigen::VectorXd::Ones(4), x,
-      options);
+  const solve::GmresResult g =
+      solve::gmres([&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return A * v; },
+                   [](const Eigen::VectorXd& v) -> Eigen::VectorXd { return v; },
+                   Eigen::VectorXd::Ones(4), x, options);
   EXPECT_FALSE(g.status.ok);
   EXPECT_NE(g.status.message.find("gmres: interrupted"), std::string::npos) << g.status.message;
 }
@@ -241,7 +245,8 @@ TEST(Budgets, SizesAreParsedAndPrinted) {
   EXPECT_DOUBLE_EQ(bytes, 512.0 * 1024 * 1024);
   EXPECT_TRUE(parse_bytes("2e9", &bytes));
   EXPECT_DOUBLE_EQ(bytes, 2e9);
-  for (const char* bad : {"", "-1G", "0", "8X", "nan", "1e999", "G"}) EXPECT_FALSE(parse_bytes(bad, &bytes)) << bad;
+  for (const char* bad : {"", "-1G", "0", "8X", "nan", "1e999", "G"})
+    EXPECT_FALSE(parse_bytes(bad, &bytes)) << bad;
   EXPECT_EQ(format_bytes(1536.0 * 1024 * 1024), "1.5 GiB");
   EXPECT_EQ(format_bytes(100), "100 bytes");
 }

@@ -14,8 +14,8 @@
 #include "fem/dynamics.hpp"
 #include "fem/mesh_tools.hpp"
 #include "fem/scenes.hpp"
-#include "geom/error.hpp"
 #include "metrics/metrics.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -42,59 +42,59 @@ bool on_boundary(const Eigen::RowVectorXd& p) {
 TEST(Fem, PassesThePatchTest) {
   for (int dim : {2, 3}) {
     for (PlaneModel plane : {PlaneModel::Strain, PlaneModel::Stress})
-    for (bool simplices : {false, true}) {
-      if (dim == 3 && plane == PlaneModel::Stress) continue;
-      const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
-      Material m;
-      m.young = 5000.0;
-      m.poisson = 0.45;
-      m.plane = plane;
-      Eigen::MatrixXd A = Eigen::MatrixXd::Random(dim, dim) * 0.01;
-      Eigen::VectorXd c = Eigen::VectorXd::Random(dim) * 0.01;
-      Constraints held;
-      Eigen::VectorXd exact(mesh.num_dofs());
-      for (int v = 0; v < mesh.num_nodes(); ++v) {
-        const Eigen::VectorXd u = A * mesh.nodes.row(v).transpose() + c;
-        exact.segment(dim * v, dim) = u;
-        if (on_boundary(mesh.nodes.row(v)))
-          for (int a = 0; a < dim; ++a) held.hold(dim * v + a, u[a]);
+      for (bool simplices : {false, true}) {
+        if (dim == 3 && plane == PlaneModel::Stress) continue;
+        const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
+        Material m;
+        m.young = 5000.0;
+        m.poisson = 0.45;
+        m.plane = plane;
+        Eigen::MatrixXd A = Eigen::MatrixXd::Random(dim, dim) * 0.01;
+        Eigen::VectorXd c = Eigen::VectorXd::Random(dim) * 0.01;
+        Constraints held;
+        Eigen::VectorXd exact(mesh.num_dofs());
+        for (int v = 0; v < mesh.num_nodes(); ++v) {
+          const Eigen::VectorXd u = A * mesh.nodes.row(v).transpose() + c;
+          exact.segment(dim * v, dim) = u;
+          if (on_boundary(mesh.nodes.row(v)))
+            for (int a = 0; a < dim; ++a) held.hold(dim * v + a, u[a]);
+        }
+        ASSERT_LT(static_cast<int>(held.dofs.size()), mesh.num_dofs());  // inner nodes exist
+        Eigen::VectorXd u;
+        const solve::Status s = solve_static(stiffness_matrix(mesh, m),
+                                             Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u);
+        ASSERT_TRUE(s.ok) << s.message;
+        EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-14) << dim << "D, simplices " << simplices;
+        // A rigid motion costs no energy: K annihilates it.
+        Eigen::VectorXd shift(mesh.num_dofs());
+        for (int v = 0; v < mesh.num_nodes(); ++v) shift.segment(dim * v, dim) = c;
+        EXPECT_LT((stiffness_matrix(mesh, m) * shift).norm(), 1e-10 * m.young);
       }
-      ASSERT_LT(static_cast<int>(held.dofs.size()), mesh.num_dofs());  // inner nodes exist
-      Eigen::VectorXd u;
-      const solve::Status s =
-          solve_static(stiffness_matrix(mesh, m), Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u);
-      ASSERT_TRUE(s.ok) << s.message;
-      EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-14) << dim << "D, simplices " << simplices;
-      // A rigid motion costs no energy: K annihilates it.
-      Eigen::VectorXd shift(mesh.num_dofs());
-      for (int v = 0; v < mesh.num_nodes(); ++v) shift.segment(dim * v, dim) = c;
-      EXPECT_LT((stiffness_matrix(mesh, m) * shift).norm(), 1e-10 * m.young);
-    }
   }
 }
 
 TEST(Fem, MassMatricesSumToTheTotalMass) {
   for (int dim : {2, 3})
-  for (bool simplices : {false, true}) {
-    // A unit square or cube, inner nodes moved.
-    const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
-    Material m;
-    m.density = 1140.0;
-    const Eigen::SparseMatrix<double> M = mass_matrix(mesh, m);
-    // Each component carries the whole mass once.
-    EXPECT_NEAR(M.sum(), dim * 1140.0, 1e-9) << dim;
-    const Eigen::VectorXd lumped = lumped_mass(mesh, m);
-    EXPECT_NEAR(lumped.sum(), dim * 1140.0, 1e-9);
-    EXPECT_GT(lumped.minCoeff(), 0.0);
-    EXPECT_LT((Eigen::MatrixXd(M) - Eigen::MatrixXd(M).transpose()).norm(), 1e-12);
-    // Gravity's consistent forces sum to the weight.
-    const Eigen::VectorXd g = Eigen::VectorXd::Unit(dim, dim - 1) * -9.81;
-    const Eigen::VectorXd f = body_forces(mesh, m, g);
-    double weight = 0.0;
-    for (int v = 0; v < mesh.num_nodes(); ++v) weight += f[dim * v + dim - 1];
-    EXPECT_NEAR(weight, -9.81 * 1140.0, 1e-8);
-    EXPECT_NEAR(node_measures(mesh).sum(), 1.0, 1e-12);
-  }
+    for (bool simplices : {false, true}) {
+      // A unit square or cube, inner nodes moved.
+      const Mesh mesh = simplices ? to_simplices(distorted_grid(dim)) : distorted_grid(dim);
+      Material m;
+      m.density = 1140.0;
+      const Eigen::SparseMatrix<double> M = mass_matrix(mesh, m);
+      // Each component carries the whole mass once.
+      EXPECT_NEAR(M.sum(), dim * 1140.0, 1e-9) << dim;
+      const Eigen::VectorXd lumped = lumped_mass(mesh, m);
+      EXPECT_NEAR(lumped.sum(), dim * 1140.0, 1e-9);
+      EXPECT_GT(lumped.minCoeff(), 0.0);
+      EXPECT_LT((Eigen::MatrixXd(M) - Eigen::MatrixXd(M).transpose()).norm(), 1e-12);
+      // Gravity's consistent forces sum to the weight.
+      const Eigen::VectorXd g = Eigen::VectorXd::Unit(dim, dim - 1) * -9.81;
+      const Eigen::VectorXd f = body_forces(mesh, m, g);
+      double weight = 0.0;
+      for (int v = 0; v < mesh.num_nodes(); ++v) weight += f[dim * v + dim - 1];
+      EXPECT_NEAR(weight, -9.81 * 1140.0, 1e-8);
+      EXPECT_NEAR(node_measures(mesh).sum(), 1.0, 1e-12);
+    }
 }
 
 // The exact consistent mass of a tetrahedron: rho |T| (1 + delta_ab) / 20
@@ -107,7 +107,8 @@ TEST(Fem, TetrahedronMatricesAreExact) {
   const double volume = (Eigen::Matrix3d() << (corners.row(1) - corners.row(0)),
                          (corners.row(2) - corners.row(0)), (corners.row(3) - corners.row(0)))
                             .finished()
-                            .determinant() / 6.0;
+                            .determinant() /
+                        6.0;
   const Eigen::MatrixXd M = element_mass(corners, m);
   EXPECT_NEAR(M(0, 0), 3.0 * volume / 10.0, 1e-15);
   EXPECT_NEAR(M(0, 3), 3.0 * volume / 20.0, 1e-15);
@@ -185,7 +186,8 @@ TEST(Fem, CantileverConvergesToBeamTheory) {
   for (int r : {1, 2, 4}) {
     const double tip = cantilever_tip(r, &theory);
     errors.push_back(std::abs(tip - theory) / std::abs(theory));
-    std::printf("refinement %d: tip %.6e, theory %.6e, error %.4f\n", r, tip, theory, errors.back());
+    std::printf("refinement %d: tip %.6e, theory %.6e, error %.4f\n", r, tip, theory,
+                errors.back());
   }
   for (size_t k = 1; k < errors.size(); ++k) EXPECT_LT(errors[k], errors[k - 1]);
   const double order = std::log2(errors[1] / errors[2]);
@@ -238,11 +240,12 @@ Eigen::MatrixXd block(const Eigen::SparseMatrix<double>& A, const std::vector<in
 TEST(FemDynamics, NewmarkConservesEnergyAndSwingsAtTheLowestFrequency) {
   Cantilever c = cantilever_2d();
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> modes(block(c.d.K, c.free),
-                                                                       block(c.d.M, c.free));
+                                                                        block(c.d.M, c.free));
   const double omega = std::sqrt(modes.eigenvalues()[0]);
   const Eigen::VectorXd phi = modes.eigenvectors().col(0);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(c.mesh.num_dofs()), phi_full = f;
-  for (size_t i = 0; i < c.free.size(); ++i) phi_full[c.free[i]] = phi[static_cast<Eigen::Index>(i)];
+  for (size_t i = 0; i < c.free.size(); ++i)
+    phi_full[c.free[i]] = phi[static_cast<Eigen::Index>(i)];
   f = 0.01 * (c.d.M * phi_full);
   for (int dof : c.d.held) f[dof] = 0.0;
   c.d.force = [f](double) { return f; };
@@ -341,14 +344,15 @@ TEST(FemDynamics, TheRodOvershootsAndSettlesOnItsStaticShape) {
     if (cross_time < 0.0 && peak > statics && -t.u[k - 1][down] >= statics && x < statics)
       cross_time = t.times[k];
   }
-  std::printf("rod: static tip %.4e m, reached at %.2f s, peak %.4e m at %.2f s (overshoot "
-              "%.1f%%), back below at %.2f s\n", statics, reach_time, peak, peak_time,
-              100.0 * (peak / statics - 1.0), cross_time);
+  std::printf(
+      "rod: static tip %.4e m, reached at %.2f s, peak %.4e m at %.2f s (overshoot "
+      "%.1f%%), back below at %.2f s\n",
+      statics, reach_time, peak, peak_time, 100.0 * (peak / statics - 1.0), cross_time);
   // It first reaches the static shape at 3.97 s on this 2 x 2 x 4 mesh; the
   // paper's quasi-static error touches zero at about 4.2 s.
   EXPECT_NEAR(reach_time, 4.2, 0.5);
-  EXPECT_GT(peak, 1.03 * statics);  // overshoot
-  EXPECT_GT(cross_time, peak_time);  // and swings back below the static shape
+  EXPECT_GT(peak, 1.03 * statics);                      // overshoot
+  EXPECT_GT(cross_time, peak_time);                     // and swings back below the static shape
   EXPECT_NEAR(-t.u.back()[down] / statics, 1.0, 1e-3);  // settled
   // The quasi-static solver is at the static shape from the first step.
   const Trajectory q = integrate(d, Integrator::QuasiStatic, 1.0 / 30.0, 2);
@@ -407,8 +411,8 @@ TEST(FemDynamics, GaussSeidelGivesTheFactorisationsTrajectories) {
   IntegrationOptions sweeps;
   sweeps.linear = LinearMethod::GaussSeidel;
   sweeps.tolerance = 1e-12;
-  for (Integrator kind : {Integrator::ImplicitNewmark, Integrator::ExplicitConsistent,
-                          Integrator::QuasiStatic}) {
+  for (Integrator kind :
+       {Integrator::ImplicitNewmark, Integrator::ExplicitConsistent, Integrator::QuasiStatic}) {
     const Trajectory direct = integrate(block.dynamics, kind, 1.0 / 30.0, 90);
     const Trajectory iterated = integrate(block.dynamics, kind, 1.0 / 30.0, 90, sweeps);
     ASSERT_TRUE(direct.ok && iterated.ok) << iterated.message;
@@ -418,7 +422,8 @@ TEST(FemDynamics, GaussSeidelGivesTheFactorisationsTrajectories) {
         << to_string(kind);
   }
   sweeps.max_sweeps = 2;
-  const Trajectory starved = integrate(block.dynamics, Integrator::QuasiStatic, 1.0 / 30.0, 10, sweeps);
+  const Trajectory starved =
+      integrate(block.dynamics, Integrator::QuasiStatic, 1.0 / 30.0, 10, sweeps);
   EXPECT_FALSE(starved.ok);
   EXPECT_NE(starved.message.find("Gauss-Seidel did not converge"), std::string::npos);
   EXPECT_NE(starved.message.find("t = 0.0333"), std::string::npos) << starved.message;

@@ -6,11 +6,11 @@
 #include <gtest/gtest.h>
 
 #include "fem/mesh_tools.hpp"
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "metrics/metrics.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -39,7 +39,8 @@ TEST(TetMesher, FillsTheSurface) {
   fine.size = 0.1;
   const Mesh finer = tetrahedralize(sphere, fine);
   EXPECT_GT(finer.elements.rows(), 4 * mesh.elements.rows());
-  EXPECT_LT(std::abs(tetrahedra_volume(finer) / volume - 1.0), std::abs(tetrahedra_volume(mesh) / volume - 1.0) + 1e-3);
+  EXPECT_LT(std::abs(tetrahedra_volume(finer) / volume - 1.0),
+            std::abs(tetrahedra_volume(mesh) / volume - 1.0) + 1e-3);
   // The same input, the same mesh.
   const Mesh again = tetrahedralize(sphere);
   ASSERT_EQ(again.nodes.rows(), mesh.nodes.rows());
@@ -58,12 +59,14 @@ TEST(TetMesher, ItsTetrahedraPassThePatchTest) {
   const Boundary b = boundary(mesh);
   Constraints held;
   Eigen::VectorXd exact(mesh.num_dofs());
-  for (int v = 0; v < mesh.num_nodes(); ++v) exact.segment(3 * v, 3) = A * mesh.nodes.row(v).transpose();
+  for (int v = 0; v < mesh.num_nodes(); ++v)
+    exact.segment(3 * v, 3) = A * mesh.nodes.row(v).transpose();
   for (int v : b.nodes)
     for (int a = 0; a < 3; ++a) held.hold(3 * v + a, exact[3 * v + a]);
   ASSERT_LT(static_cast<int>(b.nodes.size()), mesh.num_nodes());  // inner nodes exist
   Eigen::VectorXd u;
-  ASSERT_TRUE(solve_static(stiffness_matrix(mesh, m), Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u).ok);
+  ASSERT_TRUE(
+      solve_static(stiffness_matrix(mesh, m), Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u).ok);
   EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-13);
 }
 

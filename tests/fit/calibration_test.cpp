@@ -7,10 +7,10 @@
 
 #include <ceres/rotation.h>
 
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "model/assembly.hpp"
 #include "model/boundary_conditions.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -46,9 +46,9 @@ std::vector<MeasuredStep> synthetic_targets(const model::Model& m, const solve::
   const solve::SteppingSummary s =
       solve::solve_load_steps(m, o, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
         if (std::find(steps.begin(), steps.end(), r.step) != steps.end())
-          targets.push_back({make_target("step " + std::to_string(r.step),
-                                         model::positions(m, x), m.surface.F),
-                             r.step});
+          targets.push_back(
+              {make_target("step " + std::to_string(r.step), model::positions(m, x), m.surface.F),
+               r.step});
       });
   EXPECT_TRUE(s.success) << s.message;
   return targets;
@@ -72,12 +72,12 @@ TEST(Calibration, JacobianMatchesFiniteDifferencesForEveryParameterKind) {
     targets[0].target.points.row(i) += Eigen::RowVector3d(0.01, -0.02, 0.015);
   FitOptions options;
   options.symmetric = true;
-  const Calibration c(m, newton(2), targets,
-                      {parameter("Y0", 2500.0), parameter("beta", 4.0, false),
-                       parameter("gamma", 350.0), parameter("factor_x", 1.2),
-                       parameter("rotation_y", 0.02, false), parameter("translation_z", -0.01, false),
-                       parameter("scale", 1.03)},
-                      options);
+  const Calibration c(
+      m, newton(2), targets,
+      {parameter("Y0", 2500.0), parameter("beta", 4.0, false), parameter("gamma", 350.0),
+       parameter("factor_x", 1.2), parameter("rotation_y", 0.02, false),
+       parameter("translation_z", -0.01, false), parameter("scale", 1.03)},
+      options);
   EXPECT_TRUE(c.analytic_jacobian());
   const Eigen::VectorXd phi = c.parameters().initial_phi();
   const Evaluation e = c.evaluate(phi, true);
@@ -109,8 +109,8 @@ TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   const model::Model m = hanging_sphere();
   const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {1, 2});
   // From a start a factor 3 away.
-  const std::vector<Parameter> parameters = {parameter("Y0", 9000.0), parameter("beta", 5.0 / 3.0, false),
-                                             parameter("gamma", 100.0)};
+  const std::vector<Parameter> parameters = {
+      parameter("Y0", 9000.0), parameter("beta", 5.0 / 3.0, false), parameter("gamma", 100.0)};
   const Eigen::Vector3d truth(3000.0, 5.0, 300.0);
   const FitResult lm = Calibration(m, newton(2), targets, parameters).run();
   ASSERT_TRUE(lm.success) << lm.message;
@@ -158,7 +158,7 @@ TEST(Calibration, EvaluationsAreKeptAndCounted) {
   EXPECT_EQ(cache.forward_runs, 1);
   EXPECT_EQ(cache.at(phi, true).jacobian.cols(), 2);
   EXPECT_EQ(cache.forward_runs, 2);
-  EXPECT_EQ(cache.sensitivity_solves, 2);  // one tangent solve per material parameter
+  EXPECT_EQ(cache.sensitivity_solves, 2);              // one tangent solve per material parameter
   EXPECT_EQ(cache.at(phi, false).jacobian.cols(), 2);  // the kept one, Jacobian and all
   EXPECT_EQ(cache.forward_runs, 2);
   Eigen::VectorXd moved = phi;
@@ -176,11 +176,11 @@ TEST(Calibration, AlignmentRecoversAKnownScale) {
   const Eigen::RowVector3d shift(0.01, -0.02, 0.005);
   for (Eigen::Index i = 0; i < targets[0].target.points.rows(); ++i)
     targets[0].target.points.row(i) = targets[0].target.points.row(i) / 1.04 - shift;
-  const FitResult r = Calibration(m, newton(1), targets,
-                                  {parameter("scale", 1.0), parameter("translation_x", 0.0, false),
-                                   parameter("translation_y", 0.0, false),
-                                   parameter("translation_z", 0.0, false)})
-                          .run();
+  const FitResult r =
+      Calibration(m, newton(1), targets,
+                  {parameter("scale", 1.0), parameter("translation_x", 0.0, false),
+                   parameter("translation_y", 0.0, false), parameter("translation_z", 0.0, false)})
+          .run();
   ASSERT_EQ(r.status, FitStatus::Converged) << r.message << " " << r.status_detail;
   EXPECT_NEAR(r.values[0], 1.04, 1e-8);
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(r.values[1 + a], 1.04 * shift[a], 1e-8);
@@ -207,7 +207,8 @@ TEST(Calibration, AlignmentRecoversAKnownRigidMotion) {
   ASSERT_TRUE(r.success) << r.message;
   // The fitted motion takes the target back onto the body: T(M(p)) = p.
   const double back[3] = {r.values[0], r.values[1], r.values[2]};
-  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
     double moved[3], returned[3];
     const double pp[3] = {p.x(), p.y(), p.z()};
     ceres::AngleAxisRotatePoint(omega, pp, moved);
@@ -239,7 +240,8 @@ TEST(Calibration, FitsAPointCloudTarget) {
   targets[0].target = make_target("cloud", targets[0].target.points);
   ASSERT_TRUE(targets[0].target.is_point_cloud());
   const FitResult r =
-      Calibration(m, newton(2), targets, {parameter("Y0", 1000.0), parameter("gamma", 900.0)}).run();
+      Calibration(m, newton(2), targets, {parameter("Y0", 1000.0), parameter("gamma", 900.0)})
+          .run();
   ASSERT_TRUE(r.success) << r.message;
   EXPECT_NEAR(r.values[0] / 3000.0, 1.0, 1e-6);
   EXPECT_NEAR(r.values[1] / 300.0, 1.0, 1e-6);
@@ -332,8 +334,9 @@ TEST(Calibration, BadFitsAreNamed) {
                      "tied to load step 5");
   FitOptions global;
   global.method = Method::DirectL;
-  expect_input_error([&] { Calibration(m, newton(1), targets, {parameter("Y0", 3000.0)}, global).run(); },
-                     "needs finite lower and upper bounds");
+  expect_input_error(
+      [&] { Calibration(m, newton(1), targets, {parameter("Y0", 3000.0)}, global).run(); },
+      "needs finite lower and upper bounds");
 
   // A forward run that fails is a result with a message, not a crash.
   const Calibration soft(m, newton(1), targets, {parameter("Y0", 1e-3)});

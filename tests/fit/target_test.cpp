@@ -5,27 +5,29 @@
 
 #include <random>
 
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {
 
 // Point-to-triangle distance by brute force: the plane's foot when it lies
 // inside, else the nearest point of the three edges.
-double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                        const Eigen::Vector3d& b) {
   const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
   return (p - (a + t * (b - a))).norm();
 }
-double triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& c) {
+double triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
   const Eigen::Vector3d foot = p - n.dot(p - a) * n;
   const bool inside = (b - a).cross(foot - a).dot(n) >= 0 && (c - b).cross(foot - b).dot(n) >= 0 &&
                       (a - c).cross(foot - c).dot(n) >= 0;
   if (inside) return std::abs(n.dot(p - a));
-  return std::min({segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
 }
 
 TEST(TargetDistance, AgreesWithBruteForceOnAnOpenNoisySoup) {
@@ -42,15 +44,16 @@ TEST(TargetDistance, AgreesWithBruteForceOnAnOpenNoisySoup) {
     if (!high) kept.push_back(s.F.row(f).transpose());
   }
   Eigen::MatrixXi F(static_cast<Eigen::Index>(kept.size()), 3);
-  for (size_t f = 0; f < kept.size(); ++f) F.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
+  for (size_t f = 0; f < kept.size(); ++f)
+    F.row(static_cast<Eigen::Index>(f)) = kept[f].transpose();
   const Target target = make_target("soup", s.V, F);
-  EXPECT_NE(target.description.find("unused points dropped"), std::string::npos) << target.description;
+  EXPECT_NE(target.description.find("unused points dropped"), std::string::npos)
+      << target.description;
   const TargetDistance distance(target);
 
   std::uniform_real_distribution<double> box(-1.5, 1.5);
   Eigen::MatrixXd queries(300, 3);
-  for (Eigen::Index i = 0; i < queries.rows(); ++i)
-    queries.row(i) << box(rng), box(rng), box(rng);
+  for (Eigen::Index i = 0; i < queries.rows(); ++i) queries.row(i) << box(rng), box(rng), box(rng);
   const auto hits = distance.closest(queries);
   for (Eigen::Index i = 0; i < queries.rows(); ++i) {
     const Eigen::Vector3d p = queries.row(i).transpose();
@@ -87,8 +90,8 @@ TEST(Targets, ReadSoupsAndCloudsAndSayWhatWasRead) {
   EXPECT_TRUE(cloud.is_point_cloud());
   EXPECT_EQ(cloud.points.rows(), 3);
   // An open soup with a degenerate triangle and an unused vertex.
-  const Target soup = read_target(dir.write(
-      "soup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 2 2\nv 2 0 0\nf 1 2 3\nf 1 2 5\n"));
+  const Target soup = read_target(
+      dir.write("soup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 2 2\nv 2 0 0\nf 1 2 3\nf 1 2 5\n"));
   EXPECT_EQ(soup.triangles.rows(), 1);
   EXPECT_EQ(soup.points.rows(), 3);
   EXPECT_NE(soup.description.find("1 degenerate triangles dropped"), std::string::npos)
@@ -98,8 +101,10 @@ TEST(Targets, ReadSoupsAndCloudsAndSayWhatWasRead) {
     read_target(dir.write("nan.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
     ADD_FAILURE() << "read a NaN";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("nan.obj: vertex 0 has a coordinate that is not a finite number"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "nan.obj: vertex 0 has a coordinate that is not a finite number"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(read_target(dir.path() / "missing.obj"), InputError);
 }

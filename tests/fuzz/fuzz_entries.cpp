@@ -12,11 +12,11 @@
 #include "app/output_folder.hpp"
 #include "app/runner.hpp"
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
-#include "geom/run_control.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
 
 namespace fiberfluid::fuzz {
 namespace {
@@ -74,8 +74,8 @@ void check_output_name(const std::string& name) {
   } catch (const InputError&) {
     return;
   }
-  require(folder.parent_path() == "out" && folder.filename() == name && name != ".." && name != "." &&
-              name.find('/') == std::string::npos,
+  require(folder.parent_path() == "out" && folder.filename() == name && name != ".." &&
+              name != "." && name.find('/') == std::string::npos,
           "an accepted name is one folder below out/");
 }
 
@@ -148,7 +148,8 @@ void set_up_fit(const uint8_t* data, size_t size) {
     app::build_experiment(ex);
     const app::FitSetup setup = app::setup_fit(ex);
     const fit::Calibration& c = *setup.calibration;
-    require(c.num_residuals() >= c.parameters().size(), "a fit has at least one distance per parameter");
+    require(c.num_residuals() >= c.parameters().size(),
+            "a fit has at least one distance per parameter");
     const fit::Evaluation e = c.evaluate(c.parameters().initial_phi(), false);
     if (!e.ok) {
       require(!e.message.empty(), "a failed forward run says why");
@@ -173,14 +174,18 @@ void compare_with_unit(int dim, const uint8_t* data, size_t size) {
     return;
   }
   if (m.dim != dim || m.num_vertices() > 2000) return;
-  const geom::Surface unit = dim == 2 ? geom::rectangle({0, 0}, {1, 1}) : geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
+  const geom::Surface unit =
+      dim == 2 ? geom::rectangle({0, 0}, {1, 1}) : geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
   for (const bool fuzzed_first : {true, false}) {
     try {
-      const app::Comparison c = fuzzed_first ? app::compare_surfaces(m, unit, nullptr, "fuzz.obj", "unit")
-                                             : app::compare_surfaces(unit, m, nullptr, "unit", "fuzz.obj");
+      const app::Comparison c = fuzzed_first
+                                    ? app::compare_surfaces(m, unit, nullptr, "fuzz.obj", "unit")
+                                    : app::compare_surfaces(unit, m, nullptr, "unit", "fuzz.obj");
       if (c.surface_error) {
-        require(std::isfinite(*c.surface_error) && *c.surface_error >= -1e-9, "E_s is finite and not negative");
-        require(std::isfinite(*c.reference_measure) && *c.reference_measure > 0.0, "|M| is positive");
+        require(std::isfinite(*c.surface_error) && *c.surface_error >= -1e-9,
+                "E_s is finite and not negative");
+        require(std::isfinite(*c.reference_measure) && *c.reference_measure > 0.0,
+                "|M| is positive");
       } else {
         require(dim == 3 && !c.surface_error_missing.empty(), "a missing E_s says why (3D only)");
       }
@@ -198,8 +203,10 @@ void compare_with_unit(int dim, const uint8_t* data, size_t size) {
 const std::vector<Target>& targets() {
   using geom::MeshFormat;
   static const std::vector<Target> all = {
-      {"obj", ".obj", [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Obj, "fuzz.obj", d, n); }},
-      {"off", ".off", [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Off, "fuzz.off", d, n); }},
+      {"obj", ".obj",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Obj, "fuzz.obj", d, n); }},
+      {"off", ".off",
+       [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Off, "fuzz.off", d, n); }},
       {"stl_ascii", ".stl",
        [](const uint8_t* d, size_t n) { read_mesh(MeshFormat::Stl, "fuzz.stl", d, n); }},
       {"stl_binary", ".stl",

@@ -14,8 +14,8 @@
 namespace fiberfluid::fuzz {
 
 struct Target {
-  const char* name;        // "obj", "experiment", ... (the seeds' folder name)
-  const char* extension;   // what the inputs are, for the corpora: ".obj", ".json"
+  const char* name;       // "obj", "experiment", ... (the seeds' folder name)
+  const char* extension;  // what the inputs are, for the corpora: ".obj", ".json"
   void (*run)(const uint8_t* data, size_t size);
 };
 

@@ -69,8 +69,8 @@ TEST(CertifiedSign, NeverContradictsTheExactSignAndDecidesGenericCases) {
     }
   }
   EXPECT_EQ(contradictions, 0);
-  EXPECT_GT(decided, 100000);          // random points: nearly all certified
-  EXPECT_GT(degenerate, 10000);        // the near-coplanar half was exercised
+  EXPECT_GT(decided, 100000);                 // random points: nearly all certified
+  EXPECT_GT(degenerate, 10000);               // the near-coplanar half was exercised
   EXPECT_LT(degenerate_decided, degenerate);  // and there the filter says "unsure"
 }
 

@@ -99,7 +99,8 @@ bool brute_force_keep_3d(const Surface& s, int i, int j) {
         }
       }
       pieces.add_interval(lo, hi, eps);
-    } else if ((dp <= eps * scale && dq >= -eps * scale) || (dp >= -eps * scale && dq <= eps * scale)) {
+    } else if ((dp <= eps * scale && dq >= -eps * scale) ||
+               (dp >= -eps * scale && dq <= eps * scale)) {
       const double t = dp / (dp - dq);
       const Eigen::Vector3d x = p + t * d;
       // Barycentric test with a tolerance.
@@ -115,7 +116,9 @@ bool brute_force_keep_2d(const Surface& s, int i, int j) {
   const Eigen::Vector2d p = s.V.row(i).transpose(), q = s.V.row(j).transpose(), d = q - p;
   const double eps = 1e-10;
   Pieces pieces;
-  auto cross = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x.x() * y.y() - x.y() * y.x(); };
+  auto cross = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return x.x() * y.y() - x.y() * y.x();
+  };
   for (int f = 0; f < s.num_faces(); ++f) {
     const Eigen::Vector2d a = s.V.row(s.F(f, 0)).transpose(), b = s.V.row(s.F(f, 1)).transpose();
     const Eigen::Vector2d e = b - a;
@@ -140,7 +143,8 @@ void expect_agreement(const Surface& s, const PruningResult& pruned, int row_ste
   for (int i = 0; i < s.num_vertices(); i += row_step)
     for (int j = 0; j < s.num_vertices(); ++j) {
       if (j == i) continue;
-      const bool expected = s.dim == 3 ? brute_force_keep_3d(s, i, j) : brute_force_keep_2d(s, i, j);
+      const bool expected =
+          s.dim == 3 ? brute_force_keep_3d(s, i, j) : brute_force_keep_2d(s, i, j);
       ++compared;
       if (pruned.mask.kept(i, j) != expected && ++disagreements <= 5)
         ADD_FAILURE() << "pair (" << i << ", " << j << "): CGAL keeps " << pruned.mask.kept(i, j)
@@ -180,7 +184,8 @@ Surface l_prism() {
     faces.push_back({9, a + 6, b + 6});  // top, facing +z
   }
   s.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t f = 0; f < faces.size(); ++f) s.F.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
+  for (size_t f = 0; f < faces.size(); ++f)
+    s.F.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
   return s;
 }
 
@@ -212,8 +217,8 @@ TEST(FiberPruning, LPolygonIn2D) {
 }
 
 TEST(FiberPruning, CubeKeepsEveryFiberAlsoAlongItsFacesWithoutTheFastPath) {
-  for (const Surface& s : {cube(), box({0, 0, 0}, {1, 1, 1}, {2, 2, 2}),
-                           box({-1, 0, 2}, {1, 3, 2.5}, {3, 2, 1})}) {
+  for (const Surface& s :
+       {cube(), box({0, 0, 0}, {1, 1, 1}, {2, 2, 2}), box({-1, 0, 2}, {1, 3, 2.5}, {3, 2, 1})}) {
     EXPECT_TRUE(is_convex(s));
     const PruningResult exact = prune_fibers(s, /*convex_fast_path=*/false);
     EXPECT_EQ(exact.mask.num_kept(), exact.mask.num_pairs());

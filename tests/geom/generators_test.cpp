@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_check.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

@@ -5,10 +5,10 @@
 
 #include <limits>
 
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {
@@ -77,7 +77,8 @@ TEST(MeshCheck, EachBadMeshHasItsOwnMessage) {
   expect_problem(repeated, "face 0 is degenerate (a repeated vertex)");
 
   Surface flat = box({0, 0, 0}, {1, 1, 1}, {2, 1, 1});  // collapse a face onto a line
-  flat.V.row(flat.F(0, 2)) = flat.V.row(flat.F(0, 0)) + 0.5 * (flat.V.row(flat.F(0, 1)) - flat.V.row(flat.F(0, 0)));
+  flat.V.row(flat.F(0, 2)) =
+      flat.V.row(flat.F(0, 0)) + 0.5 * (flat.V.row(flat.F(0, 1)) - flat.V.row(flat.F(0, 0)));
   expect_problem(flat, "degenerate (zero area)");
 
   Surface nan = icosahedron();

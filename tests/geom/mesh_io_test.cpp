@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_check.hpp"
 #include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {
@@ -211,8 +211,8 @@ std::string as_off(const Surface& s) {
 std::string as_binary_ply(const Surface& s) {
   std::ostringstream out;
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << s.num_vertices()
-      << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
-      << s.num_faces() << "\nproperty list uchar int vertex_indices\nend_header\n";
+      << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << s.num_faces()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
   for (int i = 0; i < s.num_vertices(); ++i)
     for (int a = 0; a < 3; ++a) out.write(reinterpret_cast<const char*>(&s.V(i, a)), 8);
   for (int f = 0; f < s.num_faces(); ++f) {
@@ -280,14 +280,16 @@ TEST(MeshIO, BadFilesAreRejectedWithTheirOwnMessage) {
   expect_read_error(dir.write("short.stl", "abc"), "truncated binary STL");
   expect_read_error(dir.write("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"),
                     "face index 5 is out of range");
-  expect_read_error(dir.write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                         "property float x\nproperty float y\nproperty float z\n"
-                                         "element face 1\nproperty list uchar int vertex_index\n"
-                                         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"),
+  expect_read_error(dir.write("bad.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 3\n"
+                              "property float x\nproperty float y\nproperty float z\n"
+                              "element face 1\nproperty list uchar int vertex_index\n"
+                              "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"),
                     "refers to vertex 9");
-  expect_read_error(dir.write("word.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"
-                                          "property float x\nproperty float y\nproperty float z\n"
-                                          "end_header\n0 zero 0\n"),
+  expect_read_error(dir.write("word.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 1\n"
+                              "property float x\nproperty float y\nproperty float z\n"
+                              "end_header\n0 zero 0\n"),
                     "word.ply: expected a number for a PLY value, got 'zero'");
 }
 
@@ -296,8 +298,9 @@ TEST(MeshIO, BadFilesAreRejectedWithTheirOwnMessage) {
 // whose size would exhaust memory before the file ran out.
 TEST(MeshIO, NonFiniteCoordinatesAndHugeCountsAreErrors) {
   ScratchDir dir;
-  expect_read_error(dir.write("nan.stl", "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\n"
-                                         "vertex 1 0 nan\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n"),
+  expect_read_error(dir.write("nan.stl",
+                              "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\n"
+                              "vertex 1 0 nan\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n"),
                     "nan.stl: facet 1 has a corner with a coordinate that is not a finite number");
   const Surface ico = icosahedron();
   std::string binary = binary_stl(ico, ico.num_faces());
@@ -316,14 +319,17 @@ TEST(MeshIO, NonFiniteCoordinatesAndHugeCountsAreErrors) {
                     "face index nan is out of range 0..2");
   expect_read_error(dir.write("half_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"),
                     "face index 1.5 is out of range 0..2");
-  const std::string ply_header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                 "property float y\nproperty float z\nelement face 1\n"
-                                 "property list uchar int vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
   expect_read_error(dir.write("big_index.ply", ply_header + "3 0 1 1e300\n"),
                     "face 0 refers to an index that is no vertex number");
-  expect_read_error(dir.write("big_list.ply", ply_header + "1e300 0 1 2\n"), "a list length that is not a count");
-  expect_read_error(dir.write("big_count.ply", "ply\nformat ascii 1.0\nelement vertex 1e300\nproperty float x\n"
-                                               "end_header\n0\n"),
+  expect_read_error(dir.write("big_list.ply", ply_header + "1e300 0 1 2\n"),
+                    "a list length that is not a count");
+  expect_read_error(dir.write("big_count.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 1e300\nproperty float x\n"
+                              "end_header\n0\n"),
                     "big_count.ply:3: expected an element count no larger than the file's");
 }
 

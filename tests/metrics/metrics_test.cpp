@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/generators.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::metrics {
 namespace {
@@ -99,14 +99,16 @@ TEST(SurfaceError, ABodyFarFromTheOriginKeepsItsDigits) {
   // Moved by 0.5 along each axis: overlap 0.125, |xor| = 2 - 0.25.
   EXPECT_NEAR(surface_error(cube, translated(cube, Eigen::RowVector3d(0.5, 0.5, 0.5))), 1.75, 1e-8);
   // The same in 2D (exact areas there, but the same rule for the inputs).
-  const geom::Surface square = translated(geom::rectangle({0, 0}, {1, 1}, 1, 1), Eigen::RowVector2d(1e8, 1e8));
+  const geom::Surface square =
+      translated(geom::rectangle({0, 0}, {1, 1}, 1, 1), Eigen::RowVector2d(1e8, 1e8));
   EXPECT_NEAR(surface_error(square, translated(square, Eigen::RowVector2d(0.5, 0.5))), 1.5, 1e-8);
 }
 
 // Issue 27: a coordinate of 1e301 reached undefined behaviour inside CGAL's
 // Booleans; inputs beyond what the exact kernel and doubles carry are refused.
 TEST(SurfaceError, CoordinatesTheExactBooleansCannotCarryAreRefusedByName) {
-  auto expect_refused = [](const geom::Surface& a, const geom::Surface& b, const std::string& part) {
+  auto expect_refused = [](const geom::Surface& a, const geom::Surface& b,
+                           const std::string& part) {
     try {
       surface_error(a, b, "m.obj", "m_prime.obj");
       ADD_FAILURE() << "no error, expected one mentioning " << part;

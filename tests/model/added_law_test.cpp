@@ -78,7 +78,8 @@ TEST(AddedLaw, TangentAndParameterDerivativesMatchCentralDifferences) {
     plus.material.law.set_parameter(name, m.material.law.parameter(name) + step);
     minus.material.law.set_parameter(name, m.material.law.parameter(name) - step);
     const Eigen::VectorXd fd = (model::Equilibrium(plus).residual(x, factors) -
-                                model::Equilibrium(minus).residual(x, factors)) / (2.0 * step);
+                                model::Equilibrium(minus).residual(x, factors)) /
+                               (2.0 * step);
     EXPECT_LT((D.col(k) - fd).norm(), 1e-7 * fd.norm()) << name;
     EXPECT_GT(fd.norm(), 0.0) << name;
   }

@@ -6,13 +6,13 @@
 #include <random>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/fiber_network.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
-#include "test_support.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -26,15 +26,10 @@ TEST(Assembly, PaperRectangleMatrixEntryByEntry) {
   Eigen::VectorXd B = right_hand_side(m, m.surface.V, {1.0, 1.0});
   apply_penalty(partition, Eigen::VectorXd::Zero(3), 1e9, A, B);
   Eigen::MatrixXd paper(9, 9);  // the paper's Eq. 8
-  paper << 329, -105, -84, -140, 0, 0, 0, 0, 28,
-          -105, 329, -140, -84, 0, 0, 0, 0, 28,
-          -84, -140, 1e9, -105, 0, 0, 0, 0, -28,
-          -140, -84, -105, 329, 0, 0, 0, 0, -28,
-          0, 0, 0, 0, 329, -105, -84, -140, 21,
-          0, 0, 0, 0, -105, 1e9, -140, -84, -21,
-          0, 0, 0, 0, -84, -140, 1e9, -105, -21,
-          0, 0, 0, 0, -140, -84, -105, 329, 21,
-          28, 28, -28, -28, 21, -21, -21, 21, 0;
+  paper << 329, -105, -84, -140, 0, 0, 0, 0, 28, -105, 329, -140, -84, 0, 0, 0, 0, 28, -84, -140,
+      1e9, -105, 0, 0, 0, 0, -28, -140, -84, -105, 329, 0, 0, 0, 0, -28, 0, 0, 0, 0, 329, -105, -84,
+      -140, 21, 0, 0, 0, 0, -105, 1e9, -140, -84, -21, 0, 0, 0, 0, -84, -140, 1e9, -105, -21, 0, 0,
+      0, 0, -140, -84, -105, 329, 21, 28, 28, -28, -28, 21, -21, -21, 21, 0;
   EXPECT_NEAR((A - paper).cwiseAbs().maxCoeff(), 0.0, 1e-10);
   Eigen::VectorXd paper_B(9);
   paper_B << 0, 0, 0, 0, 1680, 0, 0, 1680, 0;
@@ -45,9 +40,9 @@ class AssemblyOnMeshes : public ::testing::TestWithParam<const char*> {
  protected:
   Model model() const {
     Model m;
-    m.surface = geom::remove_unused_vertices(
-                    geom::read_surface(testing::data_mesh(GetParam())).surface)
-                    .surface;
+    m.surface =
+        geom::remove_unused_vertices(geom::read_surface(testing::data_mesh(GetParam())).surface)
+            .surface;
     m.material = Material::linear(Eigen::Vector3d(2.0, 3.0, 5.0));  // anisotropic on purpose
     m.material.surface_tension = 0.7;
     return m;
@@ -72,10 +67,10 @@ TEST_P(AssemblyOnMeshes, FiberBlocksAreSymmetricLaplaciansAndIgnoreTranslation) 
   }
   // The blocks differ only by their Y: (K_y - K_x) = (Y_y - Y_x) L_bulk.
   const geom::VertexAreaVectors areas = geom::vertex_area_vectors(m.surface.V, m.surface.F);
-  const FiberLaplacians L = fiber_laplacians(m.surface.V, areas.magnitude,
-                                             geom::unique_edges(m.surface));
-  EXPECT_NEAR((A.block(n, n, n, n) - A.block(0, 0, n, n) - 1.0 * L.bulk).cwiseAbs().maxCoeff(),
-              0.0, 1e-12 * L.bulk.diagonal().maxCoeff());
+  const FiberLaplacians L =
+      fiber_laplacians(m.surface.V, areas.magnitude, geom::unique_edges(m.surface));
+  EXPECT_NEAR((A.block(n, n, n, n) - A.block(0, 0, n, n) - 1.0 * L.bulk).cwiseAbs().maxCoeff(), 0.0,
+              1e-12 * L.bulk.diagonal().maxCoeff());
 }
 
 TEST_P(AssemblyOnMeshes, VolumeRowIsThreeCTimesTheVolumeGradient) {
@@ -92,8 +87,9 @@ TEST_P(AssemblyOnMeshes, VolumeRowIsThreeCTimesTheVolumeGradient) {
       Eigen::MatrixXd plus = m.surface.V, minus = m.surface.V;
       plus(i, a) += h;
       minus(i, a) -= h;
-      const double gradient = (geom::enclosed_volume(plus, m.surface.F) -
-                               geom::enclosed_volume(minus, m.surface.F)) / (2 * h);
+      const double gradient =
+          (geom::enclosed_volume(plus, m.surface.F) - geom::enclosed_volume(minus, m.surface.F)) /
+          (2 * h);
       const double row = A(m.pressure_dof(), m.dof(i, a));
       EXPECT_NEAR(row, 3 * C * gradient, 1e-6 * scale);
       EXPECT_EQ(row, A(m.dof(i, a), m.pressure_dof()));  // bordered symmetrically

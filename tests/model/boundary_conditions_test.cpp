@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "geom/error.hpp"
 #include "model/model_fixtures.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

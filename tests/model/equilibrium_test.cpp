@@ -8,11 +8,11 @@
 
 #include <random>
 
-#include "geom/error.hpp"
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -86,8 +86,8 @@ TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLaw) {
 
 TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
   Model m = testing::paper_rectangle_model();
-  m.surface = geom::polygon((Eigen::MatrixXd(6, 2) << 15, 20, 18, 0, 15, -20, -15, -20, -18, 0,
-                             -15, 20).finished());
+  m.surface = geom::polygon(
+      (Eigen::MatrixXd(6, 2) << 15, 20, 18, 0, 15, -20, -15, -20, -18, 0, -15, 20).finished());
   m.material.law = FiberLaw::exponential(360.0, 3.0);
   m.material.surface_tension = 20.0;
   Load gravity;
@@ -151,15 +151,18 @@ TEST(Equilibrium, ParameterDerivativesMatchCentralDifferences) {
     for (size_t k = 0; k < names.size(); ++k) {
       auto with = [&](double delta) {
         Model changed = m;
-        if (names[k] == "gamma") changed.material.surface_tension += delta;
-        else if (names[k] == "factor_y") changed.material.axis_factors.y() += delta;
-        else changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
+        if (names[k] == "gamma")
+          changed.material.surface_tension += delta;
+        else if (names[k] == "factor_y")
+          changed.material.axis_factors.y() += delta;
+        else
+          changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
         return Equilibrium(changed).residual(x, factors);
       };
-      const double h = 1e-5 * std::max(1.0, std::abs(names[k] == "gamma" ? 500.0
-                                                      : names[k] == "factor_y"
-                                                          ? 0.8
-                                                          : law.parameter(names[k])));
+      const double h =
+          1e-5 * std::max(1.0, std::abs(names[k] == "gamma"      ? 500.0
+                                        : names[k] == "factor_y" ? 0.8
+                                                                 : law.parameter(names[k])));
       const Eigen::VectorXd fd = (with(h) - with(-h)) / (2.0 * h);
       EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - fd).norm(), 1e-6 * fd.norm() + 1e-12)
           << law.name() << " " << names[k];
@@ -180,9 +183,8 @@ namespace {
 // term knows is an error, never silently another kind.
 TEST(EquilibriumTerms, EachLoadIsATermAndAnUnknownKindIsAnError) {
   Model m = small_sphere(FiberLaw::constant(3000.0));
-  const std::vector<std::string> expected = {"bulk fibers", "surface tension",
-                                             "pressure and volume", "hydrostatic load",
-                                             "point load"};
+  const std::vector<std::string> expected = {
+      "bulk fibers", "surface tension", "pressure and volume", "hydrostatic load", "point load"};
   EXPECT_EQ(Equilibrium(m).term_names(), expected);
   m.loads[0].kind = static_cast<Load::Kind>(7);
   EXPECT_THROW(Equilibrium{m}, std::invalid_argument);

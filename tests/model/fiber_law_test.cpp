@@ -33,15 +33,15 @@ TEST(FiberLaw, ValuesOfEachLaw) {
 }
 
 TEST(FiberLaw, SlopesAndParameterDerivativesMatchCentralDifferences) {
-  const FiberLaw laws[] = {
-      FiberLaw::constant(3000.0), FiberLaw::exponential(2000.0, 5.0),
-      FiberLaw::bilinear(3000.0, 1000.0),
-      FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
+  const FiberLaw laws[] = {FiberLaw::constant(3000.0), FiberLaw::exponential(2000.0, 5.0),
+                           FiberLaw::bilinear(3000.0, 1000.0),
+                           FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
   for (const FiberLaw& law : laws)
     for (double e : {-0.37, -0.05, -0.004, 0.001, 0.03, 0.17, 0.6}) {
       const double h = 1e-6;
       const double fd = (law.modulus(e + h) - law.modulus(e - h)) / (2 * h);
-      EXPECT_NEAR(law.slope(e), fd, 1e-6 * (std::abs(law.modulus(e)) + std::abs(fd)) + 1e-9) << law.name() << e;
+      EXPECT_NEAR(law.slope(e), fd, 1e-6 * (std::abs(law.modulus(e)) + std::abs(fd)) + 1e-9)
+          << law.name() << e;
       for (const std::string& name : law.parameter_names()) {
         const double p = law.parameter(name), step = 1e-6 * std::max(1.0, std::abs(p));
         FiberLaw up = law, down = law;

@@ -7,8 +7,8 @@
 #include "geom/mesh_io.hpp"
 #include "model/assembly.hpp"
 #include "model/model_fixtures.hpp"
-#include "test_support.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "test_support.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -35,7 +35,9 @@ void expect_same_as_full_assembly(const Model& m, BoundaryMethod method) {
   const Eigen::MatrixXd structured = system.dense_matrix();
   ASSERT_EQ(structured.rows(), expected.rows());
   const double scale = expected.topLeftCorner(expected.rows() - 1, expected.rows() - 1)
-                           .diagonal().cwiseAbs().minCoeff();
+                           .diagonal()
+                           .cwiseAbs()
+                           .minCoeff();
   EXPECT_LT((structured - expected).cwiseAbs().maxCoeff(), 1e-11 * std::max(scale, 1.0));
 
   // Matrix-free products agree with the dense blocks.
@@ -57,9 +59,9 @@ TEST(FiberSystem, MatchesTheFullAssemblyWithBothBoundaryMethods) {
 
 Model pruned_liver(ConnectionCount count) {
   Model m;
-  m.surface = geom::remove_unused_vertices(
-                  geom::read_surface(testing::data_mesh("liver.obj")).surface)
-                  .surface;
+  m.surface =
+      geom::remove_unused_vertices(geom::read_surface(testing::data_mesh("liver.obj")).surface)
+          .surface;
   m.material.law = FiberLaw::constant(2000.0);
   m.material.surface_tension = 3.0;
   for (int v : select_half_space(m.surface.V, parse_half_space("y >= 4.75", 3)))
@@ -107,8 +109,8 @@ TEST(FiberSystem, AFullMaskWithEitherCountIsTheUnprunedModel) {
     // (n_i + n_j) / 2 = N - 1 for a convex body: the paper's normalisation.
     EXPECT_LT((system_matrix(m, m.surface.V) - unpruned).cwiseAbs().maxCoeff(), 1e-12);
     const FiberSystem system(m, m.surface.V, BoundaryMethod::Elimination, 1e9);
-    const FiberSystem plain(testing::paper_sphere_model(), m.surface.V,
-                            BoundaryMethod::Elimination, 1e9);
+    const FiberSystem plain(testing::paper_sphere_model(), m.surface.V, BoundaryMethod::Elimination,
+                            1e9);
     EXPECT_LT((system.dense_block(0) - plain.dense_block(0)).cwiseAbs().maxCoeff(), 1e-12);
   }
 }
@@ -138,7 +140,8 @@ TEST(FiberSystem, PrescribedDisplacementsMoveToTheRightHandSide) {
   full.head(U_c.size()) = U_c;
   const Eigen::VectorXd moved = -(A * full);
   Eigen::VectorXd expected(p.free.size());
-  for (size_t k = 0; k < p.free.size(); ++k) expected[static_cast<Eigen::Index>(k)] = moved[p.free[k]];
+  for (size_t k = 0; k < p.free.size(); ++k)
+    expected[static_cast<Eigen::Index>(k)] = moved[p.free[k]];
   EXPECT_LT((rhs - expected).norm(), 1e-12 * expected.norm());
 }
 

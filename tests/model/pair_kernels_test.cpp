@@ -136,7 +136,8 @@ TEST(BulkPairs, SameThreadsSameBitsOneOrTwoThreadsClose) {
   omp_set_num_threads(1);
   const Eigen::MatrixXd serial = pairs.laplacian_product(V);
   omp_set_num_threads(before);
-  EXPECT_EQ(0, std::memcmp(first.data(), again.data(), sizeof(double) * static_cast<size_t>(first.size())));
+  EXPECT_EQ(0, std::memcmp(first.data(), again.data(),
+                           sizeof(double) * static_cast<size_t>(first.size())));
   EXPECT_LT((serial - first).cwiseAbs().maxCoeff(), 1e-13 * first.cwiseAbs().maxCoeff());
 }
 

@@ -58,8 +58,8 @@ TEST(Treecode, PotentialsMatchTheDirectSumsToTheirDegree) {
     const Treecode tree(X, options);
     const Eigen::MatrixXd approximate = tree.potentials(Q);
     const double error = (approximate - exact).norm() / exact.norm();
-    EXPECT_GT(tree.proxy_terms(), 0) << degree;   // far boxes were approximated
-    EXPECT_LT(error, 0.5 * previous) << degree;   // and the error falls with the degree
+    EXPECT_GT(tree.proxy_terms(), 0) << degree;  // far boxes were approximated
+    EXPECT_LT(error, 0.5 * previous) << degree;  // and the error falls with the degree
     previous = error;
   }
   EXPECT_LT(previous, 1e-7);

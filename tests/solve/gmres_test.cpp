@@ -23,7 +23,8 @@ void expect_failure(const GmresResult& r, const std::string& part) {
 
 TEST(Gmres, SolvesANonsymmetricSystem) {
   std::srand(3);
-  const Eigen::MatrixXd M = Eigen::MatrixXd::Random(40, 40) + 40.0 * Eigen::MatrixXd::Identity(40, 40);
+  const Eigen::MatrixXd M =
+      Eigen::MatrixXd::Random(40, 40) + 40.0 * Eigen::MatrixXd::Identity(40, 40);
   const Eigen::VectorXd b = Eigen::VectorXd::Random(40);
   Eigen::VectorXd x;
   GmresOptions options;
@@ -42,13 +43,15 @@ TEST(Gmres, StagnationIsNamed) {
   GmresOptions options;
   options.restart = 1;
   const GmresResult r = gmres(matrix(rotation), identity, Eigen::Vector2d(1, 0), x, options);
-  expect_failure(r, "gmres: stagnation: a restart cycle of 1 iterations left the relative residual at 1");
+  expect_failure(
+      r, "gmres: stagnation: a restart cycle of 1 iterations left the relative residual at 1");
   EXPECT_LT(r.iterations, 5);  // stopped at once, not after max_iterations
 }
 
 TEST(Gmres, TooFewIterationsIsNamed) {
   std::srand(4);
-  const Eigen::MatrixXd M = Eigen::MatrixXd::Random(30, 30) + 5.0 * Eigen::MatrixXd::Identity(30, 30);
+  const Eigen::MatrixXd M =
+      Eigen::MatrixXd::Random(30, 30) + 5.0 * Eigen::MatrixXd::Identity(30, 30);
   Eigen::VectorXd x;
   GmresOptions options;
   options.max_iterations = 3;
@@ -58,15 +61,19 @@ TEST(Gmres, TooFewIterationsIsNamed) {
 
 TEST(Gmres, BreakdownAndNonFiniteValuesAreNamed) {
   Eigen::VectorXd x;
-  const LinearOperator zero = [](const Eigen::VectorXd& v) { return Eigen::VectorXd(Eigen::VectorXd::Zero(v.size())); };
+  const LinearOperator zero = [](const Eigen::VectorXd& v) {
+    return Eigen::VectorXd(Eigen::VectorXd::Zero(v.size()));
+  };
   expect_failure(gmres(zero, identity, Eigen::Vector3d(1, 2, 3), x, {}), "gmres: breakdown");
   const LinearOperator poisoned = [](const Eigen::VectorXd& v) {
-    return Eigen::VectorXd(Eigen::VectorXd::Constant(v.size(), std::numeric_limits<double>::quiet_NaN()));
+    return Eigen::VectorXd(
+        Eigen::VectorXd::Constant(v.size(), std::numeric_limits<double>::quiet_NaN()));
   };
   x.resize(0);
   expect_failure(gmres(identity, poisoned, Eigen::Vector3d(1, 2, 3), x, {}), "gmres: breakdown");
   x = Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0, 0);  // a poisoned start
-  expect_failure(gmres(identity, identity, Eigen::Vector3d(1, 2, 3), x, {}), "gmres: the residual is not finite");
+  expect_failure(gmres(identity, identity, Eigen::Vector3d(1, 2, 3), x, {}),
+                 "gmres: the residual is not finite");
 }
 
 }  // namespace

@@ -13,9 +13,9 @@
 #include "model/fiber_system.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
+#include "model/reference/dense_assembly.hpp"
 #include "solve/load_stepper.hpp"
 #include "test_support.hpp"
-#include "model/reference/dense_assembly.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -26,9 +26,8 @@ using model::BoundaryMethod;
 
 model::Model mesh_model(const char* file, const char* support) {
   model::Model m;
-  m.surface = geom::remove_unused_vertices(
-                  geom::read_surface(testing::data_mesh(file)).surface)
-                  .surface;
+  m.surface =
+      geom::remove_unused_vertices(geom::read_surface(testing::data_mesh(file)).surface).surface;
   m.material.law = model::FiberLaw::constant(5000.0);
   m.material.surface_tension = 20.0;
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space(support, 3)))
@@ -192,8 +191,8 @@ TEST(BackendFailures, PcgWithoutConvergence) {
 }
 
 TEST(BackendFailures, PcgNamesNonFiniteValues) {
-  const Eigen::MatrixXd K = 4.0 * Eigen::MatrixXd::Identity(20, 20) +
-                            Eigen::MatrixXd::Constant(20, 20, 0.1);
+  const Eigen::MatrixXd K =
+      4.0 * Eigen::MatrixXd::Identity(20, 20) + Eigen::MatrixXd::Constant(20, 20, 0.1);
   PcgOptions pcg;
   auto solve_with = [&](const Eigen::MatrixXd& block, const Eigen::VectorXd& rhs) {
     const model::DenseBorderedSystem system({block}, Eigen::VectorXd::Ones(20));
@@ -211,14 +210,15 @@ TEST(BackendFailures, PcgNamesNonFiniteValues) {
   // A right-hand side near the largest double: its inner products overflow.
   const std::string message = solve_with(K, 1e300 * Eigen::VectorXd::Ones(21));
   EXPECT_NE(message.find("pcg: a product with the matrix is not finite at iteration 1"),
-            std::string::npos) << message;
+            std::string::npos)
+      << message;
 }
 
 TEST(BackendFailures, SingularSetupForEveryBackend) {
   model::Model m = testing::paper_sphere_model();
   m.constraints.clear();
-  for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod,
-                          SolverKind::PCG})
+  for (SolverKind kind :
+       {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod, SolverKind::PCG})
     expect_failure(run(m, kind), "no supports");
 }
 
@@ -237,8 +237,8 @@ TEST(EveryBackend, SolvesAnyBorderedSystem) {
     EXPECT_EQ(system.blocks_equal(), equal);
     const Eigen::VectorXd rhs = Eigen::VectorXd::Random(91);
     const Eigen::VectorXd expected = system.dense_matrix().partialPivLu().solve(rhs);
-    for (SolverKind kind : {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod,
-                            SolverKind::PCG}) {
+    for (SolverKind kind :
+         {SolverKind::DenseLU, SolverKind::BlockCholesky, SolverKind::Cholmod, SolverKind::PCG}) {
       PcgOptions pcg;
       pcg.tolerance = 1e-13;
       const auto solver = make_linear_solver(kind, pcg);

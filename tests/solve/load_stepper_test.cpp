@@ -11,8 +11,8 @@
 #include "model/equilibrium.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
-#include "solve/dense_lu.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "solve/dense_lu.hpp"
 
 namespace fiberfluid::solve {
 namespace {
@@ -72,7 +72,7 @@ TEST(LoadStepper, PaperRectangleWithPenaltyAsInThePaper) {
   const SteppingSummary s =
       solve_load_steps(testing::paper_rectangle_model(), options(1, BoundaryMethod::Penalty));
   ASSERT_TRUE(s.success) << s.message;
-  EXPECT_NEAR(15 + s.unknowns[0], 11.0, 1e-5);          // right corners at x = 11
+  EXPECT_NEAR(15 + s.unknowns[0], 11.0, 1e-5);            // right corners at x = 11
   EXPECT_NEAR(20 + s.unknowns[4], 25.0 + 1.0 / 3, 1e-5);  // top corners at y = 25.33
   EXPECT_NEAR(s.unknowns[8], 32.0, 1e-5);
   EXPECT_LT(std::abs(s.unknowns[2]), 1e-5);  // "fixed" only up to the penalty
@@ -84,7 +84,8 @@ Eigen::VectorXd eigen_reference_solution(const model::Model& m, const std::vecto
   const Eigen::MatrixXd A = model::reference::system_matrix(m, m.surface.V);
   const Eigen::VectorXd B = model::right_hand_side(m, m.surface.V, f);
   std::vector<char> fixed(static_cast<size_t>(m.num_unknowns()), 0);
-  for (const model::Constraint& c : m.constraints) fixed[static_cast<size_t>(m.dof(c.vertex, c.axis))] = 1;
+  for (const model::Constraint& c : m.constraints)
+    fixed[static_cast<size_t>(m.dof(c.vertex, c.axis))] = 1;
   std::vector<int> free;
   for (int d = 0; d < m.num_unknowns(); ++d)
     if (!fixed[static_cast<size_t>(d)]) free.push_back(d);
@@ -318,7 +319,8 @@ TEST(Reactions, PaperRectangleSupportsCarryTheAppliedForce) {
   // model.md section 8 by hand: the rows of v3 and v2 in y give
   // -84 (16/3) - 105 (16/3) - 21 (32) = -1680 each; v3's x row gives 0.
   for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
-    const SteppingSummary s = solve_load_steps(testing::paper_rectangle_model(), options(1, method));
+    const SteppingSummary s =
+        solve_load_steps(testing::paper_rectangle_model(), options(1, method));
     ASSERT_TRUE(s.success) << s.message;
     EXPECT_NEAR(s.reaction_forces(2, 1), -1680.0, 1e-9);
     EXPECT_NEAR(s.reaction_forces(1, 1), -1680.0, 1e-9);
@@ -341,8 +343,8 @@ TEST(Reactions, AgreeWithTheDenseAssemblyRows) {
   const Eigen::VectorXd residual = model::reference::linear_residual(m, s.unknowns, {1.0, 1.0});
   double largest = 0.0;
   for (const model::Constraint& c : m.constraints)
-    largest = std::max(largest, std::abs(s.reaction_forces(c.vertex, c.axis) -
-                                         residual[m.dof(c.vertex, c.axis)]));
+    largest = std::max(
+        largest, std::abs(s.reaction_forces(c.vertex, c.axis) - residual[m.dof(c.vertex, c.axis)]));
   EXPECT_LT(largest, 1e-9 * s.reaction_forces.cwiseAbs().maxCoeff());
 }
 

@@ -7,8 +7,8 @@
 
 #include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
-#include "model/model_fixtures.hpp"
 #include "model/equilibrium.hpp"
+#include "model/model_fixtures.hpp"
 #include "solve/load_stepper.hpp"
 #include "solve/tangent_solve.hpp"
 
@@ -121,8 +121,10 @@ TEST(Newton, FinalTangentGivesParameterSensitivities) {
       ASSERT_TRUE(s.final_tangent->solve_full(-dR, &du).ok);
       auto solve_with = [&](double delta) {
         model::Model changed = m;
-        if (name == "gamma") changed.material.surface_tension += delta;
-        else changed.material.law.set_parameter(name, 5.0 + delta);
+        if (name == "gamma")
+          changed.material.surface_tension += delta;
+        else
+          changed.material.law.set_parameter(name, 5.0 + delta);
         SteppingOptions plain = newton(2);
         plain.newton.residual_tolerance = 1e-13;
         return solve_load_steps(changed, plain).unknowns;
@@ -144,15 +146,19 @@ TEST(Newton, SensitivitiesAtChosenStepsMatchFiniteDifferences) {
   for (size_t p = 0; p < names.size(); ++p) {
     auto states_with = [&](double delta) {
       model::Model changed = m;
-      if (names[p] == "gamma") changed.material.surface_tension += delta;
-      else if (names[p] == "factor_z") changed.material.axis_factors.z() += delta;
-      else changed.material.law.set_parameter(names[p],
-                                              changed.material.law.parameter(names[p]) + delta);
+      if (names[p] == "gamma")
+        changed.material.surface_tension += delta;
+      else if (names[p] == "factor_z")
+        changed.material.axis_factors.z() += delta;
+      else
+        changed.material.law.set_parameter(names[p],
+                                           changed.material.law.parameter(names[p]) + delta);
       SteppingOptions plain = newton(3);
       plain.newton.residual_tolerance = 1e-13;
       std::vector<Eigen::VectorXd> states;
       const SteppingSummary run = solve_load_steps(
-          changed, plain, [&](const StepRecord&, const Eigen::VectorXd& x) { states.push_back(x); });
+          changed, plain,
+          [&](const StepRecord&, const Eigen::VectorXd& x) { states.push_back(x); });
       EXPECT_TRUE(run.success) << run.message;
       return states;
     };
@@ -230,7 +236,8 @@ TEST(Newton, ADivergingStepIsAStatusNamingTheStepWithFiniteUnknowns) {
     // Far from equilibrium the tangent itself becomes singular: named, with its condition.
     EXPECT_NE(s.message.find("newton: the tangent: the system matrix is numerically singular "
                              "(reciprocal condition "),
-              std::string::npos) << s.message;
+              std::string::npos)
+        << s.message;
   }
 }
 
@@ -294,7 +301,8 @@ TEST(Newton, ThePredictorSavesIterationsAndKeepsTheAnswer) {
     without.newton.predictor = false;
     const SteppingSummary a = solve_load_steps(m, with), b = solve_load_steps(m, without);
     ASSERT_TRUE(a.success && b.success) << a.message << b.message;
-    EXPECT_LT(displacement_norm(m, a.unknowns - b.unknowns), 1e-9 * displacement_norm(m, b.unknowns))
+    EXPECT_LT(displacement_norm(m, a.unknowns - b.unknowns),
+              1e-9 * displacement_norm(m, b.unknowns))
         << name;
     EXPECT_LT(a.newton_iterations, b.newton_iterations) << name;
     if (!m.paddles.empty()) {

@@ -4,10 +4,10 @@
 #include <string>
 
 #include "geom/area_vectors.hpp"
-#include "geom/error.hpp"
 #include "model/assembly.hpp"
 #include "model/fiber_network.hpp"
 #include "model/pair_stencil.hpp"
+#include "util/error.hpp"
 
 namespace fiberfluid::model::reference {
 namespace {
@@ -42,7 +42,8 @@ FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd
     factors.row(i, h.data());
     for (int j = i + 1; j < n; ++j)
       if (h[static_cast<size_t>(j)] != 0.0)
-        add_fiber(out.bulk, i, j, bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
+        add_fiber(out.bulk, i, j,
+                  bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
   }
   out.surface = Eigen::MatrixXd(surface_tension_laplacian(X, area, edges));
   return out;
@@ -105,7 +106,8 @@ void reduce_system(const DofPartition& partition, const Eigen::VectorXd& values,
   A_free.resize(nf, nf);
   for (Eigen::Index c = 0; c < nf; ++c)
     for (Eigen::Index r = 0; r < nf; ++r)
-      A_free(r, c) = A(partition.free[static_cast<size_t>(r)], partition.free[static_cast<size_t>(c)]);
+      A_free(r, c) =
+          A(partition.free[static_cast<size_t>(r)], partition.free[static_cast<size_t>(c)]);
   B_free = reduce_rhs(partition, values, A, B);
 }
 

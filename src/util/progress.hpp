@@ -13,8 +13,8 @@ namespace fiberfluid {
 // ProgressLabel); phase: "pruning", "factorize", "pcg iteration", "step",
 // "variants"; done of total in the phase's own unit (total 0 when it is not
 // known; done 0 and total 0: the phase has begun).
-using ProgressSink = std::function<void(const std::string& label, const char* phase,
-                                        double done, double total)>;
+using ProgressSink =
+    std::function<void(const std::string& label, const char* phase, double done, double total)>;
 
 // Install before starting work; the sink must be safe to call from several
 // threads at once (a sweep runs variants side by side). An empty sink stops it.

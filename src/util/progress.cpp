@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/progress.hpp"
+#include "util/progress.hpp"
 
 #include <utility>
 

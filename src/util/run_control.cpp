@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/run_control.hpp"
+#include "util/run_control.hpp"
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -55,11 +55,16 @@ bool parse_bytes(const std::string& text, double* bytes) {
   std::string unit(end);
   for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   double scale = 0.0;
-  if (unit.empty() || unit == "B") scale = 1.0;
-  else if (unit == "K" || unit == "KB" || unit == "KIB") scale = 1024.0;
-  else if (unit == "M" || unit == "MB" || unit == "MIB") scale = 1024.0 * 1024.0;
-  else if (unit == "G" || unit == "GB" || unit == "GIB") scale = 1024.0 * 1024.0 * 1024.0;
-  else if (unit == "T" || unit == "TB" || unit == "TIB") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  if (unit.empty() || unit == "B")
+    scale = 1.0;
+  else if (unit == "K" || unit == "KB" || unit == "KIB")
+    scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MIB")
+    scale = 1024.0 * 1024.0;
+  else if (unit == "G" || unit == "GB" || unit == "GIB")
+    scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T" || unit == "TB" || unit == "TIB")
+    scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
   if (scale == 0.0 || !std::isfinite(value * scale)) return false;
   *bytes = value * scale;
   return true;

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// What both steppers share: the checks before a run and after every step,
+// the options' validation and names, and the summary's report. Its own file
+// so that newton_stepper.cpp does not call into load_stepper.cpp (which
+// hands the Newton scheme to it).
+#include "solve/stepping_common.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "geom/area_vectors.hpp"
+#include "model/boundary_conditions.hpp"
+#include "solve/linear_solver.hpp"
+
+namespace fiberfluid::solve {
+
+// Why the state reached after a step is a runaway rather than a result, or "".
+std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
+                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
+                           double reference_volume, const Eigen::MatrixXd& reference_face_areas) {
+  if (!unknowns.allFinite()) return "the solution (displacements or pressure) is not finite";
+  if (options.stop_on_inverted_faces) {
+    const Eigen::MatrixXd now = geom::face_area_vectors(X, model.surface.F);
+    for (Eigen::Index f = 0; f < now.rows(); ++f)
+      if (now.row(f).dot(reference_face_areas.row(f)) <= 0.0)
+        return "face " + std::to_string(f) +
+               " turned over (its normal reversed): the load is too large for the material";
+  }
+  const double change = (volume - reference_volume) / reference_volume;
+  if (!std::isfinite(change) || std::abs(change) > options.max_volume_change) {
+    std::ostringstream out;
+    out << "the enclosed volume changed by " << 100.0 * change << "% (limit "
+        << 100.0 * options.max_volume_change
+        << "%, stepping.max_volume_change): the load is too large for the material";
+    return out.str();
+  }
+  return {};
+}
+
+std::string treecode_problem(const model::Model& model, const SteppingOptions& options) {
+  if (!(model.treecode_tolerance > 0.0)) return {};
+  const std::string what = "the treecode product (treecode_tolerance) ";
+  if (!(model.treecode_tolerance >= 1e-10 && model.treecode_tolerance <= 1e-2))
+    return what + "takes a relative error from 1e-10 to 1e-2, got " +
+           std::to_string(model.treecode_tolerance);
+  if (options.scheme != Scheme::Incremental)
+    return what +
+           "approximates the incremental scheme's linear product; Newton's tangent is "
+           "exact (the incremental scheme)";
+  if (!model.material.law.is_constant()) return what + "needs a linear material (a constant law)";
+  if (options.solver != SolverKind::Auto && options.solver != SolverKind::PCG)
+    return what + "is matrix-free: it goes with the pcg solver, not " +
+           std::string(to_string(options.solver));
+  return {};
+}
+
+SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
+                            double budget_bytes) {
+  if (model.treecode_tolerance > 0.0) return SolverKind::PCG;  // the only matrix-free backend
+  return choose_solver(largest_block, factors, budget_bytes);
+}
+
+std::string setup_problem(const model::Model& model, const SteppingOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) return why;
+  why = treecode_problem(model, options);
+  if (!why.empty()) return why;
+  return model::singular_setup_reason(model);
+}
+
+bool SteppingOptions::IsValid(std::string* why) const {
+  if (steps < 1) return *why = "steps must be at least 1", false;
+  if (!(penalty > 0.0) || !std::isfinite(penalty))
+    return *why = "penalty must be a positive number", false;
+  if (!(pcg.tolerance > 0.0) || pcg.max_iterations < 1)
+    return *why = "pcg tolerance must be positive and max_iterations at least 1", false;
+  if (!(max_volume_change > 0.0)) return *why = "max_volume_change must be positive", false;
+  if (!sensitivities.parameters.empty()) {
+    if (scheme != Scheme::Newton)
+      return *why =
+                 "sensitivities need the Newton scheme (the incremental one has no tangent "
+                 "at equilibrium)",
+             false;
+    for (int k : sensitivities.steps)
+      if (k < 1 || k > steps)
+        return *why = "sensitivities at step " + std::to_string(k) + ": expected 1.." +
+                      std::to_string(steps),
+               false;
+  }
+  return scheme != Scheme::Newton || newton.IsValid(why);
+}
+
+bool NewtonOptions::IsValid(std::string* why) const {
+  if (!(residual_tolerance > 0.0) || !(increment_tolerance > 0.0) || !(krylov_tolerance > 0.0))
+    return *why = "newton tolerances must be positive", false;
+  if (max_iterations < 1 || max_step_cuts < 0 || krylov_restart < 1 || krylov_max_iterations < 1 ||
+      max_contact_rounds < 1)
+    return *why = "newton iteration limits must be at least 1 (max_step_cuts at least 0)", false;
+  return true;
+}
+
+const char* to_string(Scheme scheme) { return scheme == Scheme::Newton ? "newton" : "incremental"; }
+
+const char* to_string(TangentSolver solver) {
+  switch (solver) {
+    case TangentSolver::Auto:
+      return "auto";
+    case TangentSolver::Dense:
+      return "dense";
+    case TangentSolver::Krylov:
+      return "krylov";
+  }
+  return "?";
+}
+
+TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns) {
+  if (requested != TangentSolver::Auto) return requested;
+  return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
+}
+
+std::string SteppingSummary::BriefReport() const {
+  std::ostringstream out;
+  out << (success ? "success" : "failure") << ": ";
+  if (scheme == Scheme::Newton) {
+    out << "newton (" << to_string(tangent);
+    if (tangent == TangentSolver::Krylov) out << ", preconditioner " << to_string(solver);
+    out << "), " << steps.size() << " steps, " << newton_iterations << " newton iterations";
+    if (tangent == TangentSolver::Krylov)
+      out << ", " << krylov_iterations << " gmres iterations, " << factorizations
+          << " preconditioner factorizations";
+  } else {
+    out << to_string(solver) << ", " << steps.size() << " steps, " << factorizations
+        << " factorizations";
+  }
+  if (solver == SolverKind::PCG) out << ", " << solver_statistics.iterations << " pcg iterations";
+  out << ", " << total_seconds << " s";
+  if (!success) out << ": " << message;
+  return out.str();
+}
+
+}  // namespace fiberfluid::solve
