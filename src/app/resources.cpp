@@ -10,6 +10,7 @@
 
 #include "app/case_spec.hpp"
 #include "model/treecode.hpp"
+#include "solve/cost_model.hpp"
 #include "util/error.hpp"
 #include "util/run_control.hpp"
 
@@ -30,7 +31,6 @@ double treecode_product_seconds(double N, double tolerance) {
 // Typical counts where the work depends on the data (scripts/resources.sh:
 // the sphere's load steps and Newton steps): PCG iterations per solve, Newton
 // iterations per load step, GMRES products per Newton iteration.
-constexpr double kPcgIterations = 15.0;
 constexpr double kNewtonIterations = 2.5;
 constexpr double kKrylovProducts = 6.0;
 // The process itself (libraries, CGAL, OpenMP pools) and each vertex's
@@ -38,39 +38,8 @@ constexpr double kKrylovProducts = 6.0;
 constexpr double kProcessBytes = 20.0 * 1024 * 1024;
 constexpr double kBytesPerVertex = 1024.0;
 
-// The axis blocks of the structured system as the solvers see them
-// (FiberSystem): per axis the vertices not held by a support, or all of them
-// with the penalty method; equal when every axis holds the same vertices
-// with the same axis factor, so one factor serves all.
-struct Blocks {
-  double largest = 0.0;
-  int factors = 1;
-  int newton_unknowns = 1;  // the supports eliminated (as Newton always does), then P
-};
-
-Blocks axis_blocks(const model::Model& m, const solve::SteppingOptions& o) {
-  const int n = m.num_vertices(), dim = m.dim();
-  std::vector<std::vector<bool>> supported(static_cast<size_t>(dim),
-                                           std::vector<bool>(static_cast<size_t>(n)));
-  for (const model::Constraint& c : m.constraints)
-    supported[static_cast<size_t>(c.axis)][static_cast<size_t>(c.vertex)] = true;
-  // The penalty method keeps the supported vertices in the blocks.
-  const bool eliminated = o.boundary_method == model::BoundaryMethod::Elimination;
-  Blocks b;
-  bool equal = true;
-  for (int a = 0; a < dim; ++a) {
-    const auto& s = supported[static_cast<size_t>(a)];
-    const int free = static_cast<int>(std::count(s.begin(), s.end(), false));
-    b.newton_unknowns += free;
-    b.largest = std::max(b.largest, static_cast<double>(eliminated ? free : n));
-    // As FiberSystem::blocks_equal: the same supports (eliminated or penalised) and factor.
-    equal = equal && s == supported[0] && m.material.axis_factors[a] == m.material.axis_factors[0];
-  }
-  b.factors = equal ? 1 : dim;
-  return b;
-}
-
-solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o, const Blocks& b) {
+solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
+                         const solve::BlockShape& b) {
   if (o.solver != solve::SolverKind::Auto) return o.solver;
   return solve::automatic_solver(m, b.largest, b.factors, memory_budget_bytes());
 }
@@ -122,8 +91,7 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
     e.parts.push_back({"pruning", N * N + 12000.0 * surface.num_faces(),
                        pairs / speed.prune_pairs_per_second, true});
 
-  const Blocks blocks = axis_blocks(model, o);
-  const double n = blocks.largest, factors = blocks.factors;
+  const solve::BlockShape blocks = solve::block_shape(model, o.boundary_method);
   const double product = model.treecode_tolerance > 0.0  // K v, every axis block
                              ? treecode_product_seconds(N, model.treecode_tolerance)
                              : d * pairs / speed.pair_updates_per_second;
@@ -137,34 +105,10 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)
-  // and one solve with it.
-  ResourcePart factor{"factorisation", 0.0, 0.0};
-  double solve_seconds = 0.0;
-  const double m = d * n + 1.0;  // the reduced unknowns
-  switch (kind) {
-    case solve::SolverKind::DenseLU:  // the assembled matrix, factored in a copy
-      factor.bytes = 1.2 * 8.0 * m * m;
-      factor.seconds = 2.0 / 3.0 * m * m * m / speed.factor_flops_per_second + product;
-      solve_seconds = 2.0 * m * m / speed.triangular_flops_per_second;
-      break;
-    case solve::SolverKind::BlockCholesky:
-      factor.bytes = 8.0 * n * n * factors;
-      factor.seconds = factors * n * n * n / 3.0 / speed.factor_flops_per_second + product;
-      // The Schur complement's solves and each step's: forward and back per axis.
-      solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;
-      break;
-    case solve::SolverKind::Cholmod:  // dense bulk blocks: every pair a nonzero
-      factor.bytes = factors * (12.0 * n * n + 4.0 * n * n);
-      factor.seconds = factors * n * n * n / 3.0 / speed.sparse_flops_per_second + product;
-      solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;
-      break;
-    case solve::SolverKind::PCG:  // the bulk diagonal and the surface Laplacian's sparse factor
-    case solve::SolverKind::Auto:
-      factor.bytes = 500.0 * N;
-      factor.seconds = product;
-      solve_seconds = (kPcgIterations + 1.0) * product;
-      break;
-  }
+  // and one solve with it: the backend's own cost model.
+  const solve::BackendCost cost = solve::backend_cost(kind, blocks, product, speed);
+  ResourcePart factor{"factorisation", cost.factor_bytes, cost.factor_seconds};
+  const double solve_seconds = cost.solve_seconds;
 
   if (newton) {
     const double iterations = steps * kNewtonIterations;

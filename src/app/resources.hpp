@@ -9,26 +9,15 @@
 #include <vector>
 
 #include "model/model.hpp"
+#include "solve/cost_model.hpp"
 #include "solve/load_stepper.hpp"
 
 namespace fiberfluid::app {
 
 struct CaseSpec;  // case_spec.hpp, which keeps an estimate in each Case
 
-// This machine's speed for the kernels the estimate counts (Release build,
-// both cores), from scripts/resources.sh on this 2-core machine: rerun it
-// and put the figures here on another machine.
-struct KernelSpeed {
-  double prune_pairs_per_second = 6e5;        // pruning: 5,000-vertex torus, 12.5M pairs in 21 s
-                                              // (the bunny's 930k: 0.75 s)
-  double orientation_tests_per_second = 4e9;  // the convexity check, counted as N x F tests
-                                              // (clusters culled: 10,242 vertices in 0.054 s)
-  double factor_flops_per_second = 6.5e10;    // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
-  double triangular_flops_per_second = 1e10;  // solves with a dense factor (memory-bound)
-  double pair_updates_per_second = 4.5e9;     // one fiber pair in one axis block's product (tiled)
-  double residual_pairs_per_second = 8e8;     // one ordered pair of the Newton residual (tiled)
-  double sparse_flops_per_second = 3e9;       // CHOLMOD on dense bulk blocks
-};
+// This machine's kernel speeds (solve/cost_model.hpp).
+using KernelSpeed = solve::KernelSpeed;
 
 struct ResourcePart {
   std::string name;    // "pruning", "factorisation", "10 load steps" ...

@@ -147,3 +147,32 @@ TEST(FiberSystem, PrescribedDisplacementsMoveToTheRightHandSide) {
 
 }  // namespace
 }  // namespace fiberfluid::model
+
+#include "solve/cost_model.hpp"
+
+namespace fiberfluid::model {
+namespace {
+
+// The cost model's block shape, from the model alone, is the structured
+// system's own: the same largest block and the same equal-blocks rule, for
+// supports on every axis, on one axis, per-axis factors and the penalty.
+TEST(FiberSystem, TheCostModelsBlockShapeIsTheSystems) {
+  Model all = testing::paper_sphere_model();
+  Model factors = all;
+  factors.material.axis_factors = {1.0, 2.0, 1.0};
+  Model partial = all;
+  partial.constraints.erase(std::remove_if(partial.constraints.begin(), partial.constraints.end(),
+                                           [](const Constraint& c) { return c.axis == 2; }),
+                            partial.constraints.end());
+  partial.constraints.push_back({0, 2, 0.0, {}});
+  for (const Model* m : {&all, &factors, &partial})
+    for (BoundaryMethod method : {BoundaryMethod::Elimination, BoundaryMethod::Penalty}) {
+      const FiberSystem system(*m, m->surface.V, method, 1e9);
+      const solve::BlockShape shape = solve::block_shape(*m, method);
+      EXPECT_EQ(shape.largest, system.largest_block()) << to_string(method);
+      EXPECT_EQ(shape.factors == 1, system.blocks_equal()) << to_string(method);
+    }
+}
+
+}  // namespace
+}  // namespace fiberfluid::model
