@@ -1,18 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
-// A finite-element reference for any simulation on a closed 3D surface:
-// the body filled with linear tetrahedra (fem::tetrahedralize), the same
-// supports, prescribed displacements, point loads and gravity at their
-// final load factors, solved quasi-statically by linear elasticity. Its
-// deformed boundary is a target surface the calibration can fit
-// (fem_reference.obj), a model that no one tuned.
-//
-// The tetrahedral boundary approximates the surface. A boundary node is held
-// where the surface under it is held: when every vertex spanning its
-// closest surface point is held on that axis (interpolated values); a held
-// vertex that no node reached holds its nearest node. A point load acts on
-// the node nearest its vertex; gravity is a body force of the load's density.
+// The "fem_reference" section of an experiment: the FEM of the same case
+// (bridge/fem_bridge.hpp) and its comparison with the fiber model's run.
 
 #include <Eigen/Core>
 #include <map>

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// A finite-element reference for any simulation on a closed 3D surface:
+// the body filled with linear tetrahedra (fem::tetrahedralize), the same
+// supports, prescribed displacements, point loads and gravity at their
+// final load factors, solved quasi-statically by linear elasticity. Its
+// deformed boundary is a target surface the calibration can fit
+// (fem_reference.obj), a model that no one tuned.
+//
+// The tetrahedral boundary approximates the surface. A boundary node is held
+// where the surface under it is held: when every vertex spanning its
+// closest surface point is held on that axis (interpolated values); a held
+// vertex that no node reached holds its nearest node. A point load acts on
+// the node nearest its vertex; gravity is a body force of the load's density.
+
+#include <Eigen/Core>
+
+#include "fem/fem.hpp"
+#include "fem/tet_mesher.hpp"
+#include "geom/surface.hpp"
+#include "model/model.hpp"
+
+namespace fiberfluid::bridge {
+
+struct FemOfModel {
+  fem::Mesh mesh;                // the tetrahedra at rest
+  Eigen::MatrixXd displacement;  // per node
+  geom::Surface rest_boundary, deformed_boundary;
+  double mesh_seconds = 0.0, solve_seconds = 0.0;
+};
+
+// The FEM of a model's body with every load and prescribed value at its
+// factor after step `steps` of `steps`. Throws InputError for what it cannot
+// pose (a 2D surface, paddles, a load of an unknown kind, a singular setup).
+FemOfModel solve_fem_of_model(const model::Model& model, int steps, const fem::Material& material,
+                              const fem::TetMeshOptions& mesh_options);
+
+}  // namespace fiberfluid::bridge
