@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "model/terms.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -76,9 +77,19 @@ Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixX
   const Eigen::MatrixXi& F = ctx.model.surface.F;
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    // sum_v dA_f/dx_v w_v, then spread over the corners with their c_i.
+    // sum_v dA_f/dx_v w_v (face_area_derivative applied directly: in 3D
+    // sum_k (x_{k+2} - x_{k+1}) x w_k / 2, in 2D the rotated w_1 - w_0), then
+    // spread over the corners with their c_i.
     Eigen::Vector3d dA = Eigen::Vector3d::Zero();
-    for (int k = 0; k < F.cols(); ++k) dA += face_area_derivative(X, F, f, k) * row3(W, F(f, k));
+    if (X.cols() == 3) {
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d next = X.row(F(f, (k + 1) % 3)), after = X.row(F(f, (k + 2) % 3));
+        dA += 0.5 * (after - next).cross(row3(W, F(f, k)));
+      }
+    } else {
+      const Eigen::Vector3d dw = row3(W, F(f, 1)) - row3(W, F(f, 0));
+      dA = Eigen::Vector3d(dw.y(), -dw.x(), 0.0);
+    }
     for (int corner = 0; corner < F.cols(); ++corner)
       out.row(F(f, corner)) += ctx.C0 * c[F(f, corner)] * dA.transpose();
   }
@@ -385,6 +396,34 @@ void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::Matr
   });
 }
 
+namespace {
+
+// Row i of the bulk tangent times w from the stored coefficients c1, c2
+// (column i: the pairs (i, j)): sum_j the stencil's pair_tangent. The
+// row's own values are hoisted so that the loop over j vectorises.
+template <class K>
+void stored_product_row(int i, int n, const double* c1, const double* c2, const double* const x[3],
+                        const double* const d[3], const double* const w[3], double product[3]) {
+  const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *d0 = d[0], *d1 = d[1], *d2 = d[2];
+  const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
+  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], di0 = d0[i], di1 = d1[i], di2 = d2[i];
+  const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
+  double p0 = 0.0, p1 = 0.0, p2 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2)
+  for (int j = 0; j < n; ++j) {
+    const PairCoefficients c{c1[j], c2[j]};
+    const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
+    const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
+    const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+    p0 += pair_tangent<K>(c, v0, b_dot_v, b0, di0 - d0[j]);
+    p1 += pair_tangent<K>(c, v1, b_dot_v, b1, di1 - d1[j]);
+    p2 += pair_tangent<K>(c, v2, b_dot_v, b2, di2 - d2[j]);
+  }
+  product[0] = p0, product[1] = p1, product[2] = p2;
+}
+
+}  // namespace
+
 void BulkFiberTerm::add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
                                        const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2,
                                        const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
@@ -397,26 +436,14 @@ void BulkFiberTerm::add_stored_product(const Eigen::MatrixXd& X, const Eigen::Ma
     d[a] = a < dim ? U.col(a).data() : zeros.data();
     w[a] = a < dim ? W.col(a).data() : zeros.data();
   }
+  double* o = out.data();
   with_kinematics(c_.model.material.kinematics, [&](auto policy) {
     using K = decltype(policy);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      const double* c1 = C1.col(i).data();
-      const double* c2 = C2.col(i).data();
-      const auto u = static_cast<size_t>(i);
-      double p0 = 0.0, p1 = 0.0, p2 = 0.0;
-#pragma omp simd reduction(+ : p0, p1, p2)
-      for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
-        const PairCoefficients c{c1[j], c2[j]};
-        const double b0 = x[0][u] - x[0][j], b1 = x[1][u] - x[1][j], b2 = x[2][u] - x[2][j];
-        const double v0 = w[0][u] - w[0][j], v1 = w[1][u] - w[1][j], v2 = w[2][u] - w[2][j];
-        const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-        p0 += pair_tangent<K>(c, v0, b_dot_v, b0, d[0][u] - d[0][j]);
-        p1 += pair_tangent<K>(c, v1, b_dot_v, b1, d[1][u] - d[1][j]);
-        p2 += pair_tangent<K>(c, v2, b_dot_v, b2, d[2][u] - d[2][j]);
-      }
-      const double product[3] = {p0, p1, p2};
-      for (int a = 0; a < dim; ++a) out[a * n + i] += m[a] * product[a];
+      double product[3];
+      stored_product_row<K>(i, n, C1.col(i).data(), C2.col(i).data(), x, d, w, product);
+      for (int a = 0; a < dim; ++a) o[a * n + i] += m[a] * product[a];
     }
   });
 }
