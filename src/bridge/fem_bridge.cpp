@@ -7,6 +7,7 @@
 
 #include "fem/mesh_tools.hpp"
 #include "fit/target.hpp"
+#include "geom/area_vectors.hpp"
 #include "util/error.hpp"
 
 namespace fiberfluid::bridge {
@@ -20,16 +21,6 @@ int nearest_row(const Eigen::MatrixXd& points, const Eigen::RowVectorXd& p) {
   Eigen::Index best = 0;
   (points.rowwise() - p).rowwise().squaredNorm().minCoeff(&best);
   return static_cast<int>(best);
-}
-
-// Barycentric coordinates of p (in the triangle's plane) in triangle abc.
-Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d u = b - a, v = c - a, w = p - a;
-  const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), wu = w.dot(u), wv = w.dot(v);
-  const double det = uu * vv - uv * uv;
-  const double beta = (vv * wu - uv * wv) / det, gamma = (uu * wv - uv * wu) / det;
-  return {1.0 - beta - gamma, beta, gamma};
 }
 
 [[noreturn]] void fail(const std::string& what) { throw InputError(what); }
@@ -63,8 +54,8 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
     const fit::TargetDistance::Closest closest =
         surface.closest(Eigen::Vector3d(out.mesh.nodes.row(node)));
     const Eigen::Vector3i corners = m.surface.F.row(closest.primitive);
-    const Eigen::Vector3d weights =
-        barycentric(closest.point, V.row(corners[0]), V.row(corners[1]), V.row(corners[2]));
+    const Eigen::Vector3d weights = geom::barycentric_coordinates(
+        closest.point, V.row(corners[0]), V.row(corners[1]), V.row(corners[2]));
     for (int axis = 0; axis < 3; ++axis) {
       double value = 0.0;
       bool all = true;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "fit/optimizers.hpp"
+#include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
 #include "util/error.hpp"
 #include "util/run_control.hpp"
@@ -81,16 +82,6 @@ Eigen::Vector3d direction(const Eigen::Vector3d& q, const Eigen::Vector3d& c, co
   const Eigen::Vector3d a = target.points.row(t[0]), b = target.points.row(t[1]),
                         e = target.points.row(t[2]);
   return (b - a).cross(e - a).normalized();
-}
-
-// The barycentric coordinates of c in the triangle (a, b, e).
-Eigen::Vector3d barycentric(const Eigen::Vector3d& c, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& e) {
-  const Eigen::Vector3d u = b - a, v = e - a, w = c - a;
-  const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), wu = w.dot(u), wv = w.dot(v);
-  const double det = uu * vv - uv * uv;
-  const double s = (vv * wu - uv * wv) / det, t = (uu * wv - uv * wu) / det;
-  return {1.0 - s - t, s, t};
 }
 
 Eigen::Vector3d bounding_low(const Eigen::MatrixXd& P) {
@@ -429,9 +420,9 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
       // make_target keeps every vertex of a closed surface in order, so the
       // simulated triangle's corners are model vertices.
       const Eigen::Vector3i corners = simulated.triangles.row(hit.primitive).transpose();
-      const Eigen::Vector3d b =
-          barycentric(hit.point, X.row(corners[0]).transpose(), X.row(corners[1]).transpose(),
-                      X.row(corners[2]).transpose());
+      const Eigen::Vector3d b = geom::barycentric_coordinates(
+          hit.point, X.row(corners[0]).transpose(), X.row(corners[1]).transpose(),
+          X.row(corners[2]).transpose());
       if (S)
         for (int k = 0; k < 3; ++k)
           e.jacobian.row(row) -= b[k] * n.transpose() * vertex_sensitivity(*S, corners[k]);

@@ -31,4 +31,15 @@ double surface_area(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 // Signed enclosed volume (signed area in 2D); positive for outward faces.
 double enclosed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 
+// The barycentric coordinates of p (projected on the triangle's plane) in
+// the triangle (a, b, c): weights summing to 1 with p = w0 a + w1 b + w2 c.
+inline Eigen::Vector3d barycentric_coordinates(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                               const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d u = b - a, v = c - a, w = p - a;
+  const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), wu = w.dot(u), wv = w.dot(v);
+  const double det = uu * vv - uv * uv;
+  const double s = (vv * wu - uv * wv) / det, t = (uu * wv - uv * wu) / det;
+  return {1.0 - s - t, s, t};
+}
+
 }  // namespace fiberfluid::geom

@@ -8,17 +8,14 @@
 #include "util/error.hpp"
 
 namespace fiberfluid::model {
-namespace {
 
-double fiber_length(const Eigen::MatrixXd& X, int i, int j) {
+double checked_fiber_length(const Eigen::MatrixXd& X, int i, int j) {
   const double length = (X.row(i) - X.row(j)).norm();
   if (!(length > 0.0))
     throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(j) +
                      " coincide: the fiber between them has zero length");
   return length;
 }
-
-}  // namespace
 
 const char* to_string(ConnectionCount count) {
   return count == ConnectionCount::Global ? "global" : "symmetric";
@@ -61,7 +58,7 @@ Eigen::SparseMatrix<double> surface_tension_laplacian(const Eigen::MatrixXd& X,
   entries.reserve(static_cast<size_t>(4 * edges.rows()));
   for (Eigen::Index e = 0; e < edges.rows(); ++e) {
     const int i = edges(e, 0), k = edges(e, 1);
-    fiber_length(X, i, k);  // throws for coincident ends
+    checked_fiber_length(X, i, k);  // throws for coincident ends
     const double w = surface_weight(area[i], area[k], (X.row(i) - X.row(k)).squaredNorm());
     entries.insert(entries.end(), {{i, i, w}, {k, k, w}, {i, k, -w}, {k, i, -w}});
   }

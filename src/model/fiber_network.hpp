@@ -30,6 +30,10 @@ class PairFactors {
   double global_ = 0.0;       // the count for ConnectionCount::Global or a full body
 };
 
+// |x_i - x_j|; throws InputError naming both when they coincide (a fiber of
+// zero length).
+double checked_fiber_length(const Eigen::MatrixXd& X, int i, int j);
+
 // The surface-tension Laplacian gamma-free (paper Eq. 7), sparse: weight
 // (|S_i| + |S_k|) / (2 |x_i - x_k|^2) on every mesh edge (i, k). The one
 // builder of it (the linear system, Newton's equilibrium, the oracle).

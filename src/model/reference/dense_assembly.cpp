@@ -19,14 +19,6 @@ void add_fiber(Eigen::MatrixXd& L, int i, int j, double weight) {
   L(j, i) -= weight;
 }
 
-double fiber_length(const Eigen::MatrixXd& X, int i, int j) {
-  const double length = (X.row(i) - X.row(j)).norm();
-  if (!(length > 0.0))
-    throw InputError("vertices " + std::to_string(i) + " and " + std::to_string(j) +
-                     " coincide: the fiber between them has zero length");
-  return length;
-}
-
 }  // namespace
 
 FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
@@ -43,7 +35,8 @@ FiberLaplacians fiber_laplacians(const Eigen::MatrixXd& X, const Eigen::VectorXd
     for (int j = i + 1; j < n; ++j)
       if (h[static_cast<size_t>(j)] != 0.0)
         add_fiber(out.bulk, i, j,
-                  bulk_weight(h[static_cast<size_t>(j)], area[i], area[j], fiber_length(X, i, j)));
+                  bulk_weight(h[static_cast<size_t>(j)], area[i], area[j],
+                              checked_fiber_length(X, i, j)));
   }
   out.surface = Eigen::MatrixXd(surface_tension_laplacian(X, area, edges));
   return out;
