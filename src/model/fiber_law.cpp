@@ -18,6 +18,11 @@ void LawModel::evaluate(const double* p, const double* strain, size_t n, double*
   }
 }
 
+void LawModel::evaluate_derivative(const double* p, int k, const double* strain, size_t n,
+                                   double* dY) const {
+  for (size_t j = 0; j < n; ++j) dY[j] = modulus_derivative(p, k, strain[j]);
+}
+
 namespace {
 
 std::string finite_parameters(const LawModel& law, const double* p) {

@@ -29,6 +29,10 @@ class LawModel {
   // Y and dY/de at n strains (a loop over modulus and slope unless overridden).
   virtual void evaluate(const double* p, const double* strain, size_t n, double* Y,
                         double* Yp) const;
+  // dY/dp_k at n strains (a loop over modulus_derivative unless overridden):
+  // one call per row of pairs, not one per pair.
+  virtual void evaluate_derivative(const double* p, int k, const double* strain, size_t n,
+                                   double* dY) const;
   // "" when the law is usable, else why not, naming the parameter. The
   // default: every parameter finite, and Y positive and finite at 65 strains
   // spread over [lowest, highest].
@@ -95,6 +99,10 @@ class FiberLaw {
   }
   double modulus_derivative(const std::string& name, double strain) const {
     return modulus_derivative(parameter_index(name), strain);
+  }
+  // dY/dtheta at n strains, for the parameter at `index`.
+  void evaluate_derivative(int index, const double* strain, size_t n, double* dY) const {
+    model_->evaluate_derivative(p(), index, strain, n, dY);
   }
 
   // "" when the law is usable, else why not (naming the parameter): a

@@ -303,8 +303,8 @@ struct Columns {
 
 // One row's pair state for dR/dtheta: h, L, r, strain, Y, Y' for every j.
 struct RowState {
-  std::vector<double> h, L, r, e, Y, Yp;
-  explicit RowState(size_t n) : h(n), L(n), r(n), e(n), Y(n), Yp(n) {}
+  std::vector<double> h, L, r, e, Y, Yp, dY;
+  explicit RowState(size_t n) : h(n), L(n), r(n), e(n), Y(n), Yp(n), dY(n) {}
 };
 
 void fill_row(const TermContext& c, int i, const Columns& col, RowState& row) {
@@ -466,6 +466,7 @@ void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialP
 #pragma omp for schedule(dynamic, 16)
       for (int i = 0; i < n; ++i) {
         fill_row(c_, i, col, row);
+        if (axis < 0) law.evaluate_derivative(p.index, row.e.data(), row.e.size(), row.dY.data());
         const auto u = static_cast<size_t>(i);
         double sum[3] = {0.0, 0.0, 0.0};
         for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
@@ -473,7 +474,7 @@ void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialP
           const double a =
               bulk_weight(row.h[j], c_.area0[i], c_.area0[static_cast<Eigen::Index>(j)], row.L[j]);
           const PairCoefficients pc = K::coefficients(a, row.Y[j], row.Yp[j], row.r[j], row.L[j]);
-          const double dY = axis >= 0 ? 0.0 : law.modulus_derivative(p.index, row.e[j]);
+          const double dY = axis >= 0 ? 0.0 : row.dY[j];
           for (int k = 0; k < 3; ++k) {
             const double b = col.x[k][u] - col.x[k][j], d = col.u[k][u] - col.u[k][j];
             sum[k] += axis >= 0 ? pair_force<K>(pc, b, d)
