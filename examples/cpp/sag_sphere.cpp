@@ -2,8 +2,8 @@
 // Uses fiberfluid as a library: a soft sphere hanging from its cap, with the
 // experiment built in code rather than read from a file, swept over Y, and
 // the cap's reaction read back. Prints one line per variant.
-#include <fiberfluid/app/experiment.hpp>
-#include <fiberfluid/app/runner.hpp>
+#include <fiberfluid/experiment/experiment.hpp>
+#include <fiberfluid/experiment/runner.hpp>
 #include <fiberfluid/geom/area_vectors.hpp>
 
 #include <cstdio>
@@ -21,9 +21,10 @@ int main() {
       {"variants",
        {{{"name", "soft"}, {"material", {{"Y", 10000.0}}}},
         {{"name", "stiff"}, {"material", {{"Y", 40000.0}}}}}}};
-  const fiberfluid::app::Experiment ex =
-      fiberfluid::app::parse_experiment(document, ".", "in code");
-  const fiberfluid::app::ExperimentResult result = fiberfluid::app::run_experiment(ex);
+  const fiberfluid::experiment::Experiment ex =
+      fiberfluid::experiment::parse_experiment(document, ".", "in code");
+  const fiberfluid::experiment::ExperimentResult result =
+      fiberfluid::experiment::run_experiment(ex);
   for (size_t r = 0; r < result.runs.size(); ++r) {
     const auto& summary = result.runs[r].summary;
     if (!summary.success) {

@@ -13,7 +13,7 @@
 #include <iostream>
 #include <vector>
 
-#include "app/experiment.hpp"
+#include "experiment/experiment.hpp"
 #include "fit/calibration.hpp"
 #include "model/assembly.hpp"
 
@@ -28,8 +28,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(cli, argc, argv);
 
   const auto load_start = std::chrono::steady_clock::now();
-  const ff::app::Experiment ex = ff::app::load_experiment(experiment);
-  const ff::app::Case& c = ex.cases.front();
+  const ff::experiment::Experiment ex = ff::experiment::load_experiment(experiment);
+  const ff::experiment::Case& c = ex.cases.front();
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   std::printf(

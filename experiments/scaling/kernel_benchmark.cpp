@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "app/experiment.hpp"
+#include "experiment/experiment.hpp"
 #include "gemm_peak.hpp"
 #include "model/equilibrium.hpp"
 #include "model/fiber_system.hpp"
@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
   nlohmann::json config = nlohmann::json::parse(in);
   config["surface"]["subdivisions"] = subdivisions;
   config["expected"] = nlohmann::json::array();
-  const fiberfluid::app::Experiment ex =
-      fiberfluid::app::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
+  const fiberfluid::experiment::Experiment ex =
+      fiberfluid::experiment::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
   const fiberfluid::model::Model& model = ex.cases.front().model;
   const int n = model.num_vertices();
   const double ordered = static_cast<double>(n) * (n - 1), unordered = ordered / 2.0;

@@ -16,8 +16,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "app/experiment.hpp"
-#include "app/runner.hpp"
+#include "experiment/experiment.hpp"
+#include "experiment/runner.hpp"
 #include "gemm_peak.hpp"
 
 namespace {
@@ -83,11 +83,12 @@ int main(int argc, char** argv) {
       config["material"]["law"] = {{"type", "exponential"}, {"Y0", Y}, {"beta", beta}};
     }
   }
-  const fiberfluid::app::Experiment ex =
-      fiberfluid::app::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
+  const fiberfluid::experiment::Experiment ex =
+      fiberfluid::experiment::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
 
-  const fiberfluid::app::ExperimentResult result = fiberfluid::app::run_experiment(ex);
-  const fiberfluid::app::RunResult& run = result.runs.front();
+  const fiberfluid::experiment::ExperimentResult result =
+      fiberfluid::experiment::run_experiment(ex);
+  const fiberfluid::experiment::RunResult& run = result.runs.front();
   const auto& s = run.summary;
   double slowest_step = 0.0;
   for (const auto& step : s.steps) slowest_step = std::max(slowest_step, step.seconds);

@@ -15,12 +15,12 @@
 #include <optional>
 #include <thread>
 
-#include "app/compare.hpp"
-#include "app/experiment.hpp"
-#include "app/fitting.hpp"
-#include "app/output_folder.hpp"
-#include "app/outputs.hpp"
-#include "app/runner.hpp"
+#include "experiment/compare.hpp"
+#include "experiment/experiment.hpp"
+#include "experiment/fitting.hpp"
+#include "experiment/output_folder.hpp"
+#include "experiment/outputs.hpp"
+#include "experiment/runner.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "util/error.hpp"
@@ -29,7 +29,7 @@
 
 namespace {
 
-namespace app = fiberfluid::app;
+namespace experiment = fiberfluid::experiment;
 
 enum ExitCode {
   kOk = 0,
@@ -180,8 +180,8 @@ struct RunFlags {
 // Loads an experiment (throwing before anything is written), drawing the
 // progress of long phases such as pruning unless quiet; the sink stays set.
 // Estimates of long runs are printed before they start (as notes).
-app::Experiment load_showing_progress(const std::string& path, bool quiet,
-                                      ProgressPrinter& printer) {
+experiment::Experiment load_showing_progress(const std::string& path, bool quiet,
+                                             ProgressPrinter& printer) {
   if (!quiet) {
     fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
                                              double done,
@@ -191,7 +191,7 @@ app::Experiment load_showing_progress(const std::string& path, bool quiet,
       std::cerr << "note: " << (label.empty() ? "" : "[" + label + "] ") << text << "\n";
     });
   }
-  app::Experiment ex = app::load_experiment(path);
+  experiment::Experiment ex = experiment::load_experiment(path);
   printer.close();
   fiberfluid::set_note_sink({});
   for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
@@ -202,15 +202,15 @@ int run_command(const std::string& path, const RunFlags& flags) {
   fiberfluid::set_memory_budget(flags.max_memory);
   fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
-  const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
+  const experiment::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   if (ex.fit)
     std::cerr << "note: " << path << " has a \"fit\" section: `run` simulates at the starting "
               << "values; `fiberfluid fit` calibrates\n";
-  app::OutputWriter writer(ex, app::output_folder(flags.output, ex.name));
+  experiment::OutputWriter writer(ex, experiment::output_folder(flags.output, ex.name));
   writer.begin();
-  app::RunOptions options;
+  experiment::RunOptions options;
   options.jobs = flags.jobs;
-  const app::ExperimentResult result = app::run_experiment(
+  const experiment::ExperimentResult result = experiment::run_experiment(
       ex,
       [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
         writer.on_step(run, r, x);
@@ -223,8 +223,8 @@ int run_command(const std::string& path, const RunFlags& flags) {
   for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
-  if (ex.kind == app::Experiment::Kind::Simulate) {
-    const app::FiberReport& f = ex.cases.front().fibers;
+  if (ex.kind == experiment::Experiment::Kind::Simulate) {
+    const experiment::FiberReport& f = ex.cases.front().fibers;
     std::cout << "  fibers: " << f.kept << " kept of " << f.pairs << " ("
               << (!f.pruning ? "pruning off"
                   : f.convex ? "convex"
@@ -232,23 +232,23 @@ int run_command(const std::string& path, const RunFlags& flags) {
               << "; per vertex " << f.min_per_vertex << " / " << f.mean_per_vertex << " / "
               << f.max_per_vertex << "; " << f.seconds << " s)\n";
   }
-  for (const app::RunResult& run : result.runs)
+  for (const experiment::RunResult& run : result.runs)
     std::cout << "  " << (run.variant.empty() ? "run" : run.variant) << ": "
               << run.summary.BriefReport() << "\n";
   if (result.benchmark) {  // its many figures are in summary.json
-    std::cout << app::benchmark_report(*result.benchmark);
+    std::cout << experiment::benchmark_report(*result.benchmark);
   } else {
     for (const auto& [name, value] : result.figures)
       std::cout << "  " << name << " = " << value << "\n";
   }
-  for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
+  for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
 
   if (!result.failure.empty()) {
     std::cerr << "error: " << result.failure << "\n";
     return kSolverFailed;
   }
   if (!result.runs_succeeded()) {
-    for (const app::RunResult& run : result.runs)
+    for (const experiment::RunResult& run : result.runs)
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
@@ -324,14 +324,14 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   fiberfluid::set_memory_budget(flags.max_memory);
   fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
-  const app::Experiment ex = load_showing_progress(path, flags.quiet, printer);
+  const experiment::Experiment ex = load_showing_progress(path, flags.quiet, printer);
   fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
   const std::filesystem::path folder =
-      app::output_folder(flags.output, ex.name);  // refused now, not after the fit
+      experiment::output_folder(flags.output, ex.name);  // refused now, not after the fit
   std::vector<std::string> names;
   if (ex.fit)
     for (const auto& p : ex.fit->parameters) names.push_back(p.request.name);
-  const app::FitSetup setup = app::setup_fit(ex, [&](const fit::IterationRecord& r) {
+  const experiment::FitSetup setup = experiment::setup_fit(ex, [&](const fit::IterationRecord& r) {
     if (!flags.quiet) print_iteration(r, names);
   });
   for (const auto& t : setup.targets)
@@ -350,39 +350,41 @@ int fit_command(const std::string& path, const RunFlags& flags) {
             << ")\n";
   const fit::FitResult fitted = setup.calibration->run();
 
-  const app::Experiment at_fit = app::with_fitted_material(ex, *setup.calibration, fitted);
-  app::OutputWriter writer(at_fit, folder);
+  const experiment::Experiment at_fit =
+      experiment::with_fitted_material(ex, *setup.calibration, fitted);
+  experiment::OutputWriter writer(at_fit, folder);
   writer.begin();
   if (fitted.status == fit::FitStatus::Interrupted) {
-    const app::ExperimentResult none;
+    const experiment::ExperimentResult none;
     writer.keep_interrupted("the fit was interrupted after " +
                                 std::to_string(fitted.iterations.size()) +
                                 " iterations; fit.json holds the best point so far (continue "
                                 "with \"start_from\" in the fit section)",
                             [&](const std::filesystem::path& dir) {
-                              app::write_fit_files(dir, at_fit, setup, fitted, none);
+                              experiment::write_fit_files(dir, at_fit, setup, fitted, none);
                             });
     std::cerr
         << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
         << (writer.folder() / "fit.json").string() << " (continue with \"start_from\": \""
         << (writer.folder() / "fit.json").string() << "\" in the fit section)\n";
-    return app::fit_exit_status(fitted.status);
+    return experiment::fit_exit_status(fitted.status);
   }
-  app::ExperimentResult result;
+  experiment::ExperimentResult result;
   if (fitted.status != fit::FitStatus::StartFailed) {
-    result =
-        app::run_experiment(at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r,
-                                        const Eigen::VectorXd& x) { writer.on_step(run, r, x); });
+    result = experiment::run_experiment(
+        at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
+          writer.on_step(run, r, x);
+        });
     stop_if_interrupted("the run at the fitted values");
-    for (const auto& [name, value] : app::fit_figures(fitted)) result.figures[name] = value;
-    result.checks = app::check_expected(at_fit, result);
+    for (const auto& [name, value] : experiment::fit_figures(fitted)) result.figures[name] = value;
+    result.checks = experiment::check_expected(at_fit, result);
   }
-  if (!app::fit_result_kept(fitted.status))
+  if (!experiment::fit_result_kept(fitted.status))
     result.failure = std::string("the fit ended ") + fit::to_string(fitted.status) + ": " +
                      fitted.message +
                      (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
   writer.finish(result, [&](const std::filesystem::path& dir) {
-    app::write_fit_files(dir, at_fit, setup, fitted, result);
+    experiment::write_fit_files(dir, at_fit, setup, fitted, result);
   });
   for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
@@ -390,18 +392,18 @@ int fit_command(const std::string& path, const RunFlags& flags) {
             << "; results in " << writer.folder().string() << "\n";
   if (!fitted.status_detail.empty()) std::cout << "  " << fitted.status_detail << "\n";
   print_fit(fitted);
-  for (const app::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
+  for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
   if (!result.runs_succeeded()) {
-    for (const app::RunResult& run : result.runs)
+    for (const experiment::RunResult& run : result.runs)
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
   if (fitted.status == fit::FitStatus::ConvergedAtBounds)
     std::cerr << "warning: the fit converged on bounds: " << fitted.status_detail
               << ". A bound is no estimate: widen it, fix the parameter, or check the model\n";
-  else if (!app::fit_result_kept(fitted.status))
+  else if (!experiment::fit_result_kept(fitted.status))
     std::cerr << "error: " << result.failure << "\n";
-  if (const int status = app::fit_exit_status(fitted.status); status != kOk) return status;
+  if (const int status = experiment::fit_exit_status(fitted.status); status != kOk) return status;
   if (flags.check_expected && !result.checks_passed()) {
     std::cerr << "error: some expected figures were not met (see above)\n";
     return kChecksFailed;
@@ -411,13 +413,13 @@ int fit_command(const std::string& path, const RunFlags& flags) {
 
 int compare_command(const std::string& reference, const std::string& approximation,
                     const std::string& undeformed, bool as_json) {
-  const app::Comparison c = app::compare_files(
+  const experiment::Comparison c = experiment::compare_files(
       reference, approximation,
       undeformed.empty() ? std::nullopt : std::optional<std::filesystem::path>(undeformed));
   if (as_json)
-    std::cout << app::comparison_json(c).dump(2) << "\n";
+    std::cout << experiment::comparison_json(c).dump(2) << "\n";
   else
-    std::cout << app::comparison_text(c);
+    std::cout << experiment::comparison_text(c);
   return kOk;
 }
 

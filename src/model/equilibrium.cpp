@@ -66,23 +66,26 @@ std::vector<std::string> Equilibrium::term_names() const {
   return names;
 }
 
+Eigen::VectorXd Equilibrium::residual_of(EquilibriumTerm::Role role, const Eigen::VectorXd& x,
+                                         const std::vector<double>& factors) const {
+  const TermState s(context_, x, factors);
+  Eigen::VectorXd R = Eigen::VectorXd::Zero(num_unknowns());
+  if (bulk_.role() == role) bulk_.add_residual(s, R);
+  for (const auto& term : terms_)
+    if (term->role() == role) term->add_residual(s, R);
+  return R;
+}
+
 Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
-  const Eigen::MatrixXd X = positions(model_, x), U = displacements(model_, x);
-  const int dim = model_.dim();
-  const Eigen::Vector3d m = model_.material.axis_factors;
-  const Eigen::MatrixXd bulk = bulk_.forces(X, U);
-  Eigen::MatrixXd forces(model_.num_vertices(), dim);
-  for (int a = 0; a < dim; ++a) forces.col(a) = m[a] * bulk.col(a);
-  return forces + model_.material.surface_tension * (surface_ * U);
+  const std::vector<double> no_load(model_.loads.size(), 0.0);
+  const Eigen::VectorXd R = residual_of(EquilibriumTerm::Role::Fibers, x, no_load);
+  const int n = model_.num_vertices();
+  return Eigen::Map<const Eigen::MatrixXd>(R.data(), n, model_.dim());  // [u_x.., u_y.., ..]
 }
 
 Eigen::VectorXd Equilibrium::external_forces(const Eigen::VectorXd& x,
                                              const std::vector<double>& factors) const {
-  const TermState s(context_, x, factors);
-  Eigen::VectorXd R = Eigen::VectorXd::Zero(num_unknowns());
-  for (const auto& term : terms_)
-    if (term->is_load()) term->add_residual(s, R);
-  return -R;  // a load's residual is minus its force
+  return -residual_of(EquilibriumTerm::Role::Load, x, factors);  // minus a load's residual
 }
 
 Eigen::VectorXd Equilibrium::residual(const Eigen::VectorXd& x,

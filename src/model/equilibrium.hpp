@@ -111,6 +111,9 @@ class Equilibrium {
 
  private:
   friend class TangentOperator;
+  // The residual of the terms with this role alone.
+  Eigen::VectorXd residual_of(EquilibriumTerm::Role role, const Eigen::VectorXd& x,
+                              const std::vector<double>& factors) const;
   // out += dR/dx v of every term but the bulk fibers.
   void add_other_products(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
                           Eigen::VectorXd& out) const;

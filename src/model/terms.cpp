@@ -102,6 +102,7 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
  public:
   explicit SurfaceTensionTerm(const TermContext& c) : c_(c) {}
   const char* name() const override { return "surface tension"; }
+  Role role() const override { return Role::Fibers; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
     add_rows(gamma() * (c_.surface * s.U), R);
   }
@@ -139,6 +140,7 @@ class PressureVolumeTerm final : public EquilibriumTerm {
  public:
   explicit PressureVolumeTerm(const TermContext& c) : c_(c) {}
   const char* name() const override { return "pressure and volume"; }
+  Role role() const override { return Role::Fluid; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     for (int a = 0; a < dim; ++a) R.segment(a * n, n) += s.P * s.S.col(a);
@@ -179,7 +181,7 @@ class PointLoadTerm final : public EquilibriumTerm {
  public:
   PointLoadTerm(const TermContext& c, size_t index) : c_(c), index_(index) {}
   const char* name() const override { return "point load"; }
-  bool is_load() const override { return true; }
+  Role role() const override { return Role::Load; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
     const Load& load = c_.model.loads[index_];
     for (int a = 0; a < c_.model.dim(); ++a)
@@ -204,7 +206,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
         index_(index),
         level_(hydrostatic_level(c.model.surface.V, c.model.loads[index].acceleration)) {}
   const char* name() const override { return "hydrostatic load"; }
-  bool is_load() const override { return true; }
+  Role role() const override { return Role::Load; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
     if (inactive(s)) return;
     const Eigen::VectorXd q = pressures(s);
@@ -325,10 +327,6 @@ void fill_row(const TermContext& c, int i, const Columns& col, RowState& row) {
 
 }  // namespace
 
-Eigen::MatrixXd BulkFiberTerm::forces(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const {
-  return deformed_pairs(c_, X, U).forces();
-}
-
 void BulkFiberTerm::coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
                                  Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
   deformed_pairs(c_, X, U).coefficients(c1, c2);
@@ -337,7 +335,7 @@ void BulkFiberTerm::coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd
 void BulkFiberTerm::add_residual(const TermState& s, Eigen::VectorXd& R) const {
   const int n = c_.model.num_vertices();
   const Eigen::Vector3d m = c_.model.material.axis_factors;
-  const Eigen::MatrixXd bulk = forces(s.X, s.U);
+  const Eigen::MatrixXd bulk = deformed_pairs(c_, s.X, s.U).forces();
   for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) += m[a] * bulk.col(a);
 }
 

@@ -48,10 +48,13 @@ struct TermState {
 class EquilibriumTerm {
  public:
   virtual ~EquilibriumTerm() = default;
-  virtual const char* name() const = 0;
-  // A load's residual is minus the external force it applies (reactions,
+  // What a term stands for: the tissue's fibers (bulk and surface tension,
+  // Equilibrium::fiber_forces), the fluid (pressure and volume), or a load,
+  // whose residual is minus the external force it applies (reactions,
   // Equilibrium::external_forces).
-  virtual bool is_load() const { return false; }
+  enum class Role { Fibers, Fluid, Load };
+  virtual const char* name() const = 0;
+  virtual Role role() const = 0;
   // R += this term's part at the state (full layout [u; P]).
   virtual void add_residual(const TermState& s, Eigen::VectorXd& R) const = 0;
   // J += its dR/dx (dense, full layout).
@@ -71,6 +74,7 @@ class BulkFiberTerm final : public EquilibriumTerm {
  public:
   explicit BulkFiberTerm(const TermContext& context) : c_(context) {}
   const char* name() const override { return "bulk fibers"; }
+  Role role() const override { return Role::Fibers; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override;
   void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override;
   void add_tangent_product(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
@@ -78,8 +82,6 @@ class BulkFiberTerm final : public EquilibriumTerm {
   void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
                                 Eigen::Ref<Eigen::VectorXd> column) const override;
 
-  // The fiber forces before the axis factors, #V by 3.
-  Eigen::MatrixXd forces(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U) const;
   // c1 and c2 of every pair (N x N, symmetric, zero diagonal).
   void coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U, Eigen::MatrixXd* c1,
                     Eigen::MatrixXd* c2) const;

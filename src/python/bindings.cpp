@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The Python module `fiberfluid`: read and check meshes, build experiments
 // from files or dicts, run them (sweeps too) and get the results as numpy
-// arrays. A thin layer over fiberfluid::app; bad input raises ValueError with
+// arrays. A thin layer over fiberfluid::experiment; bad input raises ValueError with
 // the library's message.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
@@ -11,10 +11,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "app/experiment.hpp"
-#include "app/output_folder.hpp"
-#include "app/outputs.hpp"
-#include "app/runner.hpp"
+#include "experiment/experiment.hpp"
+#include "experiment/output_folder.hpp"
+#include "experiment/outputs.hpp"
+#include "experiment/runner.hpp"
 #include "fit/calibration.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
@@ -30,7 +30,7 @@ namespace {
 // A plain dict (or list) to JSON, through Python's own json module.
 nlohmann::json to_json(const py::object& document) {
   const std::string text = py::module_::import("json").attr("dumps")(document).cast<std::string>();
-  return ff::app::parse_json(text, "<dict>");
+  return ff::experiment::parse_json(text, "<dict>");
 }
 
 py::object to_python(const nlohmann::json& document) {
@@ -38,7 +38,7 @@ py::object to_python(const nlohmann::json& document) {
 }
 
 // Per-step records of one run as numpy arrays (SI units).
-py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s) {
+py::dict steps_dict(const ff::experiment::Case& c, const ff::solve::SteppingSummary& s) {
   const auto n = static_cast<Eigen::Index>(s.steps.size());
   const int dim = c.model.dim();
   Eigen::VectorXi step(n);
@@ -83,10 +83,10 @@ py::dict steps_dict(const ff::app::Case& c, const ff::solve::SteppingSummary& s)
 }
 
 // One run's results: the deformed surface in input order, the steps, the figures.
-py::dict run_dict(const ff::app::Experiment& ex, const ff::app::ExperimentResult& result,
-                  size_t r) {
-  const ff::app::Case& c = ex.cases[r];
-  const ff::app::RunResult& run = result.runs[r];
+py::dict run_dict(const ff::experiment::Experiment& ex,
+                  const ff::experiment::ExperimentResult& result, size_t r) {
+  const ff::experiment::Case& c = ex.cases[r];
+  const ff::experiment::RunResult& run = result.runs[r];
   py::dict out;
   out["variant"] = run.variant;
   out["success"] = run.summary.success;
@@ -95,7 +95,7 @@ py::dict run_dict(const ff::app::Experiment& ex, const ff::app::ExperimentResult
   out["reference_positions"] = c.input_surface.V;
   out["faces"] = c.input_surface.F;
   if (run.summary.success) {
-    const Eigen::MatrixXd X = ff::app::input_positions(c, run.summary.unknowns);
+    const Eigen::MatrixXd X = ff::experiment::input_positions(c, run.summary.unknowns);
     out["positions"] = X;
     out["displacements"] = Eigen::MatrixXd(X - c.input_surface.V);
     out["pressure"] = run.summary.unknowns[c.model.pressure_dof()];
@@ -111,18 +111,18 @@ py::dict run_dict(const ff::app::Experiment& ex, const ff::app::ExperimentResult
 
 // Runs an experiment; with `output`, also writes its result folder as the
 // command line does. Returns {"success", "runs": [...], "figures", "checks"}.
-py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output) {
-  ff::app::ExperimentResult result;
+py::dict run(const ff::experiment::Experiment& ex, int jobs, const std::string& output) {
+  ff::experiment::ExperimentResult result;
   {
     py::gil_scoped_release release;  // a long solve lets other Python threads run
-    ff::app::RunOptions options;
+    ff::experiment::RunOptions options;
     options.jobs = jobs;
     if (output.empty()) {
-      result = ff::app::run_experiment(ex, {}, options);
+      result = ff::experiment::run_experiment(ex, {}, options);
     } else {
-      ff::app::OutputWriter writer(ex, ff::app::output_folder(output, ex.name));
+      ff::experiment::OutputWriter writer(ex, ff::experiment::output_folder(output, ex.name));
       writer.begin();
-      result = ff::app::run_experiment(
+      result = ff::experiment::run_experiment(
           ex,
           [&](size_t run, const ff::solve::StepRecord& record, const Eigen::VectorXd& x) {
             writer.on_step(run, record, x);
@@ -138,7 +138,7 @@ py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output)
   out["runs"] = runs;
   out["figures"] = result.figures;
   py::list checks;
-  for (const ff::app::FigureCheck& c : result.checks) {
+  for (const ff::experiment::FigureCheck& c : result.checks) {
     py::dict check;
     check["figure"] = c.expected.figure;
     check["actual"] = c.actual;
@@ -154,12 +154,12 @@ py::dict run(const ff::app::Experiment& ex, int jobs, const std::string& output)
 
 // A fit of an experiment's material to measured surfaces given as numpy
 // arrays: no JSON needed (fiberfluid.fit).
-py::dict fit_experiment(const ff::app::Experiment& ex, const py::list& targets,
+py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& targets,
                         const py::list& parameters, const std::string& method,
                         const std::string& jacobian, bool symmetric, const std::string& loss,
                         double loss_scale, int max_iterations) {
   if (ex.cases.size() != 1) throw ff::InputError("fit: the experiment must be one simulation");
-  const ff::app::Case& c = ex.cases.front();
+  const ff::experiment::Case& c = ex.cases.front();
   std::vector<ff::fit::MeasuredStep> measured;
   for (size_t k = 0; k < targets.size(); ++k) {
     const py::dict t = targets[k].cast<py::dict>();
@@ -281,9 +281,9 @@ PYBIND11_MODULE(fiberfluid, m) {
       "Reads an OBJ, OFF, STL or PLY surface and checks it. Returns a dict: vertices (#V x 3), "
       "faces, ok, problems, warnings, report (the text of `fiberfluid check`).");
 
-  py::class_<ff::app::Experiment>(m, "Experiment",
-                                  "A parsed, validated experiment: one run or a sweep of variants.")
-      .def_static("from_file", &ff::app::load_experiment, py::arg("path"),
+  py::class_<ff::experiment::Experiment>(
+      m, "Experiment", "A parsed, validated experiment: one run or a sweep of variants.")
+      .def_static("from_file", &ff::experiment::load_experiment, py::arg("path"),
                   "Reads an experiment file (JSON). Raises InputError (a ValueError) naming the "
                   "file and field on bad input.")
       .def_static(
@@ -291,11 +291,12 @@ PYBIND11_MODULE(fiberfluid, m) {
           [](const py::object& document, const std::filesystem::path& folder,
              const std::optional<Eigen::MatrixXd>& vertices,
              const std::optional<Eigen::MatrixXi>& faces) {
-            ff::app::Experiment ex = ff::app::read_experiment(to_json(document), folder, "<dict>");
+            ff::experiment::Experiment ex =
+                ff::experiment::read_experiment(to_json(document), folder, "<dict>");
             if (vertices.has_value() != faces.has_value())
               throw ff::InputError("<dict>: give both vertices and faces, or neither");
             if (!vertices) {
-              ff::app::build_experiment(ex);
+              ff::experiment::build_experiment(ex);
               return ex;
             }
             ff::geom::Surface surface;
@@ -306,7 +307,7 @@ PYBIND11_MODULE(fiberfluid, m) {
                   "#V x 2 with segments #F x 2)");
             surface.V = *vertices;
             surface.F = *faces;
-            ff::app::build_experiment(ex, &surface);
+            ff::experiment::build_experiment(ex, &surface);
             return ex;
           },
           py::arg("document"), py::arg("folder") = std::filesystem::path("."),
@@ -315,16 +316,18 @@ PYBIND11_MODULE(fiberfluid, m) {
           "mesh paths are taken from `folder`. A program's own surface may be given as "
           "`vertices` (#V x 3) and `faces` (#F x 3, from 0) instead of the dict's \"surface\"; "
           "it is checked like a mesh file.")
-      .def_property_readonly("name", [](const ff::app::Experiment& ex) { return ex.name; })
+      .def_property_readonly("name", [](const ff::experiment::Experiment& ex) { return ex.name; })
       .def_property_readonly("variants",
-                             [](const ff::app::Experiment& ex) {
+                             [](const ff::experiment::Experiment& ex) {
                                std::vector<std::string> names;
-                               for (const ff::app::Case& c : ex.cases) names.push_back(c.variant);
+                               for (const ff::experiment::Case& c : ex.cases)
+                                 names.push_back(c.variant);
                                return names;
                              })
-      .def_property_readonly("warnings", [](const ff::app::Experiment& ex) { return ex.warnings; })
+      .def_property_readonly("warnings",
+                             [](const ff::experiment::Experiment& ex) { return ex.warnings; })
       .def_property_readonly("num_vertices",
-                             [](const ff::app::Experiment& ex) {
+                             [](const ff::experiment::Experiment& ex) {
                                return ex.cases.empty() ? 0 : ex.cases.front().model.num_vertices();
                              })
       .def("run", &run, py::arg("jobs") = 0, py::arg("output") = std::string(),
@@ -355,7 +358,7 @@ PYBIND11_MODULE(fiberfluid, m) {
       [](const std::filesystem::path& folder) {
         std::ifstream in(folder / "summary.json");
         if (!in) throw ff::InputError((folder / "summary.json").string() + ": cannot open");
-        return to_python(ff::app::parse_json(in, (folder / "summary.json").string()));
+        return to_python(ff::experiment::parse_json(in, (folder / "summary.json").string()));
       },
       py::arg("folder"), "Reads the summary.json of a result folder as a dict.");
   m.attr("__version__") = FIBERFLUID_VERSION;

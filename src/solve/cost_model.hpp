@@ -3,7 +3,7 @@
 // sizes alone: each backend's memory and time for one factorisation and one
 // solve (backend_cost), and the axis blocks a model's structured system will
 // have (block_shape, FiberSystem's rule). The resource estimate of a whole
-// run (app/resources) composes these with the pruning and the steps.
+// run (experiment/resources) composes these with the pruning and the steps.
 #pragma once
 
 #include "model/boundary_conditions.hpp"

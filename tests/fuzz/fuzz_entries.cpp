@@ -6,11 +6,11 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "app/compare.hpp"
-#include "app/experiment.hpp"
-#include "app/fitting.hpp"
-#include "app/output_folder.hpp"
-#include "app/runner.hpp"
+#include "experiment/compare.hpp"
+#include "experiment/experiment.hpp"
+#include "experiment/fitting.hpp"
+#include "experiment/output_folder.hpp"
+#include "experiment/runner.hpp"
 #include "geom/area_vectors.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_check.hpp"
@@ -58,7 +58,8 @@ void read_mesh(geom::MeshFormat format, const char* name, const uint8_t* data, s
 // Through the program's own reader (its nesting limit included).
 std::optional<nlohmann::json> parse_json(const uint8_t* data, size_t size) {
   try {
-    return app::parse_json(std::string(reinterpret_cast<const char*>(data), size), "fuzz.json");
+    return experiment::parse_json(std::string(reinterpret_cast<const char*>(data), size),
+                                  "fuzz.json");
   } catch (const InputError& e) {
     require(std::string(e.what()).size() < 1000, "a JSON error quotes a short excerpt");
     return std::nullopt;
@@ -70,7 +71,7 @@ std::optional<nlohmann::json> parse_json(const uint8_t* data, size_t size) {
 void check_output_name(const std::string& name) {
   std::filesystem::path folder;
   try {
-    folder = app::output_folder("", name);
+    folder = experiment::output_folder("", name);
   } catch (const InputError&) {
     return;
   }
@@ -85,9 +86,10 @@ void read_experiment(const uint8_t* data, size_t size) {
   const std::optional<nlohmann::json> document = parse_json(data, size);
   if (!document) return;
   try {
-    const app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    const experiment::Experiment ex =
+        experiment::read_experiment(*document, kExperiments, "fuzz.json");
     check_output_name(ex.name);
-    for (const app::CaseSpec& spec : ex.specs) {
+    for (const experiment::CaseSpec& spec : ex.specs) {
       if (!spec.variant.empty()) check_output_name(spec.variant);
       std::string why;
       require(spec.stepping.IsValid(&why), "parsed stepping options are valid");
@@ -111,14 +113,14 @@ void build_and_run(const uint8_t* data, size_t size) {
   if (!document) return;
   const SmallBudgets budgets;  // the estimate refuses longer cases before pruning
   try {
-    app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
-    if (ex.kind != app::Experiment::Kind::Simulate || ex.specs.size() > 4) return;
-    app::build_experiment(ex);
+    experiment::Experiment ex = experiment::read_experiment(*document, kExperiments, "fuzz.json");
+    if (ex.kind != experiment::Experiment::Kind::Simulate || ex.specs.size() > 4) return;
+    experiment::build_experiment(ex);
     ex.fem_reference.reset();  // tetrahedral meshing: seconds per input
-    app::RunOptions options;
+    experiment::RunOptions options;
     options.jobs = 1;
-    const app::ExperimentResult result = app::run_experiment(ex, {}, options);
-    for (const app::RunResult& run : result.runs) {
+    const experiment::ExperimentResult result = experiment::run_experiment(ex, {}, options);
+    for (const experiment::RunResult& run : result.runs) {
       if (!run.summary.success) {
         require(!run.summary.message.empty(), "a failed run says why");
         continue;
@@ -141,12 +143,12 @@ void set_up_fit(const uint8_t* data, size_t size) {
   if (!document) return;
   const SmallBudgets budgets;
   try {
-    app::Experiment ex = app::read_experiment(*document, kExperiments, "fuzz.json");
+    experiment::Experiment ex = experiment::read_experiment(*document, kExperiments, "fuzz.json");
     check_output_name(ex.name);
     if (!ex.fit) return;
     fit::check_options(ex.fit->options);  // read_fit checked them: they pass again
-    app::build_experiment(ex);
-    const app::FitSetup setup = app::setup_fit(ex);
+    experiment::build_experiment(ex);
+    const experiment::FitSetup setup = experiment::setup_fit(ex);
     const fit::Calibration& c = *setup.calibration;
     require(c.num_residuals() >= c.parameters().size(),
             "a fit has at least one distance per parameter");
@@ -178,9 +180,9 @@ void compare_with_unit(int dim, const uint8_t* data, size_t size) {
       dim == 2 ? geom::rectangle({0, 0}, {1, 1}) : geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
   for (const bool fuzzed_first : {true, false}) {
     try {
-      const app::Comparison c = fuzzed_first
-                                    ? app::compare_surfaces(m, unit, nullptr, "fuzz.obj", "unit")
-                                    : app::compare_surfaces(unit, m, nullptr, "unit", "fuzz.obj");
+      const experiment::Comparison c =
+          fuzzed_first ? experiment::compare_surfaces(m, unit, nullptr, "fuzz.obj", "unit")
+                       : experiment::compare_surfaces(unit, m, nullptr, "unit", "fuzz.obj");
       if (c.surface_error) {
         require(std::isfinite(*c.surface_error) && *c.surface_error >= -1e-9,
                 "E_s is finite and not negative");

@@ -9,7 +9,7 @@
 #include <memory>
 #include <random>
 
-#include "app/experiment.hpp"
+#include "experiment/experiment.hpp"
 #include "model/equilibrium.hpp"
 #include "model/model_fixtures.hpp"
 #include "solve/load_stepper.hpp"
@@ -130,7 +130,7 @@ TEST(AddedLaw, ExperimentFilesNameItByItsTypeAndCheckItsParameters) {
     "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
     "stepping": {"steps": 2, "scheme": "newton"}
   })");
-  const app::Experiment ex = app::parse_experiment(document, ".", "cubic.json");
+  const experiment::Experiment ex = experiment::parse_experiment(document, ".", "cubic.json");
   const model::FiberLaw& law = ex.cases[0].model.material.law;
   EXPECT_EQ(law.name(), "cubic_test_law");
   EXPECT_EQ(law.parameter("c"), 12.0);
@@ -141,7 +141,7 @@ TEST(AddedLaw, ExperimentFilesNameItByItsTypeAndCheckItsParameters) {
   nlohmann::json missing = document;
   missing["material"]["law"].erase("c");
   try {
-    app::parse_experiment(missing, ".", "cubic.json");
+    experiment::parse_experiment(missing, ".", "cubic.json");
     ADD_FAILURE() << "a missing parameter was accepted";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("c"), std::string::npos) << e.what();

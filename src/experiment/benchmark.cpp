@@ -1,0 +1,657 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/benchmark.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "bridge/scene_model.hpp"
+#include "experiment/json_fields.hpp"
+#include "fem/mesh_tools.hpp"
+#include "fit/calibration.hpp"
+#include "fit/golden_section.hpp"
+#include "metrics/metrics.hpp"
+#include "model/assembly.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using json = nlohmann::json;
+using fem::Integrator;
+
+const std::vector<std::pair<std::string, Integrator>>& integrator_names() {
+  static const std::vector<std::pair<std::string, Integrator>> names = {
+      {"implicit-newmark", Integrator::ImplicitNewmark},
+      {"explicit", Integrator::ExplicitConsistent},
+      {"explicit-lumped", Integrator::ExplicitLumped},
+      {"implicit-lumped", Integrator::ImplicitLumped},
+      {"quasi-static", Integrator::QuasiStatic}};
+  return names;
+}
+
+std::vector<Integrator> read_solvers(Fields& f, const std::string& key, bool with_reference) {
+  std::vector<Integrator> out;
+  const json& list = f.raw(key);
+  std::vector<std::string> allowed;
+  for (const auto& [name, kind] : integrator_names())
+    if (with_reference || kind != Integrator::ImplicitNewmark) allowed.push_back(name);
+  std::string expected;
+  for (const std::string& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
+  if (!list.is_array() || list.empty())
+    f.fail(key, "expected a non-empty list of solvers (" + expected + ")");
+  for (const json& item : list) {
+    const std::string name = item.is_string() ? item.get<std::string>() : excerpt(item);
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
+      f.fail(key, "unknown solver \"" + name + "\" (expected " + expected + ")");
+    for (const auto& [known, kind] : integrator_names())
+      if (known == name) {
+        if (std::find(out.begin(), out.end(), kind) != out.end())
+          f.fail(key, "\"" + name + "\" is listed twice");
+        out.push_back(kind);
+      }
+  }
+  return out;
+}
+
+// "MP1" (a preset) or {"E", "nu", "density", "alpha", "beta"}.
+fem::MaterialPreset read_material(Fields& f, const std::string& key, std::string* label) {
+  const json& value = f.raw(key);
+  if (value.is_string()) {
+    const std::string name = value.get<std::string>();
+    if (name != "MP1" && name != "MP2" && name != "MP3")
+      f.fail(key,
+             "expected a preset (MP1, MP2, MP3) or an object {E, nu, density, alpha, beta}, "
+             "got \"" +
+                 name + "\"");
+    *label = name;
+    return fem::material_preset(name);
+  }
+  Fields m = f.object(key);
+  fem::MaterialPreset p;
+  p.material.young = m.positive("E", 1.0);
+  p.material.poisson = m.number("nu");
+  if (!(p.material.poisson > -1.0 && p.material.poisson < 0.5))
+    m.fail("nu", "expected a Poisson ratio between -1 and 0.5");
+  p.material.density = m.positive("density", 1000.0);
+  p.alpha = m.non_negative("alpha", 1.0);
+  p.beta = m.non_negative("beta", 0.1);
+  m.finish();
+  *label = "custom";
+  return p;
+}
+
+}  // namespace
+
+BenchmarkSpec read_benchmark(Fields& root) {
+  BenchmarkSpec spec;
+  const bool block = root.choice("scene", "", {"block-needle", "bending-rod"}) == "block-needle";
+  spec.scene = block ? BenchmarkSpec::Scene::BlockNeedle : BenchmarkSpec::Scene::BendingRod;
+  const int dim = block ? 2 : 3;
+  fem::MaterialPreset material = fem::material_preset(block ? "MP1" : "MP3");
+  spec.material_label = block ? "MP1" : "MP3";
+  if (root.has("material")) material = read_material(root, "material", &spec.material_label);
+  (block ? spec.block.material : spec.rod.material) = material;
+
+  if (root.has("mesh")) {
+    Fields m = root.object("mesh");
+    if (m.has("cells")) {
+      const Eigen::VectorXd cells = m.vector("cells", dim);
+      for (Eigen::Index a = 0; a < dim; ++a)
+        if (cells[a] != std::floor(cells[a]) || cells[a] < 1 || cells[a] > 200)
+          m.fail("cells", "expected whole numbers of cells from 1 to 200 per axis");
+      if (block) {
+        spec.block.cells = cells.cast<int>();
+        if (spec.block.cells[1] % 2 != 0)
+          m.fail("cells",
+                 "expected an even number of cells along y (the needle sits on the "
+                 "node in the middle of the right side)");
+      } else {
+        spec.rod.cells = cells.cast<int>();
+      }
+    }
+    const std::string elements =
+        m.choice("elements", block ? "quadrilateral" : "hexahedron",
+                 block ? std::vector<std::string>{"quadrilateral", "triangle"}
+                       : std::vector<std::string>{"hexahedron", "tetrahedron"});
+    (block ? spec.block.simplices : spec.rod.simplices) =
+        elements == "triangle" || elements == "tetrahedron";
+    if (block) {
+      spec.block.material.material.plane =
+          m.choice("plane", "strain", {"strain", "stress"}) == "stress" ? fem::PlaneModel::Stress
+                                                                        : fem::PlaneModel::Strain;
+    }
+    m.finish();
+  }
+  if (root.has("needle")) {
+    if (!block) root.fail("needle", "only the block-needle scene has a needle");
+    Fields n = root.object("needle");
+    spec.block.needle_speed = n.positive("speed", spec.block.needle_speed);
+    spec.block.push_time = n.positive("push_time", spec.block.push_time);
+    n.finish();
+  }
+  if (root.has("gravity")) {
+    if (block) root.fail("gravity", "only the bending-rod scene has gravity");
+    spec.rod.gravity = root.positive("gravity", spec.rod.gravity);
+  }
+  if (root.has("time")) {
+    Fields t = root.object("time");
+    spec.step = t.positive("step", spec.step);
+    spec.duration = t.positive("duration", spec.duration);
+    if (spec.duration / spec.step > 1e6) t.fail("duration", "more than a million steps");
+    if (spec.duration < spec.step) t.fail("duration", "shorter than one step");
+    t.finish();
+  }
+  spec.metrics_every = root.integer("metrics_every", 1, 1, 1000000);
+  spec.solvers =
+      root.has("solvers")
+          ? read_solvers(root, "solvers", false)
+          : std::vector<Integrator>{Integrator::ExplicitConsistent, Integrator::ExplicitLumped,
+                                    Integrator::ImplicitLumped, Integrator::QuasiStatic};
+  if (root.has("linear_solver")) {
+    Fields l = root.object("linear_solver");
+    spec.linear.linear =
+        l.choice("method", "cholesky", {"cholesky", "gauss-seidel"}) == "gauss-seidel"
+            ? fem::LinearMethod::GaussSeidel
+            : fem::LinearMethod::Cholesky;
+    spec.linear.tolerance = l.positive("tolerance", spec.linear.tolerance);
+    spec.linear.max_sweeps = l.integer("max_sweeps", spec.linear.max_sweeps, 1, 100000000);
+    l.finish();
+  }
+  for (Fields o : root.objects("compare_materials")) {
+    BenchmarkSpec::OtherMaterial other;
+    std::string preset_label;
+    other.material = read_material(o, "material", &preset_label);
+    other.label = o.string("label", preset_label);
+    if (other.label.empty() || other.label.find(',') != std::string::npos)
+      o.fail("label", "expected a name without commas");
+    other.solvers = read_solvers(o, "solvers", true);
+    if (block) other.material.material.plane = spec.block.material.material.plane;
+    o.finish();
+    spec.other_materials.push_back(other);
+  }
+  if (root.has("fiber_model")) {
+    Fields f = root.object("fiber_model");
+    spec.fiber.enabled = true;
+    spec.fiber.fit = f.boolean("fit", !f.has("Y"));
+    if (!spec.fiber.fit) {
+      spec.fiber.Y = f.positive("Y", 1.0);
+      spec.fiber.gamma = f.non_negative("gamma", 0.0);
+    } else if (f.has("Y") || f.has("gamma")) {
+      f.fail("fit", "give Y and gamma, or fit them, not both");
+    }
+    spec.fiber.steps = f.integer("steps", spec.fiber.steps, 1, 10000);
+    spec.fiber.newton = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton";
+    f.finish();
+  }
+  return spec;
+}
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// What every series is compared with: the reference's boundary and nodes.
+struct ReferenceFrames {
+  const fem::Scene* scene = nullptr;
+  fem::Boundary rest;              // the undeformed boundary
+  Eigen::VectorXd volume_weights;  // node measures
+  double measure = 0.0;            // |Int(M0)|
+};
+
+geom::Surface deformed_boundary(const ReferenceFrames& frames, const Eigen::MatrixXd& positions) {
+  geom::Surface s = frames.rest.surface;
+  for (size_t v = 0; v < frames.rest.nodes.size(); ++v)
+    s.V.row(static_cast<Eigen::Index>(v)) = positions.row(frames.rest.nodes[v]);
+  return s;
+}
+
+// Appends one time step's E_n, E_s and E_i: the reference and the
+// approximation as positions of the same nodes (#nodes x dim) with their
+// rest positions, E_i's weights and measure, and the boundaries for E_s
+// (only on metrics steps: NaN between them, and where a diverging boundary
+// crosses itself and bounds no solid).
+struct Frame {
+  const Eigen::MatrixXd* rest = nullptr;
+  const Eigen::VectorXd* weights = nullptr;
+  double measure = 0.0;
+};
+void append_metrics(MetricSeries& s, double t, const Frame& frame, const Eigen::MatrixXd& reference,
+                    const Eigen::MatrixXd& approximation, const geom::Surface* reference_boundary,
+                    const geom::Surface* approximation_boundary) {
+  const Eigen::MatrixXd U = reference - *frame.rest, V = approximation - *frame.rest;
+  const int dim = static_cast<int>(U.cols());
+  s.times.push_back(t);
+  s.energy_norm.push_back(U.norm() > 0.0 ? metrics::relative_energy_norm(U, V)
+                                         : std::numeric_limits<double>::quiet_NaN());
+  double es = std::numeric_limits<double>::quiet_NaN();
+  if (reference_boundary != nullptr) {
+    try {
+      es = metrics::surface_error(*reference_boundary, *approximation_boundary, "the reference",
+                                  s.label);
+    } catch (const InputError&) {
+    }
+  }
+  s.surface.push_back(es);
+  s.interior.push_back(
+      metrics::interior_error(reference, approximation, *frame.weights, frame.measure, dim));
+}
+
+bool metrics_step(size_t k, size_t count, int every) {
+  return k % static_cast<size_t>(every) == 0 || k + 1 == count;
+}
+
+// E_n, E_s, E_i of a FEM trajectory against the reference, step by step.
+MetricSeries compare_fem(const ReferenceFrames& frames, const fem::Trajectory& reference,
+                         const fem::Trajectory& run, const std::string& label, int metrics_every) {
+  MetricSeries out;
+  out.label = label;
+  out.interior_weights = "volume";
+  const int dim = frames.scene->mesh.dim;
+  const Eigen::MatrixXd& X0 = frames.scene->mesh.nodes;
+  const Frame frame{&X0, &frames.volume_weights, frames.measure};
+  const size_t count = std::min(reference.u.size(), run.u.size());
+  for (size_t k = 1; k < count; ++k) {
+    const Eigen::MatrixXd R = X0 + fem::displacement_rows(reference.u[k], dim),
+                          A = X0 + fem::displacement_rows(run.u[k], dim);
+    if (metrics_step(k, count, metrics_every)) {
+      const geom::Surface reference_boundary = deformed_boundary(frames, R),
+                          run_boundary = deformed_boundary(frames, A);
+      append_metrics(out, run.times[k], frame, R, A, &reference_boundary, &run_boundary);
+    } else {
+      append_metrics(out, run.times[k], frame, R, A, nullptr, nullptr);
+    }
+  }
+  return out;
+}
+
+struct FiberRun {
+  bool ok = false;
+  std::string message;
+  std::vector<Eigen::MatrixXd> positions;  // per load step 0..steps, boundary vertex order
+  double seconds = 0.0;
+};
+
+// The scene's fiber model (bridge::fiber_model_of_scene, built once: the
+// surface, its fibers) run with Y and gamma set, over `steps` load steps.
+FiberRun run_fiber_model(const model::Model& scene_model, double Y, double gamma, int steps,
+                         bool newton) {
+  const auto start = std::chrono::steady_clock::now();
+  model::Model m = scene_model;
+  m.material = model::Material::linear(Y, gamma);
+  solve::SteppingOptions stepping;
+  stepping.steps = steps;
+  stepping.scheme = newton ? solve::Scheme::Newton : solve::Scheme::Incremental;
+  FiberRun out;
+  out.positions.assign(static_cast<size_t>(steps) + 1, m.surface.V);
+  const solve::SteppingSummary summary = solve::solve_load_steps(
+      m, stepping, [&](const solve::StepRecord& record, const Eigen::VectorXd& x) {
+        out.positions[static_cast<size_t>(record.step)] = model::positions(m, x);
+      });
+  out.ok = summary.success;
+  out.message = summary.message;
+  out.seconds = seconds_since(start);
+  return out;
+}
+
+// The load step whose load the scene has reached at time t.
+size_t fiber_step(const fem::Scene& scene, double t, int steps) {
+  return static_cast<size_t>(std::lround(scene.load_factor(t) * steps));
+}
+
+// The FEM's static state under the full load.
+Eigen::VectorXd static_state(const fem::Scene& scene) {
+  const fem::Dynamics& d = scene.dynamics;
+  fem::Constraints held;
+  const double late = 1e9;
+  const Eigen::VectorXd values =
+      d.held_values ? d.held_values(late)
+                    : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size()));
+  for (size_t k = 0; k < d.held.size(); ++k)
+    held.hold(d.held[k], values[static_cast<Eigen::Index>(k)]);
+  Eigen::VectorXd u;
+  const Eigen::VectorXd f = d.force ? d.force(late) : Eigen::VectorXd::Zero(d.K.rows());
+  const solve::Status status = fem::solve_static(d.K, f, held, &u);
+  if (!status.ok) throw InputError("benchmark: the static problem is singular: " + status.message);
+  return u;
+}
+
+Eigen::MatrixXd boundary_rows(const fem::Boundary& b, const Eigen::MatrixXd& node_rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(b.nodes.size()), node_rows.cols());
+  for (size_t v = 0; v < b.nodes.size(); ++v)
+    out.row(static_cast<Eigen::Index>(v)) = node_rows.row(b.nodes[v]);
+  return out;
+}
+
+// Y and gamma of the fiber model whose static shape is closest to the FEM's.
+// The block is driven by a displacement alone: its shape depends on gamma /
+// Y only, so Y = E and gamma is found by a golden-section search on E_n
+// (log scale, and gamma = 0). The rod is fitted by the calibration
+// (Levenberg-Marquardt on the surface distances to the FEM's static boundary).
+FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Scene& scene,
+                                       const model::Model& scene_model, const fem::Boundary& rest,
+                                       const Eigen::MatrixXd& target, int steps) {
+  FiberModelReport report;
+  const double E = scene.material.young;
+  const Eigen::MatrixXd target_u = target - rest.surface.V;
+  if (spec.scene == BenchmarkSpec::Scene::BlockNeedle) {
+    auto error = [&](double gamma) {
+      const FiberRun run = run_fiber_model(scene_model, E, gamma, steps, spec.fiber.newton);
+      if (!run.ok) return std::numeric_limits<double>::infinity();
+      return metrics::relative_energy_norm(target_u, run.positions.back() - rest.surface.V);
+    };
+    // gamma / (E L), L = 1 m: from 1e-4 to 10, in log scale.
+    const fit::LineMinimum m =
+        fit::golden_section_minimum([&](double log_gamma) { return error(std::exp(log_gamma)); },
+                                    std::log(1e-4 * E), std::log(10.0 * E), 30);
+    const double best = std::exp(m.x), best_error = m.value;
+    const double zero_error = error(0.0);
+    report.Y = E;
+    report.gamma = zero_error <= best_error ? 0.0 : best;
+    std::ostringstream how;
+    how << "Y = E (the displacement-driven block's shape depends on gamma / Y only); gamma by a "
+           "golden-section search on the static E_n (gamma = 0 gives "
+        << zero_error << ", the best gamma " << best_error << ")";
+    report.how = how.str();
+    return report;
+  }
+  model::Model start = scene_model;
+  start.material = model::Material::linear(E, 0.01 * E);
+  solve::SteppingOptions stepping;
+  stepping.steps = steps;
+  stepping.scheme = spec.fiber.newton ? solve::Scheme::Newton : solve::Scheme::Incremental;
+  std::vector<fit::MeasuredStep> measured = {
+      {fit::make_target("the FEM's static boundary", target, rest.surface.F), steps}};
+  std::vector<fit::Parameter> parameters(2);
+  parameters[0] = {"Y", E, 1e-6 * E, 1e3 * E, true};
+  parameters[1] = {"gamma", 0.01 * E, 1e-6 * E, 1e2 * E, true};
+  fit::FitOptions options;
+  options.symmetric = true;
+  const fit::Calibration calibration(start, stepping, measured, parameters, options);
+  const fit::FitResult fitted = calibration.run();
+  if (fitted.values.size() != 2)
+    throw InputError("benchmark: the fiber model's fit failed: " + fitted.message);
+  report.Y = fitted.values[0];
+  report.gamma = fitted.values[1];
+  std::ostringstream how;
+  how << "fitted to the FEM's static boundary (Levenberg-Marquardt, symmetric surface distances; "
+      << fitted.message << "; " << fitted.forward_runs << " forward runs)";
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    const double v = fitted.values[static_cast<Eigen::Index>(k)];
+    if (v <= parameters[k].lower * (1.0 + 1e-6) || v >= parameters[k].upper * (1.0 - 1e-6))
+      how << "; " << parameters[k].name << " stopped at its bound " << v
+          << " (the data push it further)";
+  }
+  report.how = how.str();
+  return report;
+}
+
+void add_series_figures(const BenchmarkSpec& spec, const MetricSeries& s,
+                        std::map<std::string, double>& figures) {
+  const std::string& L = s.label;
+  figures[L + ".diverged"] = s.ok ? 0.0 : 1.0;
+  if (!s.ok && !s.times.empty()) figures[L + ".stopped_at"] = s.times.back();
+  figures[L + ".seconds"] = s.seconds;
+  const struct {
+    const char* name;
+    const std::vector<double>& values;
+  } metrics[] = {{"E_n", s.energy_norm}, {"E_s", s.surface}, {"E_i", s.interior}};
+  for (const auto& m : metrics) {
+    auto at = [&](double t) -> std::optional<double> {  // the nearest step with a value
+      std::optional<double> best;
+      double gap = 0.6 * spec.step * spec.metrics_every;
+      for (size_t k = 0; k < s.times.size(); ++k)
+        if (std::abs(s.times[k] - t) <= gap && std::isfinite(m.values[k])) {
+          gap = std::abs(s.times[k] - t);
+          best = m.values[k];
+        }
+      return best;
+    };
+    for (double t : {1.0, 2.0, 5.0})
+      if (const auto v = at(t))
+        figures[L + "." + m.name + ".at_" + std::to_string(static_cast<int>(t)) + "s"] = *v;
+    if (s.ok && !s.times.empty())
+      if (const auto v = at(s.times.back())) figures[L + "." + m.name + ".final"] = *v;
+    double sum = 0.0;
+    int count = 0;
+    for (size_t k = 0; k < s.times.size(); ++k)
+      if (std::isfinite(m.values[k]) && s.times[k] <= 2.0 + 1e-9) sum += m.values[k], ++count;
+    if (count > 0) figures[L + "." + m.name + ".mean_to_2s"] = sum / count;
+    // The first local minimum: where the quasi-static error touches bottom
+    // as the reference swings through the static shape.
+    std::vector<size_t> valid;
+    for (size_t k = 0; k < s.times.size(); ++k)
+      if (std::isfinite(m.values[k])) valid.push_back(k);
+    for (size_t j = 1; j + 1 < valid.size(); ++j) {
+      const double here = m.values[valid[j]];
+      if (here < m.values[valid[j - 1]] && here <= m.values[valid[j + 1]]) {
+        figures[L + "." + m.name + ".first_minimum"] = here;
+        figures[L + "." + m.name + ".first_minimum_time"] = s.times[valid[j]];
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
+                              const std::function<void(int, int)>& progress) {
+  int total = 1 + static_cast<int>(spec.solvers.size()) + (spec.fiber.enabled ? 1 : 0), done = 0;
+  for (const BenchmarkSpec::OtherMaterial& other : spec.other_materials)
+    total += static_cast<int>(other.solvers.size());
+  auto tell = [&](const std::string&) {
+    if (progress) progress(done++, total);
+  };
+  const bool block = spec.scene == BenchmarkSpec::Scene::BlockNeedle;
+  auto scene_with = [&](const fem::MaterialPreset& material) {
+    if (block) {
+      fem::BlockOptions o = spec.block;
+      o.material = material;
+      return fem::needle_block(o);
+    }
+    fem::RodOptions o = spec.rod;
+    o.material = material;
+    return fem::bending_rod(o);
+  };
+  BenchmarkResult result;
+  result.scene = block ? fem::needle_block(spec.block) : fem::bending_rod(spec.rod);
+  const fem::Scene& scene = result.scene;
+  const int steps = static_cast<int>(std::lround(spec.duration / spec.step));
+  ReferenceFrames frames;
+  frames.scene = &scene;
+  frames.rest = fem::boundary(scene.mesh);
+  frames.volume_weights = fem::node_measures(scene.mesh);
+  frames.measure = frames.volume_weights.sum();
+  const int dim = scene.mesh.dim;
+
+  tell("reference (implicit-newmark)");
+  auto start = std::chrono::steady_clock::now();
+  const fem::Trajectory reference =
+      fem::integrate(scene.dynamics, Integrator::ImplicitNewmark, spec.step, steps, spec.linear);
+  result.reference_seconds = seconds_since(start);
+  result.reference_sweeps = reference.sweeps;
+  if (!reference.ok) {
+    result.ok = false;
+    result.message = "the implicit Newmark reference failed: " + reference.message;
+    return result;
+  }
+  const Eigen::VectorXd statics = static_state(scene);
+  result.figures["reference.static_gap"] = (reference.u.back() - statics).norm() / statics.norm();
+  result.figures["reference.seconds"] = result.reference_seconds;
+  result.reference_final =
+      deformed_boundary(frames, scene.mesh.nodes + fem::displacement_rows(reference.u.back(), dim));
+
+  // One solver on a scene (this one, or another material's) whose static state is given.
+  auto run_one = [&](const fem::Scene& on, const Eigen::VectorXd& on_statics, Integrator kind,
+                     const std::string& label) {
+    tell(label);
+    const auto t0 = std::chrono::steady_clock::now();
+    const fem::Trajectory run = fem::integrate(on.dynamics, kind, spec.step, steps, spec.linear);
+    const double seconds = seconds_since(t0);
+    MetricSeries s = compare_fem(frames, reference, run, label, spec.metrics_every);
+    s.ok = run.ok;
+    s.message = run.message;
+    s.seconds = seconds;
+    s.sweeps = run.sweeps;
+    if (run.ok)
+      result.figures[label + ".static_gap"] =
+          (run.u.back() - on_statics).norm() / on_statics.norm();
+    result.series.push_back(std::move(s));
+  };
+  for (Integrator kind : spec.solvers) run_one(scene, statics, kind, fem::to_string(kind));
+  for (const BenchmarkSpec::OtherMaterial& other : spec.other_materials) {
+    const fem::Scene on = scene_with(other.material);
+    const Eigen::VectorXd on_statics = static_state(on);
+    for (Integrator kind : other.solvers)
+      run_one(on, on_statics, kind, other.label + "/" + fem::to_string(kind));
+  }
+
+  if (spec.fiber.enabled) {
+    tell("fiber model");
+    // The block: one load step per time step of the push, so that each time
+    // step has its own quasi-static state; the rod: its gravity in steps.
+    const int fiber_steps =
+        block ? std::max(1, static_cast<int>(std::lround(scene.push_time / spec.step)))
+              : spec.fiber.steps;
+    const Eigen::MatrixXd X0 = scene.mesh.nodes;
+    const Eigen::MatrixXd target =
+        boundary_rows(frames.rest, X0 + fem::displacement_rows(statics, dim));
+    const model::Model scene_model =
+        bridge::fiber_model_of_scene(scene, frames.rest, model::Material::linear(1.0));
+    FiberModelReport report;
+    if (spec.fiber.fit) {
+      report = choose_fiber_material(spec, scene, scene_model, frames.rest, target, fiber_steps);
+    } else {
+      report.Y = spec.fiber.Y;
+      report.gamma = spec.fiber.gamma;
+      report.how = "given";
+    }
+    const FiberRun run =
+        run_fiber_model(scene_model, report.Y, report.gamma, fiber_steps, spec.fiber.newton);
+    MetricSeries s;
+    s.label = "fiber-model";
+    s.ok = run.ok;
+    s.message = run.message;
+    s.seconds = run.seconds;
+    s.interior_weights = "surface";
+    report.vertices = frames.rest.surface.num_vertices();
+    if (run.ok) {
+      const Eigen::VectorXd weights = metrics::boundary_node_measures(frames.rest.surface);
+      const Eigen::MatrixXd& rest = frames.rest.surface.V;
+      const Frame frame{&rest, &weights, metrics::enclosed_measure(frames.rest.surface)};
+      geom::Surface reference_boundary = frames.rest.surface, fiber_boundary = frames.rest.surface;
+      for (size_t k = 1; k < reference.u.size(); ++k) {
+        const double t = reference.times[k];
+        reference_boundary.V =
+            boundary_rows(frames.rest, X0 + fem::displacement_rows(reference.u[k], dim));
+        fiber_boundary.V = run.positions[fiber_step(scene, t, fiber_steps)];
+        const bool surface_step = metrics_step(k, reference.u.size(), spec.metrics_every);
+        append_metrics(s, t, frame, reference_boundary.V, fiber_boundary.V,
+                       surface_step ? &reference_boundary : nullptr, &fiber_boundary);
+      }
+      report.static_energy_norm =
+          metrics::relative_energy_norm(target - rest, run.positions.back() - rest);
+      result.fiber_final = frames.rest.surface;
+      result.fiber_final.V = run.positions.back();
+    }
+    result.figures["fiber-model.Y"] = report.Y;
+    result.figures["fiber-model.gamma"] = report.gamma;
+    result.figures["fiber-model.static_E_n"] = report.static_energy_norm;
+    result.fiber = report;
+    result.series.push_back(std::move(s));
+  }
+  for (const MetricSeries& s : result.series) add_series_figures(spec, s, result.figures);
+  if (progress) progress(total, total);
+  return result;
+}
+
+std::string benchmark_report(const BenchmarkResult& result) {
+  std::ostringstream out;
+  out << "  E_n / E_s / E_i against implicit Newmark (" << result.reference_seconds << " s):\n";
+  for (const MetricSeries& s : result.series) {
+    out << "  " << s.label << ":";
+    for (const char* when : {"at_1s", "at_2s", "at_5s", "final"}) {
+      const auto figure = [&](const char* metric) {
+        const auto it = result.figures.find(s.label + "." + metric + "." + when);
+        return it == result.figures.end()
+                   ? std::string("-")
+                   : (std::ostringstream() << std::setprecision(3) << it->second).str();
+      };
+      out << " " << (std::string(when) == "final" ? "end" : std::string(when).substr(3)) << " "
+          << figure("E_n") << " / " << figure("E_s") << " / " << figure("E_i") << ";";
+    }
+    out << " " << std::setprecision(3) << s.seconds << " s";
+    if (!s.ok) out << "; stopped: " << s.message;
+    out << "\n";
+  }
+  if (result.fiber)
+    out << "  fiber model: Y = " << result.fiber->Y << ", gamma = " << result.fiber->gamma << " ("
+        << result.fiber->how << ")\n";
+  return out.str();
+}
+
+std::string benchmark_csv(const BenchmarkResult& result) {
+  std::ostringstream out;
+  out.precision(10);
+  out << "time_s,series,E_n,E_s,E_i\n";
+  auto cell = [](double v) {
+    return std::isfinite(v) ? (std::ostringstream() << std::setprecision(10) << v).str()
+                            : std::string();
+  };
+  for (const MetricSeries& s : result.series)
+    for (size_t k = 0; k < s.times.size(); ++k)
+      out << s.times[k] << "," << s.label << "," << cell(s.energy_norm[k]) << ","
+          << cell(s.surface[k]) << "," << cell(s.interior[k]) << "\n";
+  return out.str();
+}
+
+std::string benchmark_json(const BenchmarkSpec& spec, const BenchmarkResult& result) {
+  const fem::Scene& scene = result.scene;
+  json series = json::array();
+  for (const MetricSeries& s : result.series)
+    series.push_back({{"label", s.label},
+                      {"ok", s.ok},
+                      {"message", s.message},
+                      {"seconds", s.seconds},
+                      {"gauss_seidel_sweeps", s.sweeps},
+                      {"steps", s.times.size()},
+                      {"interior_weights", s.interior_weights}});
+  json doc = {{"scene", scene.name},
+              {"material",
+               {{"label", spec.material_label},
+                {"E", scene.material.young},
+                {"nu", scene.material.poisson},
+                {"density", scene.material.density},
+                {"alpha", scene.dynamics.alpha},
+                {"beta", scene.dynamics.beta}}},
+              {"mesh",
+               {{"nodes", scene.mesh.num_nodes()},
+                {"elements", scene.mesh.elements.rows()},
+                {"nodes_per_element", scene.mesh.elements.cols()},
+                {"plane", scene.mesh.dim == 3                               ? "3D"
+                          : scene.material.plane == fem::PlaneModel::Strain ? "strain"
+                                                                            : "stress"}}},
+              {"time", {{"step", spec.step}, {"duration", spec.duration}}},
+              {"linear_solver", fem::to_string(spec.linear.linear)},
+              {"reference",
+               {{"solver", "implicit-newmark"},
+                {"seconds", result.reference_seconds},
+                {"gauss_seidel_sweeps", result.reference_sweeps}}},
+              {"series", series}};
+  if (result.fiber)
+    doc["fiber_model"] = {{"Y", result.fiber->Y},
+                          {"gamma", result.fiber->gamma},
+                          {"how", result.fiber->how},
+                          {"vertices", result.fiber->vertices},
+                          {"static_E_n", result.fiber->static_energy_norm}};
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,357 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Building a parsed case on its surface: what needs the mesh (case_spec.hpp).
+#include <algorithm>
+#include <sstream>
+#include <string>
+
+#include "experiment/case_spec.hpp"
+#include "geom/fiber_pruning.hpp"
+#include "geom/mesh_check.hpp"
+#include "geom/mesh_io.hpp"
+#include "model/boundary_conditions.hpp"
+#include "util/error.hpp"
+#include "util/progress.hpp"
+#include "util/run_control.hpp"
+
+namespace fiberfluid::experiment {
+
+void FieldName::fail(const std::string& key, const std::string& what) const {
+  const std::string name = key.empty() ? path : path.empty() ? key : path + "." + key;
+  throw InputError(file + ": " + name + (name.empty() ? "" : ": ") + what);
+}
+
+geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
+                                   std::vector<std::string>* warnings) {
+  geom::ReadResult read = geom::read_surface(path);
+  if (flip) geom::flip_orientation(read.surface);
+  const geom::MeshReport report = geom::inspect(read.surface);
+  geom::require_usable(report, path.string());
+  if (warnings) {
+    warnings->insert(warnings->end(), read.warnings.begin(), read.warnings.end());
+    for (const auto& w : report.warnings) warnings->push_back(path.string() + ": " + w);
+  }
+  return read.surface;
+}
+
+geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* warnings) {
+  if (spec.empty())
+    spec.field.fail("",
+                    "missing (required): the document names no surface and the program "
+                    "gave none");
+  geom::Surface surface;
+  if (!spec.file.empty()) {
+    try {
+      surface = load_checked_surface(spec.file, spec.flip, warnings);
+    } catch (const InputError& e) {
+      spec.field.fail("file", e.what());  // names the experiment field as well as the mesh
+    }
+  } else {
+    surface = spec.generate();
+    const geom::MeshReport report = geom::inspect(surface);
+    geom::require_usable(report, spec.field.file + ": " +
+                                     (spec.field.path.empty() ? "" : spec.field.path + ".") +
+                                     "generator");
+  }
+  surface.V *= spec.scale;
+  // The checks above saw the unscaled mesh: a scale can still push coordinates
+  // past what squares and cross products of them can hold (or to nothing).
+  const double size = geom::bounding_box_diagonal(surface.V);
+  if (!(size > 1e-100 && size < 1e100))
+    spec.field.fail(
+        "scale", (std::ostringstream() << "scaled by " << spec.scale << " the surface is " << size
+                                       << " m across; expected a size from "
+                                          "1e-100 to 1e100 m")
+                     .str());
+  return surface;
+}
+
+namespace {
+
+std::string axis_names(int dim) { return std::string("xyz").substr(0, static_cast<size_t>(dim)); }
+
+// A per-axis list must have one entry per axis of the surface.
+void require_per_axis(const FieldName& field, const std::string& key, const Eigen::VectorXd& v,
+                      int dim) {
+  if (v.size() != dim)
+    field.fail(key, "expected a list of " + std::to_string(dim) + " numbers (one per axis of the " +
+                        std::to_string(dim) + "D surface), got " + std::to_string(v.size()));
+}
+
+// ------------------------------------------------------------ fibers
+// Bodies beyond this are not pruned: N^2 pair tests (a 5,000-vertex torus:
+// about 20 s here, so 20,000 vertices about 6 minutes) and an N^2 byte table.
+constexpr int kLargestPruned = 20000;
+
+// Prunes the fibers that leave a concave body and reports what it did.
+FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
+  FiberReport report;
+  report.pruning = spec.pruning;
+  report.write = spec.write;
+  m.connection_count = spec.count;
+  m.treecode_tolerance = spec.treecode_tolerance;
+  const int n = m.num_vertices();
+  report.pairs = static_cast<long long>(n) * (n - 1) / 2;
+  report.kept = report.pairs;
+  report.min_per_vertex = report.max_per_vertex = n - 1;
+  report.mean_per_vertex = n - 1;
+  if (!report.pruning) return report;
+  report.convex = !concave;
+  if (report.convex) return report;
+  geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
+  report.seconds = pruned.seconds;
+  report.exact_fallbacks = pruned.exact_fallbacks;
+  report.kept = pruned.mask.num_kept();
+  const std::vector<int> per_vertex = pruned.mask.kept_per_vertex();
+  report.min_per_vertex = *std::min_element(per_vertex.begin(), per_vertex.end());
+  report.max_per_vertex = *std::max_element(per_vertex.begin(), per_vertex.end());
+  report.mean_per_vertex = 2.0 * report.kept / n;
+  if (report.min_per_vertex == 0)
+    spec.field.fail("pruning",
+                    "vertex " +
+                        std::to_string(std::find(per_vertex.begin(), per_vertex.end(), 0) -
+                                       per_vertex.begin()) +
+                        " keeps no fiber: is the mesh self-intersecting?");
+  if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Symmetric)
+    spec.field.fail("product",
+                    "\"treecode\" needs one connection count for every fiber: this "
+                    "concave body prunes " +
+                        std::to_string(report.pairs - report.kept) +
+                        " fibers; set \"connection_count\": \"global\" (pruned "
+                        "fibers are then exact corrections) or \"product\": \"exact\"");
+  m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
+  return report;
+}
+
+// The surface as given and its used vertices as the model's.
+void set_surface(geom::Surface input, Case& c) {
+  c.input_surface = std::move(input);
+  const geom::CompactSurface compact = geom::remove_unused_vertices(c.input_surface);
+  c.model_to_input = compact.to_input;
+  c.model.surface = compact.surface;
+}
+
+// Refuses a case whose estimate exceeds the budgets; notes a long one.
+void estimate(const CaseSpec& spec, PruningWork pruning, Case& c) {
+  c.estimate = estimate_resources(c.model, c.stepping, pruning);
+  require_within_budget(c.estimate, spec);
+}
+
+// The fibers of a case whose model parts are built: its cost is estimated
+// (and refused beyond the memory or time budget) before the convexity check,
+// and again before pruning once the check has said whether it prunes.
+void add_fibers(const CaseSpec& spec, Case& c) {
+  const int n = c.model.num_vertices();
+  estimate(spec, spec.fibers.pruning ? PruningWork::ConvexityCheck : PruningWork::None, c);
+  const bool concave = spec.fibers.pruning && !geom::is_convex(c.model.surface);
+  if (concave && n > kLargestPruned)
+    spec.fibers.field.fail("pruning", "a concave body of " + std::to_string(n) +
+                                          " vertices is beyond exact pruning (at most " +
+                                          std::to_string(kLargestPruned) + "); set \"off\"");
+  if (concave) estimate(spec, PruningWork::Prune, c);
+  if (c.estimate.seconds >= 10.0 || c.estimate.peak_bytes >= 0.25 * memory_budget_bytes())
+    report_note("estimate for a long run: " + c.estimate.describe());
+  c.fibers = prune(spec.fibers, concave, c.model);
+}
+
+// ------------------------------------------------------------ model parts
+// Resolves the parts that need the mesh, on a case whose geometry is built.
+class ModelBuilder {
+ public:
+  ModelBuilder(const CaseSpec& spec, Case& c)
+      : spec_(spec),
+        c_(c),
+        dim_(c.model.dim()),
+        input_to_model_(static_cast<size_t>(c.input_surface.num_vertices()), -1) {
+    for (size_t m = 0; m < c.model_to_input.size(); ++m)
+      input_to_model_[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
+  }
+
+  void build() {
+    c_.variant = spec_.variant;
+    c_.patch = spec_.patch;
+    c_.stepping = spec_.stepping;
+    c_.model.material = material();
+    c_.model.loads.clear();
+    for (const LoadSpec& l : spec_.loads) c_.model.loads.push_back(load(l));
+    c_.model.constraints.clear();
+    c_.model.constraint_groups.clear();
+    for (const ConstraintSpec& k : spec_.constraints) add_group(k);
+    c_.model.paddles.clear();
+    for (const PaddleSpec& p : spec_.paddles) c_.model.paddles.push_back(paddle(p));
+    check_paddles_leave_room();
+  }
+
+ private:
+  int model_vertex(const FieldName& field, const std::string& key, int input) const {
+    if (input >= static_cast<int>(input_to_model_.size()))
+      field.fail(key, "vertex " + std::to_string(input) + " does not exist (the mesh has " +
+                          std::to_string(input_to_model_.size()) + " vertices, from 0)");
+    const int m = input_to_model_[static_cast<size_t>(input)];
+    if (m < 0) field.fail(key, "vertex " + std::to_string(input) + " belongs to no face");
+    return m;
+  }
+
+  model::Material material() const {
+    const MaterialSpec& spec = spec_.material;
+    model::Material m = spec.material;
+    if (spec.per_axis.size() > 0) {
+      require_per_axis(spec.field, spec.per_axis_moduli ? "Y" : "axis_factors", spec.per_axis,
+                       dim_);
+      if (spec.per_axis_moduli) m.axis_factors.setZero();
+      m.axis_factors.head(dim_) = spec.per_axis;
+    }
+    return m;
+  }
+
+  model::Load load(const LoadSpec& spec) const {
+    model::Load load = spec.load;
+    switch (load.kind) {
+      case model::Load::Kind::Point:
+        require_per_axis(spec.field, "force", spec.vector, dim_);
+        load.vertex = model_vertex(spec.field, "vertex", spec.input_vertex);
+        load.force.head(dim_) = spec.vector;
+        return load;
+      case model::Load::Kind::Hydrostatic:
+        require_per_axis(spec.field, "acceleration", spec.vector, dim_);
+        load.acceleration.head(dim_) = spec.vector;
+        return load;
+    }
+    spec.field.fail("type", "a load of an unknown kind");
+  }
+
+  std::vector<int> select(const SelectionSpec& spec) const { return resolve_selection(spec, c_); }
+
+  void add_group(const ConstraintSpec& spec) {
+    model::Model& m = c_.model;
+    m.constraint_groups.push_back(spec.label);
+    const int group = static_cast<int>(m.constraint_groups.size()) - 1;
+    const std::vector<int> vertices = select(spec.selection);
+    if (spec.prescribed) {
+      require_per_axis(spec.field, "displacement", spec.displacement, dim_);
+      for (int v : vertices)
+        for (int a = 0; a < dim_; ++a)
+          m.constraints.push_back({v, a, spec.displacement[a], spec.schedule, group});
+      return;
+    }
+    const std::string axes = spec.axes.empty() ? axis_names(dim_) : spec.axes;
+    for (char letter : axes)
+      if (letter - 'x' >= dim_)
+        spec.field.fail("axes", "expected distinct letters from \"" + axis_names(dim_) +
+                                    "\", got \"" + axes + "\"");
+    for (int v : vertices)
+      for (char letter : axes) m.constraints.push_back({v, letter - 'x', 0.0, {}, group});
+  }
+
+  model::Paddle paddle(const PaddleSpec& spec) const {
+    model::Paddle p = spec.paddle;
+    if (p.axis >= dim_)
+      spec.field.fail("axis", "expected one of \"" + axis_names(dim_) +
+                                  "\" (the paddle's normal), got \"" +
+                                  std::string(1, static_cast<char>('x' + p.axis)) + "\"");
+    const Eigen::VectorXd along = c_.model.surface.V.col(p.axis);
+    const double extent = along.maxCoeff() - along.minCoeff();
+    const double touching = p.above ? along.maxCoeff() : along.minCoeff();
+    p.position = spec.position.value_or(touching);
+    if (p.penetration(touching, p.position) > 1e-9 * extent)
+      spec.field.fail("position", "the paddle starts inside the body: it must be " +
+                                      std::string(p.above ? "at or above " : "at or below ") +
+                                      std::to_string(touching));
+    p.travel = spec.travel ? *spec.travel
+                           : (p.above ? -1.0 : 1.0) * spec.compression.value_or(0.0) * extent;
+    return p;
+  }
+
+  // Two paddles on one axis may not meet (checked at every step by the solver too).
+  void check_paddles_leave_room() const {
+    for (const model::Paddle& a : c_.model.paddles)
+      for (const model::Paddle& b : c_.model.paddles)
+        if (a.axis == b.axis && a.above && !b.above &&
+            !(a.plane(1.0) > b.plane(1.0) && a.position > b.position))
+          spec_.paddles_field.fail("", "paddles " + a.label + " and " + b.label +
+                                           " meet or pass each other: their travels leave no "
+                                           "room for the body");
+  }
+
+  const CaseSpec& spec_;
+  Case& c_;
+  int dim_;
+  std::vector<int> input_to_model_;
+};
+
+}  // namespace
+
+std::vector<int> resolve_selection(const SelectionSpec& spec, const Case& c) {
+  const Eigen::MatrixXd& V = c.model.surface.V;
+  const int dim = c.model.dim();
+  std::vector<int> selected;
+  if (!spec.vertices.empty()) {
+    std::vector<int> input_to_model(static_cast<size_t>(c.input_surface.num_vertices()), -1);
+    for (size_t m = 0; m < c.model_to_input.size(); ++m)
+      input_to_model[static_cast<size_t>(c.model_to_input[m])] = static_cast<int>(m);
+    for (int input : spec.vertices) {
+      if (input >= static_cast<int>(input_to_model.size()))
+        spec.field.fail("vertices",
+                        "vertex " + std::to_string(input) + " does not exist (the mesh has " +
+                            std::to_string(input_to_model.size()) + " vertices, from 0)");
+      const int m = input_to_model[static_cast<size_t>(input)];
+      if (m < 0)
+        spec.field.fail("vertices", "vertex " + std::to_string(input) + " belongs to no face");
+      selected.push_back(m);
+    }
+  } else if (!spec.where.empty()) {
+    try {
+      selected = model::select_half_space(V, model::parse_half_space(spec.where, dim));
+    } catch (const InputError& e) {
+      spec.field.fail("where", e.what());
+    }
+    if (selected.empty()) spec.field.fail("where", "\"" + spec.where + "\" selects no vertex");
+  } else {
+    require_per_axis(spec.field, "box.min", spec.box_min, dim);
+    require_per_axis(spec.field, "box.max", spec.box_max, dim);
+    selected = model::select_box(V, spec.box_min, spec.box_max);
+    if (selected.empty()) spec.field.fail("box", "the box selects no vertex");
+  }
+  return selected;
+}
+
+Case build_case(const CaseSpec& spec, std::vector<std::string>* warnings) {
+  Case c;
+  set_surface(build_surface(spec.surface, warnings), c);
+  ModelBuilder(spec, c).build();
+  add_fibers(spec, c);
+  return c;
+}
+
+Case build_case(const CaseSpec& spec, const geom::Surface& surface,
+                std::vector<std::string>* warnings) {
+  if (!spec.surface.empty())
+    spec.surface.field.fail("",
+                            "the program gives the surface; the document must not name "
+                            "one too");
+  const std::string label = spec.surface.field.file + ": the given surface";
+  const geom::MeshReport report = geom::inspect(surface);
+  geom::require_usable(report, label);
+  if (warnings)
+    for (const auto& w : report.warnings) warnings->push_back(label + ": " + w);
+  Case c;
+  set_surface(surface, c);
+  ModelBuilder(spec, c).build();
+  add_fibers(spec, c);
+  return c;
+}
+
+Case build_case(const CaseSpec& spec, const Case& earlier) {
+  Case c;
+  c.input_surface = earlier.input_surface;
+  c.model_to_input = earlier.model_to_input;
+  c.model.surface = earlier.model.surface;
+  c.model.fibers = earlier.model.fibers;
+  c.model.connection_count = earlier.model.connection_count;
+  c.model.treecode_tolerance = earlier.model.treecode_tolerance;
+  c.fibers = earlier.fibers;
+  ModelBuilder(spec, c).build();
+  estimate(spec, PruningWork::None, c);  // pruned once, for the earlier case
+  return c;
+}
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,749 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/experiment.hpp"
+
+#include "experiment/json_fields.hpp"
+#include "experiment/output_folder.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <functional>
+#include <istream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <utility>
+
+#include "geom/generators.hpp"
+#include "model/boundary_conditions.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using nlohmann::json;
+
+// ------------------------------------------------------------ surfaces
+// A generator's parameters, checked now; the surface is made when the case is built.
+std::function<geom::Surface()> read_generator(Fields& f) {
+  const std::string kind = f.choice("generator", "",
+                                    {"icosphere", "tetrahedron", "octahedron", "icosahedron",
+                                     "cube", "box", "dome", "torus", "rectangle", "polygon"});
+  if (kind == "icosphere") {
+    const int subdivisions = f.integer("subdivisions", 2, 0, 7);
+    const double radius = f.positive("radius", 1.0);
+    return [=] { return geom::icosphere(subdivisions, radius); };
+  }
+  if (kind == "tetrahedron" || kind == "octahedron" || kind == "icosahedron") {
+    const double radius = f.positive("radius", 1.0);
+    if (kind == "tetrahedron") return [=] { return geom::tetrahedron(radius); };
+    if (kind == "octahedron") return [=] { return geom::octahedron(radius); };
+    return [=] { return geom::icosahedron(radius); };
+  }
+  if (kind == "cube") {
+    const double edge = f.positive("edge", 1.0);
+    return [=] { return geom::cube(edge); };
+  }
+  if (kind == "box") {
+    const Eigen::Vector3d min = f.vector("min", 3), max = f.vector("max", 3);
+    Eigen::Vector3i segments = Eigen::Vector3i::Ones();
+    if (f.has("segments")) segments = f.counts("segments", 3, 1, 200);
+    if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on every axis");
+    return [=] { return geom::box(min, max, segments); };
+  }
+  if (kind == "dome") {
+    const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
+    const int subdivisions = f.integer("subdivisions", 2, 0, 6);
+    return [=] { return geom::dome(semi_axes, subdivisions); };
+  }
+  if (kind == "torus") {
+    const double major = f.positive("major_radius", 2.0), minor = f.positive("minor_radius", 0.7);
+    if (minor >= major)
+      f.fail("minor_radius", "must be below major_radius (a ring, not a spindle)");
+    Eigen::Vector2i segments(40, 20);
+    if (f.has("segments")) segments = f.counts("segments", 2, 3, 1000);
+    return [=] { return geom::torus(major, minor, segments.x(), segments.y()); };
+  }
+  if (kind == "rectangle") {
+    const Eigen::Vector2d min = f.vector("min", 2), max = f.vector("max", 2);
+    Eigen::Vector2i segments = Eigen::Vector2i::Ones();
+    if (f.has("segments")) segments = f.counts("segments", 2, 1, 1000);
+    if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on both axes");
+    return [=] { return geom::rectangle(min, max, segments.x(), segments.y()); };
+  }
+  // polygon
+  const json& points = f.raw("points");
+  if (!points.is_array() || points.size() < 3)
+    f.fail("points", "expected a list of at least 3 [x, y] points");
+  Eigen::MatrixXd P(static_cast<Eigen::Index>(points.size()), 2);
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (!points[k].is_array() || points[k].size() != 2 || !points[k][0].is_number() ||
+        !points[k][1].is_number())
+      f.fail("points", "expected [x, y] pairs, got " + excerpt(points[k]));
+    P.row(static_cast<Eigen::Index>(k)) << points[k][0].get<double>(), points[k][1].get<double>();
+  }
+  return [=] { return geom::polygon(P); };
+}
+
+// "file" (with "flip") or "generator", then "scale".
+SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
+  SurfaceSpec spec;
+  spec.field = f.field();
+  if (f.has("file") == f.has("generator"))
+    f.fail("", "expected exactly one of \"file\" or \"generator\"");
+  if (f.has("file")) {
+    spec.file = f.string("file");
+    if (spec.file.is_relative()) spec.file = folder / spec.file;
+    spec.flip = f.boolean("flip", false);
+  } else {
+    spec.generate = read_generator(f);
+    spec.generator = f.string("generator");
+  }
+  spec.scale = f.positive("scale", 1.0);
+  return spec;
+}
+
+// ------------------------------------------------------------ selections
+model::Schedule read_schedule(Fields& f, const std::string& fallback) {
+  model::Schedule schedule;
+  if (f.has("schedule") && f.raw("schedule").is_array()) {
+    schedule.kind = model::Schedule::Kind::Table;
+    const Eigen::VectorXd values = f.vector("schedule", -1);
+    schedule.values.assign(values.data(), values.data() + values.size());
+    return schedule;
+  }
+  const std::string name = f.choice("schedule", fallback, {"ramp", "final", "up_down"});
+  schedule.kind = name == "ramp"    ? model::Schedule::Kind::Ramp
+                  : name == "final" ? model::Schedule::Kind::Final
+                                    : model::Schedule::Kind::UpDown;
+  return schedule;
+}
+
+// A list with one number per axis: 2 or 3 now, the surface's dimension when built.
+Eigen::VectorXd per_axis_vector(Fields& f, const std::string& key) {
+  const Eigen::VectorXd v = f.vector(key, -1);
+  if (v.size() != 2 && v.size() != 3)
+    f.fail(key, "expected one number per axis (2 or 3), got " + std::to_string(v.size()));
+  return v;
+}
+
+// Exactly one of "vertices" (input indices), "where" (a half-space) or "box".
+SelectionSpec read_selection(Fields& f) {
+  const int chosen = f.has("vertices") + f.has("where") + f.has("box");
+  if (chosen != 1) f.fail("", "expected exactly one of \"vertices\", \"where\" or \"box\"");
+  SelectionSpec spec;
+  spec.field = f.field();
+  if (f.has("vertices")) {
+    spec.vertices = f.indices("vertices");
+  } else if (f.has("where")) {
+    spec.where = f.string("where");
+    try {
+      model::parse_half_space(spec.where, 3);  // the syntax; the axis is checked when built
+    } catch (const InputError& e) {
+      f.fail("where", e.what());
+    }
+  } else {
+    Fields box = f.object("box");
+    spec.box_min = per_axis_vector(box, "min");
+    spec.box_max = per_axis_vector(box, "max");
+    box.finish();
+  }
+  return spec;
+}
+
+// The held axes: distinct letters of "xyz" ("" for all of the surface's axes).
+std::string read_axes(Fields& f) {
+  const std::string text = f.string("axes", "");
+  for (char c : text)
+    if (c < 'x' || c > 'z' || std::count(text.begin(), text.end(), c) > 1)
+      f.fail("axes", "expected distinct letters from \"xyz\", got \"" + text + "\"");
+  if (f.has("axes") && text.empty()) f.fail("axes", "expected at least one axis");
+  return text;
+}
+
+// ------------------------------------------------------------ model parts
+double required_positive(Fields& f, const std::string& key) {
+  const double x = f.number(key);
+  if (!(x > 0.0)) f.fail(key, "expected a positive number, got " + std::to_string(x));
+  return x;
+}
+
+model::FiberLaw read_law(Fields f) {
+  const std::string type = f.choice("type", "constant", model::law_type_names());
+  model::FiberLaw law = model::FiberLaw::constant(1.0);
+  if (type == "constant") {
+    const double Y = f.number("Y");
+    if (Y < 0.0) f.fail("Y", "expected a number >= 0, got " + std::to_string(Y));
+    law = model::FiberLaw::constant(Y);
+  } else if (type == "exponential") {
+    law = model::FiberLaw::exponential(required_positive(f, "Y0"), f.number("beta"));
+  } else if (type == "bilinear") {
+    const double Y_t = required_positive(f, "Y_t"), Y_c = required_positive(f, "Y_c");
+    law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
+  } else if (type != "tabulated") {
+    // A law registered by the program that links the library: its parameters by name.
+    const std::shared_ptr<const model::LawModel> registered = model::find_registered_law(type);
+    std::vector<double> values;
+    for (const std::string& name : registered->parameter_names()) values.push_back(f.number(name));
+    law = model::FiberLaw(registered, values);
+  } else {
+    const Eigen::VectorXd strain = f.vector("strain", -1), stress = f.vector("stress", -1);
+    if (stress.size() != strain.size())
+      f.fail("stress", "expected as many stresses as strains (" + std::to_string(strain.size()) +
+                           "), got " + std::to_string(stress.size()));
+    law = model::FiberLaw::tabulated({strain.data(), strain.data() + strain.size()},
+                                     {stress.data(), stress.data() + stress.size()});
+    law.set_parameter("scale", f.positive("scale", 1.0));
+  }
+  f.finish();
+  const std::string why = law.check();
+  if (!why.empty()) f.fail(type == "tabulated" ? "stress" : "", why);
+  return law;
+}
+
+MaterialSpec read_material(Fields f) {
+  MaterialSpec spec;
+  spec.field = f.field();
+  model::Material& m = spec.material;
+  if (f.has("law") && f.has("Y"))
+    f.fail("Y", "give either Y (the linear model) or a law with its parameters, not both");
+  if (f.has("law")) {
+    m.law = read_law(f.object("law"));
+    if (f.has("axis_factors")) {
+      spec.per_axis = per_axis_vector(f, "axis_factors");
+      if (!(spec.per_axis.array() > 0).all()) f.fail("axis_factors", "expected positive numbers");
+    }
+  } else if (f.raw("Y").is_array()) {
+    // The paper's per-axis moduli: the constant law 1 times exact factors.
+    spec.per_axis = per_axis_vector(f, "Y");
+    if ((spec.per_axis.array() < 0).any()) f.fail("Y", "expected numbers >= 0");
+    spec.per_axis_moduli = true;
+    m.law = model::FiberLaw::constant(1.0);
+  } else {
+    m.law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
+  }
+  m.surface_tension = f.non_negative("gamma", 0.0);
+  f.finish();
+  return spec;
+}
+
+std::vector<LoadSpec> read_loads(Fields& root) {
+  std::vector<LoadSpec> loads;
+  for (Fields f : root.objects("loads")) {
+    LoadSpec spec;
+    spec.field = f.field();
+    model::Load& load = spec.load;
+    const std::string type = f.choice("type", "", {"gravity", "point"});
+    load.label = f.string("label", type + "_" + std::to_string(loads.size()));
+    if (type == "gravity") {
+      load.kind = model::Load::Kind::Hydrostatic;
+      spec.vector = per_axis_vector(f, "acceleration");
+      load.density = f.positive("density", 1000.0);
+    } else {
+      load.kind = model::Load::Kind::Point;
+      if (!f.has("vertex")) f.fail("vertex", "missing (required): the vertex the force acts on");
+      spec.input_vertex = f.integer("vertex", 0, 0, std::numeric_limits<int>::max());
+      spec.vector = per_axis_vector(f, "force");
+    }
+    load.schedule = read_schedule(f, "ramp");
+    f.finish();
+    loads.push_back(spec);
+  }
+  return loads;
+}
+
+// Each entry of "supports" and "prescribed" is a group with its own reaction
+// force, named by "label" (default support_K / prescribed_K).
+std::vector<ConstraintSpec> read_constraints(Fields& root) {
+  std::vector<ConstraintSpec> groups;
+  auto read_group = [&](Fields& f, bool prescribed, const std::string& fallback) {
+    ConstraintSpec spec;
+    spec.field = f.field();
+    spec.prescribed = prescribed;
+    spec.label = f.string("label", fallback);
+    for (const ConstraintSpec& other : groups)
+      if (other.label == spec.label)
+        f.fail("label", "\"" + spec.label + "\" names another group already");
+    spec.selection = read_selection(f);
+    if (prescribed) {
+      spec.displacement = per_axis_vector(f, "displacement");
+      spec.schedule = read_schedule(f, "ramp");
+    } else {
+      spec.axes = read_axes(f);
+    }
+    f.finish();
+    groups.push_back(spec);
+  };
+  int k = 0;
+  for (Fields f : root.objects("supports")) read_group(f, false, "support_" + std::to_string(k++));
+  k = 0;
+  for (Fields f : root.objects("prescribed"))
+    read_group(f, true, "prescribed_" + std::to_string(k++));
+  return groups;
+}
+
+// Rigid paddles: planes normal to an axis on one side of the body, moving by
+// "travel" (m) or by "compression" (a share of the body's extent along the
+// axis, towards the body). "position" defaults to touching the body.
+std::vector<PaddleSpec> read_paddles(Fields& root) {
+  std::vector<PaddleSpec> paddles;
+  for (Fields f : root.objects("paddles")) {
+    PaddleSpec spec;
+    spec.field = f.field();
+    model::Paddle& p = spec.paddle;
+    p.label = f.string("label", "paddle_" + std::to_string(paddles.size()));
+    for (const PaddleSpec& other : paddles)
+      if (other.paddle.label == p.label)
+        f.fail("label", "\"" + p.label + "\" names another paddle");
+    const std::string axis = f.string("axis");
+    if (axis.size() != 1 || axis[0] < 'x' || axis[0] > 'z')
+      f.fail("axis", "expected one of \"xyz\" (the paddle's normal), got \"" + axis + "\"");
+    p.axis = axis[0] - 'x';
+    p.above = f.choice("side", "", {"above", "below"}) == "above";
+    if (f.has("position")) spec.position = f.number("position");
+    if (f.has("travel") == f.has("compression"))
+      f.fail("travel",
+             "give either travel (m, along the axis) or compression (a share of "
+             "the body's extent), one of them");
+    if (f.has("travel")) {
+      spec.travel = f.number("travel");
+    } else {
+      spec.compression = f.number("compression");
+      if (!(*spec.compression > 0.0 && *spec.compression < 1.0))
+        f.fail("compression", "expected a share of the body's extent between 0 and 1");
+    }
+    p.schedule = read_schedule(f, "ramp");
+    p.sticking = f.choice("contact", "frictionless", {"frictionless", "sticking"}) == "sticking";
+    f.finish();
+    paddles.push_back(spec);
+  }
+  return paddles;
+}
+
+solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
+  o.residual_tolerance = f.positive("residual_tolerance", o.residual_tolerance);
+  o.increment_tolerance = f.positive("increment_tolerance", o.increment_tolerance);
+  o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
+  o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
+  o.line_search = f.boolean("line_search", o.line_search);
+  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov"});
+  o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
+              : tangent == "krylov" ? solve::TangentSolver::Krylov
+                                    : solve::TangentSolver::Auto;
+  o.krylov_tolerance = f.positive("krylov_tolerance", o.krylov_tolerance);
+  o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
+  o.krylov_max_iterations = f.integer("krylov_max_iterations", o.krylov_max_iterations, 1, 100000);
+  o.max_contact_rounds = f.integer("max_contact_rounds", o.max_contact_rounds, 1, 1000);
+  o.predictor = f.boolean("predictor", o.predictor);
+  f.finish();
+  return o;
+}
+
+solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
+  options.scheme = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton"
+                       ? solve::Scheme::Newton
+                       : solve::Scheme::Incremental;
+  if (f.has("newton")) {
+    if (options.scheme != solve::Scheme::Newton)
+      f.fail("newton", "Newton options need \"scheme\": \"newton\"");
+    options.newton = read_newton(f.object("newton"), options.newton);
+  }
+  options.steps = f.integer("steps", options.steps, 1, 100000);
+  options.rebuild_matrix = f.boolean("rebuild_matrix", options.rebuild_matrix);
+  options.update_load_geometry = f.boolean("update_load_geometry", options.update_load_geometry);
+  const std::string method = f.choice("boundary_method", model::to_string(options.boundary_method),
+                                      {"elimination", "penalty"});
+  options.boundary_method =
+      method == "penalty" ? model::BoundaryMethod::Penalty : model::BoundaryMethod::Elimination;
+  options.penalty = f.positive("penalty", options.penalty);
+  const std::string solver =
+      f.choice("solver", solve::to_string(options.solver), solve::solver_kind_names());
+  options.solver = *solve::solver_kind_from_string(solver);
+  options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
+  options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
+  options.max_volume_change = f.positive("max_volume_change", options.max_volume_change);
+  options.measure_residual = f.boolean("measure_residual", options.measure_residual);
+  options.stop_on_inverted_faces =
+      f.boolean("stop_on_inverted_faces", options.stop_on_inverted_faces);
+  f.finish();
+  return options;
+}
+
+void check_tables(const Fields& root, const CaseSpec& c) {
+  auto check = [&](const model::Schedule& s, const std::string& what) {
+    if (s.kind == model::Schedule::Kind::Table &&
+        static_cast<int>(s.values.size()) != c.stepping.steps)
+      root.fail(what, "the schedule lists " + std::to_string(s.values.size()) +
+                          " factors but stepping.steps is " + std::to_string(c.stepping.steps));
+  };
+  for (const LoadSpec& l : c.loads) check(l.load.schedule, l.field.path + ".schedule");
+  for (const ConstraintSpec& k : c.constraints) check(k.schedule, k.field.path + ".schedule");
+  for (const PaddleSpec& p : c.paddles) check(p.paddle.schedule, p.field.path + ".schedule");
+}
+
+std::vector<ExpectedFigure> read_expected(Fields& root) {
+  std::vector<ExpectedFigure> expected;
+  for (Fields f : root.objects("expected")) {
+    ExpectedFigure e;
+    e.figure = f.string("figure");
+    e.note = f.string("note", "");
+    if (f.has("value") && f.raw("value").is_array()) {
+      const json& rows = f.raw("value");
+      e.matrix.resize(static_cast<Eigen::Index>(rows.size()),
+                      rows.empty() ? 0 : static_cast<Eigen::Index>(rows[0].size()));
+      for (size_t r = 0; r < rows.size(); ++r) {
+        if (!rows[r].is_array() || rows[r].size() != static_cast<size_t>(e.matrix.cols()))
+          f.fail("value", "expected a number or a matrix (a list of equal-length rows)");
+        for (size_t c = 0; c < rows[r].size(); ++c) {
+          if (!rows[r][c].is_number()) f.fail("value", "expected numbers in the matrix");
+          e.matrix(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
+              rows[r][c].get<double>();
+        }
+      }
+    } else if (f.has("value")) {
+      e.value = f.number("value");
+    }
+    e.tolerance = f.non_negative("tolerance", 0.0);
+    if (f.has("at_most")) e.at_most = f.number("at_most");
+    if (f.has("at_least")) e.at_least = f.number("at_least");
+    if (!e.value && e.matrix.size() == 0 && !e.at_most && !e.at_least)
+      f.fail("", "expected \"value\", \"at_most\" or \"at_least\"");
+    f.finish();
+    expected.push_back(e);
+  }
+  return expected;
+}
+
+FiberSpec read_fibers(Fields& root) {
+  FiberSpec spec;
+  spec.field = {root.file(), root.name("fibers")};
+  if (!root.has("fibers")) return spec;
+  Fields f = root.object("fibers");
+  spec.pruning = f.choice("pruning", "auto", {"auto", "off"}) == "auto";
+  spec.count = f.choice("connection_count", "symmetric", {"symmetric", "global"}) == "global"
+                   ? model::ConnectionCount::Global
+                   : model::ConnectionCount::Symmetric;
+  spec.write = f.choice("write", "none", {"none", "kept", "pruned"});
+  if (f.choice("product", "exact", {"exact", "treecode"}) == "treecode") {
+    spec.treecode_tolerance = f.number("treecode_tolerance", 1e-6);
+    if (!(spec.treecode_tolerance >= 1e-10 && spec.treecode_tolerance <= 1e-2))
+      f.fail("treecode_tolerance", "expected a relative error from 1e-10 to 1e-2, got " +
+                                       std::to_string(spec.treecode_tolerance));
+  } else if (f.has("treecode_tolerance"))
+    f.fail("treecode_tolerance", "applies to \"product\": \"treecode\" only");
+  f.finish();
+  return spec;
+}
+
+// The treecode's rules are the library's (solve::treecode_problem): the
+// reader names the field.
+void check_treecode(Fields& root, const CaseSpec& c) {
+  model::Model probe;
+  probe.material = c.material.material;
+  probe.treecode_tolerance = c.fibers.treecode_tolerance;
+  const std::string why = solve::treecode_problem(probe, c.stepping);
+  if (!why.empty()) root.fail("fibers", "\"product\": \"treecode\": " + why);
+}
+
+// Parses one case from a complete simulation document; opens no file.
+CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
+                   std::vector<std::string>* warnings) {
+  CaseSpec c;
+  if (root.has("surface")) {
+    Fields surface = root.object("surface");
+    c.surface = read_surface_spec(surface, folder);
+    surface.finish();
+  } else {  // the program building the case gives the surface
+    c.surface.field = {root.file(), root.name("surface")};
+  }
+  c.fibers = read_fibers(root);
+  c.surface_key = (root.has("surface") ? root.raw("surface").dump() : std::string()) + "|" +
+                  (root.has("fibers") ? root.raw("fibers").dump() : std::string());
+  c.material = read_material(root.object("material"));
+  c.loads = read_loads(root);
+  c.constraints = read_constraints(root);
+  c.paddles = read_paddles(root);
+  c.paddles_field = {root.file(), root.name("paddles")};
+  c.stepping =
+      root.has("stepping") ? read_stepping(root.object("stepping"), {}) : solve::SteppingOptions{};
+  if (!c.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
+    root.fail("paddles",
+              "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
+              "an active set inside the equilibrium iterations)");
+  if (!c.material.material.law.is_constant() && c.stepping.scheme == solve::Scheme::Incremental &&
+      !c.stepping.rebuild_matrix && warnings != nullptr)
+    warnings->push_back(
+        "material.law: the incremental scheme without stepping.rebuild_matrix "
+        "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
+        "scheme \"newton\" for the strain-dependent law");
+  if (c.fibers.treecode_tolerance > 0.0) check_treecode(root, c);
+  check_tables(root, c);
+  root.finish();
+  return c;
+}
+
+// ------------------------------------------------------------ fit
+FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
+  FitSpec spec;
+  spec.field = f.field();
+  for (Fields t : f.objects("targets")) {
+    FitTargetSpec target;
+    target.field = t.field();
+    target.file = t.string("file");
+    if (target.file.is_relative()) target.file = folder / target.file;
+    target.step = t.integer("step", 0, 1, 100000);
+    if (t.has("scale") && t.has("units"))
+      t.fail("units", "give the scan's units or its scale, not both");
+    if (t.has("units")) {
+      const std::string units = t.choice("units", "m", {"m", "cm", "mm", "um"});
+      target.scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
+    }
+    target.scale = t.positive("scale", target.scale);
+    t.finish();
+    spec.targets.push_back(target);
+  }
+  if (spec.targets.empty()) f.fail("targets", "expected at least one target surface");
+  for (Fields p : f.objects("parameters")) {
+    FitParameterSpec parameter;
+    parameter.field = p.field();
+    parameter.request.name = p.string("name");
+    for (const FitParameterSpec& other : spec.parameters)
+      if (other.request.name == parameter.request.name)
+        p.fail("name", "\"" + parameter.request.name + "\" is fitted twice");
+    if (p.has("start")) parameter.request.start = p.number("start");
+    if (p.has("lower")) parameter.request.lower = p.number("lower");
+    if (p.has("upper")) parameter.request.upper = p.number("upper");
+    if (p.has("log_scale")) parameter.request.log_scale = p.boolean("log_scale", false);
+    p.finish();
+    spec.parameters.push_back(parameter);
+  }
+  if (spec.parameters.empty()) f.fail("parameters", "expected at least one parameter to fit");
+  if (f.has("start_from")) {
+    spec.start_from = f.string("start_from");
+    if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;
+  }
+  // The options' values are checked once, by fit::check_options, for every
+  // front end alike (its messages begin with the option's name); here only
+  // their types.
+  const auto named = [&f](const std::string& key, const InputError& e) {
+    const std::string what = e.what();
+    const size_t colon = what.find(": ");
+    f.fail(key, colon == std::string::npos ? what : what.substr(colon + 2));
+  };
+  fit::FitOptions& o = spec.options;
+  try {
+    o.method = fit::method_from_string(f.string("method", "levenberg-marquardt"));
+  } catch (const InputError& e) {
+    named("method", e);
+  }
+  o.finite_differences =
+      f.choice("jacobian", "analytic", {"analytic", "finite-differences"}) == "finite-differences";
+  o.difference_step = f.number("difference_step", o.difference_step);
+  if (f.has("objective")) {
+    Fields objective = f.object("objective");
+    o.symmetric = objective.boolean("symmetric", false);
+    try {
+      o.loss = fit::loss_from_string(objective.string("loss", "squared"));
+    } catch (const InputError& e) {
+      named("objective.loss", e);
+    }
+    o.loss_scale = objective.number("loss_scale", o.loss_scale);
+    if (objective.has("exclude")) {
+      Fields exclude = objective.object("exclude");
+      spec.exclude = read_selection(exclude);
+      exclude.finish();
+    }
+    objective.finish();
+  }
+  const int any_min = std::numeric_limits<int>::min(), any_max = std::numeric_limits<int>::max();
+  o.max_iterations = f.integer("max_iterations", o.max_iterations, any_min, any_max);
+  o.max_evaluations = f.integer("max_evaluations", o.max_evaluations, any_min, any_max);
+  o.function_tolerance = f.number("function_tolerance", o.function_tolerance);
+  o.parameter_tolerance = f.number("parameter_tolerance", o.parameter_tolerance);
+  o.initial_trust_region_radius =
+      f.number("initial_trust_region_radius", o.initial_trust_region_radius);
+  try {
+    fit::check_options(o);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    const std::string option = what.substr(0, what.find(':'));
+    named(option == "loss_scale" ? "objective.loss_scale" : option, e);
+  }
+  f.finish();
+  return spec;
+}
+
+// Fields of the experiment that a variant may not patch.
+const char* const kExperimentFields[] = {"name",     "description", "kind", "variants",
+                                         "expected", "output",      "fit",  "fem_reference"};
+
+void check_variant_name(const Fields& f, const std::string& name,
+                        const std::vector<CaseSpec>& earlier) {
+  if (const std::string problem = folder_name_problem(name); !problem.empty())
+    f.fail("name", "expected " + problem);
+  for (const CaseSpec& c : earlier)
+    if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
+}
+
+// A simulation: the base document, or one case per variant, each the base
+// with the variant's JSON merge patch (RFC 7386) applied.
+void read_simulation(Fields& root, const nlohmann::json& document,
+                     const std::filesystem::path& folder, Experiment& ex) {
+  json base = document;
+  for (const char* field : kExperimentFields) base.erase(field);
+  if (!root.has("variants")) {
+    Fields f(base, "", root.file());
+    ex.specs.push_back(read_case(f, folder, &ex.warnings));
+  } else {
+    const json& variants = root.raw("variants");
+    if (!variants.is_array() || variants.empty())
+      root.fail("variants", "expected a non-empty list of objects");
+    for (size_t k = 0; k < variants.size(); ++k) {
+      Fields v(variants[k], "variants[" + std::to_string(k) + "]", root.file());
+      const std::string name = v.string("name");
+      check_variant_name(v, name, ex.specs);
+      json patch = variants[k];
+      patch.erase("name");
+      for (const char* field : kExperimentFields)
+        if (patch.contains(field))
+          v.fail(field, "belongs to the whole experiment; a variant cannot change it");
+      json patched = base;
+      patched.merge_patch(patch);
+      Fields f(patched, "", root.file() + " [variant " + name + "]");
+      CaseSpec c = read_case(f, folder, &ex.warnings);
+      c.variant = name;
+      c.patch = patch;
+      ex.specs.push_back(std::move(c));
+    }
+  }
+  if (root.has("output")) {
+    Fields f = root.object("output");
+    ex.output.vtk = f.boolean("vtk", true);
+    ex.output.obj = f.boolean("obj", true);
+    ex.output.every = f.integer("every", 1, 1, 1000000);
+    f.finish();
+  }
+}
+
+void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
+  for (Fields f : root.objects("surfaces")) {
+    NamedSurfaceSpec named;
+    named.name = f.string("name");
+    named.surface = read_surface_spec(f, folder);
+    f.finish();
+    ex.area_specs.push_back(named);
+  }
+  if (ex.area_specs.empty()) root.fail("surfaces", "expected at least one surface");
+}
+
+}  // namespace
+
+Experiment read_experiment(const json& document, const std::filesystem::path& folder,
+                           const std::string& label) {
+  Fields root(document, "", label);
+  Experiment ex;
+  ex.name = root.string("name", "experiment");
+  if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
+    root.fail("name", "expected " + problem);
+  ex.description = root.string("description", "");
+  const std::string kind = root.choice("kind", "simulate", {"simulate", "areas", "benchmark"});
+  ex.kind = kind == "areas"       ? Experiment::Kind::Areas
+            : kind == "benchmark" ? Experiment::Kind::Benchmark
+                                  : Experiment::Kind::Simulate;
+  ex.expected = read_expected(root);
+  if (root.has("fit")) {
+    if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
+    if (root.has("variants"))
+      root.fail("fit",
+                "a fit calibrates one simulation: remove \"variants\" (fit several loads "
+                "with several targets, each tied to its step)");
+    ex.fit = read_fit(root.object("fit"), folder);
+  }
+  if (root.has("fem_reference")) {
+    if (ex.kind != Experiment::Kind::Simulate)
+      root.fail("fem_reference", "only a simulation has a FEM reference");
+    if (root.has("variants"))
+      root.fail("fem_reference", "a FEM reference solves one simulation: remove \"variants\"");
+    Fields f = root.object("fem_reference");
+    ex.fem_reference = read_fem_reference(f);
+  }
+  if (ex.kind == Experiment::Kind::Simulate) {
+    read_simulation(root, document, folder, ex);  // each case checks its own fields
+  } else if (ex.kind == Experiment::Kind::Benchmark) {
+    ex.benchmark = read_benchmark(root);
+    root.finish();
+  } else {
+    read_areas(root, folder, ex);
+    root.finish();
+  }
+  return ex;
+}
+
+void build_experiment(Experiment& ex, const geom::Surface* surface) {
+  ex.cases.clear();
+  ex.area_surfaces.clear();
+  for (const NamedSurfaceSpec& named : ex.area_specs)
+    ex.area_surfaces.push_back({named.name, build_surface(named.surface, &ex.warnings)});
+  for (const CaseSpec& spec : ex.specs) {
+    const auto same = std::find_if(ex.specs.begin(), ex.specs.end(), [&](const CaseSpec& s) {
+      return s.surface_key == spec.surface_key;
+    });
+    const size_t earlier = static_cast<size_t>(same - ex.specs.begin());
+    if (earlier < ex.cases.size())
+      ex.cases.push_back(build_case(spec, ex.cases[earlier]));
+    else if (surface != nullptr)
+      ex.cases.push_back(build_case(spec, *surface, &ex.warnings));
+    else
+      ex.cases.push_back(build_case(spec, &ex.warnings));
+  }
+}
+
+Experiment parse_experiment(const json& document, const std::filesystem::path& folder,
+                            const std::string& label) {
+  Experiment ex = read_experiment(document, folder, label);
+  build_experiment(ex);
+  return ex;
+}
+
+namespace {
+
+template <class Input>
+json parse_json_from(Input&& input, const std::string& label) {
+  struct TooDeep {};
+  const json::parser_callback_t guard = [](int depth, json::parse_event_t event, json&) {
+    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+        depth >= kDeepestJson)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    return json::parse(std::forward<Input>(input), guard);
+  } catch (const TooDeep&) {
+    throw InputError(label + ": nested more than " + std::to_string(kDeepestJson) +
+                     " levels deep (an experiment needs a few)");
+  } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
+    // The parser quotes the token it last read, which may be a whole line: cut it short.
+    std::string what = e.what();
+    if (what.size() > 200) what = what.substr(0, 200) + "...";
+    throw InputError(label + ": not valid JSON: " + what);
+  }
+}
+
+}  // namespace
+
+json parse_json(std::istream& in, const std::string& label) { return parse_json_from(in, label); }
+json parse_json(const std::string& text, const std::string& label) {
+  return parse_json_from(text, label);
+}
+
+Experiment load_experiment(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open the experiment file");
+  json document = parse_json(in, path.string());
+  if (document.is_object() && !document.contains("name"))
+    document["name"] = folder_name_from(path.stem().string());
+  Experiment ex = parse_experiment(document, path.parent_path(), path.string());
+  ex.source = path;
+  return ex;
+}
+
+}  // namespace fiberfluid::experiment

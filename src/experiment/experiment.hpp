@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <filesystem>
+#include <istream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "experiment/benchmark.hpp"
+#include "experiment/case_spec.hpp"
+#include "experiment/fem_reference.hpp"
+#include "experiment/fit_spec.hpp"
+#include "geom/surface.hpp"
+
+namespace fiberfluid::experiment {
+
+// A figure the experiment expects, checked after the run: either a value
+// with an absolute tolerance, or bounds.
+struct ExpectedFigure {
+  std::string figure;  // e.g. "max_displacement", "position.0.x"
+  std::optional<double> value;
+  double tolerance = 0.0;  // |actual - value| <= tolerance
+  std::optional<double> at_most, at_least;
+  Eigen::MatrixXd matrix;  // for matrix figures ("system_matrix")
+  std::string note;        // where the number comes from
+};
+
+struct OutputOptions {
+  bool vtk = true;  // one .vtu per load step and a .pvd series
+  bool obj = true;  // final.obj, the deformed surface in input vertex order
+  int every = 1;    // write every k-th step's .vtu (the last always)
+};
+
+// A named surface for an "areas" experiment (the paper's Table 1).
+struct NamedSurface {
+  std::string name;
+  geom::Surface surface;
+};
+
+struct NamedSurfaceSpec {
+  std::string name;
+  SurfaceSpec surface;
+};
+
+// A parsed and validated experiment file.
+struct Experiment {
+  enum class Kind { Simulate, Areas, Benchmark };
+  Kind kind = Kind::Simulate;
+  std::string name;
+  std::string description;
+  std::filesystem::path source;  // the JSON file ("" for a document built in a program)
+
+  // As parsed (read_experiment), and as built (build_experiment):
+  std::vector<CaseSpec> specs;  // Simulate: one, or one per variant
+  std::vector<Case> cases;
+  OutputOptions output;
+
+  // Areas:
+  std::vector<NamedSurfaceSpec> area_specs;
+  std::vector<NamedSurface> area_surfaces;
+
+  std::optional<BenchmarkSpec> benchmark;  // Benchmark: the scene, solvers and comparisons
+
+  std::optional<FitSpec> fit;
+  // "fem_reference": also solve the simulation by linear FEM on tetrahedra
+  // and write its deformed boundary (fem_reference.obj) as a target.
+  std::optional<FemReferenceSpec>
+      fem_reference;  // the "fit" section: what `fiberfluid fit` calibrates
+
+  std::vector<ExpectedFigure> expected;
+  std::vector<std::string> warnings;  // e.g. from the mesh reader
+
+  bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
+};
+
+// Reads and validates an experiment file, then builds it. Throws InputError
+// naming the file and the field (e.g. "sphere.json: material.Y: expected a
+// positive number") for an unknown field, a wrong type, a missing or bad
+// mesh, a selection that selects nothing; nothing is written.
+Experiment load_experiment(const std::filesystem::path& path);
+
+// The deepest nesting of arrays and objects a JSON document may have: an
+// experiment needs a handful; a deeper one is refused while it is parsed,
+// before anything copies it (copies recurse).
+constexpr int kDeepestJson = 64;
+// Parses JSON text, refusing documents nested deeper than kDeepestJson and
+// syntax errors with an InputError naming `label`.
+nlohmann::json parse_json(std::istream& in, const std::string& label);
+nlohmann::json parse_json(const std::string& text, const std::string& label);
+
+// The same from a JSON document built in a program (e.g. a Python dict):
+// relative mesh paths are taken from `folder`, and errors name `label`.
+Experiment parse_experiment(const nlohmann::json& document, const std::filesystem::path& folder,
+                            const std::string& label);
+
+// The two phases of parse_experiment. read_experiment checks every field
+// that needs no mesh and opens no file (the cases stay unbuilt);
+// build_experiment loads the meshes, prunes and builds every case, on
+// `surface` when given (for documents without a "surface": a program's own mesh).
+Experiment read_experiment(const nlohmann::json& document, const std::filesystem::path& folder,
+                           const std::string& label);
+void build_experiment(Experiment& experiment, const geom::Surface* surface = nullptr);
+
+}  // namespace fiberfluid::experiment

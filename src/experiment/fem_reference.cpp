@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/fem_reference.hpp"
+
+#include <limits>
+
+#include "bridge/fem_bridge.hpp"
+#include "experiment/case_spec.hpp"
+#include "experiment/json_fields.hpp"
+#include "experiment/runner.hpp"
+#include "fit/target.hpp"
+#include "metrics/metrics.hpp"
+#include "model/assembly.hpp"
+#include "model/model.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw InputError("fem_reference: " + what); }
+
+}  // namespace
+
+FemReferenceSpec read_fem_reference(Fields& f) {
+  FemReferenceSpec spec;
+  spec.young = f.positive("E", 1.0);
+  spec.poisson = f.number("nu");
+  if (!(spec.poisson > -1.0 && spec.poisson < 0.5))
+    f.fail("nu", "expected a Poisson ratio between -1 and 0.5 (exclusive)");
+  spec.mesh.size = f.non_negative("size", 0.0);
+  spec.mesh.facet_distance = f.non_negative("facet_distance", 0.0);
+  spec.mesh.feature_angle = f.positive("feature_angle", spec.mesh.feature_angle);
+  if (spec.mesh.feature_angle > 180.0) f.fail("feature_angle", "expected degrees up to 180");
+  f.finish();
+  return spec;
+}
+
+FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
+                                       const FemReferenceSpec& spec) {
+  const model::Model& m = c.model;
+  fem::Material material;
+  material.young = spec.young;
+  material.poisson = spec.poisson;
+  FemReferenceResult out;
+  bridge::FemOfModel fem;
+  try {
+    fem = bridge::solve_fem_of_model(m, c.stepping.steps, material, spec.mesh);
+  } catch (const InputError& e) {
+    fail(e.what());
+  }
+  out.mesh = std::move(fem.mesh);
+  out.displacement = std::move(fem.displacement);
+  out.rest_boundary = std::move(fem.rest_boundary);
+  out.deformed_boundary = std::move(fem.deformed_boundary);
+  const double mesh_seconds = fem.mesh_seconds, solve_seconds = fem.solve_seconds;
+  const Eigen::MatrixXd& V = m.surface.V;
+
+  auto& fig = out.figures;
+  fig["fem_reference.nodes"] = out.mesh.num_nodes();
+  fig["fem_reference.tetrahedra"] = static_cast<double>(out.mesh.elements.rows());
+  fig["fem_reference.mesh_seconds"] = mesh_seconds;
+  fig["fem_reference.solve_seconds"] = solve_seconds;
+  fig["fem_reference.max_displacement"] = out.displacement.rowwise().norm().maxCoeff();
+  try {  // how far the tetrahedra's boundary is from the surface before any load
+    fig["fem_reference.rest_surface_error"] = metrics::surface_error(m.surface, out.rest_boundary);
+  } catch (const InputError&) {
+  }
+  fig["fem_reference.volume_change"] = metrics::enclosed_measure(out.deformed_boundary) /
+                                           metrics::enclosed_measure(out.rest_boundary) -
+                                       1.0;
+  if (run.summary.success) {  // the fiber model's final surface against the FEM's
+    geom::Surface fiber = m.surface;
+    fiber.V = V + model::displacements(m, run.summary.unknowns);
+    const fit::TargetDistance distance(
+        fit::make_target("the FEM reference", out.deformed_boundary.V, out.deformed_boundary.F));
+    const std::vector<fit::TargetDistance::Closest> closest = distance.closest(fiber.V);
+    Eigen::VectorXd d(static_cast<Eigen::Index>(closest.size()));
+    for (size_t k = 0; k < closest.size(); ++k)
+      d[static_cast<Eigen::Index>(k)] = closest[k].distance;
+    const fit::DistanceStatistics stats =
+        fit::distance_statistics(d, geom::bounding_box_diagonal(V));
+    fig["fem_reference.distance_mean"] = stats.mean;
+    fig["fem_reference.distance_sd"] = stats.standard_deviation;
+    fig["fem_reference.distance_sd_share"] = stats.share(stats.standard_deviation);
+    fig["fem_reference.distance_largest"] = stats.largest;
+    try {
+      fig["fem_reference.surface_error"] = metrics::surface_error(
+          out.deformed_boundary, fiber, "the FEM reference", "the fiber model");
+    } catch (const InputError&) {  // a surface that crosses itself has no E_s; the distances stand
+    }
+  }
+  return out;
+}
+
+}  // namespace fiberfluid::experiment

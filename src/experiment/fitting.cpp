@@ -1,0 +1,323 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/fitting.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "geom/mesh_io.hpp"
+#include "geom/vtk_writer.hpp"
+#include "model/assembly.hpp"
+#include "model/equilibrium.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using nlohmann::json;
+
+// NaN and infinities as JSON null.
+json number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json statistics_json(const fit::DistanceStatistics& s) {
+  return {{"count", s.count},
+          {"mean", number(s.mean)},
+          {"rms", number(s.rms)},
+          {"standard_deviation", number(s.standard_deviation)},
+          {"largest", number(s.largest)},
+          {"share_of_length",
+           {{"mean", number(s.share(s.mean))},
+            {"rms", number(s.share(s.rms))},
+            {"standard_deviation", number(s.share(s.standard_deviation))},
+            {"largest", number(s.share(s.largest))}}}};
+}
+
+json iteration_json(const fit::IterationRecord& it, const std::vector<std::string>& names) {
+  json values = json::object();
+  for (size_t k = 0; k < names.size(); ++k)
+    values[names[k]] = it.values[static_cast<Eigen::Index>(k)];
+  json out = {{"iteration", it.iteration}, {"cost", number(it.cost)},
+              {"accepted", it.accepted},   {"trial_cost", number(it.trial_cost)},
+              {"values", values},          {"forward_runs", it.forward_runs},
+              {"seconds", it.seconds}};
+  if (!it.trial_failure.empty()) out["trial_failure"] = it.trial_failure;
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file) {
+  std::ifstream in(fit_json_file);
+  if (!in)
+    throw InputError(fit_json_file.string() +
+                     ": cannot open (expected the fit.json of an earlier fit)");
+  const json doc = parse_json(in, fit_json_file.string());
+  std::map<std::string, double> values;
+  if (doc.is_object() && doc.contains("parameters") && doc["parameters"].is_array())
+    for (const json& p : doc["parameters"])
+      if (p.is_object() && p.contains("name") && p["name"].is_string() && p.contains("value") &&
+          p["value"].is_number() && std::isfinite(p["value"].get<double>()))
+        values[p["name"].get<std::string>()] = p["value"].get<double>();
+  if (values.empty())
+    throw InputError(fit_json_file.string() +
+                     ": expected a fit.json with parameters[].name and "
+                     "parameters[].value");
+  return values;
+}
+
+int fit_exit_status(fit::FitStatus status) {
+  switch (status) {
+    case fit::FitStatus::Converged:
+      return 0;
+    case fit::FitStatus::ConvergedAtBounds:
+      return 4;
+    case fit::FitStatus::Interrupted:
+      return 130;
+    case fit::FitStatus::NotIdentifiable:
+    case fit::FitStatus::IterationLimit:
+    case fit::FitStatus::ForwardRunsFailed:
+    case fit::FitStatus::StartFailed:
+    case fit::FitStatus::OptimizerFailed:
+      break;
+  }
+  return 2;
+}
+
+bool fit_result_kept(fit::FitStatus status) { return fit::converged(status); }
+
+FitSetup setup_fit(const Experiment& ex,
+                   std::function<void(const fit::IterationRecord&)> progress) {
+  if (!ex.fit) throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");
+  if (ex.cases.size() != 1)
+    throw InputError(ex.source.string() + ": a fit calibrates one simulation");
+  const FitSpec& spec = *ex.fit;
+  const Case& c = ex.cases.front();
+  FitSetup setup;
+  for (const FitTargetSpec& t : spec.targets) {
+    fit::Target target;
+    try {
+      target = fit::read_target(t.file, t.scale);
+    } catch (const InputError& e) {
+      t.field.fail("file", e.what());
+    }
+    const int step = t.step == 0 ? c.stepping.steps : t.step;
+    if (step > c.stepping.steps)
+      t.field.fail("step", "load step " + std::to_string(step) + " is beyond the run's " +
+                               std::to_string(c.stepping.steps) + " steps");
+    setup.targets.push_back({target, step});
+  }
+  // The starts of an earlier fit (an interrupted one, continued).
+  std::map<std::string, double> earlier;
+  if (spec.start_from) earlier = fitted_values(*spec.start_from);
+  std::vector<fit::Parameter> parameters;
+  for (const FitParameterSpec& p : spec.parameters) {
+    fit::ParameterRequest request = p.request;
+    if (spec.start_from) {
+      if (!earlier.count(request.name))
+        spec.field.fail("start_from",
+                        spec.start_from->string() + " has no value for \"" + request.name + "\"");
+      request.start = earlier.at(request.name);
+    }
+    try {
+      parameters.push_back(fit::make_parameter(request, c.model.material));
+    } catch (const InputError& e) {
+      p.field.fail("name", e.what());
+    }
+    try {  // its start and bounds, by the calibration's own rules, named here
+      fit::ParameterMap({parameters.back()}, c.model.material, c.model.dim());
+    } catch (const InputError& e) {
+      p.field.fail("", e.what());
+    }
+  }
+  fit::FitOptions options = spec.options;
+  options.progress = std::move(progress);
+  if (spec.exclude) {
+    const std::vector<int> excluded = resolve_selection(*spec.exclude, c);
+    std::vector<char> out(static_cast<size_t>(c.model.num_vertices()), 0);
+    for (int v : excluded) out[static_cast<size_t>(v)] = 1;
+    for (int v = 0; v < c.model.num_vertices(); ++v)
+      if (!out[static_cast<size_t>(v)]) options.counted_vertices.push_back(v);
+    if (options.counted_vertices.empty())
+      spec.exclude->field.fail("", "excludes every vertex: no distance would count");
+  }
+  try {
+    setup.calibration =
+        std::make_unique<fit::Calibration>(c.model, c.stepping, setup.targets, parameters, options);
+  } catch (const InputError& e) {
+    spec.field.fail("", e.what());
+  }
+  return setup;
+}
+
+std::map<std::string, double> fit_figures(const fit::FitResult& r) {
+  std::map<std::string, double> figures;
+  for (size_t k = 0; k < r.names.size(); ++k)
+    figures["fit." + r.names[k]] = r.values[static_cast<Eigen::Index>(k)];
+  figures["fit.cost"] = r.final_cost;
+  figures["fit.forward_runs"] = r.forward_runs;
+  figures["fit.distance_mean"] = r.overall.mean;
+  figures["fit.distance_rms"] = r.overall.rms;
+  figures["fit.distance_sd"] = r.overall.standard_deviation;
+  figures["fit.distance_largest"] = r.overall.largest;
+  figures["fit.distance_sd_share"] = r.overall.share(r.overall.standard_deviation);
+  return figures;
+}
+
+Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
+                                const fit::FitResult& result) {
+  Experiment fitted = experiment;
+  const fit::ParameterMap& map = calibration.parameters();
+  model::Material& material = fitted.cases.front().model.material;
+  material = map.material(material, result.values);
+  return fitted;
+}
+
+json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult& r,
+              const ExperimentResult& run) {
+  const fit::Calibration& c = *setup.calibration;
+  json parameters = json::array();
+  for (size_t k = 0; k < r.names.size(); ++k) {
+    const Eigen::Index i = static_cast<Eigen::Index>(k);
+    const fit::Parameter& p = c.parameters().parameters()[k];
+    const bool at_bound =
+        std::find(r.at_bounds.begin(), r.at_bounds.end(), r.names[k]) != r.at_bounds.end();
+    parameters.push_back({{"name", r.names[k]},
+                          {"initial", r.initial[i]},
+                          {"value", number(r.values[i])},
+                          {"at_bound", at_bound},
+                          {"standard_error", number(r.standard_errors[i])},
+                          {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}},
+                          {"bounds", {number(p.lower), number(p.upper)}},
+                          {"log_scale", p.log_scale}});
+  }
+  json correlation = json::array();
+  for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
+    json row = json::array();
+    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b)
+      row.push_back(number(r.correlation(a, b)));
+    correlation.push_back(row);
+  }
+  json iterations = json::array();
+  for (const fit::IterationRecord& it : r.iterations)
+    iterations.push_back(iteration_json(it, r.names));
+  json targets = json::array();
+  for (size_t t = 0; t < setup.targets.size(); ++t) {
+    json target = {{"file", setup.targets[t].target.label},
+                   {"step", setup.targets[t].step},
+                   {"read", setup.targets[t].target.description},
+                   {"points", setup.targets[t].target.points.rows()}};
+    if (t < r.statistics.size()) target["distance"] = statistics_json(r.statistics[t]);
+    targets.push_back(target);
+  }
+  json checks = json::array();
+  for (const FigureCheck& check : run.checks)
+    checks.push_back({{"figure", check.expected.figure},
+                      {"passed", check.passed},
+                      {"actual", number(check.actual)},
+                      {"text", check.Describe()}});
+  json failures = json::object();
+  for (const auto& [cause, count] : r.failures_by_cause) failures[cause] = count;
+  json examples = json::array();
+  for (const fit::FailedRun& f : r.failed_examples) {
+    json values = json::object();
+    for (size_t k = 0; k < r.names.size(); ++k)
+      values[r.names[k]] = f.values[static_cast<Eigen::Index>(k)];
+    examples.push_back({{"values", values}, {"message", f.message}});
+  }
+  const int counted = c.num_counted_vertices();
+  int target_points = 0;
+  for (const fit::MeasuredStep& t : setup.targets)
+    target_points += static_cast<int>(t.target.points.rows());
+  json doc = {
+      {"experiment", ex.name},
+      {"status", fit::to_string(r.status)},
+      {"status_detail", r.status_detail},
+      {"success", r.success},
+      {"message", r.message},
+      {"method", fit::to_string(r.method)},
+      {"jacobian", r.analytic_jacobian ? "analytic: Newton sensitivities, one tangent solve per "
+                                         "material parameter"
+                                       : "finite differences of whole forward runs (central)"},
+      {"loss", fit::to_string(ex.fit->options.loss)},
+      {"symmetric", ex.fit->options.symmetric},
+      {"parameters", parameters},
+      {"covariance", r.covariance_ok ? "ceres covariance at the optimum, scaled by the "
+                                       "residual variance"
+                                     : "not available (see status)"},
+      {"correlation", correlation},
+      {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
+      {"iterations", iterations},
+      {"forward_runs", r.forward_runs},
+      {"sensitivity_solves", r.sensitivity_solves},
+      {"failed_runs", r.failed_runs},
+      {"failed_runs_by_cause", failures},
+      {"failed_run_examples", examples},
+      {"seconds", r.seconds},
+      {"body_length", c.body_length()},
+      {"body_length_is", "the largest extent of the rest surface's bounding box"},
+      {"counts",
+       {{"model_vertices_counted", counted},
+        {"targets", setup.targets.size()},
+        {"target_points", target_points},
+        {"forward_distances", counted * static_cast<int>(setup.targets.size())},
+        {"symmetric_distances", ex.fit->options.symmetric ? target_points : 0},
+        {"residuals", c.num_residuals()},
+        {"what_distance_counts",
+         "distance.count and targets[].distance.count are forward distances: one per counted "
+         "model vertex and target. The symmetric distances (each target point to the simulated "
+         "surface), when asked, enter the cost and the residuals, not these statistics"}}},
+      {"targets", targets},
+      {"checks", checks}};
+  if (!r.statistics.empty()) doc["distance"] = statistics_json(r.overall);
+  return doc;
+}
+
+void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
+                     const FitSetup& setup, const fit::FitResult& r, const ExperimentResult& run) {
+  geom::write_text_file(folder / "fit.json", fit_json(ex, setup, r, run).dump(2) + "\n");
+  std::ostringstream iterations;
+  iterations << "iteration,cost_m2,accepted,trial_cost_m2,forward_runs,seconds";
+  for (const std::string& name : r.names) iterations << "," << name;
+  iterations << "\n";
+  iterations.precision(12);
+  for (const fit::IterationRecord& it : r.iterations) {
+    iterations << it.iteration << "," << it.cost << "," << (it.accepted ? 1 : 0) << ","
+               << it.trial_cost << "," << it.forward_runs << "," << it.seconds;
+    for (Eigen::Index k = 0; k < it.values.size(); ++k) iterations << "," << it.values[k];
+    iterations << "\n";
+  }
+  geom::write_text_file(folder / "fit_iterations.csv", iterations.str());
+  if (r.positions.size() != setup.targets.size()) return;  // no run at the fitted values
+
+  const Case& c = ex.cases.front();
+  std::ostringstream distances;
+  distances.precision(12);
+  distances << "vertex,target,step,distance_m\n";
+  for (size_t t = 0; t < r.vertex_distances.size(); ++t) {
+    const Eigen::VectorXd& d = r.vertex_distances[t];
+    for (Eigen::Index v = 0; v < d.size(); ++v)
+      if (std::isfinite(d[v]))
+        distances << c.model_to_input[static_cast<size_t>(v)] << "," << t << ","
+                  << setup.targets[t].step << "," << d[v] << "\n";
+    // The simulated surface at the target's step, coloured by the distance
+    // (uncounted vertices: 0, and counted = 0 marks them).
+    Eigen::VectorXd shown = d, counted = Eigen::VectorXd::Ones(d.size());
+    for (Eigen::Index v = 0; v < d.size(); ++v)
+      if (!std::isfinite(d[v])) shown[v] = counted[v] = 0.0;
+    geom::Surface at_step = c.model.surface;
+    at_step.V = r.positions[t];
+    geom::write_vtu(folder / ("fit_target_" + std::to_string(t) + ".vtu"), at_step,
+                    {{"distance_to_target", shown}, {"counted", counted}});
+    geom::Surface scan;
+    scan.V = setup.targets[t].target.points;
+    scan.F = setup.targets[t].target.triangles;
+    if (scan.F.rows() > 0)
+      geom::write_obj(folder / ("fit_target_" + std::to_string(t) + "_scan.obj"), scan);
+  }
+  geom::write_text_file(folder / "fit_distances.csv", distances.str());
+}
+
+}  // namespace fiberfluid::experiment

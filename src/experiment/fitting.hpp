@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "experiment/experiment.hpp"
+#include "experiment/runner.hpp"
+#include "fit/calibration.hpp"
+
+namespace fiberfluid::experiment {
+
+// A fit set up from an experiment's "fit" section: the targets read, the
+// calibration built on the experiment's (single) case.
+struct FitSetup {
+  std::vector<fit::MeasuredStep> targets;
+  std::unique_ptr<fit::Calibration> calibration;
+};
+// Throws InputError naming the file and field. `progress` is called after
+// each iteration of the fit.
+FitSetup setup_fit(const Experiment& experiment,
+                   std::function<void(const fit::IterationRecord&)> progress = {});
+
+// The parameters' values in the fit.json of an earlier fit (fit.start_from).
+std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file);
+
+// The command line's exit status for a fit that ended so: 0 converged, 4
+// converged with parameters on their bounds, 130 interrupted, 2 otherwise.
+int fit_exit_status(fit::FitStatus status);
+// Whether the output folder takes a fit that ended so (else DIR.failed).
+bool fit_result_kept(fit::FitStatus status);
+
+// The fit's headline figures, "fit.NAME" for each parameter and the
+// distance statistics (fit.distance_sd_share is the method paper's figure).
+std::map<std::string, double> fit_figures(const fit::FitResult& result);
+
+// fit.json: fitted values, errors and intervals, correlation, iterations,
+// distance statistics per target and overall; with the checks.
+nlohmann::json fit_json(const Experiment& experiment, const FitSetup& setup,
+                        const fit::FitResult& result, const ExperimentResult& run);
+
+// The experiment with the fitted material (to run and write as usual).
+Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
+                                const fit::FitResult& result);
+
+// Writes, into `folder`: fit.json, fit_iterations.csv, fit_distances.csv and
+// fit_target_K.vtu (the simulated surface at the target's step, with the
+// distance to the target as point data).
+void write_fit_files(const std::filesystem::path& folder, const Experiment& experiment,
+                     const FitSetup& setup, const fit::FitResult& result,
+                     const ExperimentResult& run);
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "experiment/case_spec.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+
+// A value as a message quotes it: its JSON text, cut to a short excerpt (a
+// bad value may be a whole document).
+inline std::string excerpt(const nlohmann::json& value) {
+  constexpr size_t kLongest = 80;
+  std::string text = value.dump();
+  if (text.size() > kLongest)
+    text = text.substr(0, kLongest) + "... (" + std::to_string(text.size()) + " characters)";
+  return text;
+}
+
+// Reads the fields of one JSON object, naming "file: path.to.field" in every
+// error, and rejects fields nobody asked for.
+class Fields {
+ public:
+  Fields(const nlohmann::json& object, std::string path, std::string file)
+      : object_(object), path_(std::move(path)), file_(std::move(file)) {
+    if (!object_.is_object()) fail("", "expected an object");
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(file_ + ": " + name(key) + (name(key).empty() ? "" : ": ") + what);
+  }
+  std::string name(const std::string& key) const {
+    if (key.empty()) return path_;
+    return path_.empty() ? key : path_ + "." + key;
+  }
+  bool has(const std::string& key) const { return object_.contains(key); }
+
+  const nlohmann::json& raw(const std::string& key) {
+    seen_.insert(key);
+    if (!has(key)) fail(key, "missing (required)");
+    return object_.at(key);
+  }
+  Fields object(const std::string& key) { return Fields(raw(key), name(key), file_); }
+
+  double number(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    if (!v.is_number()) fail(key, "expected a number, got " + excerpt(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail(key, "expected a finite number");
+    return x;
+  }
+  double number(const std::string& key, double fallback) {
+    return has(key) ? number(key) : (seen_.insert(key), fallback);
+  }
+  double positive(const std::string& key, double fallback) {
+    const double x = number(key, fallback);
+    if (!(x > 0.0)) fail(key, "expected a positive number, got " + std::to_string(x));
+    return x;
+  }
+  double non_negative(const std::string& key, double fallback) {
+    const double x = number(key, fallback);
+    if (x < 0.0) fail(key, "expected a number >= 0, got " + std::to_string(x));
+    return x;
+  }
+  int integer(const std::string& key, int fallback, int min, int max) {
+    if (!has(key)) return seen_.insert(key), fallback;
+    const nlohmann::json& v = raw(key);
+    const std::string range =
+        "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
+    if (!v.is_number_integer() || !fits(v, min, max))
+      fail(key, "expected " + range + ", got " + excerpt(v));
+    return static_cast<int>(v.get<long long>());
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    if (!has(key)) return seen_.insert(key), fallback;
+    const nlohmann::json& v = raw(key);
+    if (!v.is_boolean()) fail(key, "expected true or false, got " + excerpt(v));
+    return v.get<bool>();
+  }
+  std::string string(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    if (!v.is_string()) fail(key, "expected a string, got " + excerpt(v));
+    return v.get<std::string>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) {
+    return has(key) ? string(key) : (seen_.insert(key), fallback);
+  }
+  std::string choice(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& allowed) {
+    const std::string s = string(key, fallback);
+    if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
+      fail(key, "expected one of " + join(allowed) + ", got " + excerpt(s));
+    return s;
+  }
+  // A list of `size` numbers (any size when size < 0).
+  Eigen::VectorXd vector(const std::string& key, int size) {
+    const nlohmann::json& v = raw(key);
+    const std::string want =
+        size < 0 ? "a list of numbers" : "a list of " + std::to_string(size) + " numbers";
+    if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size))
+      fail(key, "expected " + want + ", got " + excerpt(v));
+    Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (!v[k].is_number() || !std::isfinite(v[k].get<double>()))
+        fail(key, "expected " + want + ", got " + excerpt(v));
+      out[static_cast<Eigen::Index>(k)] = v[k].get<double>();
+    }
+    return out;
+  }
+  // A list of `size` whole numbers from min to max (counts such as segments).
+  Eigen::VectorXi counts(const std::string& key, int size, int min, int max) {
+    const nlohmann::json& v = raw(key);
+    const std::string want = "a list of " + std::to_string(size) + " whole numbers from " +
+                             std::to_string(min) + " to " + std::to_string(max);
+    if (!v.is_array() || static_cast<int>(v.size()) != size)
+      fail(key, "expected " + want + ", got " + excerpt(v));
+    Eigen::VectorXi out(size);
+    for (int k = 0; k < size; ++k) {
+      const nlohmann::json& item = v[static_cast<size_t>(k)];
+      if (!item.is_number_integer() || !fits(item, min, max))
+        fail(key, "expected " + want + ", got " + excerpt(v));
+      out[k] = static_cast<int>(item.get<long long>());
+    }
+    return out;
+  }
+  std::vector<int> indices(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    if (!v.is_array() || v.empty()) fail(key, "expected a non-empty list of vertex indices");
+    std::vector<int> out;
+    for (const nlohmann::json& item : v) {
+      if (!item.is_number_integer() || !fits(item, 0, std::numeric_limits<int>::max()))
+        fail(key, "expected vertex indices (whole numbers from 0 to " +
+                      std::to_string(std::numeric_limits<int>::max()) + "), got " + excerpt(item));
+      out.push_back(static_cast<int>(item.get<long long>()));
+    }
+    return out;
+  }
+  std::vector<Fields> objects(const std::string& key) {
+    std::vector<Fields> out;
+    if (!has(key)) return seen_.insert(key), out;
+    const nlohmann::json& v = raw(key);
+    if (!v.is_array()) fail(key, "expected a list of objects");
+    for (size_t k = 0; k < v.size(); ++k)
+      out.emplace_back(v[k], name(key) + "[" + std::to_string(k) + "]", file_);
+    return out;
+  }
+
+  // Every field of the object must have been read.
+  void finish() const {
+    for (auto it = object_.begin(); it != object_.end(); ++it)
+      if (!seen_.count(it.key()))
+        fail(it.key(), "unknown field (expected one of " + join(known()) + ")");
+  }
+
+  const std::string& file() const { return file_; }
+  // This object's name, kept with what was read from it for errors found later.
+  FieldName field() const { return {file_, path_}; }
+
+ private:
+  // Whether a JSON integer lies in [min, max] (an unsigned one may exceed long long).
+  static bool fits(const nlohmann::json& v, long long min, long long max) {
+    if (v.is_number_unsigned()) {
+      const unsigned long long u = v.get<unsigned long long>();
+      return (min <= 0 || u >= static_cast<unsigned long long>(min)) && max >= 0 &&
+             u <= static_cast<unsigned long long>(max);
+    }
+    const long long x = v.get<long long>();
+    return x >= min && x <= max;
+  }
+  std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }
+  static std::string join(const std::vector<std::string>& words) {
+    std::string out;
+    for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+    return out;
+  }
+
+  const nlohmann::json& object_;
+  std::string path_, file_;
+  std::set<std::string> seen_;
+};
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,568 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/outputs.hpp"
+
+#include <cstdio>
+#include <iomanip>
+#include <sstream>
+#include <utility>
+
+#include "experiment/output_folder.hpp"
+#include "geom/area_vectors.hpp"
+#include "geom/mesh_io.hpp"
+#include "geom/vtk_writer.hpp"
+#include "model/assembly.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+const char kAxes[] = "xyz";
+
+json vector_json(const Eigen::Vector3d& v, int dim) {
+  json out = json::array();
+  for (int a = 0; a < dim; ++a) out.push_back(v[a]);
+  return out;
+}
+
+json newton_options_json(const solve::NewtonOptions& n) {
+  return {{"residual_tolerance", n.residual_tolerance},
+          {"increment_tolerance", n.increment_tolerance},
+          {"max_iterations", n.max_iterations},
+          {"max_step_cuts", n.max_step_cuts},
+          {"line_search", n.line_search},
+          {"tangent", solve::to_string(n.tangent)},
+          {"krylov_tolerance", n.krylov_tolerance},
+          {"krylov_restart", n.krylov_restart},
+          {"krylov_max_iterations", n.krylov_max_iterations},
+          {"max_contact_rounds", n.max_contact_rounds},
+          {"predictor", n.predictor}};
+}
+
+json stepping_json(const solve::SteppingOptions& s) {
+  json out = {{"scheme", solve::to_string(s.scheme)},
+              {"steps", s.steps},
+              {"rebuild_matrix", s.rebuild_matrix},
+              {"update_load_geometry", s.update_load_geometry},
+              {"boundary_method", model::to_string(s.boundary_method)},
+              {"penalty", s.penalty},
+              {"solver", solve::to_string(s.solver)},
+              {"tolerance", s.pcg.tolerance},
+              {"max_iterations", s.pcg.max_iterations},
+              {"max_volume_change", s.max_volume_change},
+              {"stop_on_inverted_faces", s.stop_on_inverted_faces}};
+  if (s.scheme == solve::Scheme::Newton) out["newton"] = newton_options_json(s.newton);
+  return out;
+}
+
+json law_json(const model::Material& material, int dim) {
+  const model::FiberLaw& law = material.law;
+  json out = {{"type", law.name()}};
+  for (const std::string& name : law.parameter_names()) out[name] = law.parameter(name);
+  for (const model::LawModel::Setting& s : law.settings())
+    out[s.name] = s.scalar && s.values.size() == 1 ? json(s.values[0]) : json(s.values);
+  out["axis_factors"] = vector_json(material.axis_factors, dim);
+  return out;
+}
+
+// The Newton and contact records of a step (Newton scheme only).
+void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& step) {
+  step["newton"] = {{"iterations", r.newton_iterations},
+                    {"residual_norms", r.residual_norms},
+                    {"line_search_halvings", r.line_search_halvings},
+                    {"krylov_iterations", r.krylov_iterations},
+                    {"step_cuts", r.step_cuts},
+                    {"volume_drift", r.volume_drift}};
+  json paddles = json::object();
+  for (size_t p = 0; p < r.paddles.size() && p < m.paddles.size(); ++p)
+    paddles[m.paddles[p].label] = {{"plane", r.paddles[p].plane},
+                                   {"travel", r.paddles[p].travel},
+                                   {"force", vector_json(r.paddles[p].force, m.dim())},
+                                   {"contacts", r.paddles[p].contacts}};
+  if (!m.paddles.empty()) step["paddles"] = paddles;
+}
+
+std::string group_name(const model::Model& m, size_t g) {
+  return g < m.constraint_groups.size() ? m.constraint_groups[g] : "supports";
+}
+
+json reactions_json(const model::Model& m, const solve::StepRecord& r) {
+  json out = json::object();
+  for (size_t g = 0; g < r.reactions.size(); ++g)
+    out[group_name(m, g)] = vector_json(r.reactions[g], m.dim());
+  return out;
+}
+
+// What the case was expected to cost before it ran (experiment/resources.hpp).
+json estimate_json(const ResourceEstimate& e) {
+  json parts = json::array();
+  for (const ResourcePart& p : e.parts)
+    parts.push_back({{"name", p.name}, {"bytes", p.bytes}, {"seconds", p.seconds}});
+  return {
+      {"peak_bytes", e.peak_bytes}, {"seconds", e.seconds}, {"solver", e.solver}, {"parts", parts}};
+}
+
+json run_json(const Case& c, const ExperimentResult& result, const RunResult& run) {
+  const model::Model& m = c.model;
+  json steps = json::array();
+  for (const solve::StepRecord& r : run.summary.steps) {
+    json factors = json::object();
+    for (size_t l = 0; l < m.loads.size(); ++l) factors[m.loads[l].label] = r.load_factors[l];
+    steps.push_back({{"step", r.step},
+                     {"load_factors", factors},
+                     {"pressure", r.pressure},
+                     {"volume", r.volume},
+                     {"max_displacement", r.max_displacement},
+                     {"equilibrium_residual", r.residual},
+                     {"applied_force", vector_json(r.applied_force, m.dim())},
+                     {"reactions", reactions_json(m, r)},
+                     {"seconds", r.seconds}});
+    if (run.summary.scheme == solve::Scheme::Newton) add_newton_json(m, r, steps.back());
+  }
+  json final_figures = json::object();
+  const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
+  for (const auto& [name, value] : result.figures)
+    if (name.rfind(prefix, 0) == 0 && (!run.variant.empty() || name.rfind("fibers.", 0) != 0))
+      final_figures[name.substr(prefix.size())] = value;
+  json paddle_axes = json::object();  // which force component each paddle's curve shows
+  for (const model::Paddle& p : m.paddles) paddle_axes[p.label] = std::string(1, kAxes[p.axis]);
+  return {{"variant", run.variant},
+          {"patch", c.patch},
+          {"paddle_axes", paddle_axes},
+          {"solver", solve::to_string(run.summary.solver)},
+          {"pcg_iterations", run.summary.solver_statistics.iterations},
+          {"factorization_flops", run.summary.solver_statistics.factorization_flops},
+          {"stepping", stepping_json(c.stepping)},
+          {"material", law_json(m.material, m.dim())},
+          {"newton_iterations", run.summary.newton_iterations},
+          {"krylov_iterations", run.summary.krylov_iterations},
+          {"success", run.summary.success},
+          {"message", run.summary.message},
+          {"factorizations", run.summary.factorizations},
+          {"seconds",
+           {{"assemble", run.summary.assemble_seconds},
+            {"factorize", run.summary.factorize_seconds},
+            {"solve", run.summary.solve_seconds},
+            {"total", run.summary.total_seconds}}},
+          {"estimate", estimate_json(c.estimate)},
+          {"steps", steps},
+          {"final", final_figures}};
+}
+
+json fibers_json(const Case& c) {
+  const FiberReport& f = c.fibers;
+  return {{"pruning", f.pruning ? "auto" : "off"},
+          {"convex", f.convex},
+          {"connection_count", model::to_string(c.model.connection_count)},
+          {"product", c.model.treecode_tolerance > 0.0 ? "treecode" : "exact"},
+          {"treecode_tolerance", c.model.treecode_tolerance},
+          {"in_all", f.pairs},
+          {"kept", f.kept},
+          {"pruned", f.pairs - f.kept},
+          {"kept_per_vertex",
+           {{"min", f.min_per_vertex}, {"mean", f.mean_per_vertex}, {"max", f.max_per_vertex}}},
+          {"pruning_seconds", f.seconds},
+          {"exact_fallbacks", f.exact_fallbacks}};
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char ch : text) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
+// Rows of cells joined by commas, numbers with 17 significant digits.
+class CsvTable {
+ public:
+  void header(const std::string& name) { cells_.push_back(csv_field(name)); }
+  void text(const std::string& value) { cells_.push_back(csv_field(value)); }
+  void number(double value) {
+    std::ostringstream out;
+    out << std::setprecision(17) << value;
+    cells_.push_back(out.str());
+  }
+  void end_row() {
+    for (size_t k = 0; k < cells_.size(); ++k) out_ << (k ? "," : "") << cells_[k];
+    out_ << "\n";
+    cells_.clear();
+  }
+  std::string str() const { return out_.str(); }
+
+ private:
+  std::vector<std::string> cells_;
+  std::ostringstream out_;
+};
+
+}  // namespace
+
+json summary_json(const Experiment& ex, const ExperimentResult& result) {
+  json doc;
+  doc["experiment"] = ex.name;
+  doc["description"] = ex.description;
+  doc["source"] = ex.source.string();
+  doc["fiberfluid_version"] = FIBERFLUID_VERSION;
+  doc["kind"] = ex.kind == Experiment::Kind::Areas       ? "areas"
+                : ex.kind == Experiment::Kind::Benchmark ? "benchmark"
+                                                         : "simulate";
+  if (!result.failure.empty()) doc["failure"] = result.failure;
+  doc["units"] = {{"length", "m"},
+                  {"displacement", "m"},
+                  {"force", "N"},
+                  {"pressure", "Pa"},
+                  {"volume", "m^3 (m^2 in 2D)"},
+                  {"Y", "Pa"},
+                  {"gamma", "N/m"},
+                  {"time", "s"}};
+  doc["success"] = result.runs_succeeded();
+  if (ex.kind == Experiment::Kind::Simulate) {
+    const Case& first = ex.cases.front();
+    doc["surface"] = {{"dimension", first.input_surface.dim},
+                      {"vertices", first.input_surface.num_vertices()},
+                      {"used_vertices", first.model.num_vertices()},
+                      {"faces", first.input_surface.num_faces()}};
+    doc["fibers"] = fibers_json(first);
+    json runs = json::array();
+    for (size_t r = 0; r < result.runs.size(); ++r)
+      runs.push_back(run_json(ex.cases[r], result, result.runs[r]));
+    doc["runs"] = runs;
+  }
+  doc["figures"] = result.figures;
+  json checks = json::array();
+  for (const FigureCheck& c : result.checks)
+    checks.push_back({{"figure", c.expected.figure},
+                      {"actual", c.actual},
+                      {"passed", c.passed},
+                      {"report", c.Describe()},
+                      {"note", c.expected.note}});
+  doc["checks"] = checks;
+  doc["warnings"] = ex.warnings;
+  doc["peak_resident_bytes"] = peak_resident_bytes();  // of the whole process so far
+  return doc;
+}
+
+// Per paddle: its travel and the force on the body along its axis (all
+// components and the contact count when `full`).
+static void paddle_headers(CsvTable& t, const model::Paddle& p, int dim, bool full) {
+  t.header("paddle_" + p.label + "_travel_m");
+  if (full) {
+    t.header("paddle_" + p.label + "_plane_m");
+    for (int a = 0; a < dim; ++a) t.header("paddle_" + p.label + "_force_" + kAxes[a] + "_N");
+    t.header("paddle_" + p.label + "_contacts");
+  } else {
+    t.header("paddle_" + p.label + "_force_N");
+  }
+}
+
+static void paddle_numbers(CsvTable& t, const model::Model& m, const solve::StepRecord& r, int dim,
+                           bool full) {
+  for (size_t p = 0; p < m.paddles.size(); ++p) {
+    const solve::StepRecord::PaddleState s =
+        p < r.paddles.size() ? r.paddles[p] : solve::StepRecord::PaddleState{};
+    t.number(s.travel);
+    if (full) {
+      t.number(s.plane);
+      for (int a = 0; a < dim; ++a) t.number(s.force[a]);
+      t.number(s.contacts);
+    } else {
+      t.number(s.force[m.paddles[p].axis]);
+    }
+  }
+}
+
+std::string steps_csv(const Case& c, const RunResult& run) {
+  const model::Model& m = c.model;
+  const int dim = m.dim();
+  const size_t groups = std::max<size_t>(1, m.constraint_groups.size());
+  CsvTable t;
+  t.header("step");
+  for (const model::Load& load : m.loads) t.header("load_factor_" + load.label);
+  t.header("pressure_Pa");
+  t.header(dim == 3 ? "volume_m3" : "area_m2");
+  t.header("max_displacement_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("applied_force_") + kAxes[a] + "_N");
+  for (size_t g = 0; g < groups; ++g)
+    for (int a = 0; a < dim; ++a) t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
+  for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, true);
+  const bool newton = run.summary.scheme == solve::Scheme::Newton;
+  if (newton)
+    for (const char* h : {"newton_iterations", "line_search_halvings", "krylov_iterations",
+                          "step_cuts", "volume_drift"})
+      t.header(h);
+  t.header("equilibrium_residual");
+  t.header("seconds");
+  t.end_row();
+  for (const solve::StepRecord& r : run.summary.steps) {
+    t.number(r.step);
+    for (double f : r.load_factors) t.number(f);
+    t.number(r.pressure);
+    t.number(r.volume);
+    t.number(r.max_displacement);
+    for (int a = 0; a < dim; ++a) t.number(r.applied_force[a]);
+    for (size_t g = 0; g < groups; ++g)
+      for (int a = 0; a < dim; ++a) t.number(g < r.reactions.size() ? r.reactions[g][a] : 0.0);
+    paddle_numbers(t, m, r, dim, true);
+    if (newton) {
+      t.number(r.newton_iterations);
+      t.number(r.line_search_halvings);
+      t.number(r.krylov_iterations);
+      t.number(r.step_cuts);
+      t.number(r.volume_drift);
+    }
+    t.number(r.residual);
+    t.number(r.seconds);
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::string load_displacement_csv(const Case& c, const RunResult& run) {
+  const model::Model& m = c.model;
+  const int dim = m.dim();
+  CsvTable t;
+  t.header("step");
+  for (const model::Load& load : m.loads) t.header("load_factor_" + load.label);
+  for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, false);
+  t.header("max_displacement_m");
+  t.header("pressure_Pa");
+  t.header(dim == 3 ? "volume_m3" : "area_m2");
+  t.end_row();
+  for (const solve::StepRecord& r : run.summary.steps) {
+    t.number(r.step);
+    for (double f : r.load_factors) t.number(f);
+    paddle_numbers(t, m, r, dim, false);
+    t.number(r.max_displacement);
+    t.number(r.pressure);
+    t.number(r.volume);
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::string vertices_csv(const Case& c, const RunResult& run) {
+  const int dim = c.input_surface.dim;
+  const Eigen::MatrixXd& S = c.input_surface.V;
+  const Eigen::MatrixXd U = input_positions(c, run.summary.unknowns) - S;
+  Eigen::MatrixXd reactions = Eigen::MatrixXd::Zero(S.rows(), dim);
+  if (run.summary.reaction_forces.rows() == c.model.num_vertices())
+    for (size_t m = 0; m < c.model_to_input.size(); ++m)
+      reactions.row(c.model_to_input[m]) =
+          run.summary.reaction_forces.row(static_cast<Eigen::Index>(m));
+  CsvTable t;
+  t.header("vertex");
+  for (int a = 0; a < dim; ++a) t.header(std::string(1, kAxes[a]) + "_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("u") + kAxes[a] + "_m");
+  t.header("u_magnitude_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("reaction_") + kAxes[a] + "_N");
+  t.end_row();
+  for (Eigen::Index i = 0; i < S.rows(); ++i) {
+    t.number(static_cast<double>(i));
+    for (int a = 0; a < dim; ++a) t.number(S(i, a));
+    for (int a = 0; a < dim; ++a) t.number(U(i, a));
+    t.number(U.row(i).norm());
+    for (int a = 0; a < dim; ++a) t.number(reactions(i, a));
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::string comparison_csv(const Experiment& ex, const ExperimentResult& result) {
+  const char* figures[] = {"max_displacement", "final_pressure", "final_volume",
+                           "volume_change_relative"};
+  const char* headers[] = {"max_displacement_m", "final_pressure_Pa", "final_volume_m3",
+                           "volume_change_relative"};
+  CsvTable t;
+  t.header("variant");
+  t.header("success");
+  t.header("steps");
+  for (const char* h : headers) t.header(h);
+  // Reactions at the end, per group of the first case (variants may differ).
+  const model::Model& first = ex.cases.front().model;
+  const size_t groups = first.constraint_groups.size();
+  for (size_t g = 0; g < groups; ++g)
+    for (int a = 0; a < first.dim(); ++a)
+      t.header("reaction_" + group_name(first, g) + "_" + kAxes[a] + "_N");
+  t.header("seconds");
+  t.header("message");
+  t.header("patch");
+  t.end_row();
+  for (size_t r = 0; r < result.runs.size(); ++r) {
+    const RunResult& run = result.runs[r];
+    const solve::SteppingSummary& s = run.summary;
+    t.text(run.variant);
+    t.text(s.success ? "true" : "false");
+    t.number(static_cast<double>(s.steps.size()));
+    for (const char* f : figures) {  // as the runner computed them; none for a failed run
+      const auto value = result.figures.find(run.variant + "." + f);
+      if (value != result.figures.end())
+        t.number(value->second);
+      else
+        t.text("");
+    }
+    const bool same_groups = ex.cases[r].model.constraint_groups == first.constraint_groups;
+    for (size_t g = 0; g < groups; ++g)
+      for (int a = 0; a < first.dim(); ++a) {
+        if (s.success && same_groups && !s.steps.empty())
+          t.number(s.steps.back().reactions[g][a]);
+        else
+          t.text("");
+      }
+    t.number(s.total_seconds);
+    t.text(s.message);
+    t.text(ex.cases[r].patch.is_null() ? "" : ex.cases[r].patch.dump());
+    t.end_row();
+  }
+  return t.str();
+}
+
+OutputWriter::OutputWriter(const Experiment& experiment, fs::path folder)
+    : experiment_(experiment), target_(std::move(folder)), result_folder_(target_) {
+  check_replaceable(target_);
+}
+
+OutputWriter::~OutputWriter() { abandon(); }
+
+void OutputWriter::abandon() noexcept {
+  if (staging_.empty()) return;  // begin() never made it
+  std::error_code ignored;       // finish() moved it away already
+  fs::remove_all(staging_, ignored);
+  staging_.clear();
+}
+
+fs::path OutputWriter::run_folder(size_t run) const {
+  const std::string& variant = experiment_.cases[run].variant;
+  return variant.empty() ? staging_ : staging_ / variant;
+}
+
+void OutputWriter::begin() {
+  staging_ = create_staging_folder(target_, experiment_.name);
+  geom::write_text_file(staging_ / "INCOMPLETE",
+                        "fiberfluid is writing this folder, or was stopped while it did: "
+                        "these are not the results of a complete run.\n");
+  if (experiment_.kind != Experiment::Kind::Simulate) return;
+  series_.assign(experiment_.cases.size(), {});
+  write_fibers();
+  for (size_t r = 0; r < experiment_.cases.size(); ++r) {
+    fs::create_directories(run_folder(r));
+    if (!experiment_.output.vtk) continue;
+    fs::create_directories(run_folder(r) / "vtk");
+    write_state(r, 0, Eigen::VectorXd::Zero(experiment_.cases[r].model.num_unknowns()));
+  }
+}
+
+void OutputWriter::write_fibers() const {
+  const Case& c = experiment_.cases.front();
+  const std::string& which = c.fibers.write;
+  if (which == "none") return;
+  const model::Model& m = c.model;
+  std::vector<std::pair<int, int>> lines;
+  for (int i = 0; i < m.num_vertices(); ++i)
+    for (int j = i + 1; j < m.num_vertices(); ++j) {
+      const bool kept = !m.fibers || m.fibers->kept(i, j);
+      if (kept == (which == "kept")) lines.emplace_back(i, j);
+    }
+  geom::write_lines_vtu(staging_ / "fibers.vtu", m.surface.V, lines);
+}
+
+void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns) {
+  const Case& c = experiment_.cases[run];
+  const model::Model& m = c.model;
+  geom::Surface deformed = c.input_surface;
+  deformed.V = input_positions(c, unknowns);
+  const int n = deformed.num_vertices(), dim = deformed.dim;
+  const Eigen::MatrixXd U = deformed.V - c.input_surface.V;
+  // Area vectors of the current geometry, zero on vertices in no face.
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, dim);
+  const Eigen::MatrixXd model_S =
+      geom::vertex_area_vectors(m.surface.V + model::displacements(m, unknowns), m.surface.F).S;
+  for (size_t k = 0; k < c.model_to_input.size(); ++k)
+    S.row(c.model_to_input[k]) = model_S.row(static_cast<Eigen::Index>(k));
+  char name[32];
+  std::snprintf(name, sizeof name, "step_%04d.vtu", step);
+  geom::write_vtu(
+      run_folder(run) / "vtk" / name, deformed,
+      {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}, {"area_vector", S}});
+  series_[run].emplace_back(step, std::string("vtk/") + name);
+}
+
+void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
+                           const Eigen::VectorXd& unknowns) {
+  const bool last = record.step == experiment_.cases[run].stepping.steps;
+  if (experiment_.output.vtk && (last || record.step % experiment_.output.every == 0))
+    write_state(run, record.step, unknowns);
+}
+
+void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& more) {
+  for (size_t r = 0; r < result.runs.size(); ++r) {
+    const Case& c = experiment_.cases[r];
+    const RunResult& run = result.runs[r];
+    if (experiment_.output.vtk) geom::write_pvd(run_folder(r) / "series.pvd", series_[r]);
+    geom::write_text_file(run_folder(r) / "steps.csv", steps_csv(c, run));
+    geom::write_text_file(run_folder(r) / "load_displacement.csv", load_displacement_csv(c, run));
+    if (!run.summary.success) continue;
+    geom::write_text_file(run_folder(r) / "vertices.csv", vertices_csv(c, run));
+    if (experiment_.output.obj) {
+      geom::Surface deformed = c.input_surface;
+      deformed.V = input_positions(c, run.summary.unknowns);
+      geom::write_obj(run_folder(r) / "final.obj", deformed);
+    }
+  }
+  if (experiment_.sweeps())
+    geom::write_text_file(staging_ / "comparison.csv", comparison_csv(experiment_, result));
+  if (result.fem_reference) {  // the target for a fit, and the same with its displacement
+    const FemReferenceResult& f = *result.fem_reference;
+    geom::write_obj(staging_ / "fem_reference.obj", f.deformed_boundary);
+    Eigen::MatrixXd U = f.deformed_boundary.V - f.rest_boundary.V;
+    geom::write_vtu(staging_ / "fem_reference.vtu", f.deformed_boundary,
+                    {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}});
+  }
+  if (result.benchmark) {
+    const BenchmarkResult& b = *result.benchmark;
+    geom::write_text_file(staging_ / "metrics.csv", benchmark_csv(b));
+    geom::write_text_file(staging_ / "benchmark.json", benchmark_json(*experiment_.benchmark, b));
+    if (b.reference_final.num_vertices() > 0)
+      geom::write_obj(staging_ / "reference_final.obj", b.reference_final);
+    if (b.fiber_final.num_vertices() > 0)
+      geom::write_obj(staging_ / "fiber_model_final.obj", b.fiber_final);
+  }
+  geom::write_text_file(staging_ / "summary.json",
+                        summary_json(experiment_, result).dump(2) + "\n");
+  if (more) more(staging_);
+
+  if (result.runs_succeeded() && result.failure.empty()) {
+    place(target_);
+    return;
+  }
+  std::string why = result.failure.empty() ? "" : result.failure + "\n";
+  for (const RunResult& run : result.runs)
+    if (!run.summary.success)
+      why += (run.variant.empty() ? "" : run.variant + ": ") + run.summary.message + "\n";
+  set_aside("FAILED", "failed", "this run failed", why);
+}
+
+void OutputWriter::keep_interrupted(const std::string& why, const FolderFiller& more) {
+  if (more) more(staging_);
+  set_aside("INTERRUPTED", "interrupted", "this run was interrupted", why + "\n");
+}
+
+void OutputWriter::set_aside(const char* mark, const char* suffix, const std::string& what,
+                             const std::string& why) {
+  geom::write_text_file(staging_ / mark, what + "; the last complete result (if any) is in " +
+                                             target_.filename().string() + "\n" + why);
+  fs::path aside = target_;
+  aside += std::string(".") + suffix;
+  place(aside);
+}
+
+void OutputWriter::place(const fs::path& where) {
+  fs::remove(staging_ / "INCOMPLETE");
+  // From here on the folder is never removed: a move that fails names it.
+  const fs::path staged = std::exchange(staging_, fs::path());
+  move_into_place(staged, where, &warnings_);
+  result_folder_ = where;
+}
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// What a case will cost before it runs: memory and time from the mesh size,
+// the backend and the steps, so that a run that cannot fit is refused before
+// it starts, and a long one says how long it will take.
+
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+#include "solve/cost_model.hpp"
+#include "solve/load_stepper.hpp"
+
+namespace fiberfluid::experiment {
+
+struct CaseSpec;  // case_spec.hpp, which keeps an estimate in each Case
+
+// This machine's kernel speeds (solve/cost_model.hpp).
+using KernelSpeed = solve::KernelSpeed;
+
+struct ResourcePart {
+  std::string name;    // "pruning", "factorisation", "10 load steps" ...
+  double bytes = 0.0;  // held while this part runs (and after, for the kept parts)
+  double seconds = 0.0;
+  bool kept = false;  // still held by the later parts (the model, the fiber table)
+};
+
+struct ResourceEstimate {
+  std::vector<ResourcePart> parts;
+  std::string solver;       // the backend assumed ("block-cholesky", ...)
+  double peak_bytes = 0.0;  // the largest part plus what the kept parts hold
+  double seconds = 0.0;     // all parts
+  // "about 1.2 GiB and 40 s (pruning 30 s, factorisation 8 s / 1.1 GiB, ...; block-cholesky)".
+  std::string describe() const;
+};
+
+// What the fibers cost before the solve: nothing (pruning off), the
+// convexity check (a convex body, or before the check has said), or the
+// check and the exact pruning of a concave body.
+enum class PruningWork { None, ConvexityCheck, Prune };
+
+// The estimate for a model whose supports are set (the backend and its
+// block sizes follow from them, as solve::choose_solver does) with the
+// stepping options it will run with.
+ResourceEstimate estimate_resources(const model::Model& model,
+                                    const solve::SteppingOptions& stepping, PruningWork pruning,
+                                    const KernelSpeed& speed = {});
+
+// Throws InputError naming the spec's file when the estimate exceeds the
+// memory budget (fiberfluid::memory_budget_bytes()) or the time budget:
+// what it needs, the budget, and what lifts the limit (--max-memory or
+// --max-time, the pcg solver, a coarser mesh).
+void require_within_budget(const ResourceEstimate& estimate, const CaseSpec& spec);
+
+// This process's peak resident memory so far, in bytes (0 when unknown).
+double peak_resident_bytes();
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,539 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/experiment.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "experiment/outputs.hpp"
+#include "experiment/runner.hpp"
+#include "geom/generators.hpp"
+#include "geom/mesh_io.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using testing::ScratchDir;
+
+// Every experiment file carries its expected figures; each is a regression test.
+class ExperimentFile : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
+  const Experiment ex = load_experiment(testing::experiment_file(GetParam()));
+  const ExperimentResult result = run_experiment(ex);
+  EXPECT_TRUE(result.runs_succeeded());
+  EXPECT_FALSE(result.checks.empty()) << GetParam() << " expects nothing";
+  for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
+}
+
+INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
+                         ::testing::Values("rectangle.json", "areas.json", "sphere.json",
+                                           "round_trip.json", "liver_gravity.json",
+                                           "bunny_gravity.json", "liver_sweep.json",
+                                           "nonlinear_round_trip.json", "liver_paddles.json",
+                                           "stress_strain.json", "benchmark_block_mp1.json",
+                                           "benchmark_block_mp2.json", "benchmark_rod.json",
+                                           "liver_fem_reference.json"));
+
+// A minimal valid experiment, edited by each bad-config case.
+nlohmann::json base_config() {
+  return nlohmann::json::parse(R"({
+    "name": "tiny",
+    "surface": {"generator": "icosphere", "subdivisions": 1, "radius": 1.0},
+    "material": {"Y": 100000, "gamma": 10},
+    "supports": [{"where": "z >= 0.5"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "stepping": {"steps": 2}
+  })");
+}
+
+std::filesystem::path write_config(const ScratchDir& dir, const nlohmann::json& config) {
+  return dir.write("experiment.json", config.dump(2));
+}
+
+void expect_config_error(const ScratchDir& dir, const nlohmann::json& config,
+                         const std::string& part) {
+  const auto file = write_config(dir, config);
+  try {
+    load_experiment(file);
+    ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(part), std::string::npos) << message;
+    EXPECT_EQ(message.rfind(file.string(), 0), 0u) << "must name the file: " << message;
+  }
+}
+
+TEST(ExperimentConfig, BaseConfigIsValid) {
+  ScratchDir dir;
+  const Experiment ex = load_experiment(write_config(dir, base_config()));
+  ASSERT_EQ(ex.cases.size(), 1u);
+  const Case& c = ex.cases[0];
+  EXPECT_EQ(c.model.num_vertices(), 42);
+  EXPECT_FALSE(ex.sweeps());
+  EXPECT_EQ(c.stepping.steps, 2);
+  EXPECT_EQ(c.model.loads[0].density, 1000.0);  // the default
+  EXPECT_FALSE(c.model.constraints.empty());
+  EXPECT_EQ(c.model.constraint_groups, std::vector<std::string>{"support_0"});
+}
+
+TEST(ExperimentConfig, BadFieldsAreNamed) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"]["Yx"] = 3;
+  expect_config_error(dir, c, "material.Yx: unknown field");
+
+  c = base_config();
+  c["stepping"]["steps"] = "ten";
+  expect_config_error(dir, c, "stepping.steps: expected a whole number");
+
+  c = base_config();
+  c["material"]["Y"] = -1;
+  expect_config_error(dir, c, "material.Y: expected a number >= 0");
+
+  c = base_config();
+  c.erase("material");
+  expect_config_error(dir, c, "material: missing");
+
+  c = base_config();
+  c["surface"] = {{"file", "no_such_mesh.obj"}};
+  expect_config_error(dir, c, "no_such_mesh.obj: cannot open");
+
+  c = base_config();
+  c["supports"][0]["where"] = "z >= 5";
+  expect_config_error(dir, c, "supports[0].where: \"z >= 5\" selects no vertex");
+
+  // Found from outside (issue 11): each aborted, read out of bounds, or
+  // silently did something else.
+  c = base_config();
+  c["supports"][0]["where"] = "z >= 1e999";
+  expect_config_error(
+      dir, c, "supports[0].where: 'z >= 1e999': the threshold 1e999 is beyond a double's range");
+  c = base_config();
+  c["supports"][0] = {{"vertices", {2147483648LL}}};
+  expect_config_error(
+      dir, c, "supports[0].vertices: expected vertex indices (whole numbers from 0 to 2147483647)");
+  c = base_config();
+  c["supports"][0] = {{"vertices", {4294967296ULL}}};
+  expect_config_error(dir, c, "supports[0].vertices: expected vertex indices");
+  c = base_config();
+  c["loads"] = {{{"type", "point"}, {"force", {0, 0, -1}}}};
+  expect_config_error(dir, c, "loads[0].vertex: missing (required)");
+  c = base_config();
+  c["surface"] = {
+      {"generator", "box"}, {"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"segments", {1.9, 2, 2}}};
+  expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers from 1 to 200");
+  c["surface"]["segments"] = {1e300, 2, 2};
+  expect_config_error(dir, c, "surface.segments: expected a list of 3 whole numbers");
+  c = base_config();
+  c["surface"]["scale"] = 1e308;
+  expect_config_error(dir, c, "surface.scale: scaled by 1e+308 the surface is inf m across");
+  c["surface"]["scale"] = 1e-300;
+  expect_config_error(dir, c, "surface.scale: scaled by 1e-300");
+  c = base_config();
+  c["stepping"]["steps"] = 0;  // unsigned in JSON: still below the range
+  expect_config_error(dir, c, "stepping.steps: expected a whole number from 1");
+  c["stepping"]["steps"] = 18446744073709551615ULL;
+  expect_config_error(dir, c, "stepping.steps: expected a whole number from 1");
+  // A number a double cannot hold, anywhere in the file: not a crash.
+  const auto overflow = dir.write("overflow.json", R"({"name": "x", "material": {"Y": 1e999}})");
+  try {
+    load_experiment(overflow);
+    ADD_FAILURE() << "no error for 1e999";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow.json: not valid JSON"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e999"), std::string::npos) << e.what();
+  }
+
+  c = base_config();
+  c["supports"][0]["where"] = "height > 1";
+  expect_config_error(dir, c, "is not a half-space");
+
+  c = base_config();
+  c["supports"][0]["axes"] = "xw";
+  expect_config_error(dir, c, "supports[0].axes");
+
+  c = base_config();
+  c["loads"][0] = {{"type", "point"}, {"vertex", 99}, {"force", {1, 0, 0}}};
+  expect_config_error(dir, c, "loads[0].vertex: vertex 99 does not exist (the mesh has 42");
+
+  c = base_config();
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  expect_config_error(dir, c, "loads[0].acceleration: expected a list of 3 numbers");
+
+  c = base_config();
+  c["loads"][0]["schedule"] = {0.5, 1.0, 1.5};
+  expect_config_error(dir, c, "the schedule lists 3 factors but stepping.steps is 2");
+
+  c = base_config();
+  c["loads"][0]["type"] = "wind";
+  expect_config_error(dir, c, "loads[0].type: expected one of gravity, point");
+
+  c = base_config();
+  c["stepping"]["boundary_method"] = "lagrange";
+  expect_config_error(dir, c, "stepping.boundary_method");
+
+  expect_config_error(dir, nlohmann::json::array(), "expected an object");
+  const auto broken = dir.write("broken.json", "{\"name\": ");
+  EXPECT_THROW(load_experiment(broken), InputError);
+}
+
+TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 5000}, {"beta", 4}}},
+                   {"axis_factors", {1, 1, 0.5}},
+                   {"gamma", 3}};
+  c["paddles"] = {{{"label", "press"},
+                   {"axis", "z"},
+                   {"side", "below"},
+                   {"compression", 0.2},
+                   {"contact", "sticking"}}};
+  c["stepping"] = {{"steps", 4},
+                   {"scheme", "newton"},
+                   {"newton", {{"tangent", "krylov"}, {"max_step_cuts", 3}}}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const model::Model& m = ex.cases[0].model;
+  EXPECT_EQ(m.material.law.name(), "exponential");
+  EXPECT_EQ(m.material.law.parameter("beta"), 4.0);
+  EXPECT_EQ(m.material.axis_factors.z(), 0.5);
+  ASSERT_EQ(m.paddles.size(), 1u);
+  EXPECT_EQ(m.paddles[0].axis, 2);
+  EXPECT_FALSE(m.paddles[0].above);
+  EXPECT_TRUE(m.paddles[0].sticking);
+  const double bottom = m.surface.V.col(2).minCoeff(), top = m.surface.V.col(2).maxCoeff();
+  EXPECT_EQ(m.paddles[0].position, bottom);                       // touching by default
+  EXPECT_NEAR(m.paddles[0].travel, 0.2 * (top - bottom), 1e-15);  // upwards, into the body
+  EXPECT_EQ(ex.cases[0].stepping.scheme, solve::Scheme::Newton);
+  EXPECT_EQ(ex.cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
+  EXPECT_EQ(ex.cases[0].stepping.newton.max_step_cuts, 3);
+}
+
+TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"]["law"] = {{"type", "exponential"}, {"Y0", 5000}, {"beta", 2}};
+  expect_config_error(dir, c, "material.Y: give either Y");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"beta", 2}}}};
+  expect_config_error(dir, c, "material.law.Y0: missing");
+
+  c = base_config();
+  c["material"] = {
+      {"law", {{"type", "tabulated"}, {"strain", {0, 0.1, 0.2}}, {"stress", {0, 200, 150}}}}};
+  expect_config_error(dir, c, "material.law.stress: the stresses must be strictly increasing");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "tabulated"}, {"strain", {0, 0.1}}, {"stress", {0}}}}};
+  expect_config_error(dir, c, "material.law.stress: expected as many stresses as strains");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 1}, {"beta", 900}}}};
+  expect_config_error(dir, c, "check beta");
+
+  c = base_config();
+  c["material"] = {{"law", {{"type", "hyperelastic"}}}};
+  expect_config_error(dir, c, "material.law.type: expected one of");
+
+  nlohmann::json paddle = {{"axis", "z"}, {"side", "above"}, {"travel", -0.2}};
+  c = base_config();
+  c["paddles"] = {paddle};
+  expect_config_error(dir, c, "paddles: paddles need \"stepping\": {\"scheme\": \"newton\"}");
+
+  c = base_config();
+  c["stepping"]["scheme"] = "newton";
+  c["paddles"] = {paddle};
+  c["paddles"][0]["axis"] = "n";
+  expect_config_error(dir, c, "paddles[0].axis: expected one of \"xyz\"");
+
+  c["paddles"] = {paddle};
+  c["paddles"][0]["position"] = 0.5;
+  expect_config_error(dir, c, "paddles[0].position: the paddle starts inside the body");
+
+  c["paddles"] = {paddle};
+  c["paddles"][0]["compression"] = 0.3;
+  expect_config_error(dir, c, "paddles[0].travel: give either travel");
+
+  c["paddles"] = {paddle, {{"label", "floor"}, {"axis", "z"}, {"side", "below"}, {"travel", 2.0}}};
+  expect_config_error(dir, c, "paddles: paddles paddle_0 and floor meet or pass each other");
+
+  c = base_config();
+  c["stepping"]["newton"] = {{"max_iterations", 5}};
+  expect_config_error(dir, c, "stepping.newton: Newton options need");
+
+  c = base_config();
+  c["stepping"] = {{"scheme", "newton"}, {"newton", {{"tangent", "cg"}}}};
+  expect_config_error(dir, c, "stepping.newton.tangent: expected one of auto, dense, krylov");
+}
+
+TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"]["subdivisions"] = 4;  // 2,562 vertices: proxies in play
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 1e-6}};
+  const Experiment approximate = load_experiment(write_config(dir, c));
+  EXPECT_EQ(approximate.cases[0].model.treecode_tolerance, 1e-6);
+  c.erase("fibers");
+  c["stepping"]["solver"] = "pcg";
+  const Experiment exact = load_experiment(write_config(dir, c));
+  const ExperimentResult a = run_experiment(approximate), e = run_experiment(exact);
+  ASSERT_TRUE(a.runs_succeeded() && e.runs_succeeded());
+  EXPECT_EQ(a.runs[0].summary.solver, solve::SolverKind::PCG);  // auto: the matrix-free backend
+  const Eigen::VectorXd& ua = a.runs[0].summary.unknowns;
+  const Eigen::VectorXd& ue = e.runs[0].summary.unknowns;
+  EXPECT_LT((ua - ue).norm(), 1e-6 * ue.norm());
+  EXPECT_GT((ua - ue).norm(), 0.0);  // it did approximate
+
+  // Variants share the surface and its fibers, and the product with them.
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 1e-4}};
+  c["stepping"] = {{"steps", 1}};
+  c["variants"] = {{{"name", "soft"}, {"material", {{"Y", 50000}}}},
+                   {{"name", "stiff"}, {"material", {{"Y", 200000}}}}};
+  const Experiment sweep = load_experiment(write_config(dir, c));
+  ASSERT_EQ(sweep.cases.size(), 2u);
+  for (const Case& variant : sweep.cases) EXPECT_EQ(variant.model.treecode_tolerance, 1e-4);
+  c.erase("variants");
+
+  c = base_config();
+  c["fibers"] = {{"treecode_tolerance", 1e-6}};
+  expect_config_error(dir, c,
+                      "fibers.treecode_tolerance: applies to \"product\": \"treecode\" only");
+  c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 0.5}};
+  expect_config_error(dir, c,
+                      "fibers.treecode_tolerance: expected a relative error from 1e-10 to 1e-2");
+  c["fibers"] = {{"product", "treecode"}};
+  c["stepping"]["solver"] = "dense-lu";
+  expect_config_error(dir, c,
+                      "fibers: \"product\": \"treecode\": the treecode product "
+                      "(treecode_tolerance) is matrix-free");
+  c["stepping"] = {{"scheme", "newton"}};
+  expect_config_error(dir, c, "Newton's tangent is exact");
+  // A concave body pruned with the symmetric count has no single pair factor.
+  c = base_config();
+  c["surface"] = {{"generator", "torus"}, {"segments", {16, 8}}};
+  c["supports"][0] = {{"where", "z >= 0.5"}};
+  c["fibers"] = {{"product", "treecode"}};
+  expect_config_error(dir, c, "fibers.product: \"treecode\" needs one connection count");
+  c["fibers"]["connection_count"] = "global";
+  EXPECT_GT(load_experiment(write_config(dir, c)).cases[0].fibers.pairs,
+            load_experiment(write_config(dir, c)).cases[0].fibers.kept);
+}
+
+TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {
+      {"generator", "torus"}, {"major_radius", 2.0}, {"minor_radius", 0.5}, {"segments", {24, 12}}};
+  c["supports"][0] = {{"where", "z >= 0.4"}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  EXPECT_EQ(ex.cases[0].model.num_vertices(), 24 * 12);
+  EXPECT_FALSE(ex.cases[0].fibers.convex);
+  c["surface"]["minor_radius"] = 2.5;
+  expect_config_error(dir, c, "surface.minor_radius: must be below major_radius");
+  c["surface"]["minor_radius"] = 0.5;
+  c["surface"]["segments"] = {2, 12};
+  expect_config_error(dir, c,
+                      "surface.segments: expected a list of 2 whole numbers from 3 to 1000");
+}
+
+TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  EXPECT_TRUE(load_experiment(write_config(dir, c)).cases[0].fibers.convex);  // an icosphere
+
+  // The paper's 2D L: three pairs see each other across the re-entrant corner.
+  c["surface"] = {{"generator", "polygon"},
+                  {"points", {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}}};
+  c["supports"][0] = {{"where", "y <= 0"}};
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  c["fibers"] = {{"write", "pruned"}, {"connection_count", "global"}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const Case& l_case = ex.cases[0];
+  EXPECT_FALSE(l_case.fibers.convex);
+  EXPECT_EQ(l_case.fibers.pairs, 15);
+  EXPECT_EQ(l_case.fibers.kept, 12);
+  EXPECT_EQ(l_case.model.connection_count, model::ConnectionCount::Global);
+  ASSERT_TRUE(l_case.model.fibers);
+
+  OutputWriter writer(ex, dir.path() / "out");
+  writer.begin();
+  const ExperimentResult result = run_experiment(ex);
+  writer.finish(result);
+  EXPECT_TRUE(result.runs_succeeded());
+  EXPECT_EQ(result.figures.at("fibers.pruned"), 3.0);
+  std::ifstream vtu(dir.path() / "out" / "fibers.vtu");
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("NumberOfCells=\"3\""), std::string::npos) << text.substr(0, 300);
+  std::ifstream summary_file(dir.path() / "out" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["fibers"]["pruned"], 3);
+  EXPECT_EQ(summary["fibers"]["connection_count"], "global");
+
+  c["fibers"] = {{"pruning", "off"}};
+  const Experiment unpruned = load_experiment(write_config(dir, c));
+  EXPECT_FALSE(unpruned.cases[0].model.fibers);
+  EXPECT_EQ(unpruned.cases[0].fibers.kept, 15);
+
+  c["fibers"] = {{"pruning", "sometimes"}};
+  expect_config_error(dir, c, "fibers.pruning: expected one of auto, off");
+  c["fibers"] = {{"colour", "green"}};
+  expect_config_error(dir, c, "fibers.colour: unknown field");
+}
+
+TEST(ExperimentConfig, InvertedMeshNeedsFlip) {
+  ScratchDir dir;
+  geom::Surface inward = geom::read_surface(testing::data_mesh("icosahedron.obj")).surface;
+  geom::flip_orientation(inward);
+  geom::write_obj(dir.path() / "inward.obj", inward);
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", "inward.obj"}};
+  c["supports"][0]["where"] = "z >= 0.8";
+  expect_config_error(dir, c, "inverted");
+  c["surface"]["flip"] = true;
+  EXPECT_NO_THROW(load_experiment(write_config(dir, c)));
+}
+
+TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", testing::data_mesh("liver.obj").string()}, {"scale", 0.04}};
+  c["supports"][0] = {{"vertices", {0, 1, 2, 3, 4, 5}}};  // liver's vertices 0..5 are used
+  c["loads"][0]["acceleration"] = {0, -9.81, 0};
+  c["output"] = {{"vtk", true}, {"every", 1}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const Case& liver = ex.cases[0];
+  EXPECT_EQ(liver.input_surface.num_vertices(), 181);
+  EXPECT_EQ(liver.model.num_vertices(), 139);
+
+  OutputWriter writer(ex, dir.path() / "out");
+  writer.begin();
+  const ExperimentResult result =
+      run_experiment(ex, [&](size_t run, const solve::StepRecord& r, const Eigen::VectorXd& x) {
+        writer.on_step(run, r, x);
+      });
+  writer.finish(result);
+  ASSERT_TRUE(result.runs_succeeded());
+
+  const geom::Surface final_surface = geom::read_surface(dir.path() / "out" / "final.obj").surface;
+  EXPECT_EQ(final_surface.num_vertices(), 181);
+  EXPECT_EQ(final_surface.F, liver.input_surface.F);
+  for (int i = 0; i < 181; ++i) {
+    if (liver.input_surface.F.cwiseEqual(i).any()) continue;  // unused vertices stay in place
+    EXPECT_NEAR((final_surface.V.row(i) - liver.input_surface.V.row(i)).norm(), 0.0, 1e-12);
+  }
+  for (const char* file : {"summary.json", "series.pvd", "vtk/step_0000.vtu", "vtk/step_0002.vtu"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / file)) << file;
+
+  std::ifstream summary_file(dir.path() / "out" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  ASSERT_EQ(summary["runs"].size(), 1u);
+  const auto& steps = summary["runs"][0]["steps"];
+  ASSERT_EQ(steps.size(), 2u);
+  for (const char* key : {"pressure", "volume", "max_displacement", "seconds", "load_factors"})
+    EXPECT_TRUE(steps[1].contains(key)) << key;
+  EXPECT_DOUBLE_EQ(steps[1]["max_displacement"].get<double>(),
+                   summary["figures"]["max_displacement"].get<double>());
+
+  std::ifstream vtu(dir.path() / "out" / "vtk" / "step_0002.vtu");
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  for (const char* part : {"NumberOfPoints=\"181\"", "Name=\"displacement\"",
+                           "Name=\"displacement_magnitude\"", "Name=\"area_vector\""})
+    EXPECT_NE(text.find(part), std::string::npos) << part;
+}
+
+}  // namespace
+// Parsing opens no file and builds nothing; building loads, prunes and resolves.
+TEST(ExperimentPhases, ReadingOpensNoFileAndBuildingNamesTheField) {
+  nlohmann::json c = base_config();
+  c["surface"] = {{"file", "no_such_mesh.obj"}};
+  Experiment ex = read_experiment(c, "/nonexistent_folder", "doc");
+  ASSERT_EQ(ex.specs.size(), 1u);
+  EXPECT_TRUE(ex.cases.empty());
+  EXPECT_EQ(ex.specs[0].surface.file,
+            std::filesystem::path("/nonexistent_folder/no_such_mesh.obj"));
+  try {
+    build_experiment(ex);
+    ADD_FAILURE() << "built a case on a missing mesh";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("doc: surface.file: ", 0), 0u) << e.what();
+  }
+
+  // What only the mesh reveals: a list with one entry per axis of a 2D surface.
+  c = base_config();
+  c["surface"] = {{"generator", "rectangle"}, {"min", {0, 0}}, {"max", {2, 1}}};
+  c["supports"][0]["where"] = "y <= 0";
+  ex = read_experiment(c, ".", "doc");  // 3 numbers are fine before the surface is known
+  try {
+    build_experiment(ex);
+    ADD_FAILURE() << "a 3D acceleration on a 2D surface";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("doc: loads[0].acceleration: expected a list of 2 "
+                                         "numbers"),
+              std::string::npos)
+        << e.what();
+  }
+  c["supports"][0]["where"] = "z <= 0";
+  c["loads"][0]["acceleration"] = {0, -9.81};
+  ex = read_experiment(c, ".", "doc");
+  EXPECT_THROW(build_experiment(ex), InputError);  // no z axis in 2D
+}
+
+// A program builds a model on its own surface, without a mesh file, and gets
+// the very model the file-based experiment builds.
+TEST(ExperimentPhases, AProgramGivesTheSurface) {
+  const nlohmann::json with_generator = base_config();
+  const Experiment from_generator = parse_experiment(with_generator, ".", "doc");
+
+  nlohmann::json without_surface = base_config();
+  without_surface.erase("surface");
+  Experiment ex = read_experiment(without_surface, ".", "doc");
+  const geom::Surface sphere = geom::icosphere(1, 1.0);
+  build_experiment(ex, &sphere);
+  ASSERT_EQ(ex.cases.size(), 1u);
+  const model::Model& a = from_generator.cases[0].model;
+  const model::Model& b = ex.cases[0].model;
+  EXPECT_EQ(b.surface.V, a.surface.V);
+  ASSERT_EQ(b.constraints.size(), a.constraints.size());
+  for (size_t k = 0; k < a.constraints.size(); ++k)
+    EXPECT_EQ(b.constraints[k].vertex, a.constraints[k].vertex);
+  const ExperimentResult ra = run_experiment(from_generator), rb = run_experiment(ex);
+  ASSERT_TRUE(ra.runs_succeeded() && rb.runs_succeeded());
+  EXPECT_EQ(rb.runs[0].summary.unknowns, ra.runs[0].summary.unknowns);
+
+  // One spec builds on any surface: a concave one is pruned on the way.
+  Experiment on_cube = read_experiment(without_surface, ".", "doc");
+  geom::Surface dented = geom::icosphere(2, 1.0);
+  for (int i = 0; i < dented.num_vertices(); ++i)
+    if (dented.V(i, 0) > 0.9) dented.V(i, 0) -= 0.5;  // push a cap inward
+  build_experiment(on_cube, &dented);
+  EXPECT_FALSE(on_cube.cases[0].fibers.convex);
+  EXPECT_LT(on_cube.cases[0].fibers.kept, on_cube.cases[0].fibers.pairs);
+
+  // Neither the document nor the program gives a surface, or both do.
+  Experiment nothing = read_experiment(without_surface, ".", "doc");
+  try {
+    build_experiment(nothing);
+    ADD_FAILURE() << "built without a surface";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("doc: surface: missing", 0), 0u) << e.what();
+  }
+  Experiment both = read_experiment(with_generator, ".", "doc");
+  EXPECT_THROW(build_experiment(both, &sphere), InputError);
+  // A surface the program gives is checked like a mesh file.
+  geom::Surface open = sphere;
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  Experiment on_open = read_experiment(without_surface, ".", "doc");
+  try {
+    build_experiment(on_open, &open);
+    ADD_FAILURE() << "built on an open surface";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the given surface"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The FEM reference of a simulation: the same supports and loads on
+// tetrahedra, checked against exact solutions.
+#include "experiment/fem_reference.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "experiment/experiment.hpp"
+#include "experiment/runner.hpp"
+#include "fit/target.hpp"
+#include "metrics/metrics.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+// A 0.1 x 0.1 x 0.2 m box: its bottom held, its top moved by `top` (m).
+nlohmann::json column(double poisson, const nlohmann::json& top) {
+  return {{"name", "column"},
+          {"surface",
+           {{"generator", "box"},
+            {"min", {0, 0, 0}},
+            {"max", {0.1, 0.1, 0.2}},
+            {"segments", {2, 2, 4}}}},
+          {"material", {{"Y", 1000}, {"gamma", 0}}},
+          {"supports", {{{"where", "z <= 0"}, {"axes", "xyz"}}}},
+          {"prescribed", {{{"where", "z >= 0.2"}, {"displacement", top}}}},
+          {"stepping", {{"steps", 1}}},
+          {"fem_reference", {{"E", 5000}, {"nu", poisson}, {"size", 0.04}}}};
+}
+
+// With nu = 0 a column stretched between its held ends is in uniform
+// uniaxial strain, which linear tetrahedra reproduce exactly: every node at
+// u_z = delta z / H, no sideways motion. So the held faces were found and
+// nothing else was held.
+TEST(FemReference, StretchedColumnIsExact) {
+  const Experiment ex = parse_experiment(column(0.0, {0, 0, 0.01}), ".", "column.json");
+  const ExperimentResult result = run_experiment(ex);
+  ASSERT_TRUE(result.runs_succeeded());
+  ASSERT_TRUE(result.fem_reference);
+  const FemReferenceResult& f = *result.fem_reference;
+  ASSERT_GT(f.mesh.num_nodes(), 20);
+  for (int v = 0; v < f.mesh.num_nodes(); ++v) {
+    const double z = f.mesh.nodes(v, 2);
+    EXPECT_NEAR(f.displacement(v, 2), 0.01 * z / 0.2, 1e-12) << v;
+    EXPECT_NEAR(f.displacement.row(v).head<2>().norm(), 0.0, 1e-12) << v;
+  }
+  EXPECT_NEAR(result.figures.at("fem_reference.max_displacement"), 0.01, 1e-12);
+  EXPECT_NEAR(result.figures.at("fem_reference.volume_change"), 0.05, 1e-9);  // 1 cm on 20 cm
+  // The box is meshed exactly (its faces are planes): no error at rest.
+  EXPECT_LT(result.figures.at("fem_reference.rest_surface_error"), 1e-9);
+}
+
+// A sideways shift of the top with nu > 0 (no closed form): every node of
+// the held faces goes exactly where it is told, the free sides follow.
+TEST(FemReference, HeldEndsGoWhereTheyAreTold) {
+  const Experiment ex = parse_experiment(column(0.3, {0.005, 0, 0}), ".", "column.json");
+  const ExperimentResult result = run_experiment(ex);
+  ASSERT_TRUE(result.fem_reference);
+  const FemReferenceResult& f = *result.fem_reference;
+  int top = 0, bottom = 0;
+  for (int v = 0; v < f.mesh.num_nodes(); ++v) {
+    const double z = f.mesh.nodes(v, 2);
+    if (z > 0.2 - 1e-12) {
+      EXPECT_NEAR((f.displacement.row(v) - Eigen::RowVector3d(0.005, 0, 0)).norm(), 0.0, 1e-12);
+      ++top;
+    } else if (z < 1e-12) {
+      EXPECT_NEAR(f.displacement.row(v).norm(), 0.0, 1e-15);
+      ++bottom;
+    } else {
+      EXPECT_GT(f.displacement(v, 0), 0.0);  // the free sides follow the top
+    }
+  }
+  EXPECT_GE(top, 9);
+  EXPECT_GE(bottom, 9);
+  // The fiber model and the FEM, compared: both shift the column's top.
+  EXPECT_GT(result.figures.at("fem_reference.surface_error"), 0.0);
+  EXPECT_LT(result.figures.at("fem_reference.distance_largest"), 0.005);
+}
+
+TEST(FemReference, WhatItCannotPoseIsAnError) {
+  nlohmann::json d = column(0.3, {0, 0, 0.01});
+  d["fem_reference"]["nu"] = 0.5;
+  EXPECT_THROW(parse_experiment(d, ".", "column.json"), InputError);
+  d = column(0.3, {0, 0, 0.01});
+  d["fem_reference"]["E"] = -1;
+  try {
+    parse_experiment(d, ".", "column.json");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("column.json: fem_reference.E"), std::string::npos)
+        << e.what();
+  }
+  d = column(0.3, {0, 0, 0.01});
+  d["variants"] = {{{"name", "a"}}};
+  EXPECT_THROW(parse_experiment(d, ".", "column.json"), InputError);
+  d = column(0.3, {0, 0, 0.01});
+  d.erase("supports");
+  d.erase("prescribed");
+  d["loads"] = {{{"type", "point"}, {"vertex", 0}, {"force", {0, 0, -1}}}};
+  d["fem_reference"]["E"] = 5000;
+  // No supports: the fiber model's own check refuses it first, or the FEM's.
+  EXPECT_THROW(run_experiment(parse_experiment(d, ".", "column.json")), InputError);
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+namespace {
+
+// The committed target of fit_liver_fem.json is what liver_fem_reference.json
+// writes today: the two surfaces lie within a tenth of a millimetre of each
+// other (the liver sags 13 mm: a changed modulus or load would show).
+TEST(FemReference, TheCommittedLiverTargetIsCurrent) {
+  const Experiment ex = load_experiment(testing::experiment_file("liver_fem_reference.json"));
+  const ExperimentResult result = run_experiment(ex);
+  ASSERT_TRUE(result.fem_reference);
+  const geom::Surface& fresh = result.fem_reference->deformed_boundary;
+  const fit::Target committed =
+      fit::read_target(testing::experiment_file("../data/targets/liver_fem_reference.obj"));
+  const fit::TargetDistance to_committed(committed);
+  const fit::TargetDistance to_fresh(fit::make_target("fresh", fresh.V, fresh.F));
+  double largest = 0.0;
+  for (const auto& c : to_committed.closest(fresh.V)) largest = std::max(largest, c.distance);
+  for (const auto& c : to_fresh.closest(committed.points)) largest = std::max(largest, c.distance);
+  EXPECT_LT(largest, 1e-4)
+      << "regenerate data/targets/liver_fem_reference.obj (SOURCES.md says how)";
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment

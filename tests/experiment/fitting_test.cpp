@@ -1,0 +1,297 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/fitting.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "experiment/outputs.hpp"
+#include "geom/mesh_io.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+// The fit experiments as `fiberfluid fit` runs them: calibrate, run at the
+// fitted values, check the expected figures.
+class FitExperiment : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FitExperiment, RecoversItsParametersAndMeetsItsExpectedFigures) {
+  const Experiment ex = load_experiment(testing::experiment_file(GetParam()));
+  const FitSetup setup = setup_fit(ex);
+  const fit::FitResult fitted = setup.calibration->run();
+  ASSERT_TRUE(fitted.success) << fitted.message;
+  const Experiment at_fit = with_fitted_material(ex, *setup.calibration, fitted);
+  ExperimentResult result = run_experiment(at_fit);
+  ASSERT_TRUE(result.runs_succeeded());
+  for (const auto& [name, value] : fit_figures(fitted)) result.figures[name] = value;
+  result.checks = check_expected(at_fit, result);
+  EXPECT_FALSE(result.checks.empty());
+  for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
+
+  testing::ScratchDir dir;
+  write_fit_files(dir.path(), at_fit, setup, fitted, result);
+  std::ifstream in(dir.path() / "fit.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["parameters"].size(), fitted.names.size());
+  EXPECT_TRUE(report["success"].get<bool>());
+  EXPECT_EQ(report["targets"].size(), setup.targets.size());
+  for (const char* file : {"fit_iterations.csv", "fit_distances.csv", "fit_target_0.vtu"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / file)) << file;
+}
+
+INSTANTIATE_TEST_SUITE_P(Experiments, FitExperiment,
+                         ::testing::Values("fit_sphere.json", "fit_synthetic_liver_exact.json",
+                                           "fit_liver_fem.json"));
+
+nlohmann::json sphere_fit_document() {
+  std::ifstream in(testing::experiment_file("fit_sphere.json"));
+  return nlohmann::json::parse(in);
+}
+
+void expect_fit_error(const nlohmann::json& document, const std::string& part) {
+  try {
+    const Experiment ex =
+        parse_experiment(document, testing::experiment_file("").parent_path(), "doc");
+    setup_fit(ex);
+    ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+TEST(FitConfig, BadFitSectionsAreNamed) {
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["parameters"][0]["name"] = "stiffness";
+  expect_fit_error(d, "doc: fit.parameters[0].name: \"stiffness\" is not a parameter");
+  d = sphere_fit_document();
+  d["fit"]["parameters"][0]["lower"] = 5000;
+  expect_fit_error(d, "the start 1000 lies outside the bounds [5000, 1e+06]");
+  d = sphere_fit_document();
+  d["fit"]["targets"][0]["file"] = "no_such_scan.obj";
+  expect_fit_error(d, "doc: fit.targets[0].file");
+  d = sphere_fit_document();
+  d["fit"]["targets"][0]["step"] = 11;
+  expect_fit_error(d, "fit.targets[0].step: load step 11 is beyond the run's 10 steps");
+  d = sphere_fit_document();
+  d["fit"]["method"] = "newton";
+  expect_fit_error(d, "fit.method: expected levenberg-marquardt, bobyqa, direct-l or crs2");
+  d = sphere_fit_document();
+  d["fit"]["objective"] = {{"exclude", {{"where", "z >= -2"}}}};
+  expect_fit_error(d, "excludes every vertex");
+  d = sphere_fit_document();
+  d["fit"]["colour"] = "green";
+  expect_fit_error(d, "fit.colour: unknown field");
+  d = sphere_fit_document();
+  d["fit"]["initial_trust_region_radius"] = 0;
+  expect_fit_error(d, "fit.initial_trust_region_radius");
+  d = sphere_fit_document();
+  d["variants"] = {{{"name", "a"}}};
+  expect_fit_error(d, "a fit calibrates one simulation");
+}
+
+// Issue 27 and 30: each of these crashed, ended with a solver's internal
+// message, or was taken silently; each is a named error before anything runs.
+TEST(FitConfig, OptionsAreCheckedOnceForEveryFrontEnd) {
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["parameters"][0]["lower"] = 1000;  // lower == upper: Ceres' "infeasible bound"
+  d["fit"]["parameters"][0]["upper"] = 1000;
+  expect_fit_error(
+      d,
+      "doc: fit.parameters[0]: parameter \"Y\": expected a lower bound below the upper "
+      "one, got [1000, 1000]");
+  d = sphere_fit_document();
+  d["fit"]["difference_step"] = 5;  // a central-difference run at e^5 times the value: SIGSEGV
+  expect_fit_error(
+      d,
+      "doc: fit.difference_step: expected a step in the fitted variable above 0 and at most 0.5");
+  d = sphere_fit_document();
+  d["fit"]["objective"] = {{"loss", "huber"}, {"loss_scale", 0}};
+  expect_fit_error(d,
+                   "doc: fit.objective.loss_scale: expected a positive finite length in m, got 0");
+  d = sphere_fit_document();
+  d["fit"]["max_iterations"] = 0;
+  expect_fit_error(d, "doc: fit.max_iterations: expected 1 to 100000, got 0");
+  d = sphere_fit_document();
+  d["fit"]["objective"] = {{"loss", "l1"}};
+  expect_fit_error(d, "doc: fit.objective.loss: expected squared, huber or cauchy");
+  d = sphere_fit_document();
+  d["fit"]["targets"][0]["units"] = "mm";
+  d["fit"]["targets"][0]["scale"] = 0.001;
+  expect_fit_error(d, "fit.targets[0].units: give the scan's units or its scale, not both");
+  d = sphere_fit_document();
+  d["fit"]["parameters"][0]["name"] = "scale";
+  d["fit"]["parameters"][0]["lower"] = -1;
+  expect_fit_error(d, "parameter \"scale\": fitted in log scale");
+  // The C++ options the same way (the Python module goes through them too).
+  fit::FitOptions o;
+  o.loss_scale = 0;
+  EXPECT_THROW(fit::check_options(o), InputError);
+  EXPECT_THROW(fit::method_from_string("newton"), InputError);
+}
+
+TEST(FitConfig, AScanInMillimetresIsScaledToMetres) {
+  testing::ScratchDir dir;
+  const fit::Target m = fit::read_target(testing::data_target("sphere_final.obj"));
+  geom::Surface in_mm;
+  in_mm.V = 1000.0 * m.points;
+  in_mm.F = m.triangles;
+  geom::write_obj(dir.path() / "scan_mm.obj", in_mm);
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["targets"][0]["file"] = (dir.path() / "scan_mm.obj").string();
+  d["fit"]["targets"][0]["units"] = "mm";
+  const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+  const FitSetup setup = setup_fit(ex);
+  EXPECT_TRUE(setup.targets[0].target.points.isApprox(m.points, 1e-15));
+  EXPECT_NE(setup.targets[0].target.description.find("scaled by 0.001"), std::string::npos);
+  // Without the units the scan lies far from the body: refused, not fitted.
+  d["fit"]["targets"][0].erase("units");
+  expect_fit_error(d, "scan_mm.obj: the target is 1454.86 times the body's size");
+  expect_fit_error(d, "wrong units? (give the scan's \"units\" or \"scale\")");
+}
+
+// A nested document (valid JSON, 200 KB) overflowed the stack when copied.
+TEST(FitConfig, DeeplyNestedDocumentsAreRefusedWithAShortMessage) {
+  testing::ScratchDir dir;
+  std::string deep = R"({"name": "deep", "stepping": {"steps": )";
+  deep += std::string(100000, '[') + std::string(100000, ']') + "}}";
+  const auto file = dir.write("deep.json", deep);
+  try {
+    load_experiment(file);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("deep.json: nested more than 64 levels deep"), std::string::npos) << what;
+    EXPECT_LT(what.size(), 300u);
+  }
+  // 40 levels are valid JSON within the limit: the field is named, the value quoted short.
+  std::string forty = R"({"name": "deep", "surface": {"generator": "icosphere", "subdivisions": 1},
+    "material": {"Y": 1000}, "stepping": {"steps": )";
+  forty += std::string(40, '[') + std::string(40, ']') + "}}";
+  try {
+    load_experiment(dir.write("forty.json", forty));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("stepping.steps: expected"), std::string::npos) << what;
+    EXPECT_LT(what.size(), 300u) << what;
+  }
+}
+
+// A fit's ending is a status, never a silent success.
+TEST(FitStatus, ParametersOnTheirBoundsAreNamedWithTheirCorrelation) {
+  // gamma held above its truth (3000): Y runs to its lower bound to make up,
+  // as a real phantom's Y ran to 1 Pa. Converged, but on bounds.
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["parameters"][1]["lower"] = 3500;
+  const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+  const fit::FitResult r = setup_fit(ex).calibration->run();
+  ASSERT_EQ(r.status, fit::FitStatus::ConvergedAtBounds) << r.message << " " << r.status_detail;
+  EXPECT_TRUE(r.success);
+  EXPECT_EQ(r.at_bounds, (std::vector<std::string>{"Y", "gamma"}));
+  EXPECT_NEAR(r.values[0], 10.0, 1e-4);
+  EXPECT_NEAR(r.values[1], 3500.0, 1e-4);
+  EXPECT_TRUE(std::isnan(r.standard_errors[0]));  // a bound is no estimate
+  EXPECT_NE(
+      r.status_detail.find("Y = 10 is on its lower bound (its correlation with gamma is -0.9"),
+      std::string::npos)
+      << r.status_detail;
+  EXPECT_EQ(fit_exit_status(r.status), 4);
+  EXPECT_TRUE(fit_result_kept(r.status));
+
+  // Held the other way, Y = 2000 below its truth: the fit runs out of
+  // iterations against the bound, and says which parameter sits on it.
+  d = sphere_fit_document();
+  d["fit"]["parameters"][0]["upper"] = 2000;
+  const fit::FitResult limited =
+      setup_fit(parse_experiment(d, testing::experiment_file("").parent_path(), "doc"))
+          .calibration->run();
+  EXPECT_EQ(limited.status, fit::FitStatus::IterationLimit) << limited.message;
+  EXPECT_EQ(limited.at_bounds, std::vector<std::string>{"Y"});
+  EXPECT_NE(limited.status_detail.find("Y = 2000 is on its upper bound"), std::string::npos);
+}
+
+TEST(FitStatus, ALoadThatMovesNothingIsNotIdentifiable) {
+  nlohmann::json d = sphere_fit_document();
+  d["loads"][0]["acceleration"] = {0, 0, 0};
+  d["loads"][1]["force"] = {0, 0, 0};
+  const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+  const fit::FitResult r = setup_fit(ex).calibration->run();
+  EXPECT_EQ(r.status, fit::FitStatus::NotIdentifiable) << r.message;
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.status_detail.find("no distance changes with \"Y\""), std::string::npos)
+      << r.status_detail;
+  EXPECT_EQ(fit_exit_status(r.status), 2);
+  EXPECT_FALSE(fit_result_kept(r.status));
+  // The report reads every figure without a crash; errors are null.
+  testing::ScratchDir dir;
+  const FitSetup setup = setup_fit(ex);
+  write_fit_files(dir.path(), ex, setup, r, ExperimentResult{});
+  std::ifstream in(dir.path() / "fit.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["status"], "not_identifiable");
+  EXPECT_TRUE(report["parameters"][0]["standard_error"].is_null());
+
+  // The same class: a difference step too small to move a forward run.
+  nlohmann::json tiny = sphere_fit_document();
+  tiny["fit"]["jacobian"] = "finite-differences";
+  tiny["fit"]["difference_step"] = 1e-300;
+  const fit::FitResult t =
+      setup_fit(parse_experiment(tiny, testing::experiment_file("").parent_path(), "doc"))
+          .calibration->run();
+  EXPECT_EQ(t.status, fit::FitStatus::NotIdentifiable) << t.message;
+  EXPECT_NE(t.status_detail.find("no distance changes with \"Y\""), std::string::npos)
+      << t.status_detail;
+}
+
+TEST(FitStatus, TheIterationLimitAndFailedRunsAreCountedByCause) {
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["max_iterations"] = 3;
+  const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+  const FitSetup setup = setup_fit(ex);
+  const fit::FitResult r = setup.calibration->run();
+  EXPECT_EQ(r.status, fit::FitStatus::IterationLimit) << r.message;
+  EXPECT_EQ(fit_exit_status(r.status), 2);
+  EXPECT_NE(r.message.find("max_iterations 3"), std::string::npos) << r.message;
+  // The full fit meets a runaway trial point on its way (fit_sphere's log):
+  // counted under its cause, with its parameters.
+  const fit::FitResult full =
+      setup_fit(load_experiment(testing::experiment_file("fit_sphere.json"))).calibration->run();
+  ASSERT_EQ(full.status, fit::FitStatus::Converged) << full.message;
+  ASSERT_GE(full.failed_runs, 1);
+  int counted = 0;
+  for (const auto& [cause, count] : full.failures_by_cause) {
+    EXPECT_EQ(cause.find_first_of("0123456789"), std::string::npos) << cause;
+    counted += count;
+  }
+  EXPECT_EQ(counted, full.failed_runs);
+  ASSERT_FALSE(full.failed_examples.empty());
+  EXPECT_NE(full.failed_examples[0].message.find("runaway"), std::string::npos);
+  EXPECT_EQ(full.failed_examples[0].values.size(), 2);
+  bool told = false;  // the rejected step says why, not "it cost 1.79769e+308"
+  for (const fit::IterationRecord& it : full.iterations) told |= !it.trial_failure.empty();
+  EXPECT_TRUE(told);
+}
+
+TEST(FitStatus, StartFromTakesTheValuesOfAnEarlierFit) {
+  testing::ScratchDir dir;
+  const auto earlier = dir.write("fit.json", R"({"parameters": [
+    {"name": "Y", "value": 2900.5}, {"name": "gamma", "value": 3100.25}]})");
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["start_from"] = earlier.string();
+  const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+  const FitSetup setup = setup_fit(ex);
+  EXPECT_EQ(setup.calibration->parameters().parameters()[0].initial, 2900.5);
+  EXPECT_EQ(setup.calibration->parameters().parameters()[1].initial, 3100.25);
+  const auto partial =
+      dir.write("partial.json", R"({"parameters": [{"name": "Y", "value": 2900.5}]})");
+  d["fit"]["start_from"] = partial.string();
+  expect_fit_error(d, "fit.start_from: " + partial.string() + " has no value for \"gamma\"");
+  d["fit"]["start_from"] = (dir.path() / "none.json").string();
+  expect_fit_error(d, "none.json: cannot open");
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment

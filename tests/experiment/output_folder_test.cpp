@@ -1,0 +1,256 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Where a run may write and what it may replace (issue 30): names from a
+// file never leave the output root, only fiberfluid's own folders are
+// replaced, concurrent writers never mix or lose a result, and an exception
+// in a worker reaches the caller.
+#include "experiment/output_folder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <thread>
+
+#include "experiment/experiment.hpp"
+#include "experiment/outputs.hpp"
+#include "experiment/runner.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
+#include "util/run_control.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::ScratchDir;
+
+json small_config() {
+  return json::parse(R"({"name": "small",
+    "surface": {"generator": "icosphere", "subdivisions": 1},
+    "material": {"Y": 3000, "gamma": 3000},
+    "supports": [{"where": "z >= 0.8"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -10], "density": 1000}],
+    "stepping": {"steps": 2}})");
+}
+
+std::string error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(OutputFolder, NamesFromAFileStayOneFolderName) {
+  EXPECT_EQ(folder_name_problem("liver-2026_a.b"), "");
+  for (const char* bad : {"../victim", "..", ".", "", "a/b", "/etc", "a b", "x\\y"})
+    EXPECT_NE(folder_name_problem(bad), "") << bad;
+  EXPECT_NE(folder_name_problem(std::string(300, 'a')).find("at most 100 characters"),
+            std::string::npos);
+  EXPECT_EQ(folder_name_from("my scan (2)"), "my_scan__2_");
+  EXPECT_EQ(folder_name_from(".."), "experiment");
+
+  // The experiment's name and a variant's, as a file gives them.
+  json c = small_config();
+  c["name"] = "../victim";
+  EXPECT_NE(error_of([&] {
+              read_experiment(c, ".", "shared.json");
+            }).find("shared.json: name: expected a name of letters, digits"),
+            std::string::npos);
+  c = small_config();
+  c["variants"] = {{{"name", std::string(300, 'v')}}};
+  EXPECT_NE(error_of([&] {
+              read_experiment(c, ".", "shared.json");
+            }).find("variants[0].name: expected a name of at most 100 characters"),
+            std::string::npos);
+  // Without -o the output is out/NAME, and a bad name never makes a path.
+  EXPECT_EQ(output_folder("", "small"), fs::path("out/small"));
+  EXPECT_NE(error_of([] { output_folder("", "../victim"); }).find("the experiment's name"),
+            std::string::npos);
+}
+
+TEST(OutputFolder, PathsAsUsersTypeThemAreNormalisedBeforeTheRun) {
+  ScratchDir dir;
+  EXPECT_EQ(output_folder((dir.path() / "out/small/").string(), "x"), dir.path() / "out/small");
+  EXPECT_EQ(output_folder((dir.path() / "out/./a/../small").string(), "x"),
+            dir.path() / "out/small");
+  for (const std::string& bad :
+       std::vector<std::string>{".", "./", "/", "..", "a/..", std::string(200, 'o')})
+    EXPECT_NE(error_of([&] { output_folder(bad, "x"); }).find("-o " + bad), std::string::npos)
+        << bad;
+}
+
+TEST(OutputFolder, OnlyFoldersFiberfluidWroteAreReplaced) {
+  ScratchDir dir;
+  // Another tool's data set that happens to hold a summary.json.
+  const fs::path data = dir.path() / "data";
+  fs::create_directories(data);
+  std::ofstream(data / "summary.json") << "{}";
+  std::ofstream(data / "scan.obj") << "v 0 0 0\n";
+  EXPECT_NE(error_of([&] {
+              check_replaceable(data);
+            }).find("data: exists and was not written by fiberfluid"),
+            std::string::npos);
+  // An older fiberfluid's folder (before the marker) is named as such, and kept.
+  const fs::path old = dir.path() / "old";
+  fs::create_directories(old);
+  std::ofstream(old / "summary.json") << R"({"fiberfluid_version": "0.1.0"})";
+  EXPECT_NE(error_of([&] { check_replaceable(old); }).find("holds results of an older fiberfluid"),
+            std::string::npos);
+  // A marker of another format does not count either.
+  std::ofstream(data / kOutputMarker) << R"({"format": "something-else", "version": 1})";
+  EXPECT_THROW(check_replaceable(data), InputError);
+  // A file, a symbolic link.
+  std::ofstream(dir.path() / "file") << "x";
+  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "file"); }).find("is not a folder"),
+            std::string::npos);
+  fs::create_directory_symlink(data, dir.path() / "link");
+  EXPECT_NE(error_of([&] { check_replaceable(dir.path() / "link"); }).find("symbolic link"),
+            std::string::npos);
+  // Absent, empty, and written by fiberfluid: replaceable.
+  EXPECT_NO_THROW(check_replaceable(dir.path() / "absent"));
+  fs::create_directories(dir.path() / "empty");
+  EXPECT_NO_THROW(check_replaceable(dir.path() / "empty"));
+
+  const Experiment ex = parse_experiment(small_config(), ".", "small.json");
+  {
+    OutputWriter writer(ex, dir.path() / "out");
+    writer.begin();
+    writer.finish(run_experiment(ex));
+  }
+  EXPECT_TRUE(fs::exists(dir.path() / "out" / kOutputMarker));
+  EXPECT_NE(read_text(dir.path() / "out" / kOutputMarker).find("\"format\": \"fiberfluid-output\""),
+            std::string::npos);
+  EXPECT_NO_THROW(check_replaceable(dir.path() / "out"));
+  EXPECT_TRUE(fs::exists(data / "scan.obj"));
+}
+
+TEST(OutputFolder, AForeignFolderThatAppearsDuringTheRunIsSwappedBack) {
+  ScratchDir dir;
+  const fs::path target = dir.path() / "out";
+  const fs::path staging = create_staging_folder(target, "x");
+  std::ofstream(staging / "result.csv") << "1\n";
+  // Between the check and the swap, someone puts their own folder there.
+  fs::create_directories(target);
+  std::ofstream(target / "theirs.txt") << "keep me";
+  const std::string error = error_of([&] { move_into_place(staging, target, nullptr); });
+  EXPECT_NE(error.find("was not written by fiberfluid"), std::string::npos) << error;
+  EXPECT_NE(error.find("the results are in " + staging.string()), std::string::npos) << error;
+  EXPECT_EQ(read_text(target / "theirs.txt"), "keep me");
+  EXPECT_EQ(read_text(staging / "result.csv"), "1\n");
+}
+
+TEST(OutputFolder, StagingNamesAreUniqueAndOnlyDeadRunsOfThisHostAreCleaned) {
+  ScratchDir dir;
+  const fs::path target = dir.path() / "out";
+  const fs::path a = create_staging_folder(target, "x"), b = create_staging_folder(target, "x");
+  EXPECT_NE(a, b);  // the same process twice (two threads, two writers)
+  EXPECT_TRUE(fs::exists(a / kOutputMarker));
+  // Another host's folder with our PID, and this host's folder of a process that is gone.
+  const fs::path other_host =
+      dir.path() / ("out.running-elsewhere-" + std::to_string(getpid()) + "-00000000");
+  fs::create_directories(other_host);
+  std::string mine = a.filename().string();
+  mine = mine.substr(0, mine.rfind('-', mine.rfind('-') - 1));  // out.running-HOST
+  const fs::path dead = dir.path() / (mine + "-999999999-0000abcd");
+  fs::create_directories(dead);
+  create_staging_folder(target, "x");
+  EXPECT_TRUE(fs::exists(other_host));
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(a));  // its process (this one) is alive
+}
+
+TEST(OutputFolder, WritersRacingForOneFolderNeverMixOrLoseAResult) {
+  ScratchDir dir;
+  const fs::path out = dir.path() / "out";
+  json soft = small_config(), stiff = small_config();
+  stiff["material"]["Y"] = 30000;
+  const Experiment a = parse_experiment(soft, ".", "a.json"),
+                   b = parse_experiment(stiff, ".", "b.json");
+  const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
+  std::atomic<int> failures{0};
+  auto write = [&](const Experiment& ex, const ExperimentResult& r) {
+    for (int k = 0; k < 10; ++k) {
+      try {
+        OutputWriter writer(ex, out);
+        writer.begin();
+        writer.finish(r);
+      } catch (const std::exception&) {
+        ++failures;
+      }
+    }
+  };
+  std::thread first(write, std::cref(a), std::cref(ra)), second(write, std::cref(b), std::cref(rb));
+  first.join();
+  second.join();
+  EXPECT_EQ(failures, 0);
+  // One complete result, from one writer: its summary and its final state agree.
+  const json summary = json::parse(read_text(out / "summary.json"));
+  const double Y = summary["runs"][0]["material"]["Y"].get<double>();
+  EXPECT_TRUE(Y == 3000 || Y == 30000) << Y;
+  const ExperimentResult& r = Y == 3000 ? ra : rb;
+  EXPECT_NEAR(summary["figures"]["max_displacement"].get<double>(),
+              r.figures.at("max_displacement"), 0.0);
+  for (const auto& entry : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename(), "out")
+        << entry.path();  // no staging or previous result left
+}
+
+// Issue 30: an exception in a worker of a sweep (a write that failed) ended
+// the process with std::terminate; it is the caller's, as with one job.
+TEST(Runner, AnExceptionInAWorkerReachesTheCaller) {
+  json c = small_config();
+  c["variants"] = {{{"name", "a"}}, {{"name", "b"}}, {{"name", "c"}}};
+  const Experiment ex = parse_experiment(c, ".", "sweep.json");
+  RunOptions options;
+  options.jobs = 2;
+  const std::string error = error_of([&] {
+    run_experiment(
+        ex,
+        [](size_t run, const solve::StepRecord&, const Eigen::VectorXd&) {
+          if (run == 1) throw InputError("b/vtk/step_0001.vtu: writing failed: File too large");
+        },
+        options);
+  });
+  EXPECT_EQ(error, "b/vtk/step_0001.vtu: writing failed: File too large");
+  // A standard library exception too, not only the project's.
+  EXPECT_THROW(run_experiment(
+                   ex,
+                   [](size_t, const solve::StepRecord&, const Eigen::VectorXd&) {
+                     throw std::runtime_error("disk gone");
+                   },
+                   options),
+               std::runtime_error);
+}
+
+TEST(Threads, AnExceptionInAnOpenMPLoopIsRethrownAfterIt) {
+  ThreadFailure failure;
+  std::atomic<int> ran{0};
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int i = 0; i < 1000; ++i) {
+    if (failure.happened()) continue;
+    try {
+      ++ran;
+      if (i == 7) throw InputError("item 7 failed");
+    } catch (...) {
+      failure.capture();
+    }
+  }
+  EXPECT_TRUE(failure.happened());
+  EXPECT_GE(ran.load(), 8);  // (how many the other thread ran meanwhile is a race: not asserted)
+  EXPECT_EQ(error_of([&] { failure.rethrow_if_any(); }), "item 7 failed");
+  ThreadFailure none;
+  EXPECT_NO_THROW(none.rethrow_if_any());
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment
