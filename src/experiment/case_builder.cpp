@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Building a parsed case on its surface: what needs the mesh (case_spec.hpp).
 #include <algorithm>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "experiment/case_spec.hpp"
 #include "geom/fiber_pruning.hpp"
+#include "geom/horizon.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/boundary_conditions.hpp"
@@ -82,10 +84,25 @@ void require_per_axis(const FieldName& field, const std::string& key, const Eige
 // about 20 s here, so 20,000 vertices about 6 minutes) and an N^2 byte table.
 constexpr int kLargestPruned = 20000;
 
-// Prunes the fibers that leave a concave body and reports what it did.
-FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
+// The pairs within the spec's horizon, refused when it is shorter than a
+// mesh edge (a vertex would lose its neighbours on the surface).
+geom::FiberMask horizon_fibers(const FiberSpec& spec, const geom::Surface& surface) {
+  const double edge = geom::longest_edge(surface);
+  if (spec.horizon < edge)
+    spec.field.fail("horizon", "expected at least the longest mesh edge, " + std::to_string(edge) +
+                                   " m, so that the fibers join every "
+                                   "vertex to its neighbours; got " +
+                                   std::to_string(spec.horizon) + " m");
+  return geom::horizon_fibers(surface, spec.horizon);
+}
+
+// The bulk fibers of the model: every pair, or those within the horizon, of
+// which a concave body keeps those that stay inside it (pruning). Reports
+// what it did.
+FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) {
   FiberReport report;
   report.pruning = spec.pruning;
+  report.horizon = spec.horizon;
   report.write = spec.write;
   m.connection_count = spec.count;
   m.treecode_tolerance = spec.treecode_tolerance;
@@ -94,14 +111,21 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
   report.kept = report.pairs;
   report.min_per_vertex = report.max_per_vertex = n - 1;
   report.mean_per_vertex = n - 1;
-  if (!report.pruning) return report;
-  report.convex = !concave;
-  if (report.convex) return report;
-  geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
-  report.seconds = pruned.seconds;
-  report.exact_fallbacks = pruned.exact_fallbacks;
-  report.kept = pruned.mask.num_kept();
-  const std::vector<int> per_vertex = pruned.mask.kept_per_vertex();
+  report.convex = report.pruning && !concave;
+  std::optional<geom::FiberMask> mask;
+  if (spec.horizon > 0.0) mask = horizon_fibers(spec, m.surface);
+  if (report.pruning && concave) {
+    geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
+    report.seconds = pruned.seconds;
+    report.exact_fallbacks = pruned.exact_fallbacks;
+    if (mask)
+      mask->keep_only_where(pruned.mask);
+    else
+      mask = std::move(pruned.mask);
+  }
+  if (!mask) return report;
+  report.kept = mask->num_kept();
+  const std::vector<int> per_vertex = mask->kept_per_vertex();
   report.min_per_vertex = *std::min_element(per_vertex.begin(), per_vertex.end());
   report.max_per_vertex = *std::max_element(per_vertex.begin(), per_vertex.end());
   report.mean_per_vertex = 2.0 * report.kept / n;
@@ -118,7 +142,7 @@ FiberReport prune(const FiberSpec& spec, bool concave, model::Model& m) {
                         std::to_string(report.pairs - report.kept) +
                         " fibers; set \"connection_count\": \"global\" (pruned "
                         "fibers are then exact corrections) or \"product\": \"exact\"");
-  m.fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
+  m.fibers = std::make_shared<const geom::FiberMask>(std::move(*mask));
   return report;
 }
 
@@ -150,7 +174,7 @@ void add_fibers(const CaseSpec& spec, Case& c) {
   if (concave) estimate(spec, PruningWork::Prune, c);
   if (c.estimate.seconds >= 10.0 || c.estimate.peak_bytes >= 0.25 * memory_budget_bytes())
     report_note("estimate for a long run: " + c.estimate.describe());
-  c.fibers = prune(spec.fibers, concave, c.model);
+  c.fibers = choose_fibers(spec.fibers, concave, c.model);
 }
 
 // ------------------------------------------------------------ model parts
@@ -194,6 +218,7 @@ class ModelBuilder {
   model::Material material() const {
     const MaterialSpec& spec = spec_.material;
     model::Material m = spec.material;
+    m.kinematics = spec_.fibers.kinematics;
     if (spec.per_axis.size() > 0) {
       require_per_axis(spec.field, spec.per_axis_moduli ? "Y" : "axis_factors", spec.per_axis,
                        dim_);

@@ -90,6 +90,11 @@ struct FiberSpec {
   model::ConnectionCount count = model::ConnectionCount::Symmetric;
   std::string write = "none";       // "kept" or "pruned": DIR/fibers.vtu
   double treecode_tolerance = 0.0;  // "product": "treecode": its relative error
+  // "kinematics": "vector" (the paper's) or "central" (fibers that bend).
+  model::FiberKinematics kinematics = model::FiberKinematics::VectorSpring;
+  // "horizon" (m): only vertices at most this far apart are joined; 0: every
+  // pair (the paper's).
+  double horizon = 0.0;
   FieldName field;
 };
 
@@ -112,9 +117,10 @@ struct CaseSpec {
 
 // What the fiber pruning did (issue 4), for the summary.
 struct FiberReport {
-  bool pruning = true;  // "fibers.pruning": "auto" (prune a concave body) or "off"
-  bool convex = false;  // the fast path: nothing to prune
-  long long pairs = 0;  // fibers in all, N (N-1) / 2
+  bool pruning = true;   // "fibers.pruning": "auto" (prune a concave body) or "off"
+  bool convex = false;   // the fast path: nothing to prune
+  double horizon = 0.0;  // "fibers.horizon" (m), 0: none
+  long long pairs = 0;   // fibers in all, N (N-1) / 2
   long long kept = 0;
   int min_per_vertex = 0, max_per_vertex = 0;
   double mean_per_vertex = 0.0;

@@ -423,6 +423,15 @@ FiberSpec read_fibers(Fields& root) {
                    ? model::ConnectionCount::Global
                    : model::ConnectionCount::Symmetric;
   spec.write = f.choice("write", "none", {"none", "kept", "pruned"});
+  const std::string kinematics = f.choice("kinematics", model::VectorSpring::name,
+                                          {model::VectorSpring::name, model::CentralFiber::name});
+  for (model::FiberKinematics k : model::kAllKinematics)
+    if (kinematics == model::kinematics_name(k)) spec.kinematics = k;
+  if (f.has("horizon")) {
+    spec.horizon = f.number("horizon");
+    if (!(spec.horizon > 0.0) || !std::isfinite(spec.horizon))
+      f.fail("horizon", "expected a positive length (m), got " + std::to_string(spec.horizon));
+  }
   if (f.choice("product", "exact", {"exact", "treecode"}) == "treecode") {
     spec.treecode_tolerance = f.number("treecode_tolerance", 1e-6);
     if (!(spec.treecode_tolerance >= 1e-10 && spec.treecode_tolerance <= 1e-2))
@@ -430,6 +439,10 @@ FiberSpec read_fibers(Fields& root) {
                                        std::to_string(spec.treecode_tolerance));
   } else if (f.has("treecode_tolerance"))
     f.fail("treecode_tolerance", "applies to \"product\": \"treecode\" only");
+  if (spec.treecode_tolerance > 0.0 && spec.horizon > 0.0)
+    f.fail("product",
+           "\"treecode\" approximates the sum over every pair; with a \"horizon\" most pairs "
+           "are not fibers: use \"product\": \"exact\"");
   f.finish();
   return spec;
 }
@@ -442,6 +455,14 @@ void check_treecode(Fields& root, const CaseSpec& c) {
   probe.treecode_tolerance = c.fibers.treecode_tolerance;
   const std::string why = solve::treecode_problem(probe, c.stepping);
   if (!why.empty()) root.fail("fibers", "\"product\": \"treecode\": " + why);
+}
+
+// The kinematics' rules are the library's (solve::kinematics_problem).
+void check_kinematics(Fields& root, const CaseSpec& c) {
+  model::Model probe;
+  probe.material.kinematics = c.fibers.kinematics;
+  const std::string why = solve::kinematics_problem(probe, c.stepping);
+  if (!why.empty()) root.fail("fibers", "\"kinematics\": " + why);
 }
 
 // Parses one case from a complete simulation document; opens no file.
@@ -476,6 +497,7 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
         "uses the small-strain modulus Y(0) throughout; set rebuild_matrix or "
         "scheme \"newton\" for the strain-dependent law");
   if (c.fibers.treecode_tolerance > 0.0) check_treecode(root, c);
+  check_kinematics(root, c);
   check_tables(root, c);
   root.finish();
   return c;

@@ -153,7 +153,9 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
 
 json fibers_json(const Case& c) {
   const FiberReport& f = c.fibers;
-  return {{"pruning", f.pruning ? "auto" : "off"},
+  return {{"kinematics", model::kinematics_name(c.model.material.kinematics)},
+          {"horizon", f.horizon > 0.0 ? json(f.horizon) : json(nullptr)},  // m; null: every pair
+          {"pruning", f.pruning ? "auto" : "off"},
           {"convex", f.convex},
           {"connection_count", model::to_string(c.model.connection_count)},
           {"product", c.model.treecode_tolerance > 0.0 ? "treecode" : "exact"},

@@ -29,27 +29,6 @@
 
 namespace fiberfluid::geom {
 
-FiberMask::FiberMask(int num_vertices)
-    : n_(num_vertices), kept_(static_cast<size_t>(num_vertices) * num_vertices, 1) {
-  for (int i = 0; i < n_; ++i) kept_[index(i, i)] = 0;
-}
-
-void FiberMask::prune(int i, int j) {
-  kept_[index(i, j)] = 0;
-  kept_[index(j, i)] = 0;
-}
-
-long long FiberMask::num_kept() const {
-  return std::accumulate(kept_.begin(), kept_.end(), 0LL) / 2;
-}
-
-std::vector<int> FiberMask::kept_per_vertex() const {
-  std::vector<int> counts(static_cast<size_t>(n_));
-  for (int i = 0; i < n_; ++i)
-    counts[static_cast<size_t>(i)] = std::accumulate(row(i), row(i) + n_, 0);
-  return counts;
-}
-
 namespace {
 
 using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;

@@ -1,32 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
-#include <cstdint>
-#include <vector>
-
+#include "geom/fiber_mask.hpp"
 #include "geom/surface.hpp"
 
 namespace fiberfluid::geom {
-
-// Which pairs of vertices are joined by a bulk fiber: a symmetric N x N
-// table of bytes (row-major, so a vertex's fibers are contiguous for the
-// solvers' pair loops).
-class FiberMask {
- public:
-  explicit FiberMask(int num_vertices);  // every pair kept
-  bool kept(int i, int j) const { return kept_[index(i, j)] != 0; }
-  void prune(int i, int j);
-  const uint8_t* row(int i) const { return kept_.data() + index(i, 0); }
-  int num_vertices() const { return n_; }
-  long long num_pairs() const { return static_cast<long long>(n_) * (n_ - 1) / 2; }
-  long long num_kept() const;
-  std::vector<int> kept_per_vertex() const;  // n_i
-
- private:
-  size_t index(int i, int j) const { return static_cast<size_t>(i) * n_ + j; }
-  int n_;
-  std::vector<uint8_t> kept_;  // diagonal 0
-};
 
 struct PruningResult {
   FiberMask mask;

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "geom/fiber_pruning.hpp"
+#include "geom/fiber_mask.hpp"
 #include "geom/surface.hpp"
 #include "model/fiber_law.hpp"
 #include "model/pair_stencil.hpp"

@@ -7,7 +7,7 @@
 #include <array>
 #include <cmath>
 
-#include "geom/fiber_pruning.hpp"
+#include "geom/fiber_mask.hpp"
 #include "model/pair_stencil.hpp"
 #include "model/vector_clones.hpp"
 #include "util/run_control.hpp"

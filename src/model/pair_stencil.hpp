@@ -75,9 +75,10 @@ struct PairCoefficients {
 
 // The paper's vector spring (model.md section 7): f = a Y(e) (u_i - u_j).
 // It resists every relative displacement alike, across the fiber as much as
-// along it; with Y constant it is the paper's linear model exactly.
+// along it, so a body of them shears but cannot bend; with Y constant it is
+// the paper's linear model exactly.
 struct VectorSpring {
-  static constexpr const char* name = "vector_spring";
+  static constexpr const char* name = "vector";
   static double along(double /*b*/, double d) { return d; }
   static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L) {
     return {a * Y, a * Yp / (r * L)};  // d(a Y(e) d)/dx_i = a Y I + a Y' d (de/dx_i)^T
@@ -87,18 +88,45 @@ struct VectorSpring {
   }
 };
 
+// A central fiber (a bond of bond-based peridynamics, Silling 2000): the
+// force lies along the current fiber and follows its change of length,
+//   f = a Y(e) (r - L) b / r,
+// so a body of them bends, and a rigid rotation leaves every fiber unstrained
+// (zero force). Same weight a as the vector spring: a stretch along a fiber
+// gives the same force in both. Its tangent has the material part (Y') and
+// the geometric part (the force turning with the fiber):
+//   df/dx_i = a Y (1 - L/r) I + a (Y' (r - L) / (r^2 L) + Y L / r^3) b b^T.
+struct CentralFiber {
+  static constexpr const char* name = "central";
+  static double along(double b, double /*d*/) { return b; }
+  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L) {
+    const double stretch = 1.0 - L / r;  // (r - L) / r
+    return {a * Y * stretch, a * (Yp * stretch / (r * L) + Y * L / (r * r * r))};
+  }
+  static double parameter_coefficient(double a, double dY, double r, double L) {
+    return a * dY * (1.0 - L / r);
+  }
+};
+
 // The kinematics a material's bulk fibers use (Material::kinematics).
 enum class FiberKinematics {
-  VectorSpring,
+  VectorSpring,  // "vector": the paper's, the default
+  Central,       // "central"
 };
 
 inline const char* kinematics_name(FiberKinematics k) {
   switch (k) {
     case FiberKinematics::VectorSpring:
       return VectorSpring::name;
+    case FiberKinematics::Central:
+      return CentralFiber::name;
   }
   return "?";
 }
+
+// Every kinematics, in the order of the enum (for readers and tests).
+inline constexpr FiberKinematics kAllKinematics[] = {FiberKinematics::VectorSpring,
+                                                     FiberKinematics::Central};
 
 // Calls body(Policy{}) with the policy of `k`: the one switch over the kinematics.
 template <class Body>
@@ -106,6 +134,8 @@ decltype(auto) with_kinematics(FiberKinematics k, Body&& body) {
   switch (k) {
     case FiberKinematics::VectorSpring:
       return body(VectorSpring{});
+    case FiberKinematics::Central:
+      return body(CentralFiber{});
   }
   throw std::logic_error("unknown fiber kinematics");
 }

@@ -98,38 +98,100 @@ Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixX
 
 // ---- Surface tension -----------------------------------------------------------
 
+// The surface fibers: each mesh edge i-k a fiber of weight gamma b_ik (paper
+// Eq. 7) and modulus 1, with the material's kinematics. For the paper's
+// vector spring that is the Laplacian gamma B u, applied as the sparse
+// product (bit for bit the paper's); any other kinematics goes through its
+// policy edge by edge (so that a central body's skin rotates freely too).
 class SurfaceTensionTerm final : public EquilibriumTerm {
  public:
   explicit SurfaceTensionTerm(const TermContext& c) : c_(c) {}
   const char* name() const override { return "surface tension"; }
   Role role() const override { return Role::Fibers; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
-    add_rows(gamma() * (c_.surface * s.U), R);
+    if (paper_spring()) return add_rows(gamma() * (c_.surface * s.U), R);
+    add_edge_forces(s, gamma(), R);
   }
-  void add_tangent(const TermState&, Eigen::MatrixXd& J) const override {
-    const int n = c_.model.num_vertices();
-    for (int col = 0; col < c_.surface.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it)
-        for (int a = 0; a < c_.model.dim(); ++a)
-          J(a * n + it.row(), a * n + it.col()) += gamma() * it.value();
+  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    if (paper_spring()) {
+      for (int col = 0; col < c_.surface.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it)
+          for (int a = 0; a < dim; ++a)
+            J(a * n + it.row(), a * n + it.col()) += gamma() * it.value();
+      return;
+    }
+    for_each_edge(s, gamma(),
+                  [&](auto policy, int i, int k, const PairCoefficients& c,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
+                    using K = decltype(policy);
+                    for (int a = 0; a < dim; ++a)
+                      for (int e = 0; e < dim; ++e) {
+                        const double entry = pair_tangent_entry<K>(c, a == e, b[a], d[a], b[e]);
+                        J(a * n + i, e * n + i) += entry;
+                        J(a * n + i, e * n + k) -= entry;
+                      }
+                  });
   }
-  void add_tangent_product(const TermState&, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
+  void add_tangent_product(const TermState& s, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
                            Eigen::VectorXd& out) const override {
-    add_rows(gamma() * (c_.surface * W), out);
+    if (paper_spring()) return add_rows(gamma() * (c_.surface * W), out);
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    for_each_edge(s, gamma(),
+                  [&](auto policy, int i, int k, const PairCoefficients& c,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
+                    using K = decltype(policy);
+                    const Eigen::Vector3d v = row3(W, i) - row3(W, k);
+                    const double b_dot_v = b.dot(v);
+                    for (int a = 0; a < dim; ++a)
+                      out[a * n + i] += pair_tangent<K>(c, v[a], b_dot_v, b[a], d[a]);
+                  });
   }
   void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
                                 Eigen::Ref<Eigen::VectorXd> column) const override {
     if (p.kind != MaterialParameter::Kind::SurfaceTension) return;
-    const Eigen::MatrixXd L = c_.surface * s.U;
-    const int n = c_.model.num_vertices();
-    for (int a = 0; a < c_.model.dim(); ++a) column.segment(a * n, n) += L.col(a);
+    Eigen::VectorXd R = Eigen::VectorXd::Zero(column.size());
+    if (paper_spring())
+      add_rows(c_.surface * s.U, R);
+    else
+      add_edge_forces(s, 1.0, R);  // the forces are linear in gamma
+    column += R;
   }
 
  private:
   double gamma() const { return c_.model.material.surface_tension; }
+  bool paper_spring() const {
+    return c_.model.material.kinematics == FiberKinematics::VectorSpring;
+  }
   void add_rows(const Eigen::MatrixXd& rows, Eigen::VectorXd& out) const {
     const int n = c_.model.num_vertices();
     for (int a = 0; a < c_.model.dim(); ++a) out.segment(a * n, n) += rows.col(a);
+  }
+  // body(policy, i, k, coefficients, b = x_i - x_k, d = u_i - u_k) for each
+  // edge seen from each of its ends, with weight scale * b_ik.
+  template <class Body>
+  void for_each_edge(const TermState& s, double scale, Body&& body) const {
+    const Eigen::MatrixXd& V0 = c_.model.surface.V;
+    with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+      using K = decltype(policy);
+      for (int col = 0; col < c_.surface.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it) {
+          const int i = static_cast<int>(it.row()), k = static_cast<int>(it.col());
+          if (i == k) continue;
+          const Eigen::Vector3d b = row3(s.X, i) - row3(s.X, k), d = row3(s.U, i) - row3(s.U, k);
+          const double L = (row3(V0, i) - row3(V0, k)).norm(), r = b.norm();
+          body(policy, i, k, K::coefficients(-scale * it.value(), 1.0, 0.0, r, L), b, d);
+        }
+    });
+  }
+  void add_edge_forces(const TermState& s, double scale, Eigen::VectorXd& R) const {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    for_each_edge(s, scale,
+                  [&](auto policy, int i, int, const PairCoefficients& c, const Eigen::Vector3d& b,
+                      const Eigen::Vector3d& d) {
+                    using K = decltype(policy);
+                    for (int a = 0; a < dim; ++a) R[a * n + i] += pair_force<K>(c, b[a], d[a]);
+                  });
   }
   const TermContext& c_;
 };

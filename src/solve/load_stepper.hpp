@@ -176,6 +176,11 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
 // the same message.
 std::string treecode_problem(const model::Model& model, const SteppingOptions& options);
 
+// "" when the material's fiber kinematics can run with these options, else
+// why not: every kinematics but the paper's vector spring needs the Newton
+// scheme (the incremental scheme's matrix is the vector spring's).
+std::string kinematics_problem(const model::Model& model, const SteppingOptions& options);
+
 // The backend SolverKind::Auto runs: pcg with the treecode, else
 // choose_solver's rule by size (the largest axis block, the distinct factors).
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,

@@ -55,6 +55,14 @@ std::string treecode_problem(const model::Model& model, const SteppingOptions& o
   return {};
 }
 
+std::string kinematics_problem(const model::Model& model, const SteppingOptions& options) {
+  const model::FiberKinematics k = model.material.kinematics;
+  if (k == model::FiberKinematics::VectorSpring || options.scheme == Scheme::Newton) return {};
+  return std::string("the ") + model::kinematics_name(k) +
+         " fiber kinematics needs the Newton scheme (stepping.scheme \"newton\"): the "
+         "incremental scheme's matrix is the paper's vector spring";
+}
+
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
                             double budget_bytes) {
   if (model.treecode_tolerance > 0.0) return SolverKind::PCG;  // the only matrix-free backend
@@ -65,6 +73,8 @@ std::string setup_problem(const model::Model& model, const SteppingOptions& opti
   std::string why;
   if (!options.IsValid(&why)) return why;
   why = treecode_problem(model, options);
+  if (!why.empty()) return why;
+  why = kinematics_problem(model, options);
   if (!why.empty()) return why;
   return model::singular_setup_reason(model);
 }

@@ -324,6 +324,27 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
             load_experiment(write_config(dir, c)).cases[0].fibers.kept);
 }
 
+// fibers.kinematics: the paper's vector spring by default, central fibers
+// with the Newton scheme; the run's summary says which.
+TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.material.kinematics,
+            model::FiberKinematics::VectorSpring);
+  c["fibers"] = {{"kinematics", "central"}};
+  expect_config_error(dir, c,
+                      "fibers: \"kinematics\": the central fiber kinematics needs the Newton "
+                      "scheme");
+  c["stepping"]["scheme"] = "newton";
+  const Experiment ex = load_experiment(write_config(dir, c));
+  EXPECT_EQ(ex.cases[0].model.material.kinematics, model::FiberKinematics::Central);
+  const ExperimentResult r = run_experiment(ex);
+  ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+  EXPECT_GT(r.figures.at("max_displacement"), 0.0);
+  c["fibers"]["kinematics"] = "bent";
+  expect_config_error(dir, c, "fibers.kinematics");
+}
+
 TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
   ScratchDir dir;
   nlohmann::json c = base_config();

@@ -20,13 +20,15 @@ namespace {
 using namespace fiberfluid::model::reference;  // the oracle
 
 // A 42-vertex sphere with a cap held, gravity, a point load and surface tension.
-Model small_sphere(const FiberLaw& law) {
+Model small_sphere(const FiberLaw& law,
+                   FiberKinematics kinematics = FiberKinematics::VectorSpring) {
   Model m = testing::paper_sphere_model();
   m.surface = geom::icosphere(1, 1.0);
   m.constraints.clear();
   for (int v : select_half_space(m.surface.V, parse_half_space("z >= 0.8", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
   m.material.law = law;
+  m.material.kinematics = kinematics;
   m.material.axis_factors = {1.0, 0.8, 1.3};  // the factors enter every term
   m.material.surface_tension = 500.0;
   m.loads[1].vertex = 7;
@@ -63,43 +65,53 @@ Eigen::MatrixXd finite_difference_tangent(const Equilibrium& eq, const Eigen::Ve
   return J;
 }
 
-TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLaw) {
-  for (const FiberLaw& law : every_law()) {
-    const Model m = small_sphere(law);
-    const Equilibrium eq(m);
-    for (unsigned seed : {1u, 2u, 3u}) {
-      const Eigen::VectorXd x = random_state(m, seed);
-      const std::vector<double> factors = {0.7, 0.4};
-      const Eigen::MatrixXd J = eq.tangent(x, factors);
-      const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
-      const double error = (J - fd).norm() / fd.norm();
-      EXPECT_LT(error, 1e-6) << law.name() << " seed " << seed;
-      // The matrix-free product is the same operator.
-      const Eigen::VectorXd v = random_state(m, seed + 10, 1.0);
-      EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm())
-          << law.name();
-      EXPECT_LT((eq.linearize(x, factors).apply(v) - J * v).norm(), 1e-10 * (J * v).norm())
-          << law.name();
+TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLawAndKinematics) {
+  for (FiberKinematics kinematics : kAllKinematics)
+    for (const FiberLaw& law : every_law()) {
+      SCOPED_TRACE(kinematics_name(kinematics));
+      const Model m = small_sphere(law, kinematics);
+      const Equilibrium eq(m);
+      for (unsigned seed : {1u, 2u, 3u}) {
+        const Eigen::VectorXd x = random_state(m, seed);
+        const std::vector<double> factors = {0.7, 0.4};
+        const Eigen::MatrixXd J = eq.tangent(x, factors);
+        const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+        const double error = (J - fd).norm() / fd.norm();
+        EXPECT_LT(error, 1e-6) << law.name() << " seed " << seed;
+        // The matrix-free product is the same operator.
+        const Eigen::VectorXd v = random_state(m, seed + 10, 1.0);
+        EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm())
+            << law.name();
+        EXPECT_LT((eq.linearize(x, factors).apply(v) - J * v).norm(), 1e-10 * (J * v).norm())
+            << law.name();
+      }
     }
-  }
 }
 
 TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
-  Model m = testing::paper_rectangle_model();
-  m.surface = geom::polygon(
-      (Eigen::MatrixXd(6, 2) << 15, 20, 18, 0, 15, -20, -15, -20, -18, 0, -15, 20).finished());
-  m.material.law = FiberLaw::exponential(360.0, 3.0);
-  m.material.surface_tension = 20.0;
-  Load gravity;
-  gravity.kind = Load::Kind::Hydrostatic;
-  gravity.acceleration = {0.0, -9.81, 0.0};
-  gravity.density = 2.0;
-  m.loads.push_back(gravity);
-  const Equilibrium eq(m);
-  const Eigen::VectorXd x = random_state(m, 5, 1.0);
-  const std::vector<double> factors = {0.5, 0.5, 1.0};
-  const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
-  EXPECT_LT((eq.tangent(x, factors) - fd).norm() / fd.norm(), 1e-6);
+  for (FiberKinematics kinematics : kAllKinematics) {
+    SCOPED_TRACE(kinematics_name(kinematics));
+    Model m = testing::paper_rectangle_model();
+    m.material.kinematics = kinematics;
+    m.surface = geom::polygon(
+        (Eigen::MatrixXd(6, 2) << 15, 20, 18, 0, 15, -20, -15, -20, -18, 0, -15, 20).finished());
+    m.material.law = FiberLaw::exponential(360.0, 3.0);
+    m.material.surface_tension = 20.0;
+    Load gravity;
+    gravity.kind = Load::Kind::Hydrostatic;
+    gravity.acceleration = {0.0, -9.81, 0.0};
+    gravity.density = 2.0;
+    m.loads.push_back(gravity);
+    const Equilibrium eq(m);
+    const Eigen::VectorXd x = random_state(m, 5, 1.0);
+    const std::vector<double> factors = {0.5, 0.5, 1.0};
+    const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+    EXPECT_LT((eq.tangent(x, factors) - fd).norm() / fd.norm(), 1e-6);
+    const Eigen::VectorXd v = random_state(m, 6, 1.0);
+    const Eigen::VectorXd Jv = eq.tangent(x, factors) * v;
+    EXPECT_LT((eq.tangent_product(x, factors, v) - Jv).norm(), 1e-10 * Jv.norm());
+    EXPECT_LT((eq.linearize(x, factors).apply(v) - Jv).norm(), 1e-10 * Jv.norm());
+  }
 }
 
 TEST(Equilibrium, ReferenceTangentIsThePapersMatrix) {
@@ -141,33 +153,35 @@ TEST(Equilibrium, ConstantLawFiberForcesAreKu) {
 }
 
 TEST(Equilibrium, ParameterDerivativesMatchCentralDifferences) {
-  for (const FiberLaw& law : every_law()) {
-    Model m = small_sphere(law);
-    const Eigen::VectorXd x = random_state(m, 4);
-    const std::vector<double> factors = {0.7, 0.4};
-    std::vector<std::string> names = law.parameter_names();
-    names.insert(names.end(), {"gamma", "factor_y"});
-    const Eigen::MatrixXd D = Equilibrium(m).parameter_derivatives(x, names);
-    for (size_t k = 0; k < names.size(); ++k) {
-      auto with = [&](double delta) {
-        Model changed = m;
-        if (names[k] == "gamma")
-          changed.material.surface_tension += delta;
-        else if (names[k] == "factor_y")
-          changed.material.axis_factors.y() += delta;
-        else
-          changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
-        return Equilibrium(changed).residual(x, factors);
-      };
-      const double h =
-          1e-5 * std::max(1.0, std::abs(names[k] == "gamma"      ? 500.0
-                                        : names[k] == "factor_y" ? 0.8
-                                                                 : law.parameter(names[k])));
-      const Eigen::VectorXd fd = (with(h) - with(-h)) / (2.0 * h);
-      EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - fd).norm(), 1e-6 * fd.norm() + 1e-12)
-          << law.name() << " " << names[k];
+  for (FiberKinematics kinematics : kAllKinematics)
+    for (const FiberLaw& law : every_law()) {
+      SCOPED_TRACE(kinematics_name(kinematics));
+      Model m = small_sphere(law, kinematics);
+      const Eigen::VectorXd x = random_state(m, 4);
+      const std::vector<double> factors = {0.7, 0.4};
+      std::vector<std::string> names = law.parameter_names();
+      names.insert(names.end(), {"gamma", "factor_y"});
+      const Eigen::MatrixXd D = Equilibrium(m).parameter_derivatives(x, names);
+      for (size_t k = 0; k < names.size(); ++k) {
+        auto with = [&](double delta) {
+          Model changed = m;
+          if (names[k] == "gamma")
+            changed.material.surface_tension += delta;
+          else if (names[k] == "factor_y")
+            changed.material.axis_factors.y() += delta;
+          else
+            changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
+          return Equilibrium(changed).residual(x, factors);
+        };
+        const double h =
+            1e-5 * std::max(1.0, std::abs(names[k] == "gamma"      ? 500.0
+                                          : names[k] == "factor_y" ? 0.8
+                                                                   : law.parameter(names[k])));
+        const Eigen::VectorXd fd = (with(h) - with(-h)) / (2.0 * h);
+        EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - fd).norm(), 1e-6 * fd.norm() + 1e-12)
+            << law.name() << " " << names[k];
+      }
     }
-  }
   EXPECT_THROW(Equilibrium(small_sphere(FiberLaw::constant(1.0)))
                    .parameter_derivatives(Eigen::VectorXd::Zero(127), {"beta"}),
                std::invalid_argument);

@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// Fibers within a horizon: as in bond-based peridynamics (Silling 2000;
+// the horizon delta of its bonds), only vertices at most delta apart in the
+// reference are joined by a bulk fiber. With central fibers a horizon of
+// about the body's thickness makes a slender body bend as a beam does
+// (model.md, the fiber kinematics).
+
+#include "geom/fiber_mask.hpp"
+#include "geom/surface.hpp"
+
+namespace fiberfluid::geom {
+
+// The pairs at most `horizon` apart. They are found on a uniform grid of
+// cells of the horizon's size, each vertex testing the 3^dim cells around
+// its own, so the pair tests grow with N times the neighbours, not N^2.
+// Throws std::invalid_argument for a horizon that is not a positive number.
+FiberMask horizon_fibers(const Surface& surface, double horizon);
+
+// The longest mesh edge: a horizon at least this long joins every vertex to
+// its neighbours on the surface (the least horizon fibers.horizon accepts).
+double longest_edge(const Surface& surface);
+
+}  // namespace fiberfluid::geom
