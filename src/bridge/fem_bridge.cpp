@@ -8,6 +8,7 @@
 #include "fem/mesh_tools.hpp"
 #include "fit/target.hpp"
 #include "geom/area_vectors.hpp"
+#include "model/boundary_conditions.hpp"
 #include "util/error.hpp"
 
 namespace fiberfluid::bridge {
@@ -46,7 +47,7 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
   std::vector<std::map<int, double>> vertex_held(
       static_cast<size_t>(m.num_vertices()));  // axis -> value
   for (const model::Constraint& k : m.constraints)
-    vertex_held[static_cast<size_t>(k.vertex)][k.axis] = k.value * k.schedule.factor(steps, steps);
+    vertex_held[static_cast<size_t>(k.vertex)][k.axis] = model::held_value(m, k, steps, steps);
   const fit::TargetDistance surface(fit::make_target("the surface", V, m.surface.F));
   std::map<std::pair<int, int>, double> held;  // (node, axis) -> value
   std::vector<bool> vertex_reached(static_cast<size_t>(m.num_vertices()), false);

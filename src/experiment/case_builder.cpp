@@ -198,6 +198,7 @@ class ModelBuilder {
     c_.model.loads.clear();
     for (const LoadSpec& l : spec_.loads) c_.model.loads.push_back(load(l));
     c_.model.constraints.clear();
+    c_.model.motions.clear();
     c_.model.constraint_groups.clear();
     for (const ConstraintSpec& k : spec_.constraints) add_group(k);
     c_.model.paddles.clear();
@@ -246,11 +247,43 @@ class ModelBuilder {
 
   std::vector<int> select(const SelectionSpec& spec) const { return resolve_selection(spec, c_); }
 
+  // The rigid motion of a rotating group (its rotation and translation).
+  int add_motion(const ConstraintSpec& spec) {
+    const ConstraintSpec::Rotation& r = *spec.rotation;
+    model::RigidMotion motion;
+    require_per_axis(r.field, "centre", r.centre, dim_);
+    motion.centre.head(dim_) = r.centre;
+    if (dim_ == 3) {
+      if (r.axis.size() != 3) r.field.fail("axis", "expected the rotation's axis, 3 numbers");
+      if (!(r.axis.norm() > 0.0)) r.field.fail("axis", "expected a nonzero axis");
+      motion.axis = r.axis.normalized();
+    } else if (r.axis.size() > 0) {
+      r.field.fail("axis", "a 2D rotation turns about z: leave the axis out");
+    }
+    motion.angle = r.angle_degrees * M_PI / 180.0;
+    if (spec.displacement.size() > 0) {
+      require_per_axis(spec.field, "displacement", spec.displacement, dim_);
+      motion.translation.head(dim_) = spec.displacement;
+    }
+    c_.model.motions.push_back(motion);
+    return static_cast<int>(c_.model.motions.size()) - 1;
+  }
+
   void add_group(const ConstraintSpec& spec) {
     model::Model& m = c_.model;
     m.constraint_groups.push_back(spec.label);
     const int group = static_cast<int>(m.constraint_groups.size()) - 1;
     const std::vector<int> vertices = select(spec.selection);
+    if (spec.rotation) {
+      const int motion = add_motion(spec);
+      for (int v : vertices)
+        for (int a = 0; a < dim_; ++a) {
+          model::Constraint c{v, a, 0.0, spec.schedule, group};
+          c.motion = motion;
+          m.constraints.push_back(c);
+        }
+      return;
+    }
     if (spec.prescribed) {
       require_per_axis(spec.field, "displacement", spec.displacement, dim_);
       for (int v : vertices)

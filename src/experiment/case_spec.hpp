@@ -65,7 +65,15 @@ struct ConstraintSpec {
   std::string label;
   SelectionSpec selection;
   std::string axes;              // supports: the held axes, e.g. "xyz"
-  Eigen::VectorXd displacement;  // prescribed: one entry per axis
+  Eigen::VectorXd displacement;  // prescribed: one entry per axis (a rotation's translation)
+  // prescribed "rotation": {"axis": [x, y, z] (3D), "angle_degrees": a,
+  // "centre": [...]}: the group moves rigidly (model::RigidMotion).
+  struct Rotation {
+    FieldName field;
+    Eigen::VectorXd axis, centre;
+    double angle_degrees = 0.0;
+  };
+  std::optional<Rotation> rotation;
   model::Schedule schedule;
 };
 

@@ -264,7 +264,18 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
       if (other.label == spec.label)
         f.fail("label", "\"" + spec.label + "\" names another group already");
     spec.selection = read_selection(f);
-    if (prescribed) {
+    if (prescribed && f.has("rotation")) {
+      Fields r = f.object("rotation");
+      ConstraintSpec::Rotation rotation;
+      rotation.field = r.field();
+      if (r.has("axis")) rotation.axis = r.vector("axis", 3);
+      rotation.angle_degrees = r.number("angle_degrees");
+      rotation.centre = per_axis_vector(r, "centre");
+      r.finish();
+      spec.rotation = rotation;
+      if (f.has("displacement")) spec.displacement = per_axis_vector(f, "displacement");
+      spec.schedule = read_schedule(f, "ramp");
+    } else if (prescribed) {
       spec.displacement = per_axis_vector(f, "displacement");
       spec.schedule = read_schedule(f, "ramp");
     } else {

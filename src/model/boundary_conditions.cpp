@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "model/boundary_conditions.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -84,6 +86,19 @@ std::string singular_setup_reason(const Model& model) {
   return {};
 }
 
+Eigen::Vector3d RigidMotion::displacement(const Eigen::Vector3d& s, double factor) const {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(factor * angle, axis).toRotationMatrix();
+  return R * (s - centre) + centre + factor * translation - s;
+}
+
+double held_value(const Model& model, const Constraint& c, int step, int steps) {
+  const double factor = c.schedule.factor(step, steps);
+  if (c.motion < 0) return c.value * factor;
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  s.head(model.dim()) = model.surface.V.row(c.vertex).transpose();
+  return model.motions.at(static_cast<size_t>(c.motion)).displacement(s, factor)[c.axis];
+}
+
 DofPartition partition_dofs(const Model& model) {
   std::map<int, int> constraint_at;  // unknown -> constraint index
   for (size_t c = 0; c < model.constraints.size(); ++c) {
@@ -92,7 +107,8 @@ DofPartition partition_dofs(const Model& model) {
     auto [it, inserted] = constraint_at.emplace(d, static_cast<int>(c));
     if (inserted) continue;
     const Constraint& other = model.constraints[static_cast<size_t>(it->second)];
-    if (other.value != constraint.value || other.schedule.kind != constraint.schedule.kind)
+    if (other.value != constraint.value || other.motion != constraint.motion ||
+        other.schedule.kind != constraint.schedule.kind)
       throw InputError("vertex " + std::to_string(constraint.vertex) + " axis " +
                        std::string(1, "xyz"[constraint.axis]) +
                        " is given two different prescribed displacements");

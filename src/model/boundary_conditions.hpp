@@ -31,6 +31,10 @@ std::vector<int> select_half_space(const Eigen::MatrixXd& X, const HalfSpace& ha
 std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min,
                             const Eigen::VectorXd& max);
 
+// The displacement a constraint holds its unknown at after step `step` of
+// `steps`: its value times its schedule's factor, or its rigid motion's.
+double held_value(const Model& model, const Constraint& constraint, int step, int steps);
+
 // ---------------------------------------------------------------- checking
 // Empty when the constraints remove rigid motion; otherwise why the system
 // is singular (e.g. no axis-x constraint: the body can translate along x).

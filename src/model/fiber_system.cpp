@@ -300,7 +300,7 @@ Eigen::VectorXd FiberSystem::expand(const Eigen::VectorXd& reduced,
 Eigen::VectorXd constrained_displacements(const Model& model, int step, int steps) {
   Eigen::VectorXd U_c = Eigen::VectorXd::Zero(model.dim() * model.num_vertices());
   for (const Constraint& c : model.constraints)
-    U_c[model.dof(c.vertex, c.axis)] = c.value * c.schedule.factor(step, steps);
+    U_c[model.dof(c.vertex, c.axis)] = held_value(model, c, step, steps);
   return U_c;
 }
 

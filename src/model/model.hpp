@@ -99,6 +99,21 @@ struct Constraint {
   double value = 0.0;  // displacement at full load
   Schedule schedule;   // how the displacement is reached
   int group = 0;       // index into Model::constraint_groups: whose reaction this adds to
+  // Index into Model::motions: the vertex follows that rigid motion (its
+  // component `axis`) and `value` is unused; -1: the value above.
+  int motion = -1;
+};
+
+// A rigid motion of a prescribed group: a rotation by `angle` (radians)
+// about `axis` (a unit vector; z in 2D) through `centre`, and a translation,
+// both reached along the group's schedule: at factor f the vertex at s is at
+// R(f angle) (s - centre) + centre + f translation.
+struct RigidMotion {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double angle = 0.0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d displacement(const Eigen::Vector3d& s, double factor) const;
 };
 
 // A rigid paddle (the paper's liver validation): a plane normal to a
@@ -136,6 +151,7 @@ struct Model {
   std::vector<Load> loads;
   std::vector<Constraint> constraints;
   std::vector<Paddle> paddles;
+  std::vector<RigidMotion> motions;  // of prescribed groups (Constraint::motion)
   // Names of the support and prescribed groups (one per experiment entry), for
   // reporting the reaction force of each; constraints refer to them by index.
   std::vector<std::string> constraint_groups;

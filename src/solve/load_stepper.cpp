@@ -94,7 +94,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
   const int n = options.steps;
   const Eigen::MatrixXd& reference = model.surface.V;
   const double reference_volume = geom::enclosed_volume(reference, model.surface.F);
-  const Eigen::MatrixXd reference_face_areas = geom::face_area_vectors(reference, model.surface.F);
+  Eigen::MatrixXd last_face_areas = geom::face_area_vectors(reference, model.surface.F);
   std::optional<Reactions> reactions;
   std::optional<model::Equilibrium> problem;
   try {
@@ -171,7 +171,7 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     const Eigen::MatrixXd X_now = model::positions(model, summary.unknowns);
     const double volume = geom::enclosed_volume(X_now, model.surface.F);
     why = runaway_reason(model, options, summary.unknowns, X_now, volume, reference_volume,
-                         reference_face_areas);
+                         last_face_areas);
     if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
 
     reactions->add_step(*system, dx, dB);

@@ -397,7 +397,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   const int n = options.steps, nv = model.num_vertices(), dim = model.dim();
   const Eigen::MatrixXd& reference = model.surface.V;
   const double reference_volume = solver->equilibrium().reference_volume();
-  const Eigen::MatrixXd reference_face_areas = geom::face_area_vectors(reference, model.surface.F);
+  Eigen::MatrixXd last_face_areas = geom::face_area_vectors(reference, model.surface.F);
   const size_t groups = std::max<size_t>(1, model.constraint_groups.size());
   Eigen::VectorXd& x = summary.unknowns;
 
@@ -444,7 +444,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
 
     const Eigen::MatrixXd X = model::positions(model, x);
     const double volume = geom::enclosed_volume(X, model.surface.F);
-    why = runaway_reason(model, options, x, X, volume, reference_volume, reference_face_areas);
+    why = runaway_reason(model, options, x, X, volume, reference_volume, last_face_areas);
     if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
 
     // Forces on the body: supports per group, paddles, and the loads.

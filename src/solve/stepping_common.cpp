@@ -18,14 +18,18 @@ namespace fiberfluid::solve {
 // Why the state reached after a step is a runaway rather than a result, or "".
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
                            const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
-                           double reference_volume, const Eigen::MatrixXd& reference_face_areas) {
+                           double reference_volume, Eigen::MatrixXd& last_face_areas) {
   if (!unknowns.allFinite()) return "the solution (displacements or pressure) is not finite";
   if (options.stop_on_inverted_faces) {
+    // Against the last accepted step, not the reference: a face that turns
+    // over passes through zero area, so its normal reverses within a step,
+    // while a body that rotates far (central fibers) turns its faces slowly.
     const Eigen::MatrixXd now = geom::face_area_vectors(X, model.surface.F);
     for (Eigen::Index f = 0; f < now.rows(); ++f)
-      if (now.row(f).dot(reference_face_areas.row(f)) <= 0.0)
+      if (now.row(f).dot(last_face_areas.row(f)) <= 0.0)
         return "face " + std::to_string(f) +
                " turned over (its normal reversed): the load is too large for the material";
+    last_face_areas = now;
   }
   const double change = (volume - reference_volume) / reference_volume;
   if (!std::isfinite(change) || std::abs(change) > options.max_volume_change) {

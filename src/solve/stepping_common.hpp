@@ -43,11 +43,12 @@ inline SteppingSummary failed(SteppingSummary& summary, const std::string& why,
 std::string setup_problem(const model::Model& model, const SteppingOptions& options);
 
 // Why the state reached after a step is a runaway rather than a result, or
-// "": non-finite unknowns, a face turned over, a volume change beyond
-// options.max_volume_change.
+// "": non-finite unknowns, a face turned over since the last accepted step
+// (last_face_areas, the face area vectors then: updated when the faces are
+// checked and none turned), a volume change beyond options.max_volume_change.
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
                            const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
-                           double reference_volume, const Eigen::MatrixXd& reference_face_areas);
+                           double reference_volume, Eigen::MatrixXd& last_face_areas);
 
 // How far a state is from equilibrium, relative (Equilibrium::relative_norm):
 // the free rows of R over the largest force seen so far along the path (the

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -10,6 +12,7 @@
 #include "experiment/runner.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
+#include "model/boundary_conditions.hpp"
 #include "test_support.hpp"
 #include "util/error.hpp"
 
@@ -343,6 +346,41 @@ TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
   EXPECT_GT(r.figures.at("max_displacement"), 0.0);
   c["fibers"]["kinematics"] = "bent";
   expect_config_error(dir, c, "fibers.kinematics");
+}
+
+// A prescribed group may turn rigidly: "rotation" (axis, angle in degrees,
+// centre) with an optional translation, along its schedule.
+TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["prescribed"] = {
+      {{"where", "z <= -0.8"},
+       {"rotation", {{"axis", {0, 1, 0}}, {"angle_degrees", 30}, {"centre", {0, 0, -1}}}},
+       {"displacement", {0.1, 0, 0}}}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const model::Model& m = ex.cases[0].model;
+  ASSERT_EQ(m.motions.size(), 1u);
+  EXPECT_NEAR(m.motions[0].angle, M_PI / 6.0, 1e-15);
+  EXPECT_EQ(m.motions[0].translation, Eigen::Vector3d(0.1, 0.0, 0.0));
+  int turning = 0;
+  for (const model::Constraint& k : m.constraints) turning += k.motion == 0;
+  EXPECT_GT(turning, 0);
+  // The held value at full load is the rigid motion's: a vertex at s moves to
+  // R (s - c) + c + t.
+  for (const model::Constraint& k : m.constraints) {
+    if (k.motion != 0) continue;
+    const Eigen::Vector3d s = m.surface.V.row(k.vertex).transpose(), centre(0, 0, -1);
+    const Eigen::Vector3d moved =
+        Eigen::AngleAxisd(M_PI / 6.0, Eigen::Vector3d::UnitY()) * (s - centre) + centre +
+        Eigen::Vector3d(0.1, 0.0, 0.0);
+    EXPECT_NEAR(model::held_value(m, k, 2, 2), (moved - s)[k.axis], 1e-14);
+  }
+  c["prescribed"][0]["rotation"]["axis"] = {0, 0, 0};
+  expect_config_error(dir, c, "prescribed[0].rotation.axis: expected a nonzero axis");
+  c["prescribed"][0]["rotation"].erase("axis");
+  expect_config_error(dir, c, "prescribed[0].rotation.axis");
+  c["prescribed"][0]["rotation"] = {{"axis", {0, 1, 0}}, {"centre", {0, 0, -1}}};
+  expect_config_error(dir, c, "prescribed[0].rotation.angle_degrees");
 }
 
 TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {

@@ -182,6 +182,56 @@ TEST(CentralFibers, ABarWithAHorizonBendsAsABeam) {
   EXPECT_GT(vector[0], 0.3);
 }
 
+// The same bar on a finer mesh (60 x 3 x 3 segments) with the same horizon:
+// the profile stays on the beam's (the figures of README's table).
+TEST(CentralFibers, TheBarsProfileHoldsAsTheMeshIsRefined) {
+  const std::vector<double> coarse = bar_profile(40, 2, 0.011, FiberKinematics::Central),
+                            fine = bar_profile(60, 3, 0.011, FiberKinematics::Central);
+  std::printf("central, horizon 1.1 cm, 60 x 3 x 3: %.3f %.3f %.3f\n", fine[0], fine[1], fine[2]);
+  const std::vector<double> stations = {0.25, 0.5, 0.75};
+  for (size_t k = 0; k < stations.size(); ++k) {
+    EXPECT_NEAR(fine[k], beam_profile(stations[k]), 0.02) << "x/L = " << stations[k];
+    EXPECT_NEAR(fine[k], coarse[k], 0.02) << "x/L = " << stations[k];
+  }
+}
+
+// A clamp turned by 90 degrees about an axis across the bar, no load: with
+// central fibers the free part follows the rigid rotation and the clamp
+// feels no reaction.
+TEST(CentralFibers, AClampTurnedByNinetyDegreesTurnsTheBodyRigidly) {
+  Model m = ball(FiberKinematics::Central);
+  const Eigen::Vector3d axis = Eigen::Vector3d(1.0, 1.0, 0.0).normalized();
+  RigidMotion turn;
+  turn.axis = axis;
+  turn.angle = M_PI / 2.0;
+  turn.centre = {0.0, 0.0, 0.1};
+  m.motions.push_back(turn);
+  m.constraint_groups = {"clamp"};
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (m.surface.V(v, 2) >= 0.08)
+      for (int a = 0; a < 3; ++a) {
+        Constraint c{v, a, 0.0, {}, 0};
+        c.motion = 0;
+        m.constraints.push_back(c);
+      }
+  solve::SteppingOptions newton;
+  newton.scheme = solve::Scheme::Newton;
+  newton.steps = 6;
+  newton.newton.tangent = solve::TangentSolver::Dense;
+  const solve::SteppingSummary run = solve::solve_load_steps(m, newton);
+  ASSERT_TRUE(run.success) << run.message;
+  const Eigen::MatrixXd X = positions(m, run.unknowns);
+  double worst = 0.0;
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const Eigen::Vector3d s = m.surface.V.row(v).transpose();
+    worst = std::max(worst, (X.row(v).transpose() - (s + turn.displacement(s, 1.0))).norm());
+  }
+  EXPECT_LT(worst, 1e-6 * 0.2);  // of the length (the diameter)
+  ASSERT_FALSE(run.steps.empty());
+  EXPECT_LT(run.steps.back().reactions[0].norm(), 1e-9);
+  EXPECT_LT(std::abs(run.unknowns[m.pressure_dof()]), 1e-6);
+}
+
 TEST(CentralFibers, TheIncrementalSchemeRefusesThemWithAReason) {
   const Model m = ball(FiberKinematics::Central);
   solve::SteppingOptions incremental;
