@@ -238,6 +238,9 @@ std::vector<LoadSpec> read_loads(Fields& root) {
       load.kind = model::Load::Kind::Hydrostatic;
       spec.vector = per_axis_vector(f, "acceleration");
       load.density = f.positive("density", 1000.0);
+      load.integration = f.choice("integration", "vertex", {"vertex", "exact"}) == "exact"
+                             ? model::Load::Integration::Exact
+                             : model::Load::Integration::Vertex;
     } else {
       load.kind = model::Load::Kind::Point;
       if (!f.has("vertex")) f.fail("vertex", "missing (required): the vertex the force acts on");

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "geom/area_vectors.hpp"
+
 namespace fiberfluid::model {
 
 double Schedule::factor(int step, int steps) const {
@@ -47,6 +49,21 @@ double hydrostatic_pressure_per_depth(const Load& load, double factor) {
   return factor * load.density * load.acceleration.norm();
 }
 
+Eigen::MatrixXd exact_pressure_forces(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
+                                      const Eigen::VectorXd& q) {
+  const Eigen::MatrixXd A = geom::face_area_vectors(X, F);
+  const Eigen::Index m = F.cols();
+  const double share = 1.0 / static_cast<double>(m * (m + 1));
+  Eigen::MatrixXd forces = Eigen::MatrixXd::Zero(X.rows(), X.cols());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    double face_sum = 0.0;
+    for (Eigen::Index k = 0; k < m; ++k) face_sum += q[F(f, k)];
+    for (Eigen::Index k = 0; k < m; ++k)
+      forces.row(F(f, k)) += share * (q[F(f, k)] + face_sum) * A.row(f);
+  }
+  return forces;
+}
+
 Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X, const Eigen::MatrixXd& S,
                             const std::vector<double>& factors) {
   const int n = model.num_vertices(), dim = model.dim();
@@ -63,7 +80,12 @@ Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X, const 
         // Outward on each vertex, rho |a| h_i S_i (hydrostatic_heads).
         const double scale = hydrostatic_pressure_per_depth(load, f);
         const Eigen::VectorXd h = hydrostatic_depths(X, load.acceleration);
-        for (int a = 0; a < dim; ++a) B.segment(a * n, n) += scale * h.cwiseProduct(S.col(a));
+        if (load.integration == Load::Integration::Exact) {
+          const Eigen::MatrixXd forces = exact_pressure_forces(X, model.surface.F, scale * h);
+          for (int a = 0; a < dim; ++a) B.segment(a * n, n) += forces.col(a);
+        } else {
+          for (int a = 0; a < dim; ++a) B.segment(a * n, n) += scale * h.cwiseProduct(S.col(a));
+        }
         continue;
       }
     }

@@ -25,6 +25,16 @@ Eigen::VectorXd hydrostatic_depths(const Eigen::MatrixXd& X, const Eigen::Vector
 // The pressure per unit depth of a hydrostatic load at load factor f: f rho |a|.
 double hydrostatic_pressure_per_depth(const Load& load, double factor);
 
+// The exact form of a pressure q (one value per vertex, linear over each
+// face): integrated against the linear shape functions of each face,
+//   F_i = sum over faces f at i of A_f (q_i + sum_{j in f} q_j) / (m (m + 1)),
+// m the face's corners (3; 2 for a 2D polygon's segments), A_f its area
+// vector (outward, |A_f| its area). The forces sum to the integral of q n over
+// the surface, exactly: for the fluid's weight rho a V (divergence theorem).
+// #V by dim.
+Eigen::MatrixXd exact_pressure_forces(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
+                                      const Eigen::VectorXd& q);
+
 // The load part of the right-hand side B (paper Eq. 4) at positions X with
 // vertex area vectors S (#V by dim), each load scaled by factors[l]. Length
 // dim * N + 1; the last (volume) entry is 0.

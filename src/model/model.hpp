@@ -89,6 +89,12 @@ struct Load {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();         // Point: force at full load (N)
   Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  // Hydrostatic, at full load (m/s^2)
   double density = 0.0;                                    // Hydrostatic: fluid density (kg/m^3)
+  // Hydrostatic: how the pressure becomes vertex forces (loads.hpp).
+  enum class Integration {
+    Vertex,  // the paper's q_i S_i: sums to 3 C0 times the weight, near but not exactly it
+    Exact,   // q linear over each face against the linear shape functions: exactly rho a V
+  };
+  Integration integration = Integration::Vertex;
   Schedule schedule;
 };
 

@@ -71,25 +71,31 @@ void add_area_vector_tangent(const TermContext& ctx, const Eigen::MatrixXd& X,
     }
 }
 
+// sum_v dA_f/dx_v w_v for face f (face_area_derivative applied directly: in
+// 3D sum_k (x_{k+2} - x_{k+1}) x w_k / 2, in 2D the rotated w_1 - w_0).
+Eigen::Vector3d face_area_rate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F, Eigen::Index f,
+                               const Eigen::MatrixXd& W) {
+  Eigen::Vector3d dA = Eigen::Vector3d::Zero();
+  if (X.cols() == 3) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d next = X.row(F(f, (k + 1) % 3)), after = X.row(F(f, (k + 2) % 3));
+      dA += 0.5 * (after - next).cross(row3(W, F(f, k)));
+    }
+  } else {
+    const Eigen::Vector3d dw = row3(W, F(f, 1)) - row3(W, F(f, 0));
+    dA = Eigen::Vector3d(dw.y(), -dw.x(), 0.0);
+  }
+  return dA;
+}
+
 // The same applied to W (#V by dim): row i is c_i dS_i/dx W; #V by 3.
 Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixXd& X,
                                     const Eigen::VectorXd& c, const Eigen::MatrixXd& W) {
   const Eigen::MatrixXi& F = ctx.model.surface.F;
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    // sum_v dA_f/dx_v w_v (face_area_derivative applied directly: in 3D
-    // sum_k (x_{k+2} - x_{k+1}) x w_k / 2, in 2D the rotated w_1 - w_0), then
-    // spread over the corners with their c_i.
-    Eigen::Vector3d dA = Eigen::Vector3d::Zero();
-    if (X.cols() == 3) {
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d next = X.row(F(f, (k + 1) % 3)), after = X.row(F(f, (k + 2) % 3));
-        dA += 0.5 * (after - next).cross(row3(W, F(f, k)));
-      }
-    } else {
-      const Eigen::Vector3d dw = row3(W, F(f, 1)) - row3(W, F(f, 0));
-      dA = Eigen::Vector3d(dw.y(), -dw.x(), 0.0);
-    }
+    // The face's rate, spread over the corners with their c_i.
+    const Eigen::Vector3d dA = face_area_rate(X, F, f, W);
     for (int corner = 0; corner < F.cols(); ++corner)
       out.row(F(f, corner)) += ctx.C0 * c[F(f, corner)] * dA.transpose();
   }
@@ -273,11 +279,17 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
     if (inactive(s)) return;
     const Eigen::VectorXd q = pressures(s);
     const int n = c_.model.num_vertices();
+    if (exact()) {
+      const Eigen::MatrixXd forces = exact_pressure_forces(s.X, c_.model.surface.F, q);
+      for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) -= forces.col(a);
+      return;
+    }
     for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) -= q.cwiseProduct(s.S.col(a));
   }
   void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
     if (inactive(s)) return;
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    if (exact()) return add_exact_tangent(s, J);
     add_area_vector_tangent(c_, s.X, -pressures(s), J);
     const Eigen::Vector3d gradient = pressure_gradient(s);
     for (int i = 0; i < n; ++i)
@@ -288,6 +300,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
                            Eigen::VectorXd& out) const override {
     if (inactive(s)) return;
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    if (exact()) return add_exact_tangent_product(s, W, out);
     const Eigen::MatrixXd geometric = area_vector_product(c_, s.X, -pressures(s), W);
     const Eigen::Vector3d gradient = pressure_gradient(s);
     for (int i = 0; i < n; ++i) {
@@ -298,6 +311,61 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
 
  private:
   const Load& load() const { return c_.model.loads[index_]; }
+  bool exact() const { return load().integration == Load::Integration::Exact; }
+  // The exact form's share of face f's area vector at corner i (loads.hpp):
+  // w_if = (q_i + sum_{j in f} q_j) / (m (m + 1)); dw_if/dq_v = (1 + [i = v]) / (m (m + 1)).
+  static double face_share(Eigen::Index corners) {
+    return 1.0 / static_cast<double>(corners * (corners + 1));
+  }
+  // J -= d(sum_f A_f w_if)/dx: the face's turning (dA_f/dx_v) and its pressures' change.
+  void add_exact_tangent(const TermState& s, Eigen::MatrixXd& J) const {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    const Eigen::MatrixXi& F = c_.model.surface.F;
+    const Eigen::Index m = F.cols();
+    const double share = face_share(m);
+    const Eigen::VectorXd q = pressures(s);
+    const Eigen::Vector3d g = pressure_gradient(s);
+    const Eigen::MatrixXd A = geom::face_area_vectors(s.X, F);
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      double face_sum = 0.0;
+      for (Eigen::Index k = 0; k < m; ++k) face_sum += q[F(f, k)];
+      for (Eigen::Index k = 0; k < m; ++k) {
+        const int v = F(f, k);
+        const Eigen::Matrix3d dA = face_area_derivative(s.X, F, f, static_cast<int>(k));
+        for (Eigen::Index corner = 0; corner < m; ++corner) {
+          const int i = F(f, corner);
+          const double w = share * (q[i] + face_sum), dw = share * (i == v ? 2.0 : 1.0);
+          for (int a = 0; a < dim; ++a)
+            for (int b = 0; b < dim; ++b)
+              J(a * n + i, b * n + v) -= w * dA(a, b) + A(f, a) * dw * g[b];
+        }
+      }
+    }
+  }
+  void add_exact_tangent_product(const TermState& s, const Eigen::MatrixXd& W,
+                                 Eigen::VectorXd& out) const {
+    const int n = c_.model.num_vertices(), dim = c_.model.dim();
+    const Eigen::MatrixXi& F = c_.model.surface.F;
+    const Eigen::Index m = F.cols();
+    const double share = face_share(m);
+    const Eigen::VectorXd q = pressures(s);
+    const Eigen::Vector3d g = pressure_gradient(s);
+    const Eigen::MatrixXd A = geom::face_area_vectors(s.X, F);
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      double face_sum = 0.0, rate_sum = 0.0;  // sum of q_j and of g . w_j over the corners
+      for (Eigen::Index k = 0; k < m; ++k) {
+        face_sum += q[F(f, k)];
+        rate_sum += g.head(dim).dot(W.row(F(f, k)).transpose());
+      }
+      const Eigen::Vector3d dA = face_area_rate(s.X, F, f, W);
+      for (Eigen::Index corner = 0; corner < m; ++corner) {
+        const int i = F(f, corner);
+        const double w = share * (q[i] + face_sum);
+        const double dw = share * (g.head(dim).dot(W.row(i).transpose()) + rate_sum);
+        for (int a = 0; a < dim; ++a) out[a * n + i] -= w * dA[a] + A(f, a) * dw;
+      }
+    }
+  }
   bool inactive(const TermState& s) const {
     return s.factors[index_] == 0.0 || load().acceleration.norm() == 0.0;
   }

@@ -383,6 +383,19 @@ TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
   expect_config_error(dir, c, "prescribed[0].rotation.angle_degrees");
 }
 
+// loads[].integration: the paper's vertex form by default, or exact.
+TEST(ExperimentConfig, TheHydrostaticLoadsIntegrationIsRead) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.loads[0].integration,
+            model::Load::Integration::Vertex);
+  c["loads"][0]["integration"] = "exact";
+  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.loads[0].integration,
+            model::Load::Integration::Exact);
+  c["loads"][0]["integration"] = "consistent";
+  expect_config_error(dir, c, "loads[0].integration: expected one of");
+}
+
 TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
   ScratchDir dir;
   nlohmann::json c = base_config();

@@ -8,10 +8,13 @@
 
 #include <random>
 
+#include "geom/area_vectors.hpp"
+#include "geom/mesh_io.hpp"
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 #include "model/reference/dense_assembly.hpp"
+#include "test_support.hpp"
 #include "util/error.hpp"
 
 namespace fiberfluid::model {
@@ -20,8 +23,8 @@ namespace {
 using namespace fiberfluid::model::reference;  // the oracle
 
 // A 42-vertex sphere with a cap held, gravity, a point load and surface tension.
-Model small_sphere(const FiberLaw& law,
-                   FiberKinematics kinematics = FiberKinematics::VectorSpring) {
+Model small_sphere(const FiberLaw& law, FiberKinematics kinematics = FiberKinematics::VectorSpring,
+                   Load::Integration integration = Load::Integration::Vertex) {
   Model m = testing::paper_sphere_model();
   m.surface = geom::icosphere(1, 1.0);
   m.constraints.clear();
@@ -32,6 +35,7 @@ Model small_sphere(const FiberLaw& law,
   m.material.axis_factors = {1.0, 0.8, 1.3};  // the factors enter every term
   m.material.surface_tension = 500.0;
   m.loads[1].vertex = 7;
+  m.loads[0].integration = integration;  // the hydrostatic load
   return m;
 }
 
@@ -63,6 +67,31 @@ Eigen::MatrixXd finite_difference_tangent(const Equilibrium& eq, const Eigen::Ve
     J.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
   }
   return J;
+}
+
+// The exact hydrostatic load's tangent (its faces turning and its pressures
+// changing with depth), with both kinematics.
+TEST(Equilibrium, TheExactHydrostaticLoadsTangentMatchesCentralDifferences) {
+  for (FiberKinematics kinematics : kAllKinematics) {
+    SCOPED_TRACE(kinematics_name(kinematics));
+    const Model m =
+        small_sphere(FiberLaw::exponential(3000.0, 4.0), kinematics, Load::Integration::Exact);
+    const Equilibrium eq(m);
+    const Eigen::VectorXd x = random_state(m, 8);
+    const std::vector<double> factors = {0.7, 0.4};
+    const Eigen::MatrixXd J = eq.tangent(x, factors);
+    const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+    EXPECT_LT((J - fd).norm() / fd.norm(), 1e-6);
+    const Eigen::VectorXd v = random_state(m, 18, 1.0);
+    EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm());
+    // The paper's scheme and Newton's put the same exact load on the reference.
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m.num_unknowns());
+    const Eigen::MatrixXd S =
+        eq.area_constant() * geom::summed_face_area_vectors(m.surface.V, m.surface.F);
+    const Eigen::VectorXd B = load_vector(m, m.surface.V, S, factors);
+    const Eigen::VectorXd F = eq.external_forces(zero, factors);
+    EXPECT_LT((B - F).norm(), 1e-12 * F.norm());
+  }
 }
 
 TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLawAndKinematics) {
@@ -101,6 +130,9 @@ TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
     gravity.kind = Load::Kind::Hydrostatic;
     gravity.acceleration = {0.0, -9.81, 0.0};
     gravity.density = 2.0;
+    // Both forms of the load in 2D: the exact one (on segments) with central fibers.
+    gravity.integration = kinematics == FiberKinematics::Central ? Load::Integration::Exact
+                                                                 : Load::Integration::Vertex;
     m.loads.push_back(gravity);
     const Equilibrium eq(m);
     const Eigen::VectorXd x = random_state(m, 5, 1.0);
@@ -217,6 +249,29 @@ TEST(EquilibriumTerms, ExternalForcesAreTheLoadTermsAlone) {
   const Eigen::VectorXd F = eq.external_forces(x, factors);
   EXPECT_GT(F.norm(), 0.0);
   EXPECT_LT((unloaded - F - loaded).norm(), 1e-12 * loaded.norm());
+}
+
+}  // namespace
+}  // namespace fiberfluid::model
+
+namespace fiberfluid::model {
+namespace {
+
+// The exact form sums to the fluid's weight rho a V on every shipped mesh;
+// the paper's vertex form to 3 C0 times it.
+TEST(ExactHydrostaticLoad, SumsToTheWeightOnEveryShippedMesh) {
+  const Eigen::Vector3d a(0.3, -1.2, -9.81);
+  const double density = 1000.0;
+  for (const char* name :
+       {"cube.obj", "icosahedron.obj", "liver.obj", "sphere_02b.obj", "torus.obj", "Bunny.stl"}) {
+    SCOPED_TRACE(name);
+    const geom::Surface s = geom::read_surface(testing::data_mesh(name)).surface;
+    const Eigen::VectorXd q =
+        density * a.norm() * hydrostatic_depths(s.V, a);  // full load, depth below the top
+    const Eigen::Vector3d total = exact_pressure_forces(s.V, s.F, q).colwise().sum();
+    const Eigen::Vector3d weight = density * geom::enclosed_volume(s.V, s.F) * a;
+    EXPECT_LT((total - weight).norm(), 1e-12 * weight.norm());
+  }
 }
 
 }  // namespace
