@@ -98,8 +98,8 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   const double residual = 2.0 * pairs / speed.residual_pairs_per_second;
   const bool newton = o.scheme == solve::Scheme::Newton;
   const bool dense_tangent =
-      newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns) ==
-                    solve::TangentSolver::Dense;
+      newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns,
+                                      model.material.kinematics) == solve::TangentSolver::Dense;
   const solve::SolverKind kind =
       dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
   e.solver = solve::to_string(kind);

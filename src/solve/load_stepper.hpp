@@ -27,14 +27,17 @@ const char* to_string(Scheme scheme);
 
 // How each Newton step's linear system with the tangent is solved.
 enum class TangentSolver {
-  Auto,    // dense up to 600 unknowns (about 200 vertices), krylov above
+  Auto,    // dense up to 600 unknowns (about 200 vertices; 4,000 for central fibers), krylov above
   Dense,   // LU of the dense tangent (LAPACK)
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
 };
 const char* to_string(TangentSolver solver);
 // What `requested` means for a Newton run with `reduced_unknowns` (the
-// unknowns left after the supports): Auto is dense up to 600, Krylov above.
-TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns);
+// unknowns left after the supports): Auto is dense up to 600 (4,000 for
+// central fibers, whose tangent the secant preconditioner fits poorly),
+// Krylov above.
+TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
+                             model::FiberKinematics kinematics);
 
 struct NewtonOptions {
   // Converged when the relative residual (force rows over the largest of the

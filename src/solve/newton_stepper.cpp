@@ -66,7 +66,8 @@ class NewtonSolver {
         stuck_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
     const Eigen::MatrixXd& V = model.surface.V;
     diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
-    const TangentSolver kind = choose_tangent(newton_.tangent, supports_.num_reduced());
+    const TangentSolver kind =
+        choose_tangent(newton_.tangent, supports_.num_reduced(), model.material.kinematics);
     tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
     summary_.tangent = kind;
     summary_.solver = tangent_->preconditioner_kind();

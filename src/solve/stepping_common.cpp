@@ -128,9 +128,14 @@ const char* to_string(TangentSolver solver) {
   return "?";
 }
 
-TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns) {
+TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
+                             model::FiberKinematics kinematics) {
   if (requested != TangentSolver::Auto) return requested;
-  return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
+  // Krylov's preconditioner is the vector spring's secant system: close to a
+  // vector-spring tangent, far from a central one (GMRES stalls), so central
+  // fibers keep the dense LU up to sizes whose LU still takes seconds.
+  const int dense_up_to = kinematics == model::FiberKinematics::VectorSpring ? 600 : 4000;
+  return reduced_unknowns <= dense_up_to ? TangentSolver::Dense : TangentSolver::Krylov;
 }
 
 std::string SteppingSummary::BriefReport() const {
