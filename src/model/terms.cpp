@@ -317,15 +317,26 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
   static double face_share(Eigen::Index corners) {
     return 1.0 / static_cast<double>(corners * (corners + 1));
   }
+  // What both exact-form tangents read at a state: the pressures, their
+  // gradient and the faces' area vectors.
+  struct ExactState {
+    Eigen::VectorXd q;
+    Eigen::Vector3d g;
+    Eigen::MatrixXd A;
+  };
+  ExactState exact_state(const TermState& s) const {
+    return {pressures(s), pressure_gradient(s), geom::face_area_vectors(s.X, c_.model.surface.F)};
+  }
   // J -= d(sum_f A_f w_if)/dx: the face's turning (dA_f/dx_v) and its pressures' change.
   void add_exact_tangent(const TermState& s, Eigen::MatrixXd& J) const {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     const Eigen::MatrixXi& F = c_.model.surface.F;
     const Eigen::Index m = F.cols();
     const double share = face_share(m);
-    const Eigen::VectorXd q = pressures(s);
-    const Eigen::Vector3d g = pressure_gradient(s);
-    const Eigen::MatrixXd A = geom::face_area_vectors(s.X, F);
+    const ExactState e = exact_state(s);
+    const Eigen::VectorXd& q = e.q;
+    const Eigen::Vector3d& g = e.g;
+    const Eigen::MatrixXd& A = e.A;
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
       double face_sum = 0.0;
       for (Eigen::Index k = 0; k < m; ++k) face_sum += q[F(f, k)];
@@ -348,9 +359,10 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
     const Eigen::MatrixXi& F = c_.model.surface.F;
     const Eigen::Index m = F.cols();
     const double share = face_share(m);
-    const Eigen::VectorXd q = pressures(s);
-    const Eigen::Vector3d g = pressure_gradient(s);
-    const Eigen::MatrixXd A = geom::face_area_vectors(s.X, F);
+    const ExactState e = exact_state(s);
+    const Eigen::VectorXd& q = e.q;
+    const Eigen::Vector3d& g = e.g;
+    const Eigen::MatrixXd& A = e.A;
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
       double face_sum = 0.0, rate_sum = 0.0;  // sum of q_j and of g . w_j over the corners
       for (Eigen::Index k = 0; k < m; ++k) {

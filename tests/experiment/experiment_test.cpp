@@ -39,7 +39,7 @@ INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
                                            "nonlinear_round_trip.json", "liver_paddles.json",
                                            "stress_strain.json", "benchmark_block_mp1.json",
                                            "benchmark_block_mp2.json", "benchmark_rod.json",
-                                           "liver_fem_reference.json"));
+                                           "liver_fem_reference.json", "bar_bending.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {

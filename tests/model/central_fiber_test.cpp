@@ -22,6 +22,15 @@
 namespace fiberfluid::model {
 namespace {
 
+// The Newton scheme in `steps` load steps with the dense tangent.
+solve::SteppingOptions dense_newton(int steps) {
+  solve::SteppingOptions newton;
+  newton.scheme = solve::Scheme::Newton;
+  newton.steps = steps;
+  newton.newton.tangent = solve::TangentSolver::Dense;
+  return newton;
+}
+
 // A 162-vertex sphere of radius 0.1 m, an exponential law and surface tension.
 Model ball(FiberKinematics kinematics) {
   Model m;
@@ -102,10 +111,7 @@ TEST(CentralFibers, ARotatedProblemGivesTheRotatedAnswer) {
     m.loads.push_back(gravity);
     return m;
   };
-  solve::SteppingOptions newton;
-  newton.scheme = solve::Scheme::Newton;
-  newton.steps = 2;
-  newton.newton.tangent = solve::TangentSolver::Dense;
+  const solve::SteppingOptions newton = dense_newton(2);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, 1.0, -0.4).normalized()).toRotationMatrix();
   const Model plain = problem(Eigen::Matrix3d::Identity()), turned = problem(R);
@@ -146,10 +152,7 @@ std::vector<double> bar_profile(int along, int across, double horizon, FiberKine
     load.force = {0.0, 0.0, -1e-5 / static_cast<double>(tip.size())};
     m.loads.push_back(load);
   }
-  solve::SteppingOptions newton;
-  newton.scheme = solve::Scheme::Newton;
-  newton.steps = 1;
-  newton.newton.tangent = solve::TangentSolver::Dense;
+  const solve::SteppingOptions newton = dense_newton(1);
   const solve::SteppingSummary run = solve::solve_load_steps(m, newton);
   EXPECT_TRUE(run.success) << run.message;
   const Eigen::MatrixXd U = displacements(m, run.unknowns);
@@ -214,10 +217,7 @@ TEST(CentralFibers, AClampTurnedByNinetyDegreesTurnsTheBodyRigidly) {
         c.motion = 0;
         m.constraints.push_back(c);
       }
-  solve::SteppingOptions newton;
-  newton.scheme = solve::Scheme::Newton;
-  newton.steps = 6;
-  newton.newton.tangent = solve::TangentSolver::Dense;
+  const solve::SteppingOptions newton = dense_newton(6);
   const solve::SteppingSummary run = solve::solve_load_steps(m, newton);
   ASSERT_TRUE(run.success) << run.message;
   const Eigen::MatrixXd X = positions(m, run.unknowns);
