@@ -312,69 +312,61 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
  private:
   const Load& load() const { return c_.model.loads[index_]; }
   bool exact() const { return load().integration == Load::Integration::Exact; }
-  // The exact form's share of face f's area vector at corner i (loads.hpp):
-  // w_if = (q_i + sum_{j in f} q_j) / (m (m + 1)); dw_if/dq_v = (1 + [i = v]) / (m (m + 1)).
-  static double face_share(Eigen::Index corners) {
-    return 1.0 / static_cast<double>(corners * (corners + 1));
-  }
-  // What both exact-form tangents read at a state: the pressures, their
-  // gradient and the faces' area vectors.
+  // What both exact-form tangents read at a state (loads.hpp): the
+  // pressures, their gradient, the faces' area vectors and the share of face
+  // f's area vector at its corner i, w_if = (q_i + sum_{j in f} q_j) / (m (m + 1)),
+  // so that dw_if/dq_v = (1 + [i = v]) / (m (m + 1)).
   struct ExactState {
-    Eigen::VectorXd q;
+    Eigen::VectorXd q, face_sum;  // per vertex; per face, q summed over its corners
     Eigen::Vector3d g;
     Eigen::MatrixXd A;
+    double share = 0.0;  // 1 / (m (m + 1))
+    double w(int i, Eigen::Index f) const { return share * (q[i] + face_sum[f]); }
   };
   ExactState exact_state(const TermState& s) const {
-    return {pressures(s), pressure_gradient(s), geom::face_area_vectors(s.X, c_.model.surface.F)};
+    const Eigen::MatrixXi& F = c_.model.surface.F;
+    ExactState e;
+    e.q = pressures(s);
+    e.g = pressure_gradient(s);
+    e.A = geom::face_area_vectors(s.X, F);
+    e.share = 1.0 / static_cast<double>(F.cols() * (F.cols() + 1));
+    e.face_sum = Eigen::VectorXd::Zero(F.rows());
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (Eigen::Index k = 0; k < F.cols(); ++k) e.face_sum[f] += e.q[F(f, k)];
+    return e;
   }
   // J -= d(sum_f A_f w_if)/dx: the face's turning (dA_f/dx_v) and its pressures' change.
   void add_exact_tangent(const TermState& s, Eigen::MatrixXd& J) const {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     const Eigen::MatrixXi& F = c_.model.surface.F;
-    const Eigen::Index m = F.cols();
-    const double share = face_share(m);
     const ExactState e = exact_state(s);
-    const Eigen::VectorXd& q = e.q;
-    const Eigen::Vector3d& g = e.g;
-    const Eigen::MatrixXd& A = e.A;
-    for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      double face_sum = 0.0;
-      for (Eigen::Index k = 0; k < m; ++k) face_sum += q[F(f, k)];
-      for (Eigen::Index k = 0; k < m; ++k) {
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (Eigen::Index k = 0; k < F.cols(); ++k) {
         const int v = F(f, k);
         const Eigen::Matrix3d dA = face_area_derivative(s.X, F, f, static_cast<int>(k));
-        for (Eigen::Index corner = 0; corner < m; ++corner) {
+        for (Eigen::Index corner = 0; corner < F.cols(); ++corner) {
           const int i = F(f, corner);
-          const double w = share * (q[i] + face_sum), dw = share * (i == v ? 2.0 : 1.0);
+          const double w = e.w(i, f), dw = e.share * (i == v ? 2.0 : 1.0);
           for (int a = 0; a < dim; ++a)
             for (int b = 0; b < dim; ++b)
-              J(a * n + i, b * n + v) -= w * dA(a, b) + A(f, a) * dw * g[b];
+              J(a * n + i, b * n + v) -= w * dA(a, b) + e.A(f, a) * dw * e.g[b];
         }
       }
-    }
   }
   void add_exact_tangent_product(const TermState& s, const Eigen::MatrixXd& W,
                                  Eigen::VectorXd& out) const {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     const Eigen::MatrixXi& F = c_.model.surface.F;
-    const Eigen::Index m = F.cols();
-    const double share = face_share(m);
     const ExactState e = exact_state(s);
-    const Eigen::VectorXd& q = e.q;
-    const Eigen::Vector3d& g = e.g;
-    const Eigen::MatrixXd& A = e.A;
+    const Eigen::VectorXd rate = W * e.g.head(dim);  // g . w_v per vertex
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      double face_sum = 0.0, rate_sum = 0.0;  // sum of q_j and of g . w_j over the corners
-      for (Eigen::Index k = 0; k < m; ++k) {
-        face_sum += q[F(f, k)];
-        rate_sum += g.head(dim).dot(W.row(F(f, k)).transpose());
-      }
+      double rate_sum = 0.0;
+      for (Eigen::Index k = 0; k < F.cols(); ++k) rate_sum += rate[F(f, k)];
       const Eigen::Vector3d dA = face_area_rate(s.X, F, f, W);
-      for (Eigen::Index corner = 0; corner < m; ++corner) {
+      for (Eigen::Index corner = 0; corner < F.cols(); ++corner) {
         const int i = F(f, corner);
-        const double w = share * (q[i] + face_sum);
-        const double dw = share * (g.head(dim).dot(W.row(i).transpose()) + rate_sum);
-        for (int a = 0; a < dim; ++a) out[a * n + i] -= w * dA[a] + A(f, a) * dw;
+        const double dw = e.share * (rate[i] + rate_sum);
+        for (int a = 0; a < dim; ++a) out[a * n + i] -= e.w(i, f) * dA[a] + e.A(f, a) * dw;
       }
     }
   }
