@@ -52,16 +52,20 @@ double hydrostatic_pressure_per_depth(const Load& load, double factor) {
 Eigen::MatrixXd exact_pressure_forces(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
                                       const Eigen::VectorXd& q) {
   const Eigen::MatrixXd A = geom::face_area_vectors(X, F);
-  const Eigen::Index m = F.cols();
-  const double share = 1.0 / static_cast<double>(m * (m + 1));
+  const ExactFaceShares shares(F, q);
   Eigen::MatrixXd forces = Eigen::MatrixXd::Zero(X.rows(), X.cols());
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    double face_sum = 0.0;
-    for (Eigen::Index k = 0; k < m; ++k) face_sum += q[F(f, k)];
-    for (Eigen::Index k = 0; k < m; ++k)
-      forces.row(F(f, k)) += share * (q[F(f, k)] + face_sum) * A.row(f);
-  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (Eigen::Index k = 0; k < F.cols(); ++k)
+      forces.row(F(f, k)) += shares.w(F(f, k), f) * A.row(f);
   return forces;
+}
+
+ExactFaceShares::ExactFaceShares(const Eigen::MatrixXi& F, const Eigen::VectorXd& q_)
+    : q(q_),
+      face_sum(Eigen::VectorXd::Zero(F.rows())),
+      per_pressure(1.0 / static_cast<double>(F.cols() * (F.cols() + 1))) {
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (Eigen::Index k = 0; k < F.cols(); ++k) face_sum[f] += q[F(f, k)];
 }
 
 Eigen::VectorXd load_vector(const Model& model, const Eigen::MatrixXd& X, const Eigen::MatrixXd& S,

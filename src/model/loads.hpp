@@ -35,6 +35,16 @@ double hydrostatic_pressure_per_depth(const Load& load, double factor);
 Eigen::MatrixXd exact_pressure_forces(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
                                       const Eigen::VectorXd& q);
 
+// The exact form's weights: the share of face f's area vector at its corner
+// i, w_if = (q_i + sum_{j in f} q_j) / (m (m + 1)), so that
+// dw_if/dq_v = (1 + [i = v]) / (m (m + 1)). The forces and their tangents use it.
+struct ExactFaceShares {
+  ExactFaceShares(const Eigen::MatrixXi& F, const Eigen::VectorXd& q);
+  double w(int i, Eigen::Index f) const { return per_pressure * (q[i] + face_sum[f]); }
+  Eigen::VectorXd q, face_sum;  // per vertex; per face, q summed over its corners
+  double per_pressure;          // 1 / (m (m + 1))
+};
+
 // The load part of the right-hand side B (paper Eq. 4) at positions X with
 // vertex area vectors S (#V by dim), each load scaled by factors[l]. Length
 // dim * N + 1; the last (volume) entry is 0.

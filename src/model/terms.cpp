@@ -312,28 +312,18 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
  private:
   const Load& load() const { return c_.model.loads[index_]; }
   bool exact() const { return load().integration == Load::Integration::Exact; }
-  // What both exact-form tangents read at a state (loads.hpp): the
-  // pressures, their gradient, the faces' area vectors and the share of face
-  // f's area vector at its corner i, w_if = (q_i + sum_{j in f} q_j) / (m (m + 1)),
-  // so that dw_if/dq_v = (1 + [i = v]) / (m (m + 1)).
+  // What both exact-form tangents read at a state: the corners' shares of
+  // the faces' area vectors (loads.hpp), the pressures' gradient and the
+  // faces' area vectors.
   struct ExactState {
-    Eigen::VectorXd q, face_sum;  // per vertex; per face, q summed over its corners
+    ExactFaceShares shares;
     Eigen::Vector3d g;
     Eigen::MatrixXd A;
-    double share = 0.0;  // 1 / (m (m + 1))
-    double w(int i, Eigen::Index f) const { return share * (q[i] + face_sum[f]); }
   };
   ExactState exact_state(const TermState& s) const {
     const Eigen::MatrixXi& F = c_.model.surface.F;
-    ExactState e;
-    e.q = pressures(s);
-    e.g = pressure_gradient(s);
-    e.A = geom::face_area_vectors(s.X, F);
-    e.share = 1.0 / static_cast<double>(F.cols() * (F.cols() + 1));
-    e.face_sum = Eigen::VectorXd::Zero(F.rows());
-    for (Eigen::Index f = 0; f < F.rows(); ++f)
-      for (Eigen::Index k = 0; k < F.cols(); ++k) e.face_sum[f] += e.q[F(f, k)];
-    return e;
+    return {ExactFaceShares(F, pressures(s)), pressure_gradient(s),
+            geom::face_area_vectors(s.X, F)};
   }
   // J -= d(sum_f A_f w_if)/dx: the face's turning (dA_f/dx_v) and its pressures' change.
   void add_exact_tangent(const TermState& s, Eigen::MatrixXd& J) const {
@@ -346,7 +336,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
         const Eigen::Matrix3d dA = face_area_derivative(s.X, F, f, static_cast<int>(k));
         for (Eigen::Index corner = 0; corner < F.cols(); ++corner) {
           const int i = F(f, corner);
-          const double w = e.w(i, f), dw = e.share * (i == v ? 2.0 : 1.0);
+          const double w = e.shares.w(i, f), dw = e.shares.per_pressure * (i == v ? 2.0 : 1.0);
           for (int a = 0; a < dim; ++a)
             for (int b = 0; b < dim; ++b)
               J(a * n + i, b * n + v) -= w * dA(a, b) + e.A(f, a) * dw * e.g[b];
@@ -365,8 +355,8 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
       const Eigen::Vector3d dA = face_area_rate(s.X, F, f, W);
       for (Eigen::Index corner = 0; corner < F.cols(); ++corner) {
         const int i = F(f, corner);
-        const double dw = e.share * (rate[i] + rate_sum);
-        for (int a = 0; a < dim; ++a) out[a * n + i] -= e.w(i, f) * dA[a] + e.A(f, a) * dw;
+        const double dw = e.shares.per_pressure * (rate[i] + rate_sum);
+        for (int a = 0; a < dim; ++a) out[a * n + i] -= e.shares.w(i, f) * dA[a] + e.A(f, a) * dw;
       }
     }
   }
