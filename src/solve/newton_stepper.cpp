@@ -209,13 +209,13 @@ class NewtonSolver {
     return !model_.paddles.empty() && (release_pulling(R, false) || add_penetrating(at, x, false));
   }
 
-  // The relative residual (the gauge's force scale: the largest load or reaction seen).
-  double measure(const Eigen::VectorXd& reduced) const {
-    return equilibrium_->relative_norm(reduced, gauge_.force_scale());
-  }
-  void update_force_scale(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
-                          const Eigen::VectorXd& R) {
-    gauge_.update_scale(*equilibrium_, dofs, x, at.factors, R);
+  // The relative residual of the state x (gauge: the scale of x's loads and
+  // reactions, or of the states accepted before, whichever is larger).
+  double measure(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
+                 const Eigen::VectorXd& R, double* scale = nullptr) const {
+    const double s = gauge_.scale_at(*equilibrium_, dofs, x, at.factors, R);
+    if (scale) *scale = s;
+    return equilibrium_->relative_norm(dofs.reduce(R), s);
   }
 
   // Newton iterations with the held set `dofs`, until converged (*converged
@@ -226,12 +226,12 @@ class NewtonSolver {
                      StepRecord& record, bool* converged) {
     *converged = false;
     Eigen::VectorXd R = equilibrium_->residual(x, at.factors);
-    update_force_scale(at, dofs, x, R);
     double last_move = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
       if (cancel_requested()) return "interrupted";
       const Eigen::VectorXd r = dofs.reduce(R);
-      const double norm = measure(r);
+      double scale = 0.0;
+      const double norm = measure(at, dofs, x, R, &scale);
       record.residual_norms.push_back(norm);
       if (!std::isfinite(norm)) return "the residual is not finite";
       // Converged: the residual is small, or it has stalled at rounding
@@ -240,6 +240,7 @@ class NewtonSolver {
       if (norm <= newton_.residual_tolerance ||
           (small_move && norm <= 1e3 * newton_.residual_tolerance)) {
         residual_ = R;
+        gauge_.commit(scale);
         *converged = true;
         return {};
       }
@@ -275,7 +276,7 @@ class NewtonSolver {
       for (int halving = 0;; ++halving) {
         trial = x + alpha * step;
         R_trial = equilibrium_->residual(trial, at.factors);
-        const double trial_norm = measure(dofs.reduce(R_trial));
+        const double trial_norm = measure(at, dofs, trial, R_trial);
         if (!newton_.line_search || trial_norm <= (1.0 - 1e-4 * alpha) * norm ||
             trial_norm <= newton_.residual_tolerance)
           break;
@@ -287,7 +288,6 @@ class NewtonSolver {
       }
       x = trial;
       R = R_trial;
-      update_force_scale(at, dofs, x, R);
       last_move = alpha * dx.head(dx.size() - 1).cwiseAbs().maxCoeff();
       ++record.newton_iterations;
       ++summary_.newton_iterations;

@@ -51,29 +51,37 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
                            double reference_volume, Eigen::MatrixXd& last_face_areas);
 
 // How far a state is from equilibrium, relative (Equilibrium::relative_norm):
-// the free rows of R over the largest force seen so far along the path (the
-// loads, or the held rows: the reactions), the volume row over dim C0 V0.
+// the free rows of R over a force scale, the volume row over dim C0 V0. The
+// scale is the largest of the forces at the state measured (its loads, and
+// its held rows of R: the reactions) and of those at the states accepted
+// before (commit). A trial iterate never raises the scale for the states
+// after it: a wild iterate's huge reactions would make the next iterate look
+// converged.
 class ResidualGauge {
  public:
+  // The relative residual of x; the scale of x is committed (x is accepted).
   double measure(const model::Equilibrium& problem, const model::DofMap& dofs,
                  const Eigen::VectorXd& x, const std::vector<double>& factors) {
     const Eigen::VectorXd R = problem.residual(x, factors);
-    update_scale(problem, dofs, x, factors, R);
-    return problem.relative_norm(dofs.reduce(R), peak_force_);
+    const double scale = scale_at(problem, dofs, x, factors, R);
+    commit(scale);
+    return problem.relative_norm(dofs.reduce(R), scale);
   }
-  // Raises the force scale with the loads and the held rows of R at x.
-  void update_scale(const model::Equilibrium& problem, const model::DofMap& dofs,
-                    const Eigen::VectorXd& x, const std::vector<double>& factors,
-                    const Eigen::VectorXd& R) {
+  // The force scale of the state x with residual R: the accepted states'
+  // scale, raised by x's loads and reactions.
+  double scale_at(const model::Equilibrium& problem, const model::DofMap& dofs,
+                  const Eigen::VectorXd& x, const std::vector<double>& factors,
+                  const Eigen::VectorXd& R) const {
     const Eigen::VectorXd F = problem.external_forces(x, factors);
     double held = 0.0;
     for (int d : dofs.held_dofs()) held += R[d] * R[d];
-    peak_force_ = std::max({peak_force_, F.head(F.size() - 1).norm(), std::sqrt(held)});
+    return std::max({accepted_scale_, F.head(F.size() - 1).norm(), std::sqrt(held)});
   }
-  double force_scale() const { return peak_force_; }
+  // Keeps a scale once its state is accepted (a converged step).
+  void commit(double scale) { accepted_scale_ = std::max(accepted_scale_, scale); }
 
  private:
-  double peak_force_ = 0.0;
+  double accepted_scale_ = 0.0;
 };
 
 }  // namespace fiberfluid::solve

@@ -10,6 +10,28 @@
 #include "util/run_control.hpp"
 
 namespace fiberfluid::solve {
+namespace {
+
+// J <- R J C with R, C diagonal powers of two (exact scaling): each row's
+// largest entry near 1, then each column's (LAPACK's dgeequ rule).
+void equilibrate(Eigen::MatrixXd& J, Eigen::VectorXd* rows, Eigen::VectorXd* columns) {
+  const auto power_of_two = [](double largest) {
+    return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest)))
+                                                   : 1.0;
+  };
+  *rows = Eigen::VectorXd::Ones(J.rows());
+  *columns = Eigen::VectorXd::Ones(J.cols());
+  for (Eigen::Index i = 0; i < J.rows(); ++i) {
+    (*rows)[i] = power_of_two(J.row(i).cwiseAbs().maxCoeff());
+    J.row(i) *= (*rows)[i];
+  }
+  for (Eigen::Index j = 0; j < J.cols(); ++j) {
+    (*columns)[j] = power_of_two(J.col(j).cwiseAbs().maxCoeff());
+    J.col(j) *= (*columns)[j];
+  }
+}
+
+}  // namespace
 
 TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium,
                            const SteppingOptions& options, TangentSolver kind)
@@ -30,7 +52,9 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
   ready_ = false;
   if (kind_ == TangentSolver::Dense) {
     lu_ = std::make_unique<DenseLU>();
-    const Status status = lu_->factorize(dofs_.reduce(equilibrium_->tangent(x_, factors_)));
+    Eigen::MatrixXd J = dofs_.reduce(equilibrium_->tangent(x_, factors_));
+    equilibrate(J, &row_scale_, &column_scale_);
+    const Status status = lu_->factorize(J);
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   } else {
     if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
@@ -73,7 +97,7 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
                            int* iterations) {
   if (!ready_) return Status::failure("newton: the tangent was not prepared");
   if (kind_ == TangentSolver::Dense) {
-    *y = lu_->solve(b);
+    *y = column_scale_.cwiseProduct(lu_->solve(row_scale_.cwiseProduct(b)));
     return {};
   }
   const LinearOperator apply_tangent = [this](const Eigen::VectorXd& v) { return apply(v); };

@@ -72,6 +72,10 @@ class TangentSolve {
   bool ready_ = false;
   // Dense.
   std::unique_ptr<DenseLU> lu_;
+  // The dense tangent is equilibrated before its LU (rows, then columns, by
+  // their largest entries): force rows of a stiff material and the volume
+  // row differ by many orders, which would make a sound system look singular.
+  Eigen::VectorXd row_scale_, column_scale_;
   // Krylov.
   bool store_ = true;
   model::TangentOperator stored_;
