@@ -191,7 +191,8 @@ model::FiberLaw read_law(Fields f) {
       f.fail("stress", "expected as many stresses as strains (" + std::to_string(strain.size()) +
                            "), got " + std::to_string(stress.size()));
     law = model::FiberLaw::tabulated({strain.data(), strain.data() + strain.size()},
-                                     {stress.data(), stress.data() + stress.size()});
+                                     {stress.data(), stress.data() + stress.size()},
+                                     f.non_negative("transition", 0.005));
     law.set_parameter("scale", f.positive("scale", 1.0));
   }
   f.finish();

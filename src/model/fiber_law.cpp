@@ -153,21 +153,27 @@ class BilinearLaw final : public LawModel {
   double w_;
 };
 
+// A piecewise-linear sigma(e) from a table. Its slope may differ on the two
+// sides of e = 0 (a tissue softer in compression), where the secant modulus,
+// and with the vector spring the force, would jump and stall Newton: over
+// |e| < transition the two sides' moduli are blended by the bilinear law's C1
+// share, each side's segment through (0, 0) extended across zero.
 class TabulatedLaw final : public LawModel {
  public:
-  TabulatedLaw(std::vector<double> strain, std::vector<double> stress)
-      : strain_(std::move(strain)), stress_(std::move(stress)) {}
+  TabulatedLaw(std::vector<double> strain, std::vector<double> stress, double transition)
+      : strain_(std::move(strain)), stress_(std::move(stress)), w_(transition) {}
   std::string name() const override { return "tabulated"; }
   std::vector<std::string> parameter_names() const override { return {"scale"}; }
-  // sigma = s_k + m (e - e_k) = m e + c on the segment: Y = m + c / e. The
-  // segments that end at (0, 0) have c = 0 exactly, so Y is finite there.
   double modulus(const double* p, double e) const override {
-    const Segment s = segment(e);
-    return p[0] * (s.c == 0.0 ? s.m : s.m + s.c / e);
+    if (!blends(e)) return p[0] * table_modulus(e);
+    const double share = tension_share(e, w_);
+    return p[0] * ((1.0 - share) * side_modulus(e, false) + share * side_modulus(e, true));
   }
   double slope(const double* p, double e) const override {
-    const Segment s = segment(e);
-    return s.c == 0.0 ? 0.0 : -p[0] * s.c / (e * e);
+    if (!blends(e)) return p[0] * table_slope(e);
+    const double share = tension_share(e, w_);
+    return p[0] * ((1.0 - share) * side_slope(e, false) + share * side_slope(e, true) +
+                   tension_share_slope(e, w_) * (side_modulus(e, true) - side_modulus(e, false)));
   }
   double modulus_derivative(const double* p, int, double e) const override {
     return modulus(p, e) / p[0];
@@ -186,11 +192,12 @@ class TabulatedLaw final : public LawModel {
     const auto zero = std::find(strain_.begin(), strain_.end(), 0.0);
     if (zero == strain_.end() || stress_[static_cast<size_t>(zero - strain_.begin())] != 0.0)
       return "the table must contain the point (0, 0): no stress at zero strain";
+    if (!(w_ >= 0.0 && w_ < 1.0)) return "transition must be a strain from 0 to 1";
     if (!(p[0] > 0.0) || !std::isfinite(p[0])) return "scale must be a positive number";
     return {};
   }
   std::vector<Setting> settings() const override {
-    return {{"strain", strain_, false}, {"stress", stress_, false}};
+    return {{"strain", strain_, false}, {"stress", stress_, false}, {"transition", {w_}, true}};
   }
 
  private:
@@ -198,8 +205,7 @@ class TabulatedLaw final : public LawModel {
     double m, c;  // sigma = m e + c on it
   };
   // The segment holding e (end segments extended). Segment k spans
-  // [strain_k, strain_k+1]; e = 0 falls in the segment that starts there, so
-  // Y(0) is the initial slope in tension.
+  // [strain_k, strain_k+1]; e = 0 falls in the segment that starts there.
   Segment segment(double e) const {
     // A table without a segment (check() names it) gives NaN, never a read past it.
     if (strain_.size() < 2 || stress_.size() != strain_.size()) return {std::nan(""), 0.0};
@@ -211,8 +217,37 @@ class TabulatedLaw final : public LawModel {
     const bool through_origin = strain_[k] == 0.0 || strain_[k + 1] == 0.0;
     return {m, through_origin ? 0.0 : stress_[k] - m * strain_[k]};
   }
+  // sigma = m e + c on the segment: Y = m + c / e. The segments that end at
+  // (0, 0) have c = 0 exactly, so Y is finite there.
+  double table_modulus(double e) const {
+    const Segment s = segment(e);
+    return s.c == 0.0 ? s.m : s.m + s.c / e;
+  }
+  double table_slope(double e) const {
+    const Segment s = segment(e);
+    return s.c == 0.0 ? 0.0 : -s.c / (e * e);
+  }
+  bool blends(double e) const { return w_ > 0.0 && std::abs(e) < w_; }
+  // The tension side (e >= 0 of the table, its first segment extended below
+  // zero) or the compression side, at e.
+  double side_modulus(double e, bool tension) const {
+    return (e >= 0.0) == tension ? table_modulus(e) : zero_segment_slope(tension);
+  }
+  // The slope of the table's segment that starts (tension) or ends at zero
+  // strain; a table that starts at zero extends its first segment.
+  double zero_segment_slope(bool tension) const {
+    const auto zero = std::find(strain_.begin(), strain_.end(), 0.0);
+    if (zero == strain_.end() || strain_.size() < 2) return std::nan("");
+    const size_t z = static_cast<size_t>(zero - strain_.begin());
+    const size_t k = tension ? std::min(z, strain_.size() - 2) : (z > 0 ? z - 1 : 0);
+    return (stress_[k + 1] - stress_[k]) / (strain_[k + 1] - strain_[k]);
+  }
+  double side_slope(double e, bool tension) const {
+    return (e >= 0.0) == tension ? table_slope(e) : 0.0;
+  }
 
   std::vector<double> strain_, stress_;
+  double w_;
 };
 
 }  // namespace
@@ -241,8 +276,10 @@ FiberLaw FiberLaw::bilinear(double Y_t, double Y_c, double transition) {
   return {std::make_shared<const BilinearLaw>(transition), {Y_t, Y_c}};
 }
 
-FiberLaw FiberLaw::tabulated(std::vector<double> strain, std::vector<double> stress) {
-  return {std::make_shared<const TabulatedLaw>(std::move(strain), std::move(stress)), {1.0}};
+FiberLaw FiberLaw::tabulated(std::vector<double> strain, std::vector<double> stress,
+                             double transition) {
+  return {std::make_shared<const TabulatedLaw>(std::move(strain), std::move(stress), transition),
+          {1.0}};
 }
 
 int FiberLaw::parameter_index(const std::string& name) const {

@@ -71,8 +71,11 @@ class FiberLaw {
   static FiberLaw bilinear(double Y_t, double Y_c, double transition = 0.005);
   // A piecewise-linear sigma(e), e.g. from a tensile test, times the
   // parameter `scale`: strain strictly increasing, one point (0, 0); outside
-  // the table the end segments are extended.
-  static FiberLaw tabulated(std::vector<double> strain, std::vector<double> stress);
+  // the table the end segments are extended. Where the slopes on the two
+  // sides of zero differ, the moduli are blended C1 over |e| < transition as
+  // in the bilinear law (0: the sharp table).
+  static FiberLaw tabulated(std::vector<double> strain, std::vector<double> stress,
+                            double transition = 0.005);
 
   std::string name() const { return model_->name(); }
   bool is_constant() const { return model_->is_constant(); }

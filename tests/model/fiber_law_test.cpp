@@ -32,10 +32,36 @@ TEST(FiberLaw, ValuesOfEachLaw) {
   EXPECT_DOUBLE_EQ(table.modulus(-0.5), 1000.0);
 }
 
+// Issue 29: a table 17.5 kPa below zero strain and 20 kPa above. Sharp, its
+// modulus jumps at e = 0; by default the two sides are blended over |e| <
+// 0.005 (C1, as the bilinear law), Y(0) their mean; outside, the table.
+TEST(FiberLaw, ATablesSlopeJumpAtZeroIsSmoothedByDefault) {
+  const std::vector<double> strain = {-0.2, 0.0, 0.2}, stress = {-3500.0, 0.0, 4000.0};
+  const FiberLaw sharp = FiberLaw::tabulated(strain, stress, 0.0);
+  EXPECT_EQ(sharp.modulus(-1e-12), 17500.0);
+  EXPECT_EQ(sharp.modulus(0.0), 20000.0);
+  const FiberLaw smooth = FiberLaw::tabulated(strain, stress);
+  EXPECT_NEAR(smooth.modulus(-1e-12), smooth.modulus(1e-12), 1e-6);
+  EXPECT_DOUBLE_EQ(smooth.modulus(0.0), 18750.0);
+  EXPECT_DOUBLE_EQ(smooth.modulus(0.005), 20000.0);
+  EXPECT_DOUBLE_EQ(smooth.modulus(-0.005), 17500.0);
+  EXPECT_DOUBLE_EQ(smooth.modulus(0.1), 20000.0);
+  // C1 at the blend's ends: the slope vanishes there from both sides.
+  EXPECT_NEAR(smooth.slope(0.005 - 1e-12), 0.0, 1e-3);
+  EXPECT_NEAR(smooth.slope(-0.005 + 1e-12), 0.0, 1e-3);
+  // The blend is part of the law's settings (written to the outputs).
+  const auto settings = smooth.settings();
+  ASSERT_EQ(settings.size(), 3u);
+  EXPECT_EQ(settings[2].name, "transition");
+  EXPECT_EQ(settings[2].values[0], 0.005);
+}
+
 TEST(FiberLaw, SlopesAndParameterDerivativesMatchCentralDifferences) {
-  const FiberLaw laws[] = {FiberLaw::constant(3000.0), FiberLaw::exponential(2000.0, 5.0),
-                           FiberLaw::bilinear(3000.0, 1000.0),
-                           FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
+  const FiberLaw laws[] = {
+      FiberLaw::constant(3000.0), FiberLaw::exponential(2000.0, 5.0),
+      FiberLaw::bilinear(3000.0, 1000.0),
+      FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0}),
+      FiberLaw::tabulated({-0.2, 0.0, 0.002, 0.3}, {-3500.0, 0.0, 40.0, 6500.0}, 0.005)};
   for (const FiberLaw& law : laws)
     for (double e : {-0.37, -0.05, -0.004, 0.001, 0.03, 0.17, 0.6}) {
       const double h = 1e-6;

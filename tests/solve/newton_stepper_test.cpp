@@ -242,6 +242,24 @@ TEST(Newton, ADivergingStepIsAStatusNamingTheStepWithFiniteUnknowns) {
   }
 }
 
+// Issue 29 (from issue 23): a tabulated law 17.5 kPa below zero strain and
+// 20 kPa above stalls Newton on the paper's hanging sphere (water) near load
+// factor 0.6 when sharp; the default blend over |e| < 0.005 runs to full load.
+TEST(Newton, ATablesSlopeJumpAtZeroNoLongerStallsNewton) {
+  const std::vector<double> strain = {-0.5, 0.0, 0.5}, stress = {-8750.0, 0.0, 10000.0};
+  const SteppingSummary sharp = solve_load_steps(
+      hanging_sphere(model::FiberLaw::tabulated(strain, stress, 0.0), 1000.0), newton(5));
+  EXPECT_FALSE(sharp.success);
+  EXPECT_NE(sharp.message.find("step 3: newton: the line search found no decrease"),
+            std::string::npos)
+      << sharp.message;
+  const SteppingSummary smooth = solve_load_steps(
+      hanging_sphere(model::FiberLaw::tabulated(strain, stress), 1000.0), newton(5));
+  ASSERT_TRUE(smooth.success) << smooth.message;
+  EXPECT_EQ(smooth.steps.size(), 5u);
+  EXPECT_TRUE(smooth.unknowns.allFinite());
+}
+
 // A sphere resting on supports at its bottom, pressed by a paddle from above.
 model::Model pressed_sphere(bool sticking) {
   model::Model m = testing::paper_sphere_model();
