@@ -2,6 +2,7 @@
 #include "bridge/fem_bridge.hpp"
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -26,39 +27,49 @@ int nearest_row(const Eigen::MatrixXd& points, const Eigen::RowVectorXd& p) {
 
 [[noreturn]] void fail(const std::string& what) { throw InputError(what); }
 
-}  // namespace
+// The body of a model posed for the FEM: its tetrahedra, their boundary, and
+// what holds and loads them at each load step (1..steps). `state` refers to
+// the model: it lives while the model does.
+struct PosedFem {
+  fem::Mesh mesh;
+  fem::Boundary boundary;
+  double mesh_seconds = 0.0;
+  fem::LoadPath state;
+};
 
-FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Material& material,
-                              const fem::TetMeshOptions& mesh_options) {
+PosedFem pose_fem(const model::Model& m, int steps, const fem::TetMeshOptions& mesh_options) {
   if (m.dim() != 3) fail("needs a closed 3D surface (this one is 2D)");
   if (!m.paddles.empty())
     fail("paddles (contact) are not supported: use supports, prescribed displacements and loads");
-  FemOfModel out;
+  PosedFem posed;
   const auto start = std::chrono::steady_clock::now();
-  out.mesh = fem::tetrahedralize(m.surface, mesh_options);
-  out.mesh_seconds = seconds_since(start);
-  const fem::Boundary boundary = fem::boundary(out.mesh);
-  out.rest_boundary = boundary.surface;
+  posed.mesh = fem::tetrahedralize(m.surface, mesh_options);
+  posed.mesh_seconds = seconds_since(start);
+  posed.boundary = fem::boundary(posed.mesh);
+  const fem::Mesh& mesh = posed.mesh;
+  const fem::Boundary& boundary = posed.boundary;
 
   // A boundary node is held on an axis where the surface under it is: when
   // every vertex spanning its closest surface point (a vertex, an edge's two,
-  // a triangle's three) is held on that axis, at their interpolated values.
+  // a triangle's three) is held on that axis, at their interpolated values:
+  // the weights, found once, interpolate each step's held values.
   const Eigen::MatrixXd& V = m.surface.V;
-  std::vector<std::map<int, double>> vertex_held(
-      static_cast<size_t>(m.num_vertices()));  // axis -> value
+  std::vector<std::map<int, const model::Constraint*>> vertex_held(
+      static_cast<size_t>(m.num_vertices()));  // axis -> its constraint
   for (const model::Constraint& k : m.constraints)
-    vertex_held[static_cast<size_t>(k.vertex)][k.axis] = model::held_value(m, k, steps, steps);
+    vertex_held[static_cast<size_t>(k.vertex)][k.axis] = &k;
   const fit::TargetDistance surface(fit::make_target("the surface", V, m.surface.F));
-  std::map<std::pair<int, int>, double> held;  // (node, axis) -> value
+  // (node, axis) -> the constraints it interpolates, with their weights.
+  std::map<std::pair<int, int>, std::vector<std::pair<const model::Constraint*, double>>> held;
   std::vector<bool> vertex_reached(static_cast<size_t>(m.num_vertices()), false);
   for (int node : boundary.nodes) {
     const fit::TargetDistance::Closest closest =
-        surface.closest(Eigen::Vector3d(out.mesh.nodes.row(node)));
+        surface.closest(Eigen::Vector3d(mesh.nodes.row(node)));
     const Eigen::Vector3i corners = m.surface.F.row(closest.primitive);
     const Eigen::Vector3d weights = geom::barycentric_coordinates(
         closest.point, V.row(corners[0]), V.row(corners[1]), V.row(corners[2]));
     for (int axis = 0; axis < 3; ++axis) {
-      double value = 0.0;
+      std::vector<std::pair<const model::Constraint*, double>> terms;
       bool all = true;
       for (int k = 0; k < 3; ++k) {
         if (weights[k] <= 1e-9) continue;  // not spanning the point
@@ -67,10 +78,10 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
         if (it == h.end())
           all = false;
         else
-          value += weights[k] * it->second;
+          terms.emplace_back(it->second, weights[k]);
       }
       if (!all) continue;
-      held[{node, axis}] = value;
+      held[{node, axis}] = terms;
       for (int k = 0; k < 3; ++k)
         if (weights[k] > 1e-9) vertex_reached[static_cast<size_t>(corners[k])] = true;
     }
@@ -81,42 +92,87 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
     if (vertex_reached[static_cast<size_t>(v)] || vertex_held[static_cast<size_t>(v)].empty())
       continue;
     const int node = boundary.nodes[static_cast<size_t>(nearest_row(boundary.surface.V, V.row(v)))];
-    for (const auto& [axis, value] : vertex_held[static_cast<size_t>(v)])
-      held.emplace(std::make_pair(node, axis), value);
+    for (const auto& [axis, constraint] : vertex_held[static_cast<size_t>(v)])
+      held.emplace(std::make_pair(node, axis),
+                   std::vector<std::pair<const model::Constraint*, double>>{{constraint, 1.0}});
   }
-  fem::Constraints constraints;
-  for (const auto& [key, value] : held) constraints.hold(3 * key.first + key.second, value);
-
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(out.mesh.num_dofs());
+  // Each load at factor 1: a point load on the node nearest its vertex,
+  // gravity as a body force of the fluid's density.
+  std::vector<Eigen::VectorXd> unit_loads;
   for (const model::Load& load : m.loads) {
-    const double factor = load.schedule.factor(steps, steps);
-    switch (load.kind) {
-      case model::Load::Kind::Point: {
-        const int node =
-            boundary
-                .nodes[static_cast<size_t>(nearest_row(boundary.surface.V, V.row(load.vertex)))];
-        f.segment(3 * node, 3) += factor * load.force;
-        continue;
-      }
-      case model::Load::Kind::Hydrostatic: {
-        // The fluid's weight as the solid's body force of the same density.
-        fem::Material fluid = material;
-        fluid.density = load.density;
-        f += fem::body_forces(out.mesh, fluid, factor * load.acceleration);
-        continue;
-      }
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh.num_dofs());
+    if (load.kind == model::Load::Kind::Point) {
+      const int node =
+          boundary.nodes[static_cast<size_t>(nearest_row(boundary.surface.V, V.row(load.vertex)))];
+      f.segment(3 * node, 3) = load.force;
+    } else if (load.kind == model::Load::Kind::Hydrostatic) {
+      fem::Material fluid;
+      fluid.density = load.density;
+      f = fem::body_forces(mesh, fluid, load.acceleration);
+    } else {
+      fail("a load of an unknown kind");
     }
-    fail("a load of an unknown kind");
+    unit_loads.push_back(std::move(f));
   }
+  posed.state = [&m, steps, held, unit_loads, dofs = mesh.num_dofs()](int step) {
+    fem::LoadState state;
+    for (const auto& [key, terms] : held) {
+      double value = 0.0;
+      for (const auto& [constraint, weight] : terms)
+        value += weight * model::held_value(m, *constraint, step, steps);
+      state.held.hold(3 * key.first + key.second, value);
+    }
+    state.forces = Eigen::VectorXd::Zero(dofs);
+    for (size_t l = 0; l < m.loads.size(); ++l)
+      state.forces += m.loads[l].schedule.factor(step, steps) * unit_loads[l];
+    return state;
+  };
+  return posed;
+}
+
+// The outputs of a solve: displacements and the boundary before and after.
+void finish(const PosedFem& posed, const Eigen::VectorXd& u, FemOfModel* out) {
+  out->mesh = posed.mesh;
+  out->mesh_seconds = posed.mesh_seconds;
+  out->displacement = fem::displacement_rows(u, 3);
+  out->rest_boundary = posed.boundary.surface;
+  out->deformed_boundary = fem::boundary(posed.mesh, posed.mesh.nodes + out->displacement).surface;
+}
+
+}  // namespace
+
+FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Material& material,
+                              const fem::TetMeshOptions& mesh_options) {
+  const PosedFem posed = pose_fem(m, steps, mesh_options);
+  const fem::LoadState last = posed.state(steps);
+  FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();
   Eigen::VectorXd u;
   const solve::Status status =
-      fem::solve_static(fem::stiffness_matrix(out.mesh, material), f, constraints, &u);
+      fem::solve_static(fem::stiffness_matrix(posed.mesh, material), last.forces, last.held, &u);
   if (!status.ok) fail(status.message);
   out.solve_seconds = seconds_since(solve_start);
-  out.displacement = fem::displacement_rows(u, 3);
-  out.deformed_boundary = fem::boundary(out.mesh, out.mesh.nodes + out.displacement).surface;
+  finish(posed, u, &out);
+  out.path.push_back(out.displacement);
+  return out;
+}
 
+FemOfModel solve_hyperelastic_fem_of_model(const model::Model& m, int steps,
+                                           const fem::HyperelasticMaterial& material,
+                                           const fem::TetMeshOptions& mesh_options,
+                                           fem::HyperelasticOptions options) {
+  const PosedFem posed = pose_fem(m, steps, mesh_options);
+  options.steps = steps;
+  FemOfModel out;
+  const auto solve_start = std::chrono::steady_clock::now();
+  fem::HyperelasticSolution solution;
+  const solve::Status status =
+      fem::solve_hyperelastic(posed.mesh, material, posed.state, options, &solution);
+  if (!status.ok) fail(status.message);
+  out.solve_seconds = seconds_since(solve_start);
+  out.newton_iterations = solution.newton_iterations;
+  finish(posed, solution.u, &out);
+  for (const Eigen::VectorXd& u : solution.path) out.path.push_back(fem::displacement_rows(u, 3));
   return out;
 }
 

@@ -4,7 +4,8 @@
 // A finite-element reference for any simulation on a closed 3D surface:
 // the body filled with linear tetrahedra (fem::tetrahedralize), the same
 // supports, prescribed displacements, point loads and gravity at their
-// final load factors, solved quasi-statically by linear elasticity. Its
+// final load factors, solved quasi-statically by linear elasticity; or, by
+// neo-Hookean elements (fem/hyperelastic.hpp), along the model's load steps. Its
 // deformed boundary is a target surface the calibration can fit
 // (fem_reference.obj), a model that no one tuned.
 //
@@ -15,8 +16,10 @@
 // the node nearest its vertex; gravity is a body force of the load's density.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "fem/fem.hpp"
+#include "fem/hyperelastic.hpp"
 #include "fem/tet_mesher.hpp"
 #include "geom/surface.hpp"
 #include "model/model.hpp"
@@ -24,8 +27,10 @@
 namespace fiberfluid::bridge {
 
 struct FemOfModel {
-  fem::Mesh mesh;                // the tetrahedra at rest
-  Eigen::MatrixXd displacement;  // per node
+  fem::Mesh mesh;                     // the tetrahedra at rest
+  Eigen::MatrixXd displacement;       // per node
+  std::vector<Eigen::MatrixXd> path;  // the displacement after each load step (linear: the last)
+  int newton_iterations = 0;          // the nonlinear solve's
   geom::Surface rest_boundary, deformed_boundary;
   double mesh_seconds = 0.0, solve_seconds = 0.0;
 };
@@ -35,5 +40,12 @@ struct FemOfModel {
 // pose (a 2D surface, paddles, a load of an unknown kind, a singular setup).
 FemOfModel solve_fem_of_model(const model::Model& model, int steps, const fem::Material& material,
                               const fem::TetMeshOptions& mesh_options);
+// The same body of neo-Hookean tetrahedra, solved along the model's `steps`
+// load steps (each load's schedule, each prescribed motion's); a step that
+// fails (after options.max_step_cuts halvings) throws InputError naming it.
+FemOfModel solve_hyperelastic_fem_of_model(const model::Model& model, int steps,
+                                           const fem::HyperelasticMaterial& material,
+                                           const fem::TetMeshOptions& mesh_options,
+                                           fem::HyperelasticOptions options = {});
 
 }  // namespace fiberfluid::bridge

@@ -25,9 +25,10 @@ using nlohmann::json;
 // ------------------------------------------------------------ surfaces
 // A generator's parameters, checked now; the surface is made when the case is built.
 std::function<geom::Surface()> read_generator(Fields& f) {
-  const std::string kind = f.choice("generator", "",
-                                    {"icosphere", "tetrahedron", "octahedron", "icosahedron",
-                                     "cube", "box", "dome", "torus", "rectangle", "polygon"});
+  const std::string kind =
+      f.choice("generator", "",
+               {"icosphere", "tetrahedron", "octahedron", "icosahedron", "cube", "box", "dome",
+                "cylinder", "torus", "rectangle", "polygon"});
   if (kind == "icosphere") {
     const int subdivisions = f.integer("subdivisions", 2, 0, 7);
     const double radius = f.positive("radius", 1.0);
@@ -54,6 +55,14 @@ std::function<geom::Surface()> read_generator(Fields& f) {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
     return [=] { return geom::dome(semi_axes, subdivisions); };
+  }
+  if (kind == "cylinder") {
+    const double radius = f.positive("radius", 1.0), length = f.positive("length", 1.0);
+    Eigen::Vector2i segments(24, 24);
+    if (f.has("segments")) segments = f.counts("segments", 2, 1, 1000);
+    if (segments.y() < 3) f.fail("segments", "expected at least 3 segments around");
+    const int cap_rings = f.integer("cap_rings", 0, 0, 1000);
+    return [=] { return geom::cylinder(radius, length, segments.x(), segments.y(), cap_rings); };
   }
   if (kind == "torus") {
     const double major = f.positive("major_radius", 2.0), minor = f.positive("minor_radius", 0.7);

@@ -26,6 +26,10 @@ FemReferenceSpec read_fem_reference(Fields& f) {
   spec.poisson = f.number("nu");
   if (!(spec.poisson > -1.0 && spec.poisson < 0.5))
     f.fail("nu", "expected a Poisson ratio between -1 and 0.5 (exclusive)");
+  const std::string material =
+      f.choice("material", "linear", {"linear", "neo_hookean", "neo_hookean_incompressible"});
+  spec.nonlinear = material != "linear";
+  if (spec.nonlinear) spec.hyperelastic = fem::hyperelastic_from_string(material);
   spec.mesh.size = f.non_negative("size", 0.0);
   spec.mesh.facet_distance = f.non_negative("facet_distance", 0.0);
   spec.mesh.feature_angle = f.positive("feature_angle", spec.mesh.feature_angle);
@@ -43,12 +47,21 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
   FemReferenceResult out;
   bridge::FemOfModel fem;
   try {
-    fem = bridge::solve_fem_of_model(m, c.stepping.steps, material, spec.mesh);
+    if (spec.nonlinear) {
+      fem::HyperelasticMaterial solid;
+      solid.kind = spec.hyperelastic;
+      solid.young = spec.young;
+      solid.poisson = spec.poisson;
+      fem = bridge::solve_hyperelastic_fem_of_model(m, c.stepping.steps, solid, spec.mesh);
+    } else {
+      fem = bridge::solve_fem_of_model(m, c.stepping.steps, material, spec.mesh);
+    }
   } catch (const InputError& e) {
     fail(e.what());
   }
   out.mesh = std::move(fem.mesh);
   out.displacement = std::move(fem.displacement);
+  out.path = std::move(fem.path);
   out.rest_boundary = std::move(fem.rest_boundary);
   out.deformed_boundary = std::move(fem.deformed_boundary);
   const double mesh_seconds = fem.mesh_seconds, solve_seconds = fem.solve_seconds;
@@ -59,6 +72,7 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
   fig["fem_reference.tetrahedra"] = static_cast<double>(out.mesh.elements.rows());
   fig["fem_reference.mesh_seconds"] = mesh_seconds;
   fig["fem_reference.solve_seconds"] = solve_seconds;
+  if (spec.nonlinear) fig["fem_reference.newton_iterations"] = fem.newton_iterations;
   fig["fem_reference.max_displacement"] = out.displacement.rowwise().norm().maxCoeff();
   try {  // how far the tetrahedra's boundary is from the surface before any load
     fig["fem_reference.rest_surface_error"] = metrics::surface_error(m.surface, out.rest_boundary);

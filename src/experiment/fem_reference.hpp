@@ -7,8 +7,10 @@
 #include <Eigen/Core>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "fem/fem.hpp"
+#include "fem/hyperelastic.hpp"
 #include "fem/tet_mesher.hpp"
 #include "geom/surface.hpp"
 
@@ -21,13 +23,18 @@ class Fields;
 struct FemReferenceSpec {
   double young = 0.0;    // E (Pa)
   double poisson = 0.3;  // nu
+  // "linear" (small strain, the final loads at once) or a neo-Hookean
+  // solid solved along the case's load steps (fem::Hyperelastic).
+  bool nonlinear = false;
+  fem::Hyperelastic hyperelastic = fem::Hyperelastic::NeoHookean;
   fem::TetMeshOptions mesh;
 };
 FemReferenceSpec read_fem_reference(Fields& f);
 
 struct FemReferenceResult {
-  fem::Mesh mesh;                // the tetrahedra at rest
-  Eigen::MatrixXd displacement;  // per node
+  fem::Mesh mesh;                     // the tetrahedra at rest
+  Eigen::MatrixXd displacement;       // per node
+  std::vector<Eigen::MatrixXd> path;  // the displacement after each load step (linear: the last)
   geom::Surface rest_boundary, deformed_boundary;
   std::map<std::string, double> figures;  // "fem_reference.*"
 };

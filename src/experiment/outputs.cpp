@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "experiment/output_folder.hpp"
+#include "fem/mesh_tools.hpp"
 #include "geom/area_vectors.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/vtk_writer.hpp"
@@ -497,6 +498,25 @@ void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
     write_state(run, record.step, unknowns);
 }
 
+void OutputWriter::write_fem_path(const FemReferenceResult& f) {
+  std::filesystem::create_directories(staging_ / "fem_reference_vtk");
+  std::vector<std::pair<double, std::string>> series;
+  const fem::Boundary boundary = fem::boundary(f.mesh);
+  for (size_t k = 0; k < f.path.size(); ++k) {
+    geom::Surface deformed = f.rest_boundary;
+    Eigen::MatrixXd U(deformed.num_vertices(), 3);
+    for (int v = 0; v < deformed.num_vertices(); ++v)
+      U.row(v) = f.path[k].row(boundary.nodes[static_cast<size_t>(v)]);
+    deformed.V += U;
+    char name[32];
+    std::snprintf(name, sizeof name, "step_%04zu.vtu", k + 1);
+    geom::write_vtu(staging_ / "fem_reference_vtk" / name, deformed,
+                    {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}});
+    series.emplace_back(static_cast<double>(k + 1), std::string("fem_reference_vtk/") + name);
+  }
+  geom::write_pvd(staging_ / "fem_reference_series.pvd", series);
+}
+
 void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& more) {
   for (size_t r = 0; r < result.runs.size(); ++r) {
     const Case& c = experiment_.cases[r];
@@ -520,6 +540,8 @@ void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& mo
     Eigen::MatrixXd U = f.deformed_boundary.V - f.rest_boundary.V;
     geom::write_vtu(staging_ / "fem_reference.vtu", f.deformed_boundary,
                     {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}});
+    // A nonlinear FEM's load path: its boundary after each step, a series.
+    if (f.path.size() > 1) write_fem_path(f);
   }
   if (result.benchmark) {
     const BenchmarkResult& b = *result.benchmark;

@@ -177,6 +177,61 @@ Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions) {
   return s;
 }
 
+Surface cylinder(double radius, double length, int along, int around, int cap_rings) {
+  require_positive(radius, "cylinder radius");
+  require_positive(length, "cylinder length");
+  if (along < 1) throw InputError("cylinder: along must be at least 1");
+  if (around < 3) throw InputError("cylinder: around must be at least 3");
+  if (cap_rings < 0) throw InputError("cylinder: cap_rings must be 0 or more");
+  if (cap_rings == 0) cap_rings = std::max(1, static_cast<int>(std::lround(around / (2.0 * M_PI))));
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> faces;
+  const auto ring = [&](double x, double rho) {  // `around` vertices; its first index
+    const int first = static_cast<int>(vertices.size());
+    for (int j = 0; j < around; ++j) {
+      const double theta = 2.0 * M_PI * j / around;
+      vertices.emplace_back(x, rho * std::cos(theta), rho * std::sin(theta));
+    }
+    return first;
+  };
+  // Quads between two rings, split in two, with normal (around) x (from ->
+  // to), or the opposite when `flip`.
+  const auto band = [&](int from, int to, bool flip) {
+    for (int j = 0; j < around; ++j) {
+      const int a = from + j, b = from + (j + 1) % around, c = to + (j + 1) % around, d = to + j;
+      if (flip)
+        faces.insert(faces.end(), {{a, c, b}, {a, d, c}});
+      else
+        faces.insert(faces.end(), {{a, b, c}, {a, c, d}});
+    }
+  };
+  std::vector<int> wall;
+  for (int i = 0; i <= along; ++i) wall.push_back(ring(length * i / along, radius));
+  for (int i = 0; i < along; ++i)
+    band(wall[static_cast<size_t>(i)], wall[static_cast<size_t>(i + 1)], false);
+  // Each cap: from its centre out to the wall's end ring.
+  for (const bool far_end : {false, true}) {
+    const double x = far_end ? length : 0.0;
+    const int centre = static_cast<int>(vertices.size());
+    vertices.emplace_back(x, 0.0, 0.0);
+    int inner = -1;
+    for (int k = 1; k <= cap_rings; ++k) {
+      const int outer = k == cap_rings ? wall[far_end ? static_cast<size_t>(along) : 0]
+                                       : ring(x, radius * k / cap_rings);
+      if (inner < 0) {
+        for (int j = 0; j < around; ++j) {
+          const int a = outer + j, b = outer + (j + 1) % around;
+          faces.push_back(far_end ? Eigen::Vector3i(centre, a, b) : Eigen::Vector3i(centre, b, a));
+        }
+      } else {
+        band(inner, outer, far_end);
+      }
+      inner = outer;
+    }
+  }
+  return from_lists(vertices, faces);
+}
+
 Surface torus(double R, double r, int around, int tube) {
   require_positive(r, "torus tube radius");
   if (!(R > r)) throw InputError("torus: the ring radius must exceed the tube radius");

@@ -29,6 +29,12 @@ Surface cube(double edge = 1.0);
 // semi-axes. The wall vertices have z = 0 exactly.
 Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions);
 
+// Closed cylinder along the x axis from x = 0 to x = length, of radius r:
+// `along` segments along it, `around` around it, each end cap a disk of
+// `cap_rings` concentric rings (0: about as many as keep its triangles the
+// size of the wall's) around a centre vertex.
+Surface cylinder(double radius, double length, int along, int around, int cap_rings = 0);
+
 // Torus around the z axis: tube centre radius R, tube radius r, with
 // `around` segments along the ring and `tube` around the tube (genus 1).
 Surface torus(double R, double r, int around, int tube);

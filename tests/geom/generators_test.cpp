@@ -27,6 +27,8 @@ TEST(Generators, EverySolidIsClosedAndOutward) {
   expect_closed_outward(cube());
   expect_closed_outward(box({-1, 0, 2}, {1, 0.5, 3}, {4, 2, 3}));
   expect_closed_outward(dome({0.07, 0.07, 0.06}, 2));
+  expect_closed_outward(cylinder(0.02, 0.18, 18, 16));
+  expect_closed_outward(cylinder(1.0, 0.5, 1, 3, 1));
   expect_closed_outward(rectangle({0, 0}, {1, 1}, 4, 3));
 }
 
@@ -39,6 +41,18 @@ TEST(Generators, Counts) {
   EXPECT_EQ(b.num_vertices(), 3 * 4 * 5 - 1 * 2 * 3);
   EXPECT_EQ(b.num_faces(), 4 * (2 * 3 + 3 * 4 + 2 * 4));
   EXPECT_EQ(rectangle({0, 0}, {1, 1}, 4, 3).num_vertices(), 14);
+}
+
+TEST(Generators, ACylindersVolumeAndCountsAreThePrismsInItsCircle) {
+  const int along = 10, around = 24, rings = 4;
+  const Surface c = cylinder(0.02, 0.18, along, around, rings);
+  // The wall's rings, each cap's inner rings and centre.
+  EXPECT_EQ(c.num_vertices(), (along + 1) * around + 2 * ((rings - 1) * around + 1));
+  // The inscribed 24-gon's area times the length: 12 r^2 sin(2 pi / 24) L.
+  const double polygon_area = 0.5 * around * 0.02 * 0.02 * std::sin(2.0 * M_PI / around);
+  EXPECT_NEAR(enclosed_volume(c.V, c.F), polygon_area * 0.18, 1e-15);
+  EXPECT_NEAR(c.V.col(0).minCoeff(), 0.0, 0.0);
+  EXPECT_NEAR(c.V.col(0).maxCoeff(), 0.18, 1e-15);
 }
 
 TEST(Generators, VerticesLieOnTheCircumsphere) {
@@ -79,6 +93,8 @@ TEST(Generators, RejectBadParameters) {
   EXPECT_THROW(box({0, 0, 0}, {1, 0, 1}), InputError);
   EXPECT_THROW(rectangle({0, 0}, {1, 1}, 0, 1), InputError);
   EXPECT_THROW(polygon(Eigen::MatrixXd::Zero(2, 2)), InputError);
+  EXPECT_THROW(cylinder(0.02, 0.18, 4, 2), InputError);
+  EXPECT_THROW(cylinder(0.02, -1.0, 4, 8), InputError);
 }
 
 }  // namespace
