@@ -128,7 +128,12 @@ def main(summary_path, png_path):
                 os.path.exists(os.path.join(run_folder(folder, r), "vertices.csv")) and
                 os.path.exists(os.path.join(run_folder(folder, r), "final.obj"))]
     paddles = [r for r in runs if r["steps"][-1].get("paddles")]
-    panels = (1 if drawable else 0) + 3 + (1 if paddles else 0) + (1 if round_trip else 0)
+    # Arc length: the load factor is an unknown; its curve against the
+    # displacement shows a limit point where it turns.
+    by_arc = [r for r in runs
+              if r["stepping"].get("newton", {}).get("control") == "arc_length"]
+    panels = ((1 if drawable else 0) + 3 + (1 if paddles else 0) + (1 if round_trip else 0)
+              + (1 if by_arc else 0))
     fig = plt.figure(figsize=(4.8 * panels, 4.5))
     k = 1
     if drawable:
@@ -163,6 +168,21 @@ def main(summary_path, png_path):
     if paddles:
         draw_paddle_forces(fig.add_subplot(1, panels, k), paddles)
         k += 1
+    if by_arc:
+        ax = fig.add_subplot(1, panels, k)
+        k += 1
+        for run in by_arc:
+            factors = [max(s["load_factors"].values()) for s in run["steps"]]
+            ax.plot([s["max_displacement"] for s in run["steps"]], factors, marker=".",
+                    label=run["variant"] or summary["experiment"])
+            if run.get("limit_load_factor") is not None:
+                ax.axhline(run["limit_load_factor"], color="k", ls="--", lw=0.8,
+                           label="limit load %.4g" % run["limit_load_factor"])
+        ax.set_xlabel("largest displacement |u| [m]")
+        ax.set_ylabel("load factor [-]")
+        ax.set_title("load path (arc length)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
     if round_trip:
         ax = fig.add_subplot(1, panels, k)
         by_kind = {}

@@ -372,6 +372,15 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
     options.newton = read_newton(f.object("newton"), options.newton);
   }
   options.steps = f.integer("steps", options.steps, 1, 100000);
+  if (f.has("control")) {
+    const bool arc = f.choice("control", "load", {"load", "arc_length"}) == "arc_length";
+    if (arc && options.scheme != solve::Scheme::Newton)
+      f.fail("control", "arc-length control needs \"scheme\": \"newton\"");
+    options.newton.control =
+        arc ? solve::NewtonOptions::Control::ArcLength : solve::NewtonOptions::Control::Load;
+  }
+  options.newton.max_arc_steps =
+      f.integer("max_arc_steps", options.newton.max_arc_steps, 1, 100000);
   options.rebuild_matrix = f.boolean("rebuild_matrix", options.rebuild_matrix);
   options.update_load_geometry = f.boolean("update_load_geometry", options.update_load_geometry);
   const std::string method = f.choice("boundary_method", model::to_string(options.boundary_method),

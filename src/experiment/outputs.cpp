@@ -29,17 +29,20 @@ json vector_json(const Eigen::Vector3d& v, int dim) {
 }
 
 json newton_options_json(const solve::NewtonOptions& n) {
-  return {{"residual_tolerance", n.residual_tolerance},
-          {"increment_tolerance", n.increment_tolerance},
-          {"max_iterations", n.max_iterations},
-          {"max_step_cuts", n.max_step_cuts},
-          {"line_search", n.line_search},
-          {"tangent", solve::to_string(n.tangent)},
-          {"krylov_tolerance", n.krylov_tolerance},
-          {"krylov_restart", n.krylov_restart},
-          {"krylov_max_iterations", n.krylov_max_iterations},
-          {"max_contact_rounds", n.max_contact_rounds},
-          {"predictor", n.predictor}};
+  return {
+      {"residual_tolerance", n.residual_tolerance},
+      {"increment_tolerance", n.increment_tolerance},
+      {"max_iterations", n.max_iterations},
+      {"max_step_cuts", n.max_step_cuts},
+      {"line_search", n.line_search},
+      {"tangent", solve::to_string(n.tangent)},
+      {"krylov_tolerance", n.krylov_tolerance},
+      {"krylov_restart", n.krylov_restart},
+      {"krylov_max_iterations", n.krylov_max_iterations},
+      {"max_contact_rounds", n.max_contact_rounds},
+      {"predictor", n.predictor},
+      {"control", n.control == solve::NewtonOptions::Control::ArcLength ? "arc_length" : "load"},
+      {"max_arc_steps", n.max_arc_steps}};
 }
 
 json stepping_json(const solve::SteppingOptions& s) {
@@ -139,6 +142,9 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"material", law_json(m.material, m.dim())},
           {"newton_iterations", run.summary.newton_iterations},
           {"krylov_iterations", run.summary.krylov_iterations},
+          {"limit_load_factor", std::isnan(run.summary.limit_load_factor)
+                                    ? json(nullptr)
+                                    : json(run.summary.limit_load_factor)},
           {"success", run.summary.success},
           {"message", run.summary.message},
           {"factorizations", run.summary.factorizations},

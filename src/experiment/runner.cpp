@@ -161,6 +161,10 @@ std::optional<double> run_figure(const Case& ex, const RunResult& run, const std
   if (name == "steps") return static_cast<double>(run.summary.steps.size());
   if (name == "factorizations") return run.summary.factorizations;
   if (name == "newton_iterations") return run.summary.newton_iterations;
+  if (name == "limit_load_factor") {  // arc length: where the path turned back
+    if (std::isnan(run.summary.limit_load_factor)) return std::nullopt;
+    return run.summary.limit_load_factor;
+  }
   if (name == "max_newton_iterations_per_step" || name == "step_cuts" ||
       name == "max_equilibrium_residual") {
     double value = 0.0;

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,6 +62,12 @@ struct NewtonOptions {
   // (quadratic in the last three converged points) rather than from the last
   // solution: fewer iterations on a smooth path.
   bool predictor = true;
+  // How the load path is followed: by the load (each step's load factor is
+  // set, as the paper steps) or by arc length (Crisfield's cylindrical
+  // constraint on the displacements: the load factor is an unknown, so the
+  // path is traced through a limit point where the load peaks).
+  enum class Control { Load, ArcLength } control = Control::Load;
+  int max_arc_steps = 200;  // arc length: steps before giving up on reaching the final load
 
   bool IsValid(std::string* why) const;
 };
@@ -142,7 +149,10 @@ struct SteppingSummary {
   SolverKind solver = SolverKind::Auto;  // the backend that ran (newton: the preconditioner's)
   TangentSolver tangent = TangentSolver::Auto;  // newton: how the tangent was solved
   int newton_iterations = 0;                    // newton: over all steps
-  int krylov_iterations = 0;                    // newton with krylov: over all solves
+  // Arc length: the largest load reached before the path turned back, as a
+  // share of the final load (the limit load), or NaN when it never turned.
+  double limit_load_factor = std::numeric_limits<double>::quiet_NaN();
+  int krylov_iterations = 0;  // newton with krylov: over all solves
   // The bordered system the backend factored last (reduced, boundary
   // conditions applied): what was actually solved.
   std::shared_ptr<const model::FiberSystem> system;

@@ -2,8 +2,10 @@
 // The Newton scheme (model.md section 7): equilibrium at every load step,
 // with a line search, step cutting, and rigid paddles as an active set.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -113,6 +115,84 @@ class NewtonSolver {
       out->col(c) = du;
     }
     return {};
+  }
+
+  using KeepStep = std::function<std::string(StepRecord&, double, Clock::time_point)>;
+
+  // Arc-length continuation (Crisfield 1981, the cylindrical constraint: each
+  // step moves the displacement unknowns by `arc` and the load parameter t
+  // is an unknown) from the point t = 1 in summary.unknowns on to the final
+  // load t = n, which the last step lands on by load control. The arc is the
+  // first step's length, halved when a step fails, grown by half after an
+  // easy one (at most 4 times the first). Where t falls, the path has passed a
+  // limit point (resolved with arcs down to 1/64 of the first, the peak of a
+  // parabola through the last three points): the largest load reached is
+  // kept (limit_load_factor) and,
+  // unless the path climbs to t = n again within max_arc_steps, the run ends
+  // naming it. `keep` records each converged point. "" or why it stopped.
+  std::string follow_arc_length(int n, SteppingSummary& summary, const KeepStep& keep) {
+    Eigen::VectorXd& x = summary.unknowns;
+    const DofMap dofs = held_map();
+    const Eigen::Index m = dofs.num_reduced() - 1;  // the displacements (the pressure last)
+    Eigen::VectorXd previous = dofs.reduce(x);      // the last step's increment (from 0)
+    const double first_arc = previous.head(m).norm();
+    if (!(first_arc > 0.0))
+      return "newton.control arc_length: the first step did not move the body";
+    double arc = first_arc, t = 1.0, peak = 1.0, previous_dt = 1.0;
+    std::vector<std::array<double, 2>> path = {{0.0, 0.0}, {first_arc, 1.0}};  // (arc length, t)
+    int cuts = 0, k = 2;
+    while (k <= newton_.max_arc_steps + 1) {
+      if (cancel_requested()) return "step " + std::to_string(k) + ": interrupted";
+      const Clock::time_point step_start = Clock::now();
+      StepRecord record;
+      record.step = k;
+      Eigen::VectorXd x_new;
+      double t_new = t;
+      std::string why = arc_step(n, dofs, x, t, arc, previous, previous_dt, &x_new, &t_new, record);
+      if (why.empty() && t_new >= n) {  // past the final load: land on it by load control
+        const double s = (n - t) / (t_new - t);
+        Eigen::VectorXd landing = x + s * (x_new - x);
+        why = solve(path_point(model_, n, n), landing, record);
+        if (why.empty()) {
+          x = landing;
+          return keep(record, n, step_start);
+        }
+      }
+      if (!why.empty()) {
+        if (cuts == newton_.max_step_cuts)
+          return "step " + std::to_string(k) + ": arc length: " + why + "; the arc was halved " +
+                 std::to_string(cuts) + " times (newton.max_step_cuts)" + limit_note(summary);
+        ++cuts;
+        arc *= 0.5;
+        continue;
+      }
+      const double dt = t_new - t;
+      // The first turn is resolved with short arcs, so that the limit load
+      // is found to a fraction of the first step's load.
+      if (dt < 0.0 && std::isnan(summary.limit_load_factor) && arc > first_arc / 64.0) {
+        arc *= 0.25;
+        continue;
+      }
+      path.push_back({path.back()[0] + arc, t_new});
+      if (dt < 0.0 && std::isnan(summary.limit_load_factor))
+        summary.limit_load_factor = std::max(peak, parabola_peak(path)) / n;
+      peak = std::max(peak, t_new);
+      previous = dofs.reduce(x_new) - dofs.reduce(x);
+      previous_dt = dt;
+      x = x_new;
+      t = t_new;
+      cuts = 0;
+      if (t <= 0.0)
+        return "step " + std::to_string(k) + ": arc length: the path returned to no load" +
+               limit_note(summary);
+      if (!(why = keep(record, t, step_start)).empty()) return why + limit_note(summary);
+      report_progress("arc-length step", k, newton_.max_arc_steps + 1);
+      if (record.newton_iterations <= 4) arc = std::min(1.5 * arc, 4.0 * first_arc);
+      ++k;
+    }
+    return "arc length: the final load was not reached in " +
+           std::to_string(newton_.max_arc_steps) + " steps (newton.max_arc_steps; load factor " +
+           std::to_string(t / n) + ")" + limit_note(summary);
   }
 
   // After a successful solve: the residual at the held unknowns is the force
@@ -295,6 +375,134 @@ class NewtonSolver {
     }
   }
 
+  // The largest t of the parabola through the path's last three points (arc
+  // length, t): the limit load between the points, where the path turned.
+  static double parabola_peak(const std::vector<std::array<double, 2>>& path) {
+    if (path.size() < 3) return path.back()[1];
+    const auto& [s0, t0] = path[path.size() - 3];
+    const auto& [s1, t1] = path[path.size() - 2];
+    const auto& [s2, t2] = path[path.size() - 1];
+    const double d01 = (t1 - t0) / (s1 - s0), d12 = (t2 - t1) / (s2 - s1);
+    const double curvature = (d12 - d01) / (s2 - s0);
+    if (!(curvature < 0.0)) return std::max({t0, t1, t2});
+    // Newton form: t(s) = t0 + d01 (s - s0) + curvature (s - s0)(s - s1).
+    const double s_peak = 0.5 * (s0 + s1) - d01 / (2.0 * curvature);
+    if (s_peak < s0 || s_peak > s2) return std::max({t0, t1, t2});
+    return t0 + d01 * (s_peak - s0) + curvature * (s_peak - s0) * (s_peak - s1);
+  }
+
+  // ": a limit point..." when the path has turned back, else "".
+  static std::string limit_note(const SteppingSummary& summary) {
+    if (std::isnan(summary.limit_load_factor)) return {};
+    std::ostringstream out;
+    out << "; a limit point: the load peaked at " << summary.limit_load_factor
+        << " of the final load (the body cannot carry more along this path)";
+    return out.str();
+  }
+
+  // The load factors at a path parameter t, the end segments extended
+  // beyond [0, n] (an arc-length corrector may step past the final load).
+  std::vector<double> factors_at(double t, int n) const {
+    if (t >= 0.0 && t <= n) return path_point(model_, t, n).factors;
+    const double edge = t > n ? n : 0.0, inner = t > n ? n - 1.0 : 1.0;
+    const std::vector<double> a = path_point(model_, edge, n).factors,
+                              b = path_point(model_, inner, n).factors;
+    std::vector<double> f(a.size());
+    for (size_t l = 0; l < a.size(); ++l) f[l] = a[l] + (t - edge) / (inner - edge) * (b[l] - a[l]);
+    return f;
+  }
+
+  // dR/dt at (x, t), reduced: exact, as R is affine in the load factors on
+  // the path segment that holds t (the one ahead in the direction `ahead`).
+  Eigen::VectorXd path_derivative(const DofMap& dofs, const Eigen::VectorXd& x, double t, int n,
+                                  bool ahead) const {
+    double lo = ahead ? std::floor(t) : std::ceil(t) - 1.0;
+    lo = std::clamp(lo, 0.0, n - 1.0);
+    const Eigen::VectorXd difference = equilibrium_->residual(x, factors_at(lo + 1.0, n)) -
+                                       equilibrium_->residual(x, factors_at(lo, n));
+    return dofs.reduce(difference);
+  }
+
+  // One arc-length step from (x0, t0): the predictor along du/dt, then
+  // corrections that keep |x - x0| = arc on the displacements (the root of
+  // the constraint's quadratic closest to the step's direction). "" or why not.
+  std::string arc_step(int n, const DofMap& dofs, const Eigen::VectorXd& x0, double t0, double arc,
+                       const Eigen::VectorXd& previous, double previous_dt, Eigen::VectorXd* x,
+                       double* t, StepRecord& record) {
+    const Eigen::Index m = dofs.num_reduced() - 1;
+    const auto solve_with_tangent = [&](const Eigen::VectorXd& at_x, double at_t,
+                                        const Eigen::VectorXd& rhs, double forcing,
+                                        Eigen::VectorXd* out) -> std::string {
+      Status status = tangent_->prepare(at_x, factors_at(at_t, n), dofs, &supports_);
+      if (status.ok) {
+        int iterations = 0;
+        status = tangent_->solve(rhs, forcing, out, &iterations);
+        record.krylov_iterations += iterations;
+        summary_.krylov_iterations += iterations;
+      }
+      summary_.factorizations = tangent_->factorizations();
+      return status.ok ? std::string() : status.message;
+    };
+    // Predictor: along du/dt = -K^-1 dR/dt, in the direction of the last step.
+    Eigen::VectorXd v;
+    std::string why =
+        solve_with_tangent(x0, t0, -path_derivative(dofs, x0, t0, n, previous_dt >= 0.0),
+                           newton_.krylov_tolerance, &v);
+    if (!why.empty()) return why;
+    const double speed = v.head(m).norm();
+    if (!(speed > 0.0) || !std::isfinite(speed)) return "the path's tangent is not finite";
+    const double sign = previous.head(m).dot(v.head(m)) >= 0.0 ? 1.0 : -1.0;
+    Eigen::VectorXd delta = (sign * arc / speed) * v;
+    double dt = sign * arc / speed;
+    for (int it = 0;; ++it) {
+      *t = t0 + dt;
+      *x = x0;
+      Eigen::VectorXd step = Eigen::VectorXd::Zero(x0.size());
+      dofs.scatter(delta, step);
+      *x += step;
+      const std::vector<double> factors = factors_at(*t, n);
+      const Eigen::VectorXd R = equilibrium_->residual(*x, factors);
+      PathPoint at;
+      at.factors = factors;
+      double scale = 0.0;
+      const double norm = measure(at, dofs, *x, R, &scale);
+      record.residual_norms.push_back(norm);
+      if (!std::isfinite(norm)) return "the residual is not finite";
+      if (norm <= newton_.residual_tolerance) {
+        residual_ = R;
+        gauge_.commit(scale);
+        return {};
+      }
+      if (it == newton_.max_iterations)
+        return "no convergence in " + std::to_string(it) + " iterations (relative residual " +
+               std::to_string(norm) + ")";
+      Eigen::VectorXd a, b;
+      const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
+      why = solve_with_tangent(*x, *t, -dofs.reduce(R), forcing, &a);
+      if (why.empty())
+        why = tangent_->solve(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
+                              newton_.krylov_tolerance, &b, nullptr)
+                      .ok
+                  ? ""
+                  : "the tangent solve for du/dt failed";
+      if (!why.empty()) return why;
+      // |delta + a + dtc b|^2 = arc^2 on the displacements: A dtc^2 + B dtc + C = 0.
+      const Eigen::VectorXd base = (delta + a).head(m), bm = b.head(m);
+      const double A = bm.squaredNorm(), B = 2.0 * bm.dot(base), C = base.squaredNorm() - arc * arc;
+      const double discriminant = B * B - 4.0 * A * C;
+      if (!(A > 0.0) || discriminant < 0.0) return "the arc-length constraint has no real root";
+      const double root = std::sqrt(discriminant);
+      const double q = -0.5 * (B + std::copysign(root, B));  // the stable pair of roots
+      const double r1 = q / A, r2 = q != 0.0 ? C / q : r1;
+      const auto alignment = [&](double r) { return (base + r * bm).dot(delta.head(m)); };
+      const double dtc = alignment(r1) >= alignment(r2) ? r1 : r2;
+      delta += a + dtc * b;
+      dt += dtc;
+      ++record.newton_iterations;
+      ++summary_.newton_iterations;
+    }
+  }
+
   const Model& model_;
   const NewtonOptions& newton_;
   SteppingSummary& summary_;
@@ -372,6 +580,101 @@ std::string paddle_problem(const Model& model, int steps) {
   return {};
 }
 
+// What every converged step leaves behind: its record (forces on the body,
+// volume, pressure, sensitivities) after the runaway checks.
+class StepFinisher {
+ public:
+  StepFinisher(const Model& model, const SteppingOptions& options, NewtonSolver& solver,
+               const model::DofPartition& partition, SteppingSummary& summary)
+      : model_(model),
+        options_(options),
+        solver_(solver),
+        partition_(partition),
+        summary_(summary),
+        reference_volume_(solver.equilibrium().reference_volume()),
+        last_face_areas_(geom::face_area_vectors(model.surface.V, model.surface.F)),
+        groups_(std::max<size_t>(1, model.constraint_groups.size())) {}
+
+  // "" or why the run stops (a runaway, failed sensitivities).
+  std::string finish(const PathPoint& at, const Eigen::VectorXd& x, StepRecord& record) {
+    const int nv = model_.num_vertices(), dim = model_.dim(), k = record.step;
+    const Eigen::MatrixXd X = model::positions(model_, x);
+    const double volume = geom::enclosed_volume(X, model_.surface.F);
+    std::string why =
+        runaway_reason(model_, options_, x, X, volume, reference_volume_, last_face_areas_);
+    if (!why.empty()) return "step " + std::to_string(k) + ": runaway: " + why;
+
+    // Forces on the body: supports per group, paddles, and the loads.
+    const Eigen::VectorXd& R = solver_.last_residual();
+    const Eigen::VectorXd F = solver_.equilibrium().external_forces(x, at.factors);
+    record.reactions.assign(groups_, Eigen::Vector3d::Zero());
+    summary_.reaction_forces = Eigen::MatrixXd::Zero(nv, dim);
+    for (size_t c = 0; c < partition_.constrained.size(); ++c) {
+      const int d = partition_.constrained[c];
+      const model::Constraint& constraint =
+          model_.constraints[static_cast<size_t>(partition_.constraint_of[c])];
+      record.reactions[static_cast<size_t>(constraint.group) % groups_][d / nv] += R[d];
+      summary_.reaction_forces(d % nv, d / nv) = R[d];
+    }
+    record.paddles.resize(model_.paddles.size());
+    for (size_t p = 0; p < model_.paddles.size(); ++p) {
+      record.paddles[p].plane = at.planes[p];
+      record.paddles[p].travel = at.planes[p] - model_.paddles[p].position;
+    }
+    const model::DofMap held = solver_.held_map();
+    for (int v = 0; v < nv; ++v) {
+      const int p = solver_.contact_paddle()[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      StepRecord::PaddleState& state = record.paddles[static_cast<size_t>(p)];
+      ++state.contacts;
+      for (int a = 0; a < dim; ++a)
+        if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v)) {
+          state.force[a] += R[a * nv + v];
+          summary_.reaction_forces(v, a) = R[a * nv + v];
+        }
+    }
+    for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
+    record.load_factors = at.factors;
+    record.pressure = x[model_.pressure_dof()];
+    record.volume = volume;
+    record.volume_drift = (volume - reference_volume_) / reference_volume_;
+    record.max_displacement = (X - model_.surface.V).rowwise().norm().maxCoeff();
+    record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
+    const std::vector<int>& wanted = options_.sensitivities.steps;
+    if (!options_.sensitivities.parameters.empty() &&
+        std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
+      why = solver_.sensitivities(at, x, options_.sensitivities.parameters, &record.sensitivities);
+      if (!why.empty()) return "step " + std::to_string(k) + ": sensitivities: " + why;
+    }
+    return {};
+  }
+
+ private:
+  const Model& model_;
+  const SteppingOptions& options_;
+  NewtonSolver& solver_;
+  const model::DofPartition& partition_;
+  SteppingSummary& summary_;
+  double reference_volume_;
+  Eigen::MatrixXd last_face_areas_;
+  size_t groups_;
+};
+
+// Why the path cannot be followed by arc length, or "": the arc-length
+// constraint acts on the loads' factor, so the held values must not move
+// along the path (prescribed motions and paddles are displacement control).
+std::string arc_length_problem(const Model& model, int steps) {
+  if (!model.paddles.empty())
+    return "newton.control arc_length: paddles move the body by displacement, which load "
+           "control already follows; use control \"load\"";
+  for (int k = 1; k <= steps; ++k)
+    if (model::constrained_displacements(model, k, steps).cwiseAbs().maxCoeff() > 0.0)
+      return "newton.control arc_length: a prescribed displacement or rotation moves along the "
+             "path; arc length follows loads only (use control \"load\")";
+  if (model.loads.empty()) return "newton.control arc_length: there is no load to follow";
+  return {};
+}
+
 }  // namespace
 
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
@@ -383,6 +686,8 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   if (!why.empty()) return fail(why);
   why = paddle_problem(model, options.steps);
   if (!why.empty()) return fail(why);
+  const bool by_arc = options.newton.control == NewtonOptions::Control::ArcLength;
+  if (by_arc && !(why = arc_length_problem(model, options.steps)).empty()) return fail(why);
   for (const std::string& name : options.sensitivities.parameters)
     if (!model.material.has_parameter(name, model.dim()))
       return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
@@ -394,18 +699,24 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   } catch (const InputError& e) {
     return fail(e.what());
   }
-
-  const int n = options.steps, nv = model.num_vertices(), dim = model.dim();
-  const Eigen::MatrixXd& reference = model.surface.V;
-  const double reference_volume = solver->equilibrium().reference_volume();
-  Eigen::MatrixXd last_face_areas = geom::face_area_vectors(reference, model.surface.F);
-  const size_t groups = std::max<size_t>(1, model.constraint_groups.size());
+  StepFinisher finisher(model, options, *solver, partition, summary);
+  const int n = options.steps;
   Eigen::VectorXd& x = summary.unknowns;
+  // A converged point of the path at t: its record, the observer.
+  const auto keep = [&](StepRecord& record, double t, const Clock::time_point step_start) {
+    const std::string stop = finisher.finish(path_point(model, t, n), x, record);
+    if (!stop.empty()) return stop;
+    record.seconds = seconds_since(step_start);
+    summary.steps.push_back(record);
+    if (observer) observer(record, x);
+    return std::string();
+  };
 
   PathPredictor predictor(options.newton.predictor ? 2 : 0);
   predictor.add(0.0, x);
   report_progress("step", 0, n);
-  for (int k = 1; k <= n; ++k) {
+  // Load control: each step to t = k (t = 1 only, the arc's first step, by arc length).
+  for (int k = 1; k <= (by_arc ? 1 : n); ++k) {
     const Clock::time_point step_start = Clock::now();
     StepRecord record;
     record.step = k;
@@ -442,59 +753,12 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
       ++record.step_cuts;
       piece *= 0.5;
     }
-
-    const Eigen::MatrixXd X = model::positions(model, x);
-    const double volume = geom::enclosed_volume(X, model.surface.F);
-    why = runaway_reason(model, options, x, X, volume, reference_volume, last_face_areas);
-    if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
-
-    // Forces on the body: supports per group, paddles, and the loads.
-    const PathPoint at = path_point(model, k, n);
-    const Eigen::VectorXd& R = solver->last_residual();
-    const Eigen::VectorXd F = solver->equilibrium().external_forces(x, at.factors);
-    record.reactions.assign(groups, Eigen::Vector3d::Zero());
-    summary.reaction_forces = Eigen::MatrixXd::Zero(nv, dim);
-    for (size_t c = 0; c < partition.constrained.size(); ++c) {
-      const int d = partition.constrained[c];
-      const model::Constraint& constraint =
-          model.constraints[static_cast<size_t>(partition.constraint_of[c])];
-      record.reactions[static_cast<size_t>(constraint.group) % groups][d / nv] += R[d];
-      summary.reaction_forces(d % nv, d / nv) = R[d];
-    }
-    record.paddles.resize(model.paddles.size());
-    for (size_t p = 0; p < model.paddles.size(); ++p) {
-      record.paddles[p].plane = at.planes[p];
-      record.paddles[p].travel = at.planes[p] - model.paddles[p].position;
-    }
-    const model::DofMap held = solver->held_map();
-    for (int v = 0; v < nv; ++v) {
-      const int p = solver->contact_paddle()[static_cast<size_t>(v)];
-      if (p < 0) continue;
-      StepRecord::PaddleState& state = record.paddles[static_cast<size_t>(p)];
-      ++state.contacts;
-      for (int a = 0; a < dim; ++a)
-        if (held.held(a * nv + v) && !partition_holds(partition, a * nv + v)) {
-          state.force[a] += R[a * nv + v];
-          summary.reaction_forces(v, a) = R[a * nv + v];
-        }
-    }
-    for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
-    for (size_t l = 0; l < model.loads.size(); ++l) record.load_factors.push_back(at.factors[l]);
-    record.pressure = x[model.pressure_dof()];
-    record.volume = volume;
-    record.volume_drift = (volume - reference_volume) / reference_volume;
-    record.max_displacement = (X - reference).rowwise().norm().maxCoeff();
-    record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
-    const std::vector<int>& wanted = options.sensitivities.steps;
-    if (!options.sensitivities.parameters.empty() &&
-        std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
-      why = solver->sensitivities(at, x, options.sensitivities.parameters, &record.sensitivities);
-      if (!why.empty()) return fail("step " + std::to_string(k) + ": sensitivities: " + why);
-    }
-    record.seconds = seconds_since(step_start);
-    summary.steps.push_back(record);
+    if (!(why = keep(record, k, step_start)).empty()) return fail(why);
     report_progress("step", k, n);
-    if (observer) observer(record, x);
+  }
+  if (by_arc && n > 1) {
+    why = solver->follow_arc_length(n, summary, keep);
+    if (!why.empty()) return fail(why);
   }
   if (options.keep_final_tangent)
     summary.final_tangent = solver->final_tangent(path_point(model, n, n), x);

@@ -44,7 +44,7 @@ TEST_P(FitExperiment, RecoversItsParametersAndMeetsItsExpectedFigures) {
 
 INSTANTIATE_TEST_SUITE_P(Experiments, FitExperiment,
                          ::testing::Values("fit_sphere.json", "fit_synthetic_liver_exact.json",
-                                           "fit_liver_fem.json"));
+                                           "fit_liver_fem.json", "fit_cantilever_large.json"));
 
 nlohmann::json sphere_fit_document() {
   std::ifstream in(testing::experiment_file("fit_sphere.json"));

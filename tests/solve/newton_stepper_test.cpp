@@ -357,5 +357,63 @@ TEST(Newton, BadPaddlesAreRejected) {
   EXPECT_NE(s.message.find("paddles need the Newton scheme"), std::string::npos) << s.message;
 }
 
+SteppingOptions arc_length(int steps) {
+  SteppingOptions o = newton(steps);
+  o.newton.control = NewtonOptions::Control::ArcLength;
+  return o;
+}
+
+// Along a path without a limit point, arc length lands on the final load at
+// the same equilibrium as load control; its steps are its own (the load
+// factor is an unknown), their factors rise to exactly 1.
+TEST(ArcLength, ReachesTheFinalLoadAtTheLoadControlledAnswer) {
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0), 300.0);
+  const SteppingSummary by_load = solve_load_steps(m, newton(5));
+  const SteppingSummary by_arc = solve_load_steps(m, arc_length(5));
+  ASSERT_TRUE(by_load.success && by_arc.success) << by_load.message << by_arc.message;
+  EXPECT_LT(displacement_norm(m, by_arc.unknowns - by_load.unknowns),
+            1e-8 * displacement_norm(m, by_load.unknowns));
+  EXPECT_NEAR(by_arc.unknowns[m.pressure_dof()], by_load.unknowns[m.pressure_dof()],
+              1e-8 * std::abs(by_load.unknowns[m.pressure_dof()]));
+  ASSERT_GE(by_arc.steps.size(), 2u);
+  EXPECT_DOUBLE_EQ(by_arc.steps.back().load_factors[0], 1.0);
+  for (size_t k = 1; k < by_arc.steps.size(); ++k)
+    EXPECT_GT(by_arc.steps[k].load_factors[0], by_arc.steps[k - 1].load_factors[0]);
+  EXPECT_TRUE(std::isnan(by_arc.limit_load_factor));
+}
+
+// The paper's sphere under gravity updated from the current geometry (its
+// own experiment, Newton's exact equilibria): load control fails at step 9 of
+// 10. Arc length shows why: the load peaks at 0.876 of full gravity (a limit
+// point at 1.76 m of sag) and falls after it while the sphere stretches on.
+TEST(ArcLength, ThePapersSphereHasALimitPointBelowFullGravity) {
+  const model::Model m = testing::paper_sphere_model();
+  const SteppingSummary s = solve_load_steps(m, arc_length(10));
+  EXPECT_FALSE(s.success);
+  EXPECT_NEAR(s.limit_load_factor, 0.8756, 0.001);
+  EXPECT_NE(s.message.find("a limit point: the load peaked at 0.87"), std::string::npos)
+      << s.message;
+  // The path: up to the peak, then down with the sag still growing.
+  double peak = 0.0;
+  size_t at_peak = 0;
+  for (size_t k = 0; k < s.steps.size(); ++k)
+    if (s.steps[k].load_factors[0] > peak) peak = s.steps[k].load_factors[0], at_peak = k;
+  ASSERT_LT(at_peak + 3, s.steps.size());
+  EXPECT_LT(s.steps.back().load_factors[0], 0.8 * peak);
+  EXPECT_GT(s.steps.back().max_displacement, 2.0 * s.steps[at_peak].max_displacement);
+  // Load control converges up to the limit and not past it: in 8 steps,
+  // step 7 (0.875, just below the limit) is the last reached.
+  const SteppingSummary by_load = solve_load_steps(m, newton(8));
+  EXPECT_FALSE(by_load.success);
+  ASSERT_EQ(by_load.steps.size(), 7u);
+  EXPECT_NEAR(by_load.steps.back().load_factors[0], 0.875, 1e-12);
+}
+
+TEST(ArcLength, DisplacementDrivenRunsAreLeftToLoadControl) {
+  const SteppingSummary pressed = solve_load_steps(pressed_sphere(false), arc_length(4));
+  EXPECT_FALSE(pressed.success);
+  EXPECT_NE(pressed.message.find("arc_length: paddles"), std::string::npos) << pressed.message;
+}
+
 }  // namespace
 }  // namespace fiberfluid::solve
