@@ -109,11 +109,16 @@ std::string newton(const Mesh& mesh, const HyperelasticMaterial& m, const LoadSt
     return Eigen::VectorXd(internal_forces(mesh, m, at, valid) - state.forces);
   };
   // Relative to the loads and the reactions at the same state (never to a
-  // scale carried over from a wild iterate).
+  // scale carried over from a wild iterate), or at least to mu D^2 (D the
+  // body's diagonal: the force of a unit strain across it), so that a state
+  // with no force at all (a body turned rigidly) has a scale too.
+  const double diagonal =
+      (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
+  const double floor = m.shear_modulus() * diagonal * diagonal;
   const auto relative = [&](const Eigen::VectorXd& R) {
     double held = 0.0;
     for (int d : state.held.dofs) held += R[d] * R[d];
-    const double scale = std::max({state.forces.norm(), std::sqrt(held), 1e-300});
+    const double scale = std::max({state.forces.norm(), std::sqrt(held), floor});
     return split.restrict(R).norm() / scale;
   };
   // The total potential energy: strain energy less the dead loads' work.
