@@ -74,10 +74,14 @@ def tip_state(path):
     return drop, math.degrees(math.acos(max(-1.0, min(1.0, cosine))))
 
 
-def tip_path(series_folder):
-    files = sorted(f for f in os.listdir(series_folder) if f.endswith(".vtu"))
-    states = [tip_state(os.path.join(series_folder, f)) for f in files]
-    return [s for s in states]
+def tip_path(series_folder, steps):
+    """(load factor, tip drop, tip rotation) for each step_NNNN.vtu of a series, from the rest."""
+    path = [(0.0, 0.0, 0.0)]
+    for name in sorted(f for f in os.listdir(series_folder) if f.endswith(".vtu")):
+        step = int(re.search(r"(\d+)\.vtu$", name).group(1))
+        if step > 0:
+            path.append((step / steps,) + tip_state(os.path.join(series_folder, name)))
+    return path
 
 
 def run(command):
@@ -102,7 +106,8 @@ def main():
     run([args.fiberfluid, "run", os.path.join(HERE, "cantilever_large.json"), "-o", reference,
          "--quiet"])
     target = os.path.abspath(os.path.join(reference, "fem_reference.obj"))
-    fem_path = tip_path(os.path.join(reference, "fem_reference_vtk"))
+    steps = json.load(open(os.path.join(HERE, "cantilever_large.json")))["stepping"]["steps"]
+    fem_path = tip_path(os.path.join(reference, "fem_reference_vtk"), steps)
 
     base = json.load(open(os.path.join(HERE, "cantilever_large.json")))
     for key in ("fem_reference", "expected", "description"):
@@ -132,7 +137,7 @@ def main():
             rows.append({"model": name, "status": "failed"})
             continue
         fit = json.load(open(os.path.join(folder, "fit.json")))
-        path = tip_path(os.path.join(folder, "vtk"))
+        path = tip_path(os.path.join(folder, "vtk"), steps)
         paths[name] = path
         finals[name] = read_vtu(os.path.join(folder, "vtk", sorted(os.listdir(
             os.path.join(folder, "vtk")))[-1]))[0]
@@ -144,12 +149,12 @@ def main():
                                     for p in fit["parameters"]),
             "sd_share_of_length": fit["distance"]["share_of_length"]["standard_deviation"],
             "E_s": metrics.get("E_s", float("nan")),
-            "tip_drop_m": path[-1][0],
-            "tip_rotation_deg": path[-1][1],
+            "tip_drop_m": path[-1][1],
+            "tip_rotation_deg": path[-1][2],
         })
     rows.insert(0, {"model": "FEM (neo-Hookean)", "status": "reference", "parameters":
                     "E = 60 kPa; nu = 0.45", "sd_share_of_length": 0.0, "E_s": 0.0,
-                    "tip_drop_m": fem_path[-1][0], "tip_rotation_deg": fem_path[-1][1]})
+                    "tip_drop_m": fem_path[-1][1], "tip_rotation_deg": fem_path[-1][2]})
 
     fields = ["model", "status", "parameters", "sd_share_of_length", "E_s", "tip_drop_m",
               "tip_rotation_deg"]
@@ -178,10 +183,10 @@ def plot(out, paths, finals, fem_final):
 
     figure, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     for name, path in paths.items():
-        factors = [(k + 1) / len(path) for k in range(len(path))]
         style = "k-" if name.startswith("FEM") else "-"
-        axes[0].plot(factors, [100 * d for d, _ in path], style, marker="o", ms=3, label=name)
-        axes[1].plot(factors, [r for _, r in path], style, marker="o", ms=3, label=name)
+        factors = [f for f, _, _ in path]
+        axes[0].plot(factors, [100 * d for _, d, _ in path], style, marker="o", ms=3, label=name)
+        axes[1].plot(factors, [r for _, _, r in path], style, marker="o", ms=3, label=name)
     axes[0].set(xlabel="load factor", ylabel="tip drop (cm)", title="tip drop along the load path")
     axes[1].set(xlabel="load factor", ylabel="tip face rotation (degrees)",
                 title="tip rotation along the load path")
