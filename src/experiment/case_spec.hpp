@@ -103,6 +103,8 @@ struct FiberSpec {
   // "horizon" (m): only vertices at most this far apart are joined; 0: every
   // pair (the paper's).
   double horizon = 0.0;
+  // "influence": "constant" (default) or "conical" (1 - L / horizon).
+  model::Influence::Kind influence = model::Influence::Kind::Constant;
   FieldName field;
 };
 

@@ -465,6 +465,11 @@ FiberSpec read_fibers(Fields& root) {
     if (!(spec.horizon > 0.0) || !std::isfinite(spec.horizon))
       f.fail("horizon", "expected a positive length (m), got " + std::to_string(spec.horizon));
   }
+  if (f.choice("influence", "constant", {"constant", "conical"}) == "conical") {
+    if (!(spec.horizon > 0.0))
+      f.fail("influence", "a conical influence (1 - L / horizon) needs a \"horizon\"");
+    spec.influence = model::Influence::Kind::Conical;
+  }
   if (f.choice("product", "exact", {"exact", "treecode"}) == "treecode") {
     spec.treecode_tolerance = f.number("treecode_tolerance", 1e-6);
     if (!(spec.treecode_tolerance >= 1e-10 && spec.treecode_tolerance <= 1e-2))

@@ -47,7 +47,7 @@ Reference reference_of(const Model& model) {
 
 Equilibrium::Equilibrium(const Model& model)
     : model_(model),
-      factors_(model.fibers.get(), model.connection_count, model.num_vertices()),
+      factors_(model),
       context_{model, factors_, area0_, surface_, 0.0, 0.0},
       bulk_(context_) {
   Reference reference = reference_of(model);

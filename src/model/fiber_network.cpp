@@ -2,6 +2,7 @@
 #include "model/fiber_network.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 #include "model/pair_stencil.hpp"
@@ -22,31 +23,66 @@ const char* to_string(ConnectionCount count) {
 }
 
 PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices)
-    : fibers_(fibers), count_(count), n_(num_vertices) {
+    : PairFactors(fibers, count, num_vertices, Influence{}, nullptr) {}
+
+PairFactors::PairFactors(const Model& model)
+    : PairFactors(model.fibers.get(), model.connection_count, model.num_vertices(), model.influence,
+                  &model.surface.V) {}
+
+PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
+                         const Influence& influence, const Eigen::MatrixXd* reference)
+    : fibers_(fibers), count_(count), n_(num_vertices), influence_(influence) {
   // The paper divides by N-1, the fibers per vertex, so that Y does not
-  // depend on the discretisation; with pruning, by the fibers that exist.
+  // depend on the discretisation; with pruning, by the fibers that exist;
+  // with a weighing influence, by their summed weights.
   global_ = n_ - 1;
-  if (fibers_ == nullptr) return;
-  const std::vector<int> kept = fibers_->kept_per_vertex();
-  kept_.assign(kept.begin(), kept.end());
+  if (influence_.weighs()) {
+    if (reference == nullptr || reference->rows() != n_)
+      throw std::invalid_argument("a weighing influence needs the reference positions");
+    if (!(influence_.horizon > 0.0))
+      throw std::invalid_argument("a conical influence needs a positive horizon");
+    reference_ = *reference;
+    kept_.assign(static_cast<size_t>(n_), 0.0);
+    std::vector<double> row(static_cast<size_t>(n_));
+    for (int i = 0; i < n_; ++i) {
+      weights(i, row.data());
+      for (int j = 0; j < n_; ++j) kept_[static_cast<size_t>(i)] += row[static_cast<size_t>(j)];
+    }
+  } else if (fibers_ != nullptr) {
+    const std::vector<int> kept = fibers_->kept_per_vertex();
+    kept_.assign(kept.begin(), kept.end());
+  } else {
+    return;
+  }
   double sum = 0.0;
   for (double k : kept_) sum += k;
   global_ = n_ > 0 ? sum / n_ : 0.0;
 }
 
+void PairFactors::weights(int i, double* row) const {
+  const uint8_t* kept = fibers_ != nullptr ? fibers_->row(i) : nullptr;
+  for (int j = 0; j < n_; ++j) {
+    double w = kept != nullptr ? kept[j] : 1.0;
+    if (influence_.weighs() && w != 0.0)
+      w *= influence_((reference_.row(i) - reference_.row(j)).norm());
+    row[j] = w;
+  }
+  row[i] = 0.0;
+}
+
 std::vector<double> PairFactors::vertex_counts() const {
-  if (fibers_ != nullptr && count_ == ConnectionCount::Symmetric) return kept_;
+  if (!kept_.empty() && count_ == ConnectionCount::Symmetric) return kept_;
   return std::vector<double>(static_cast<size_t>(n_), global_);
 }
 
 void PairFactors::row(int i, double* row) const {
-  if (fibers_ == nullptr) {
+  if (fibers_ == nullptr && !influence_.weighs()) {
     std::fill(row, row + n_, connection_factor(1.0, global_, global_));
   } else {
-    const uint8_t* kept = fibers_->row(i);
+    weights(i, row);
     const bool global = count_ == ConnectionCount::Global;
     const auto count = [&](int k) { return global ? global_ : kept_[static_cast<size_t>(k)]; };
-    for (int j = 0; j < n_; ++j) row[j] = connection_factor(kept[j], count(i), count(j));
+    for (int j = 0; j < n_; ++j) row[j] = connection_factor(row[j], count(i), count(j));
   }
   row[i] = 0.0;
 }

@@ -14,6 +14,13 @@ namespace fiberfluid::model {
 class PairFactors {
  public:
   PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices);
+  // With an influence that weighs the fibers (conical): kept_ij becomes
+  // kept_ij omega(L_ij), L_ij from `reference` (#V by dim, copied),
+  // and the counts c_i the sums of those weights.
+  PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
+              const Influence& influence, const Eigen::MatrixXd* reference);
+  // The factors of a model: its fibers, count and influence at its reference.
+  explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.
   void row(int i, double* row) const;
   // The same factors in the form the tiled pair kernels use:
@@ -21,13 +28,21 @@ class PairFactors {
   // the mean count with the global count, n_i with the symmetric one).
   std::vector<double> vertex_counts() const;
   const geom::FiberMask* mask() const { return fibers_; }  // null: every pair kept
+  const Influence& influence() const { return influence_; }
+  // The reference positions the influence weighs by (empty unless it weighs).
+  const Eigen::MatrixXd& reference() const { return reference_; }
 
  private:
+  // kept_ij omega(L_ij) for j = 0..N-1 (0 at j = i).
+  void weights(int i, double* row) const;
+
   const geom::FiberMask* fibers_;
   ConnectionCount count_;
   int n_;
-  std::vector<double> kept_;  // n_i
-  double global_ = 0.0;       // the count for ConnectionCount::Global or a full body
+  Influence influence_;
+  Eigen::MatrixXd reference_;  // for a weighing influence
+  std::vector<double> kept_;   // n_i (weighed by the influence)
+  double global_ = 0.0;        // the count for ConnectionCount::Global or a full body
 };
 
 // |x_i - x_j|; throws InputError naming both when they coincide (a fiber of

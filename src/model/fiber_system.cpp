@@ -37,7 +37,7 @@ FiberSystem::FiberSystem(const Model& model, const Eigen::MatrixXd& X, const Dof
       n_(model.num_vertices()),
       X_(X),
       fibers_(model.fibers),
-      factors_(model.fibers.get(), model.connection_count, model.num_vertices()),
+      factors_(model),
       young_(model.material.young_modulus()),
       gamma_(model.material.surface_tension),
       method_(method),

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -149,6 +150,20 @@ enum class ConnectionCount {
 };
 const char* to_string(ConnectionCount count);
 
+// How a bulk fiber's weight falls off with its reference length L within the
+// horizon delta: the influence function of peridynamics (Seleson and Parks
+// 2011, "On the role of the influence function in the peridynamic theory").
+// Constant (1: every fiber alike, the paper's) or conical (1 - L / delta).
+struct Influence {
+  enum class Kind { Constant, Conical };
+  Kind kind = Kind::Constant;
+  double horizon = 0.0;  // delta (m), for Conical
+  bool weighs() const { return kind == Kind::Conical; }
+  double operator()(double length) const {
+    return kind == Kind::Constant ? 1.0 : std::max(0.0, 1.0 - length / horizon);
+  }
+};
+
 // Everything the equations need: the reference surface (every vertex used by
 // a face), the material, the loads and the constraints.
 struct Model {
@@ -163,6 +178,7 @@ struct Model {
   std::vector<std::string> constraint_groups;
   // The bulk fibers that exist: null means every pair (a convex body).
   std::shared_ptr<const geom::FiberMask> fibers;
+  Influence influence;  // each fiber's weight by its reference length
   ConnectionCount connection_count = ConnectionCount::Symmetric;
   // Above 0: the linear bulk product and diagonal come from a treecode with
   // this relative error (bulk_treecode.hpp) instead of the exact pair sums.

@@ -246,7 +246,8 @@ FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* co
 
 BulkPairs::BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
                      const PairFactors& factors, const std::vector<int>& vertices)
-    : mask_(factors.mask()) {
+    : mask_(factors.mask()), influence_(factors.influence()) {
+  if (influence_.weighs()) reference_positions_ = factors.reference();
   if (vertices.empty()) {
     vertex_.resize(static_cast<size_t>(X.rows()));
     for (size_t k = 0; k < vertex_.size(); ++k) vertex_[k] = static_cast<int>(k);
@@ -285,6 +286,11 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
     } else {
       std::fill(row, row + t.nj, 1.0);
     }
+    if (influence_.weighs())
+      for (int q = 0; q < t.nj; ++q)
+        if (row[q] != 0.0)
+          row[q] *=
+              influence_((reference_positions_.row(vi) - reference_positions_.row(vj[q])).norm());
     if (law_ == nullptr) continue;
     // The secant modulus at e_ij = |y_i - y_j| / L_ij - 1 (zero where i == j).
     for (int q = 0; q < t.nj; ++q) {
@@ -301,7 +307,7 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
 
 template <class Visit>
 void BulkPairs::for_each_tile(Visit&& visit) const {
-  const bool weighted = mask_ != nullptr || law_ != nullptr;
+  const bool weighted = mask_ != nullptr || law_ != nullptr || influence_.weighs();
   // Unweighted: one row of ones serves every row of every tile.
   std::vector<std::vector<double>> m(static_cast<size_t>(omp_get_max_threads()),
                                      std::vector<double>(weighted ? kTile * kTile : kTile, 1.0));
@@ -356,6 +362,7 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
       count_(factors.vertex_counts()),
       area_(area),
       mask_(factors.mask()),
+      influence_(factors.influence()),
       law_(law),
       kinematics_(kinematics) {
   for (int a = 0; a < 3; ++a) {
@@ -401,6 +408,11 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
         const uint8_t* kept = mask_->row(i);
         for (int j = first; j < end; ++j) row.m[static_cast<size_t>(j - t.j0)] = kept[j];
       }
+      if (influence_.weighs())  // by the reference length L (the row's)
+        for (int j = first; j < end; ++j) {
+          const auto k = static_cast<size_t>(j - t.j0);
+          row.m[k] = (mask_ != nullptr ? mask_->row(i)[j] : 1.0) * influence_(row.L[k]);
+        }
       visit(i, t.j0, first, end, row.arrays(), thread);
     }
   });

@@ -22,8 +22,9 @@ namespace fiberfluid::model {
 // The bulk weights of a set of vertices (paper Eq. 6, model.md section 5):
 //   w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) |x_i - x_j|),
 // with c_i from PairFactors::vertex_counts (so that h_ij = 1 / (c_i + c_j)),
-// m_ij = 1 for a kept fiber and 0 for a pruned one, and for a
-// strain-dependent law m_ij times the secant modulus Y(e_ij).
+// m_ij = 1 for a kept fiber and 0 for a pruned one, times the influence
+// omega(L_ij) (PairFactors::influence), and for a strain-dependent law times
+// the secant modulus Y(e_ij).
 class BulkPairs {
  public:
   // `vertices`: the vertices of the set in order; empty means every row of X.
@@ -67,6 +68,8 @@ class BulkPairs {
   std::vector<double> x_[3], area_, count_;
   std::vector<int> vertex_;  // the set's vertices (mask and law lookups)
   const geom::FiberMask* mask_ = nullptr;
+  Influence influence_;                  // weighs each pair by its reference length
+  Eigen::MatrixXd reference_positions_;  // for a weighing influence
   const FiberLaw* law_ = nullptr;
   const Eigen::MatrixXd *reference_ = nullptr, *strained_ = nullptr;
 };
@@ -106,6 +109,7 @@ class DeformedPairs {
   std::vector<double> s_[3], x_[3], u_[3], count_;
   const Eigen::VectorXd& area_;
   const geom::FiberMask* mask_;
+  Influence influence_;
   const FiberLaw& law_;
   FiberKinematics kinematics_;
 };

@@ -32,14 +32,15 @@ TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
   for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Experiments, ExperimentFile,
-    ::testing::Values("rectangle.json", "areas.json", "sphere.json", "round_trip.json",
-                      "liver_gravity.json", "bunny_gravity.json", "liver_sweep.json",
-                      "nonlinear_round_trip.json", "liver_paddles.json", "stress_strain.json",
-                      "benchmark_block_mp1.json", "benchmark_block_mp2.json", "benchmark_rod.json",
-                      "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
-                      "compression_large.json"));
+INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
+                         ::testing::Values("rectangle.json", "areas.json", "sphere.json",
+                                           "round_trip.json", "liver_gravity.json",
+                                           "bunny_gravity.json", "liver_sweep.json",
+                                           "nonlinear_round_trip.json", "liver_paddles.json",
+                                           "stress_strain.json", "benchmark_block_mp1.json",
+                                           "benchmark_block_mp2.json", "benchmark_rod.json",
+                                           "liver_fem_reference.json", "bar_bending.json",
+                                           "cantilever_large.json", "compression_large.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
@@ -108,6 +109,16 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   c = base_config();
   c["supports"][0]["where"] = "z >= 5";
   expect_config_error(dir, c, "supports[0].where: \"z >= 5\" selects no vertex");
+
+  c = base_config();
+  c["fibers"] = {{"influence", "conical"}};
+  expect_config_error(dir, c, "fibers.influence: a conical influence (1 - L / horizon) needs a");
+  c = base_config();
+  c["stepping"]["control"] = "arc_length";
+  expect_config_error(dir, c, "stepping.control: arc-length control needs \"scheme\"");
+  c = base_config();
+  c["fem_reference"] = {{"E", 1000}, {"nu", 0.3}, {"material", "mooney"}};
+  expect_config_error(dir, c, "fem_reference.material: ");
 
   // Found from outside (issue 11): each aborted, read out of bounds, or
   // silently did something else.

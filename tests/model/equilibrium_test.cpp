@@ -9,8 +9,11 @@
 #include <random>
 
 #include "geom/area_vectors.hpp"
+#include "geom/horizon.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/assembly.hpp"
+#include "model/fiber_network.hpp"
+#include "model/fiber_system.hpp"
 #include "model/loads.hpp"
 #include "model/model_fixtures.hpp"
 #include "model/reference/dense_assembly.hpp"
@@ -115,6 +118,90 @@ TEST(Equilibrium, TangentMatchesCentralDifferencesForEveryLawAndKinematics) {
             << law.name();
       }
     }
+}
+
+// A horizon of 1.2 (the sphere's radius is 1) with the conical influence
+// 1 - L / 1.2: every pair's weight and every count change with L, and the
+// tangent, the matrix-free product and the stored operator stay one operator.
+TEST(Equilibrium, TangentMatchesCentralDifferencesWithAConicalInfluence) {
+  for (FiberKinematics kinematics : kAllKinematics)
+    for (const FiberLaw& law : {FiberLaw::constant(3000.0), FiberLaw::exponential(3000.0, 4.0)}) {
+      SCOPED_TRACE(kinematics_name(kinematics));
+      Model m = small_sphere(law, kinematics);
+      m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, 1.2));
+      m.influence = {Influence::Kind::Conical, 1.2};
+      const Equilibrium eq(m);
+      const Eigen::VectorXd x = random_state(m, 5);
+      const std::vector<double> factors = {0.7, 0.4};
+      const Eigen::MatrixXd J = eq.tangent(x, factors);
+      const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors);
+      EXPECT_LT((J - fd).norm() / fd.norm(), 1e-6) << law.name();
+      const Eigen::VectorXd v = random_state(m, 15, 1.0);
+      EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm());
+      EXPECT_LT((eq.linearize(x, factors).apply(v) - J * v).norm(), 1e-10 * (J * v).norm());
+      // The influence changes the answer: not the constant influence's residual.
+      Model constant = m;
+      constant.influence = {};
+      EXPECT_GT((Equilibrium(constant).residual(x, factors) - eq.residual(x, factors)).norm(),
+                1e-3 * eq.residual(x, factors).norm());
+    }
+}
+
+// With a conical influence the three places that weigh the pairs agree: the
+// Newton kernels (DeformedPairs, by each row's reference length), the
+// linear system's rows (PairFactors) and its tiled product (BulkPairs). For
+// a constant law the vector spring's forces are K u with the same K.
+TEST(Equilibrium, AConicalInfluenceWeighsAlikeInEveryKernel) {
+  Model m = small_sphere(FiberLaw::constant(3000.0));
+  m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, 1.2));
+  m.influence = {Influence::Kind::Conical, 1.2};
+  const Equilibrium eq(m);
+  const Eigen::VectorXd x = random_state(m, 9, 0.2);
+  const int n = m.num_vertices();
+  const Eigen::MatrixXd U = displacements(m, x);
+  const FiberSystem system(m, m.surface.V, BoundaryMethod::Elimination, 1e9);
+  std::vector<int> all(static_cast<size_t>(n));
+  for (int v = 0; v < n; ++v) all[static_cast<size_t>(v)] = v;
+  const Eigen::MatrixXd rows = system.unreduced_rows(all, U, 0.0);
+  const Eigen::MatrixXd bulk = system.bulk_product(U);
+  const Eigen::MatrixXd surface = system.surface_laplacian() * U;
+  const Eigen::MatrixXd forces = eq.fiber_forces(x);
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::VectorXd tiled =
+        system.young(a) * bulk.col(a) + system.surface_tension() * surface.col(a);
+    EXPECT_LT((forces.col(a) - rows.col(a)).norm(), 1e-11 * rows.col(a).norm()) << a;
+    EXPECT_LT((tiled - rows.col(a)).norm(), 1e-11 * rows.col(a).norm()) << a;
+  }
+}
+
+// The factors of a conical influence, by hand on four points along the axes:
+// each count is the sum of its pairs' omega = 1 - L / delta, each factor
+// omega_ij / (c_i + c_j), and a pair beyond the horizon weighs nothing.
+TEST(PairFactors, AConicalInfluenceWeighsEachPairAndEachCount) {
+  Eigen::MatrixXd S(4, 3);
+  S << 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3;
+  const Influence conical{Influence::Kind::Conical, 4.0};
+  const PairFactors factors(nullptr, ConnectionCount::Symmetric, 4, conical, &S);
+  const auto omega = [&](int i, int j) { return 1.0 - (S.row(i) - S.row(j)).norm() / 4.0; };
+  const std::vector<double> counts = factors.vertex_counts();
+  for (int i = 0; i < 4; ++i) {
+    double expected = 0.0;
+    for (int j = 0; j < 4; ++j)
+      if (j != i) expected += omega(i, j);
+    EXPECT_NEAR(counts[static_cast<size_t>(i)], expected, 1e-15);
+  }
+  std::vector<double> row(4);
+  factors.row(1, row.data());
+  EXPECT_EQ(row[1], 0.0);
+  for (int j : {0, 2, 3})
+    EXPECT_NEAR(row[static_cast<size_t>(j)],
+                omega(1, j) / (counts[1] + counts[static_cast<size_t>(j)]), 1e-15);
+  // A pair beyond the horizon weighs nothing.
+  const PairFactors short_reach(nullptr, ConnectionCount::Symmetric, 4,
+                                {Influence::Kind::Conical, 2.5}, &S);
+  short_reach.row(0, row.data());
+  EXPECT_EQ(row[3], 0.0);  // |s_0 - s_3| = 3 > 2.5
+  EXPECT_GT(row[2], 0.0);  // 2 < 2.5
 }
 
 TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
