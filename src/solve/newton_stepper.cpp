@@ -412,14 +412,15 @@ class NewtonSolver {
     return f;
   }
 
-  // dR/dt at (x, t), reduced: exact, as R is affine in the load factors on
-  // the path segment that holds t (the one ahead in the direction `ahead`).
+  // dR/dt at (x, t), reduced: exact, as only the loads depend on t and they
+  // are affine in their factors on the path segment that holds t (the one
+  // ahead in the direction `ahead`): minus the change of the external forces.
   Eigen::VectorXd path_derivative(const DofMap& dofs, const Eigen::VectorXd& x, double t, int n,
                                   bool ahead) const {
     double lo = ahead ? std::floor(t) : std::ceil(t) - 1.0;
     lo = std::clamp(lo, 0.0, n - 1.0);
-    const Eigen::VectorXd difference = equilibrium_->residual(x, factors_at(lo + 1.0, n)) -
-                                       equilibrium_->residual(x, factors_at(lo, n));
+    const Eigen::VectorXd difference = equilibrium_->external_forces(x, factors_at(lo, n)) -
+                                       equilibrium_->external_forces(x, factors_at(lo + 1.0, n));
     return dofs.reduce(difference);
   }
 
@@ -479,12 +480,14 @@ class NewtonSolver {
       Eigen::VectorXd a, b;
       const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
       why = solve_with_tangent(*x, *t, -dofs.reduce(R), forcing, &a);
-      if (why.empty())
-        why = tangent_->solve(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
-                              newton_.krylov_tolerance, &b, nullptr)
-                      .ok
-                  ? ""
-                  : "the tangent solve for du/dt failed";
+      if (why.empty()) {  // du/dt with the same tangent
+        int iterations = 0;
+        const Status status = tangent_->solve(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
+                                              newton_.krylov_tolerance, &b, &iterations);
+        record.krylov_iterations += iterations;
+        summary_.krylov_iterations += iterations;
+        if (!status.ok) why = "du/dt: " + status.message;
+      }
       if (!why.empty()) return why;
       // |delta + a + dtc b|^2 = arc^2 on the displacements: A dtc^2 + B dtc + C = 0.
       const Eigen::VectorXd base = (delta + a).head(m), bm = b.head(m);
