@@ -57,6 +57,67 @@ Eigen::Matrix3d deformation_gradient(const Mesh& mesh, int e, const RestTetrahed
   return F;
 }
 
+// Every tetrahedron's rest geometry, once per mesh (checked: dim 3, 4 nodes,
+// none inverted).
+std::vector<RestTetrahedron> rest_geometry(const Mesh& mesh) {
+  check_tetrahedra(mesh);
+  std::vector<RestTetrahedron> rest(static_cast<size_t>(mesh.elements.rows()));
+  for (int e = 0; e < mesh.elements.rows(); ++e)
+    rest[static_cast<size_t>(e)] = rest_tetrahedron(mesh, e);
+  return rest;
+}
+
+Eigen::VectorXd forces_of(const Mesh& mesh, const std::vector<RestTetrahedron>& rest,
+                          const HyperelasticMaterial& m, const Eigen::VectorXd& u, bool* valid) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh.num_dofs());
+  bool all_valid = true;
+  for (int e = 0; e < mesh.elements.rows(); ++e) {
+    const RestTetrahedron& t = rest[static_cast<size_t>(e)];
+    const Eigen::Matrix3d F = deformation_gradient(mesh, e, t, u);
+    if (!(F.determinant() > 0.0)) all_valid = false;
+    const Eigen::Matrix3d P = first_piola_stress(m, F);
+    for (int a = 0; a < 4; ++a)  // f_a = V0 P grad N_a
+      f.segment<3>(3 * mesh.elements(e, a)) += t.volume * P * t.gradients.row(a).transpose();
+  }
+  if (valid) *valid = all_valid;
+  return f;
+}
+
+Eigen::SparseMatrix<double> tangent_of(const Mesh& mesh, const std::vector<RestTetrahedron>& rest,
+                                       const HyperelasticMaterial& m, const Eigen::VectorXd& u) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(mesh.elements.rows()) * 144);
+  for (int e = 0; e < mesh.elements.rows(); ++e) {
+    const RestTetrahedron& t = rest[static_cast<size_t>(e)];
+    const Eigen::Matrix<double, 9, 9> A = stress_tangent(m, deformation_gradient(mesh, e, t, u));
+    // K(3a + i, 3b + k) = V0 sum_jl A(i + 3j, k + 3l) dN_a/dX_j dN_b/dX_l.
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int i = 0; i < 3; ++i)
+          for (int k = 0; k < 3; ++k) {
+            double value = 0.0;
+            for (int j = 0; j < 3; ++j)
+              for (int l = 0; l < 3; ++l)
+                value += A(i + 3 * j, k + 3 * l) * t.gradients(a, j) * t.gradients(b, l);
+            entries.emplace_back(3 * mesh.elements(e, a) + i, 3 * mesh.elements(e, b) + k,
+                                 t.volume * value);
+          }
+  }
+  Eigen::SparseMatrix<double> K(mesh.num_dofs(), mesh.num_dofs());
+  K.setFromTriplets(entries.begin(), entries.end());
+  return K;
+}
+
+double energy_of(const Mesh& mesh, const std::vector<RestTetrahedron>& rest,
+                 const HyperelasticMaterial& m, const Eigen::VectorXd& u) {
+  double energy = 0.0;
+  for (int e = 0; e < mesh.elements.rows(); ++e) {
+    const RestTetrahedron& t = rest[static_cast<size_t>(e)];
+    energy += t.volume * strain_energy(m, deformation_gradient(mesh, e, t, u));
+  }
+  return energy;
+}
+
 // dP for a direction dF of F (the tangent's action), both forms.
 Eigen::Matrix3d stress_differential(const HyperelasticMaterial& m, const Eigen::Matrix3d& F,
                                     const Eigen::Matrix3d& dF) {
@@ -102,11 +163,12 @@ LoadState interpolate(const LoadState& a, const LoadState& b, double s) {
 
 // Newton from u (held values already in place) to equilibrium under `state`.
 // "" when converged, else why not; u is left at the last iterate.
-std::string newton(const Mesh& mesh, const HyperelasticMaterial& m, const LoadState& state,
-                   const FreeUnknowns& split, const HyperelasticOptions& options,
-                   Eigen::VectorXd& u, HyperelasticSolution* solution) {
+std::string newton(const Mesh& mesh, const std::vector<RestTetrahedron>& rest,
+                   const HyperelasticMaterial& m, const LoadState& state, const FreeUnknowns& split,
+                   const HyperelasticOptions& options, Eigen::VectorXd& u,
+                   HyperelasticSolution* solution) {
   const auto residual = [&](const Eigen::VectorXd& at, bool* valid) {
-    return Eigen::VectorXd(internal_forces(mesh, m, at, valid) - state.forces);
+    return Eigen::VectorXd(forces_of(mesh, rest, m, at, valid) - state.forces);
   };
   // Relative to the loads and the reactions at the same state (never to a
   // scale carried over from a wild iterate), or at least to mu D^2 (D the
@@ -123,7 +185,7 @@ std::string newton(const Mesh& mesh, const HyperelasticMaterial& m, const LoadSt
   };
   // The total potential energy: strain energy less the dead loads' work.
   const auto potential = [&](const Eigen::VectorXd& at) {
-    return total_strain_energy(mesh, m, at) - state.forces.dot(at);
+    return energy_of(mesh, rest, m, at) - state.forces.dot(at);
   };
   bool valid = true;
   Eigen::VectorXd R = residual(u, &valid);
@@ -139,8 +201,8 @@ std::string newton(const Mesh& mesh, const HyperelasticMaterial& m, const LoadSt
       return out.str();
     }
     Eigen::VectorXd du_free;
-    const solve::Status status = solve_tangent(split.free_block(tangent_stiffness(mesh, m, u)),
-                                               -split.restrict(R), &du_free);
+    const solve::Status status =
+        solve_tangent(split.free_block(tangent_of(mesh, rest, m, u)), -split.restrict(R), &du_free);
     if (!status.ok) return status.message;
     Eigen::VectorXd du = Eigen::VectorXd::Zero(u.size());
     split.scatter(du_free, du);
@@ -226,56 +288,17 @@ Eigen::Matrix<double, 9, 9> stress_tangent(const HyperelasticMaterial& m,
 
 Eigen::VectorXd internal_forces(const Mesh& mesh, const HyperelasticMaterial& m,
                                 const Eigen::VectorXd& u, bool* valid) {
-  check_tetrahedra(mesh);
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh.num_dofs());
-  bool all_valid = true;
-  for (int e = 0; e < mesh.elements.rows(); ++e) {
-    const RestTetrahedron t = rest_tetrahedron(mesh, e);
-    const Eigen::Matrix3d F = deformation_gradient(mesh, e, t, u);
-    if (!(F.determinant() > 0.0)) all_valid = false;
-    const Eigen::Matrix3d P = first_piola_stress(m, F);
-    for (int a = 0; a < 4; ++a)  // f_a = V0 P grad N_a
-      f.segment<3>(3 * mesh.elements(e, a)) += t.volume * P * t.gradients.row(a).transpose();
-  }
-  if (valid) *valid = all_valid;
-  return f;
+  return forces_of(mesh, rest_geometry(mesh), m, u, valid);
 }
 
 Eigen::SparseMatrix<double> tangent_stiffness(const Mesh& mesh, const HyperelasticMaterial& m,
                                               const Eigen::VectorXd& u) {
-  check_tetrahedra(mesh);
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(static_cast<size_t>(mesh.elements.rows()) * 144);
-  for (int e = 0; e < mesh.elements.rows(); ++e) {
-    const RestTetrahedron t = rest_tetrahedron(mesh, e);
-    const Eigen::Matrix<double, 9, 9> A = stress_tangent(m, deformation_gradient(mesh, e, t, u));
-    // K(3a + i, 3b + k) = V0 sum_jl A(i + 3j, k + 3l) dN_a/dX_j dN_b/dX_l.
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int k = 0; k < 3; ++k) {
-            double value = 0.0;
-            for (int j = 0; j < 3; ++j)
-              for (int l = 0; l < 3; ++l)
-                value += A(i + 3 * j, k + 3 * l) * t.gradients(a, j) * t.gradients(b, l);
-            entries.emplace_back(3 * mesh.elements(e, a) + i, 3 * mesh.elements(e, b) + k,
-                                 t.volume * value);
-          }
-  }
-  Eigen::SparseMatrix<double> K(mesh.num_dofs(), mesh.num_dofs());
-  K.setFromTriplets(entries.begin(), entries.end());
-  return K;
+  return tangent_of(mesh, rest_geometry(mesh), m, u);
 }
 
 double total_strain_energy(const Mesh& mesh, const HyperelasticMaterial& m,
                            const Eigen::VectorXd& u) {
-  check_tetrahedra(mesh);
-  double energy = 0.0;
-  for (int e = 0; e < mesh.elements.rows(); ++e) {
-    const RestTetrahedron t = rest_tetrahedron(mesh, e);
-    energy += t.volume * strain_energy(m, deformation_gradient(mesh, e, t, u));
-  }
-  return energy;
+  return energy_of(mesh, rest_geometry(mesh), m, u);
 }
 
 solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
@@ -292,6 +315,7 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
   for (int d : done.held.dofs)
     if (d < 0 || d >= n) return solve::Status::failure("fem: a held unknown is out of range");
   const FreeUnknowns split(n, done.held.dofs);
+  const std::vector<RestTetrahedron> rest = rest_geometry(mesh);
 
   for (int step = 1; step <= options.steps; ++step) {
     const LoadState target = path(step);
@@ -307,7 +331,7 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
       Eigen::VectorXd u = solution->u;
       for (size_t k = 0; k < state.held.dofs.size(); ++k)
         u[state.held.dofs[k]] = state.held.values[k];
-      const std::string why = newton(mesh, m, state, split, options, u, solution);
+      const std::string why = newton(mesh, rest, m, state, split, options, u, solution);
       if (why.empty()) {
         solution->u = u;
         reached = s;
