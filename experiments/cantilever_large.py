@@ -3,7 +3,7 @@
 """The large-deformation study of issue 29: which fibers follow a soft body that bends far.
 
 A soft cylinder (18 cm long, 4 cm across) clamped at its base bends under its own weight until
-its tip drops by three quarters of its length. The reference is a geometrically nonlinear FEM
+its tip drops by over two thirds of its length. The reference is a geometrically nonlinear FEM
 (neo-Hookean tetrahedra, experiments/cantilever_large.json). Each fiber model below is fitted
 to the FEM's final surface (Levenberg-Marquardt, symmetric distances), then its load path is
 compared with the FEM's: the tip's drop and the tip face's rotation at every load step.
