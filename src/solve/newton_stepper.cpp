@@ -338,15 +338,7 @@ class NewtonSolver {
       // Inexact Newton: a Krylov solve only as accurate as the residual it
       // corrects (relative to it), which keeps the convergence quadratic.
       const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
-      Status status = tangent_->prepare(x, at.factors, dofs, &supports_);
-      if (status.ok) {
-        int iterations = 0;
-        status = tangent_->solve(-r, forcing, &dx, &iterations);
-        record.krylov_iterations += iterations;
-        summary_.krylov_iterations += iterations;
-      }
-      summary_.factorizations = tangent_->factorizations();
-      summary_.solver = tangent_->preconditioner_kind();
+      const Status status = prepare_and_solve(x, at.factors, dofs, -r, forcing, record, &dx);
       if (!status.ok) return status.message;
       // Backtracking: halve the step until the residual falls (Armijo).
       Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
@@ -373,6 +365,28 @@ class NewtonSolver {
       ++summary_.newton_iterations;
       report_progress("newton iteration", record.newton_iterations, 0.0);
     }
+  }
+
+  // Solves J y = b with the tangent as last prepared (Krylov to the relative
+  // residual `forcing`), counting its iterations in the step and the run.
+  Status solve_prepared(const Eigen::VectorXd& b, double forcing, StepRecord& record,
+                        Eigen::VectorXd* y) {
+    int iterations = 0;
+    const Status status = tangent_->solve(b, forcing, y, &iterations);
+    record.krylov_iterations += iterations;
+    summary_.krylov_iterations += iterations;
+    return status;
+  }
+  // Prepares the tangent at (x, factors) over `dofs`, then solve_prepared;
+  // the run's factorisations and preconditioner kept up to date.
+  Status prepare_and_solve(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                           const DofMap& dofs, const Eigen::VectorXd& b, double forcing,
+                           StepRecord& record, Eigen::VectorXd* y) {
+    Status status = tangent_->prepare(x, factors, dofs, &supports_);
+    if (status.ok) status = solve_prepared(b, forcing, record, y);
+    summary_.factorizations = tangent_->factorizations();
+    summary_.solver = tangent_->preconditioner_kind();
+    return status;
   }
 
   // The largest t of the parabola through the path's last three points (arc
@@ -434,14 +448,8 @@ class NewtonSolver {
     const auto solve_with_tangent = [&](const Eigen::VectorXd& at_x, double at_t,
                                         const Eigen::VectorXd& rhs, double forcing,
                                         Eigen::VectorXd* out) -> std::string {
-      Status status = tangent_->prepare(at_x, factors_at(at_t, n), dofs, &supports_);
-      if (status.ok) {
-        int iterations = 0;
-        status = tangent_->solve(rhs, forcing, out, &iterations);
-        record.krylov_iterations += iterations;
-        summary_.krylov_iterations += iterations;
-      }
-      summary_.factorizations = tangent_->factorizations();
+      const Status status =
+          prepare_and_solve(at_x, factors_at(at_t, n), dofs, rhs, forcing, record, out);
       return status.ok ? std::string() : status.message;
     };
     // Predictor: along du/dt = -K^-1 dR/dt, in the direction of the last step.
@@ -481,11 +489,8 @@ class NewtonSolver {
       const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
       why = solve_with_tangent(*x, *t, -dofs.reduce(R), forcing, &a);
       if (why.empty()) {  // du/dt with the same tangent
-        int iterations = 0;
-        const Status status = tangent_->solve(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
-                                              newton_.krylov_tolerance, &b, &iterations);
-        record.krylov_iterations += iterations;
-        summary_.krylov_iterations += iterations;
+        const Status status = solve_prepared(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
+                                             newton_.krylov_tolerance, record, &b);
         if (!status.ok) why = "du/dt: " + status.message;
       }
       if (!why.empty()) return why;
