@@ -29,6 +29,13 @@ def sphere(subdivisions, solver="auto", steps=10, scheme="incremental"):
                 stepping={"steps": steps, "solver": solver, "scheme": scheme})
 
 
+def horizon_sphere(subdivisions):
+    """Fibers within a tenth of the radius (issue 29), one Newton load step."""
+    return dict(sphere(subdivisions, steps=1, scheme="newton"),
+                name=f"sphere{subdivisions}_horizon",
+                material={"Y": 200000, "gamma": 1}, fibers={"horizon": 0.005})
+
+
 CASES = [
     ("sphere 642, auto", sphere(3)),
     ("sphere 2562, auto", sphere(4)),
@@ -36,6 +43,8 @@ CASES = [
     ("sphere 2562, dense-lu", sphere(4, "dense-lu", steps=3)),
     ("sphere 10242, pcg", sphere(5, "pcg", steps=3)),
     ("sphere 642, newton", sphere(3, scheme="newton", steps=5)),
+    ("sphere 10242, horizon", horizon_sphere(5)),
+    ("sphere 40962, horizon", horizon_sphere(6)),
     ("liver 139, pruned", "liver_gravity"),
     ("bunny 1366, pruned", "bunny_gravity"),
 ]

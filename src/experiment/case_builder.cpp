@@ -114,7 +114,7 @@ FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) 
   report.mean_per_vertex = n - 1;
   report.convex = report.pruning && !concave;
   std::optional<geom::FiberMask> mask;
-  if (spec.horizon > 0.0) mask = horizon_fibers(spec, m.surface);
+  if (spec.horizon > 0.0) mask = m.fibers ? *m.fibers : horizon_fibers(spec, m.surface);
   if (report.pruning && concave) {
     geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
     report.seconds = pruned.seconds;
@@ -166,6 +166,11 @@ void estimate(const CaseSpec& spec, PruningWork pruning, Case& c) {
 // and again before pruning once the check has said whether it prunes.
 void add_fibers(const CaseSpec& spec, Case& c) {
   const int n = c.model.num_vertices();
+  // A horizon's pairs are found in N times the neighbours: known before the
+  // estimate, which then counts them rather than all N^2.
+  if (spec.fibers.horizon > 0.0)
+    c.model.fibers =
+        std::make_shared<const geom::FiberMask>(horizon_fibers(spec.fibers, c.model.surface));
   estimate(spec, spec.fibers.pruning ? PruningWork::ConvexityCheck : PruningWork::None, c);
   const bool concave = spec.fibers.pruning && !geom::is_convex(c.model.surface);
   if (concave && n > kLargestPruned)

@@ -349,9 +349,10 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
   o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
   o.line_search = f.boolean("line_search", o.line_search);
-  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov"});
+  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse"});
   o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
               : tangent == "krylov" ? solve::TangentSolver::Krylov
+              : tangent == "sparse" ? solve::TangentSolver::Sparse
                                     : solve::TangentSolver::Auto;
   o.krylov_tolerance = f.positive("krylov_tolerance", o.krylov_tolerance);
   o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);

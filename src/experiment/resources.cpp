@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "experiment/case_spec.hpp"
+#include "geom/fiber_mask.hpp"
 #include "model/treecode.hpp"
 #include "solve/cost_model.hpp"
 #include "util/error.hpp"
@@ -37,6 +38,24 @@ constexpr double kKrylovProducts = 6.0;
 // surface, area vectors, unknowns, outputs.
 constexpr double kProcessBytes = 20.0 * 1024 * 1024;
 constexpr double kBytesPerVertex = 1024.0;
+// The sparse tangent's LU: factor entries per tangent entry at 10,242
+// vertices, and one measured factorisation (see sparse_tangent_cost).
+constexpr double kSparseFillPerEntry = 12.0;
+constexpr double kSparseFactorEntries = 2.76e7, kSparseFactorSeconds = 3.7;
+
+// The sparse LU of a horizon's Newton tangent (UMFPACK): its entries are
+// dim^2 (N + 2 pairs); the factors' fill grows as sqrt(N) and the flops as
+// the fill^1.5, from a measurement at 10,242 vertices (a horizon of a tenth
+// of the radius: 2.28 million entries, 27.6 million in L and U, 3.7 s).
+struct SparseTangentCost {
+  double bytes, factor_seconds;
+};
+SparseTangentCost sparse_tangent_cost(double N, double dim, double pairs) {
+  const double entries = dim * dim * (N + 2.0 * pairs);
+  const double factor_entries = kSparseFillPerEntry * entries * std::sqrt(N / 10242.0);
+  return {12.0 * factor_entries + 3.0 * 16.0 * entries,
+          kSparseFactorSeconds * std::pow(factor_entries / kSparseFactorEntries, 1.5)};
+}
 
 solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
                          const solve::BlockShape& b) {
@@ -78,7 +97,11 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   ResourceEstimate e;
   const geom::Surface& surface = model.surface;
   const double N = surface.num_vertices(), d = surface.dim;
-  const double pairs = 0.5 * N * (N - 1.0), unknowns = d * N + 1.0;
+  // A horizon stored as neighbour lists: only its pairs are visited.
+  const bool sparse_fibers = model.fibers && model.fibers->sparse();
+  const double pairs =
+      sparse_fibers ? static_cast<double>(model.fibers->num_kept()) : 0.5 * N * (N - 1.0);
+  const double unknowns = d * N + 1.0;
   const double steps = o.steps;
 
   e.parts.push_back({"model", kProcessBytes + kBytesPerVertex * N, 0.0, true});
@@ -97,9 +120,10 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
                              : d * pairs / speed.pair_updates_per_second;
   const double residual = 2.0 * pairs / speed.residual_pairs_per_second;
   const bool newton = o.scheme == solve::Scheme::Newton;
-  const bool dense_tangent =
-      newton && solve::choose_tangent(o.newton.tangent, blocks.newton_unknowns,
-                                      model.material.kinematics) == solve::TangentSolver::Dense;
+  const solve::TangentSolver tangent_kind = solve::choose_tangent(
+      o.newton.tangent, blocks.newton_unknowns, model.material.kinematics, sparse_fibers);
+  const bool dense_tangent = newton && tangent_kind == solve::TangentSolver::Dense;
+  const bool sparse_tangent = newton && tangent_kind == solve::TangentSolver::Sparse;
   const solve::SolverKind kind =
       dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
@@ -115,6 +139,10 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
     ResourcePart tangent{std::to_string(o.steps) + " Newton steps", factor.bytes, 0.0};
     if (dense_tangent) {
       tangent.seconds = iterations * (factor.seconds + residual);
+    } else if (sparse_tangent) {
+      const SparseTangentCost c = sparse_tangent_cost(N, d, pairs);
+      tangent.bytes = c.bytes;
+      tangent.seconds = iterations * (c.factor_seconds + residual);
     } else {
       // The stored pair coefficients (when they fit a quarter of the
       // budget), the preconditioner once per step, GMRES products.

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "geom/area_vectors.hpp"
 
+#include <cmath>
+
 #include <Eigen/Geometry>
 
 namespace fiberfluid::geom {
@@ -44,11 +46,18 @@ double surface_area(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
 
 double enclosed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   if (F.rows() == 0 || V.rows() == 0) return 0.0;
-  // Summed about the centre of the bounding box, not the origin: for a body
-  // far from the origin the terms about the origin are huge and cancel
-  // (a unit cube at 1e8 loses every digit). For a closed surface the sum
-  // does not depend on the point.
-  const Eigen::RowVectorXd centre = 0.5 * (V.colwise().minCoeff() + V.colwise().maxCoeff());
+  // Summed about the centre of the faces' bounding box, not the origin: for
+  // a body far from the origin the terms about the origin are huge and
+  // cancel (a unit cube at 1e8 loses every digit). For a closed surface the
+  // sum does not depend on the point. Vertices in no face are left out: one
+  // far away would move the centre as far.
+  Eigen::RowVectorXd low = Eigen::RowVectorXd::Constant(V.cols(), HUGE_VAL), high = -low;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (Eigen::Index k = 0; k < F.cols(); ++k) {
+      low = low.cwiseMin(V.row(F(f, k)));
+      high = high.cwiseMax(V.row(F(f, k)));
+    }
+  const Eigen::RowVectorXd centre = 0.5 * (low + high);
   double volume = 0.0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     if (V.cols() == 3) {

@@ -68,18 +68,28 @@ class CellGrid {
 
 }  // namespace
 
-FiberMask horizon_fibers(const Surface& surface, double horizon) {
+FiberMask horizon_fibers(const Surface& surface, double horizon, MaskStorage storage) {
   if (!(horizon > 0.0) || !std::isfinite(horizon))
     throw std::invalid_argument("the horizon must be a positive length");
   const Eigen::MatrixXd& V = surface.V;
-  FiberMask mask = FiberMask::none(static_cast<int>(V.rows()));
+  const int n = static_cast<int>(V.rows());
+  std::vector<std::vector<int>> partners(static_cast<size_t>(n));
   const CellGrid grid(V, horizon);
   const double reach = horizon * horizon;
-  for (int i = 0; i < V.rows(); ++i)
+  long long kept = 0;
+  for (int i = 0; i < n; ++i) {
     grid.for_each_near(i, [&](int j) {
-      if (j > i && (V.row(i) - V.row(j)).squaredNorm() <= reach) mask.keep(i, j);
+      if (j > i && (V.row(i) - V.row(j)).squaredNorm() <= reach)
+        partners[static_cast<size_t>(i)].push_back(j);
     });
-  return mask;
+    kept += static_cast<long long>(partners[static_cast<size_t>(i)].size());
+  }
+  const double pairs = 0.5 * static_cast<double>(n) * (n - 1);
+  const bool sparse =
+      storage == MaskStorage::Sparse ||
+      (storage == MaskStorage::Auto && static_cast<double>(kept) <= kSparseShare * pairs);
+  FiberMask mask = FiberMask::from_neighbours(std::move(partners));
+  return sparse ? mask : mask.as_dense();
 }
 
 double longest_edge(const Surface& surface) {

@@ -77,18 +77,26 @@ double symmetric_difference_2d(const geom::Surface& a, const geom::Surface& b,
   return CGAL::to_double(p.area()) + CGAL::to_double(q.area()) - 2.0 * common;
 }
 
-// The surface as a CGAL mesh of kernel K; throws unless every face makes a manifold.
+// The surface as a CGAL mesh of kernel K; throws unless every face makes a
+// manifold. Only the vertices of some face are added: CGAL's volume
+// predicates (does_bound_a_volume) fail on isolated vertices.
 template <class MeshType>
 MeshType build_mesh(const geom::Surface& s, const std::string& what) {
   using Point = typename MeshType::Point;
   MeshType mesh;
-  std::vector<typename MeshType::Vertex_index> vertices;
-  for (int v = 0; v < s.num_vertices(); ++v)
-    vertices.push_back(mesh.add_vertex(Point(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
-  for (int f = 0; f < s.num_faces(); ++f) {
+  for (int f = 0; f < s.num_faces(); ++f)
     for (int k = 0; k < 3; ++k)
       if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices())
         throw InputError(what + ": face " + std::to_string(f) + " refers to a missing vertex");
+  std::vector<typename MeshType::Vertex_index> vertices(static_cast<size_t>(s.num_vertices()),
+                                                        MeshType::null_vertex());
+  for (int f = 0; f < s.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int v = s.F(f, k);
+      if (vertices[static_cast<size_t>(v)] == MeshType::null_vertex())
+        vertices[static_cast<size_t>(v)] = mesh.add_vertex(Point(s.V(v, 0), s.V(v, 1), s.V(v, 2)));
+    }
+  for (int f = 0; f < s.num_faces(); ++f) {
     if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))],
                       vertices[static_cast<size_t>(s.F(f, 1))],
                       vertices[static_cast<size_t>(s.F(f, 2))]) == MeshType::null_face())
@@ -103,13 +111,23 @@ Mesh solid(const geom::Surface& s, const std::string& what) {
   require_representable(s, what);
   if (s.num_faces() == 0)
     throw InputError(what + ": has no faces (a point cloud), so it bounds no solid");
-  const CheckMesh check = build_mesh<CheckMesh>(s, what);
+  CheckMesh check = build_mesh<CheckMesh>(s, what);
   if (check.is_empty() || !CGAL::is_closed(check))
     throw InputError(what + ": the mesh is not closed, so it bounds no solid");
   if (PMP::does_self_intersect(check))
     throw InputError(what + ": the mesh intersects itself (an inverted or overlapping part)");
   Mesh mesh = build_mesh<Mesh>(s, what);
-  if (!PMP::is_outward_oriented(check)) PMP::reverse_face_orientations(mesh);
+  const bool outward = PMP::is_outward_oriented(check);
+  if (!outward) {
+    PMP::reverse_face_orientations(check);
+    PMP::reverse_face_orientations(mesh);
+  }
+  // Nested shells bound a solid only if they alternate (a shell inside a
+  // shell is a cavity and faces inward); corefinement is undefined otherwise.
+  if (!PMP::does_bound_a_volume(check))
+    throw InputError(what +
+                     ": the mesh bounds no volume: its shells are nested but not oriented "
+                     "alternately (a shell inside another is a cavity and must face inward)");
   return mesh;
 }
 

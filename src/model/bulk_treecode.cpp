@@ -35,13 +35,11 @@ BulkTreecode::BulkTreecode(const Eigen::MatrixXd& X, const Eigen::VectorXd& area
   const std::vector<double> counts = factors.vertex_counts();
   h_ = counts.empty() ? 0.0 : connection_factor(1.0, counts.front(), counts.front());
   if (const geom::FiberMask* mask = factors.mask())
-    for (int i = 0; i < mask->num_vertices(); ++i) {
-      const uint8_t* kept = mask->row(i);
+    for (int i = 0; i < mask->num_vertices(); ++i)
       for (int j = i + 1; j < mask->num_vertices(); ++j)
-        if (kept[j] == 0)
+        if (!mask->kept(i, j))
           pruned_.push_back(
               {i, j, bulk_weight(h_, area[i], area[j], (X.row(i) - X.row(j)).norm())});
-    }
   Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(X.rows(), 1);
   row_sums_ = weighted_sums(ones).col(0);
   for (const PrunedPair& p : pruned_) {

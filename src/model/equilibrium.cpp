@@ -101,9 +101,29 @@ Eigen::MatrixXd Equilibrium::tangent(const Eigen::VectorXd& x,
                                      const std::vector<double>& factors) const {
   const TermState s(context_, x, factors);
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(num_unknowns(), num_unknowns());
-  bulk_.add_tangent(s, J);
-  for (const auto& term : terms_) term->add_tangent(s, J);
+  TangentSink sink(J);
+  bulk_.add_tangent(s, sink);
+  for (const auto& term : terms_) term->add_tangent(s, sink);
   return J;
+}
+
+Eigen::SparseMatrix<double> Equilibrium::sparse_tangent(const Eigen::VectorXd& x,
+                                                        const std::vector<double>& factors) const {
+  const TermState s(context_, x, factors);
+  std::vector<Eigen::Triplet<double>> entries;
+  TangentSink sink(entries);
+  bulk_.add_tangent(s, sink);
+  for (const auto& term : terms_) term->add_tangent(s, sink);
+  Eigen::SparseMatrix<double> J(num_unknowns(), num_unknowns());
+  J.setFromTriplets(entries.begin(), entries.end());  // sums the duplicates
+  return J;
+}
+
+bool Equilibrium::sparse_fibers() const { return bulk_.sparse(); }
+
+double Equilibrium::stored_tangent_bytes() const {
+  if (!bulk_.sparse()) return TangentOperator::bytes_for(model_.num_vertices());
+  return 2.0 * 8.0 * 2.0 * static_cast<double>(model_.fibers->num_kept());
 }
 
 Eigen::VectorXd Equilibrium::tangent_product(const Eigen::VectorXd& x,
@@ -140,14 +160,21 @@ void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>&
   op.factors_ = factors;
   op.X_ = positions(model_, x);
   op.U_ = displacements(model_, x);
-  bulk_.coefficients(op.X_, op.U_, &op.weighted_modulus_, &op.weighted_slope_);
+  op.listed_ = bulk_.sparse();
+  if (op.listed_)
+    bulk_.listed_coefficients(op.X_, op.U_, &op.listed_modulus_, &op.listed_slope_);
+  else
+    bulk_.coefficients(op.X_, op.U_, &op.weighted_modulus_, &op.weighted_slope_);
 }
 
 Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
   const Equilibrium& eq = *equilibrium_;
   const Eigen::MatrixXd W = displacements(eq.model(), v);
   Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());
-  eq.bulk_.add_stored_product(X_, U_, weighted_modulus_, weighted_slope_, W, out);
+  if (listed_)
+    eq.bulk_.add_listed_product(X_, U_, listed_modulus_, listed_slope_, W, out);
+  else
+    eq.bulk_.add_stored_product(X_, U_, weighted_modulus_, weighted_slope_, W, out);
   eq.add_other_products(TermState(eq.context_, x_, factors_), v, W, out);
   return out;
 }

@@ -34,6 +34,9 @@ class TangentOperator {
   std::vector<double> factors_;
   Eigen::MatrixXd X_, U_;
   Eigen::MatrixXd weighted_modulus_, weighted_slope_;  // column i: the pairs (i, j)
+  // Fibers stored as neighbour lists: the kept pairs' coefficients in list order.
+  bool listed_ = false;
+  std::vector<double> listed_modulus_, listed_slope_;
 };
 
 // The equilibrium equations of the Newton scheme (model.md section 7) at any
@@ -80,6 +83,14 @@ class Equilibrium {
   // dR/dx, dense, full layout: the consistent tangent with the dY/de terms,
   // the pressure terms P dS/dx and the follower-load terms.
   Eigen::MatrixXd tangent(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
+  // dR/dx as a sparse matrix (full layout): N times the neighbours entries
+  // for fibers stored as neighbour lists (a horizon), N^2 otherwise.
+  Eigen::SparseMatrix<double> sparse_tangent(const Eigen::VectorXd& x,
+                                             const std::vector<double>& factors) const;
+  // Whether the bulk fibers are stored as neighbour lists (FiberMask::sparse).
+  bool sparse_fibers() const;
+  // The bytes linearize() stores (the pair coefficients).
+  double stored_tangent_bytes() const;
   // dR/dx v without forming the matrix (O(N^2) pairs, no storage).
   Eigen::VectorXd tangent_product(const Eigen::VectorXd& x, const std::vector<double>& factors,
                                   const Eigen::VectorXd& v) const;

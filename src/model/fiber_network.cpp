@@ -43,10 +43,15 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
       throw std::invalid_argument("a conical influence needs a positive horizon");
     reference_ = *reference;
     kept_.assign(static_cast<size_t>(n_), 0.0);
-    std::vector<double> row(static_cast<size_t>(n_));
-    for (int i = 0; i < n_; ++i) {
-      weights(i, row.data());
-      for (int j = 0; j < n_; ++j) kept_[static_cast<size_t>(i)] += row[static_cast<size_t>(j)];
+    if (fibers_ != nullptr && fibers_->sparse()) {  // only the pairs listed
+      for (int i = 0; i < n_; ++i)
+        fibers_->for_each_kept(i, [&](int j) { kept_[static_cast<size_t>(i)] += weight(i, j); });
+    } else {
+      std::vector<double> row(static_cast<size_t>(n_));
+      for (int i = 0; i < n_; ++i) {
+        weights(i, row.data());
+        for (int j = 0; j < n_; ++j) kept_[static_cast<size_t>(i)] += row[static_cast<size_t>(j)];
+      }
     }
   } else if (fibers_ != nullptr) {
     const std::vector<int> kept = fibers_->kept_per_vertex();
@@ -59,15 +64,30 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
   global_ = n_ > 0 ? sum / n_ : 0.0;
 }
 
+double PairFactors::weight(int i, int j) const {
+  return influence_.weighs() ? influence_((reference_.row(i) - reference_.row(j)).norm()) : 1.0;
+}
+
 void PairFactors::weights(int i, double* row) const {
+  if (fibers_ != nullptr && fibers_->sparse()) {
+    std::fill(row, row + n_, 0.0);
+    fibers_->for_each_kept(i, [&](int j) { row[j] = weight(i, j); });
+    return;
+  }
   const uint8_t* kept = fibers_ != nullptr ? fibers_->row(i) : nullptr;
   for (int j = 0; j < n_; ++j) {
     double w = kept != nullptr ? kept[j] : 1.0;
-    if (influence_.weighs() && w != 0.0)
-      w *= influence_((reference_.row(i) - reference_.row(j)).norm());
+    if (w != 0.0) w *= weight(i, j);
     row[j] = w;
   }
   row[i] = 0.0;
+}
+
+double PairFactors::factor(int i, int j) const {
+  const bool global = count_ == ConnectionCount::Global || kept_.empty();
+  const auto count = [&](int k) { return global ? global_ : kept_[static_cast<size_t>(k)]; };
+  const bool joined = fibers_ == nullptr ? i != j : fibers_->kept(i, j);
+  return joined ? connection_factor(weight(i, j), count(i), count(j)) : 0.0;
 }
 
 std::vector<double> PairFactors::vertex_counts() const {

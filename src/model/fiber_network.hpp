@@ -23,6 +23,8 @@ class PairFactors {
   explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.
   void row(int i, double* row) const;
+  // h_ij of one pair (0 for a pair not joined).
+  double factor(int i, int j) const;
   // The same factors in the form the tiled pair kernels use:
   // h_ij = kept_ij / (c_i + c_j), c_i per vertex (N-1 with every pair kept,
   // the mean count with the global count, n_i with the symmetric one).
@@ -35,6 +37,8 @@ class PairFactors {
  private:
   // kept_ij omega(L_ij) for j = 0..N-1 (0 at j = i).
   void weights(int i, double* row) const;
+  // omega(L_ij) (1 unless the influence weighs).
+  double weight(int i, int j) const;
 
   const geom::FiberMask* fibers_;
   ConnectionCount count_;

@@ -90,16 +90,24 @@ void FiberSystem::pair_row(int i, double* row) const {
 }
 
 bool FiberSystem::blocks_equal() const {
+  if (projected_) return false;
   for (int a = 1; a < dim_; ++a)
     if (active(a) != active(0) || penalised(a) != penalised(0) || young(a) != young(0))
       return false;
   return true;
 }
 
-BulkPairs FiberSystem::bulk_pairs(const std::vector<int>& vertices) const {
+BulkPairs FiberSystem::bulk_pairs(const std::vector<int>& vertices, int axis) const {
   BulkPairs pairs(X_, area_, factors_, vertices);
   if (law_ != nullptr) pairs.set_secant_law(law_, &reference_, &strained_);
+  if (projected_ && axis >= 0) pairs.set_axis_projection(axis, &projection_positions_);
   return pairs;
+}
+
+void FiberSystem::project_on_axes(const Eigen::MatrixXd& positions) {
+  projected_ = true;
+  projection_positions_ = positions;
+  for (Eigen::VectorXd& d : bulk_diagonal_) d.resize(0);
 }
 
 Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
@@ -111,9 +119,9 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   if (y == 0.0) {
     K.setZero();
   } else {
-    bulk_pairs(act).fill_off_diagonal(y, &K);
+    bulk_pairs(act, axis).fill_off_diagonal(y, &K);
     // The diagonal gathers the weights to every vertex, active or not.
-    const Eigen::VectorXd& diagonal = bulk_diagonal();
+    const Eigen::VectorXd& diagonal = bulk_diagonal(axis);
     for (Eigen::Index r = 0; r < m; ++r) K(r, r) = y * diagonal[act[static_cast<size_t>(r)]];
   }
   if (gamma_ != 0.0) {
@@ -131,13 +139,22 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
   return K;
 }
 
-const Eigen::VectorXd& FiberSystem::bulk_diagonal() const {
-  if (bulk_diagonal_.size() != n_)
-    bulk_diagonal_ = treecode_ ? treecode_->row_sums() : bulk_pairs().row_sums();
-  return bulk_diagonal_;
+const Eigen::VectorXd& FiberSystem::bulk_diagonal(int axis) const {
+  const int slot = projected_ ? axis : 0;
+  Eigen::VectorXd& diagonal = bulk_diagonal_[slot];
+  if (diagonal.size() != n_)
+    diagonal =
+        treecode_ ? treecode_->row_sums() : bulk_pairs({}, projected_ ? axis : -1).row_sums();
+  return diagonal;
 }
 
 Eigen::MatrixXd FiberSystem::bulk_product(const Eigen::MatrixXd& V) const {
+  if (projected_) {
+    Eigen::MatrixXd out(V.rows(), V.cols());
+    for (Eigen::Index a = 0; a < V.cols(); ++a)
+      out.col(a) = bulk_pairs({}, static_cast<int>(a)).laplacian_product(V.col(a));
+    return out;
+  }
   return treecode_ ? treecode_->laplacian_product(V) : bulk_pairs().laplacian_product(V);
 }
 
@@ -168,8 +185,18 @@ Eigen::MatrixXd FiberSystem::unreduced_rows(const std::vector<int>& vertices,
       for (int axis = 0; axis < dim_; ++axis) {
         const double* v = U.col(axis).data();
         double sum = 0.0;
+        if (projected_) {
+          const Eigen::MatrixXd& P = projection_positions_;
+          for (size_t j = 0; j < n; ++j) {
+            if (weight[j] == 0.0 || j == u) continue;
+            const Eigen::RowVectorXd d = P.row(i) - P.row(static_cast<Eigen::Index>(j));
+            const double share = d[axis] * d[axis] / d.squaredNorm() + BulkPairs::kProjectionFloor;
+            sum += weight[j] * share * (v[u] - v[j]);
+          }
+        } else {
 #pragma omp simd reduction(+ : sum)
-        for (size_t j = 0; j < n; ++j) sum += weight[j] * (v[u] - v[j]);
+          for (size_t j = 0; j < n; ++j) sum += weight[j] * (v[u] - v[j]);
+        }
         out(r, axis) = young(axis) * sum + gamma_ * surface(i, axis) + S_(i, axis) * P;
       }
     }
@@ -193,8 +220,19 @@ Eigen::SparseMatrix<double> FiberSystem::sparse_block(int axis, bool include_bul
   Eigen::SparseMatrix<double> K(m, m);
   K.setFromTriplets(entries.begin(), entries.end());
   if (include_bulk && young(axis) != 0.0) {
-    const Eigen::MatrixXd bulk = dense_block(axis) - Eigen::MatrixXd(K);
-    K += bulk.sparseView();
+    if (sparse_fibers()) {  // the listed pairs only: N times the neighbours entries
+      std::vector<Eigen::Triplet<double>> bulk;
+      bulk_pairs(act, axis).add_off_diagonal(young(axis), &bulk);
+      const Eigen::VectorXd& diagonal = bulk_diagonal(axis);
+      for (Eigen::Index r = 0; r < m; ++r)
+        bulk.emplace_back(r, r, young(axis) * diagonal[act[static_cast<size_t>(r)]]);
+      Eigen::SparseMatrix<double> B(m, m);
+      B.setFromTriplets(bulk.begin(), bulk.end());
+      K += B;
+    } else {
+      const Eigen::MatrixXd bulk = dense_block(axis) - Eigen::MatrixXd(K);
+      K += bulk.sparseView();
+    }
   }
   for (int k : penalised(axis)) K.coeffRef(k, k) = penalty_;
   K.makeCompressed();
@@ -208,11 +246,14 @@ Eigen::SparseMatrix<double> FiberSystem::preconditioner_block(int axis) const {
   for (size_t k = 0; k < active(axis).size(); ++k)
     if (!is_penalised[k])
       M.coeffRef(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) +=
-          young(axis) * bulk_diagonal()[active(axis)[k]];
+          young(axis) * bulk_diagonal(axis)[active(axis)[k]];
   return M;
 }
 
+bool FiberSystem::sparse_fibers() const { return fibers_ != nullptr && fibers_->sparse(); }
+
 bool FiberSystem::dense_blocks() const {
+  if (sparse_fibers()) return false;  // a horizon's fibers: sparse blocks
   for (int a = 0; a < dim_; ++a)
     if (young(a) != 0.0) return true;
   return false;
@@ -245,7 +286,7 @@ Eigen::VectorXd FiberSystem::apply_K(const Eigen::VectorXd& u) const {
     for (int k : penalised(a)) {
       const Eigen::Index row = offset(a) + k;
       const int i = active(a)[static_cast<size_t>(k)];
-      const double diagonal = young(a) * bulk_diagonal()[i] + gamma_ * surface_.coeff(i, i);
+      const double diagonal = young(a) * bulk_diagonal(a)[i] + gamma_ * surface_.coeff(i, i);
       out[row] += (penalty_ - diagonal) * u[row];
     }
   }

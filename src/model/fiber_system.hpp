@@ -68,6 +68,9 @@ class FiberSystem final : public BorderedSystem {
   const Eigen::VectorXd& area() const { return area_; }
   const Eigen::SparseMatrix<double>& surface_laplacian() const { return surface_; }
 
+  // The bulk fibers are stored as neighbour lists (a horizon): the blocks
+  // are sparse, N times the neighbours entries.
+  bool sparse_fibers() const;
   // K_a over the active vertices, dense.
   Eigen::MatrixXd dense_block(int axis) const override;
   // K_a as a sparse matrix (with the bulk fibers: N^2 entries).
@@ -81,9 +84,17 @@ class FiberSystem final : public BorderedSystem {
   // sparse, and close to K_a because the complete bulk graph is so well
   // connected (model.md section 5).
   Eigen::SparseMatrix<double> preconditioner_block(int axis) const override;
-  // Diagonal of L_bulk (#V), computed on first use (one pass over the pairs).
-  const Eigen::VectorXd& bulk_diagonal() const;
-  // L_bulk V for #V by k vectors, computed pair by pair without storing L_bulk.
+  // Diagonal of axis a's L_bulk (#V), computed on first use (one pass over
+  // the pairs); the same for every axis unless the weights are projected.
+  const Eigen::VectorXd& bulk_diagonal(int axis = 0) const;
+  // From now on, axis a's bulk weights are each times the share of a in the
+  // fiber's direction at `positions` (BulkPairs::set_axis_projection): the
+  // blocks then approximate a central fiber's tangent, axis by axis, for
+  // Newton's Krylov preconditioner. Call before any block or product.
+  void project_on_axes(const Eigen::MatrixXd& positions);
+  bool projected() const { return projected_; }
+  // L_bulk V for #V by k vectors, computed pair by pair without storing L_bulk
+  // (projected weights: column a with axis a's; k = dim).
   // With Model::treecode_tolerance (and a constant law) both come from the
   // treecode; dense and sparse blocks stay exact, so that option goes with PCG.
   Eigen::MatrixXd bulk_product(const Eigen::MatrixXd& V) const;
@@ -109,7 +120,8 @@ class FiberSystem final : public BorderedSystem {
 
  private:
   // The bulk pairs of `vertices` (empty: all), with the secant law if any.
-  BulkPairs bulk_pairs(const std::vector<int>& vertices = {}) const;
+  // Axis a's weights when projected (axis -1: unprojected).
+  BulkPairs bulk_pairs(const std::vector<int>& vertices = {}, int axis = -1) const;
   // Fills row (length N) with h_ij, times Y(e_ij) / ... for a strain-dependent law.
   void pair_row(int i, double* row) const;
 
@@ -120,7 +132,10 @@ class FiberSystem final : public BorderedSystem {
   Eigen::VectorXd area_;
   Eigen::MatrixXd S_;
   Eigen::SparseMatrix<double> surface_;
-  mutable Eigen::VectorXd bulk_diagonal_;  // empty until first asked for
+  mutable Eigen::VectorXd
+      bulk_diagonal_[3];  // per axis when projected, else [0]; empty until asked
+  bool projected_ = false;
+  Eigen::MatrixXd projection_positions_;
   // The approximate bulk product and diagonal (Model::treecode_tolerance).
   std::shared_ptr<const BulkTreecode> treecode_;
   Eigen::Vector3d young_;  // per axis: Y m_a, or m_a when the moduli are per pair

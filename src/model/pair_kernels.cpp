@@ -255,6 +255,11 @@ BulkPairs::BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
     vertex_ = vertices;
   }
   n_ = static_cast<int>(vertex_.size());
+  if (sparse()) {
+    position_.assign(static_cast<size_t>(X.rows()), -1);
+    for (size_t k = 0; k < vertex_.size(); ++k)
+      position_[static_cast<size_t>(vertex_[k])] = static_cast<int>(k);
+  }
   const std::vector<double> counts = factors.vertex_counts();
   for (auto& column : x_) column.assign(static_cast<size_t>(n_), 0.0);
   area_.resize(static_cast<size_t>(n_));
@@ -274,6 +279,18 @@ void BulkPairs::set_secant_law(const FiberLaw* law, const Eigen::MatrixXd* refer
   strained_ = strained;
 }
 
+void BulkPairs::set_axis_projection(int axis, const Eigen::MatrixXd* positions) {
+  projection_axis_ = axis;
+  projection_positions_ = positions;
+}
+
+double BulkPairs::projection(int vi, int vj) const {
+  const Eigen::RowVectorXd d = projection_positions_->row(vi) - projection_positions_->row(vj);
+  const double squared = d.squaredNorm();
+  return (squared > 0.0 ? d[projection_axis_] * d[projection_axis_] / squared : 0.0) +
+         kProjectionFloor;
+}
+
 void BulkPairs::multipliers(const Tile& t, double* m) const {
   std::vector<double> strain(kTile), modulus(kTile), slope(kTile);
   for (int r = 0; r < t.ni; ++r) {
@@ -291,6 +308,9 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
         if (row[q] != 0.0)
           row[q] *=
               influence_((reference_positions_.row(vi) - reference_positions_.row(vj[q])).norm());
+    if (projection_axis_ >= 0)
+      for (int q = 0; q < t.nj; ++q)
+        if (row[q] != 0.0 && vj[q] != vi) row[q] *= projection(vi, vj[q]);
     if (law_ == nullptr) continue;
     // The secant modulus at e_ij = |y_i - y_j| / L_ij - 1 (zero where i == j).
     for (int q = 0; q < t.nj; ++q) {
@@ -307,7 +327,8 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
 
 template <class Visit>
 void BulkPairs::for_each_tile(Visit&& visit) const {
-  const bool weighted = mask_ != nullptr || law_ != nullptr || influence_.weighs();
+  const bool weighted =
+      mask_ != nullptr || law_ != nullptr || influence_.weighs() || projection_axis_ >= 0;
   // Unweighted: one row of ones serves every row of every tile.
   std::vector<std::vector<double>> m(static_cast<size_t>(omp_get_max_threads()),
                                      std::vector<double>(weighted ? kTile * kTile : kTile, 1.0));
@@ -318,7 +339,37 @@ void BulkPairs::for_each_tile(Visit&& visit) const {
   });
 }
 
+double BulkPairs::listed_weight(int r, int c) const {
+  const int vi = vertex_[static_cast<size_t>(r)], vj = vertex_[static_cast<size_t>(c)];
+  double m = 1.0;
+  if (influence_.weighs())
+    m = influence_((reference_positions_.row(vi) - reference_positions_.row(vj)).norm());
+  if (law_ != nullptr) {
+    const double length = (reference_->row(vi) - reference_->row(vj)).norm();
+    m *= law_->modulus(fiber_strain((strained_->row(vi) - strained_->row(vj)).norm(), length));
+  }
+  if (projection_axis_ >= 0) m *= projection(vi, vj);
+  const auto r_ = static_cast<size_t>(r), c_ = static_cast<size_t>(c);
+  const double d0 = x_[0][r_] - x_[0][c_], d1 = x_[1][r_] - x_[1][c_], d2 = x_[2][r_] - x_[2][c_];
+  return weight(m, area_[r_], area_[c_], count_[r_], count_[c_], d0 * d0 + d1 * d1 + d2 * d2);
+}
+
+template <class Visit>
+void BulkPairs::for_each_listed(Visit&& visit) const {
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int r = 0; r < n_; ++r)
+    for (int j : mask_->neighbours(vertex_[static_cast<size_t>(r)])) {
+      const int c = position_[static_cast<size_t>(j)];
+      if (c >= 0) visit(r, c, listed_weight(r, c));
+    }
+}
+
 Eigen::VectorXd BulkPairs::row_sums() const {
+  if (sparse()) {
+    Eigen::VectorXd sums = Eigen::VectorXd::Zero(n_);
+    for_each_listed([&](int r, int, double w) { sums[r] += w; });
+    return sums;
+  }
   const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   ThreadAccumulators sums(n_, 1);
   for_each_tile([&](const Tile& t, Multipliers m, int thread) {
@@ -328,6 +379,11 @@ Eigen::VectorXd BulkPairs::row_sums() const {
 }
 
 Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
+  if (sparse()) {  // each row gathers its own pairs: no accumulators
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, V.cols());
+    for_each_listed([&](int r, int c, double w) { out.row(r) += w * (V.row(r) - V.row(c)); });
+    return out;
+  }
   const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   const auto k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
@@ -346,7 +402,30 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
   return out;
 }
 
+void BulkPairs::add_off_diagonal(double scale, std::vector<Eigen::Triplet<double>>* entries) const {
+  if (sparse()) {
+    std::vector<std::vector<Eigen::Triplet<double>>> rows(static_cast<size_t>(n_));
+    for_each_listed([&](int r, int c, double w) {
+      rows[static_cast<size_t>(r)].emplace_back(r, c, -scale * w);
+    });
+    for (const auto& row : rows) entries->insert(entries->end(), row.begin(), row.end());
+    return;
+  }
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n_, n_);
+  fill_off_diagonal(scale, &K);
+  for (int c = 0; c < n_; ++c)
+    for (int r = 0; r < n_; ++r)
+      if (r != c && K(r, c) != 0.0) entries->emplace_back(r, c, K(r, c));
+}
+
 void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
+  if (sparse()) {
+    for (int c = 0; c < n_; ++c)
+      for (int r = 0; r < n_; ++r)
+        if (r != c) (*K)(r, c) = 0.0;
+    for_each_listed([&](int r, int c, double w) { (*K)(r, c) = -scale * w; });
+    return;
+  }
   const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   double* data = K->data();
   const Eigen::Index ld = K->rows();
@@ -376,6 +455,65 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
       u_[a][static_cast<size_t>(i)] = U(i, a);
     }
   }
+  if (sparse()) {
+    offsets_.assign(static_cast<size_t>(n_) + 1, 0);
+    for (int i = 0; i < n_; ++i)
+      offsets_[static_cast<size_t>(i) + 1] =
+          offsets_[static_cast<size_t>(i)] + mask_->neighbours(i).size();
+  }
+}
+
+struct DeformedPairs::ListedRow {
+  std::vector<double> m, L, r, e, Y, Yp;
+  void resize(size_t k) {
+    for (std::vector<double>* v : {&m, &L, &r, &e, &Y, &Yp})
+      if (v->size() < k) v->resize(k);
+  }
+  RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
+};
+
+template <class Visit>
+void DeformedPairs::for_each_listed_row(Visit&& visit) const {
+#pragma omp parallel
+  {
+    ListedRow row;
+#pragma omp for schedule(dynamic, 64)
+    for (int i = 0; i < n_; ++i) {
+      const std::vector<int>& partners = mask_->neighbours(i);
+      const size_t k = partners.size();
+      if (k == 0) continue;
+      row.resize(k);
+      const auto u = static_cast<size_t>(i);
+      for (size_t q = 0; q < k; ++q) {
+        const auto j = static_cast<size_t>(partners[q]);
+        row.L[q] = pair_length(s_[0][u] - s_[0][j], s_[1][u] - s_[1][j], s_[2][u] - s_[2][j]);
+        row.r[q] = pair_length(x_[0][u] - x_[0][j], x_[1][u] - x_[1][j], x_[2][u] - x_[2][j]);
+        row.e[q] = fiber_strain(row.r[q], row.L[q]);
+        row.m[q] = influence_.weighs() ? influence_(row.L[q]) : 1.0;
+      }
+      law_.evaluate(row.e.data(), k, row.Y.data(), row.Yp.data());
+      visit(i, partners, row.arrays());
+    }
+  }
+}
+
+void DeformedPairs::listed_coefficients(std::vector<double>* c1, std::vector<double>* c2) const {
+  c1->assign(offsets_.back(), 0.0);
+  c2->assign(offsets_.back(), 0.0);
+  const double *area = area_.data(), *count = count_.data();
+  with_kinematics(kinematics_, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
+      const size_t first = offsets_[static_cast<size_t>(i)];
+      for (size_t q = 0; q < partners.size(); ++q) {
+        const int j = partners[q];
+        const PairCoefficients c =
+            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+        (*c1)[first + q] = c.c1;
+        (*c2)[first + q] = c.c2;
+      }
+    });
+  });
 }
 
 struct DeformedPairs::RowScratch {
@@ -419,6 +557,27 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
 }
 
 Eigen::MatrixXd DeformedPairs::forces() const {
+  if (sparse()) {
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, 3);
+    const double *area = area_.data(), *count = count_.data();
+    with_kinematics(kinematics_, [&](auto policy) {
+      using K = decltype(policy);
+      for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
+        const auto u = static_cast<size_t>(i);
+        double f[3] = {0.0, 0.0, 0.0};
+        for (size_t q = 0; q < partners.size(); ++q) {
+          const int j = partners[q];
+          const PairCoefficients c =
+              row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+          for (int a = 0; a < 3; ++a)
+            f[a] += pair_force<K>(c, x_[a][u] - x_[a][static_cast<size_t>(j)],
+                                  u_[a][u] - u_[a][static_cast<size_t>(j)]);
+        }
+        for (int a = 0; a < 3; ++a) out(i, a) = f[a];
+      });
+    });
+    return out;
+  }
   const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators forces(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {
@@ -438,6 +597,30 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
     if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, directions[a].begin());
     w[a] = directions[a].data();
   }
+  if (sparse()) {
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, 3);
+    const double *area = area_.data(), *count = count_.data();
+    with_kinematics(kinematics_, [&](auto policy) {
+      using K = decltype(policy);
+      for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
+        const auto u = static_cast<size_t>(i);
+        double p[3] = {0.0, 0.0, 0.0};
+        for (size_t q = 0; q < partners.size(); ++q) {
+          const int j = partners[q];
+          const auto v = static_cast<size_t>(j);
+          const PairCoefficients c =
+              row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+          const double b[3] = {x_[0][u] - x_[0][v], x_[1][u] - x_[1][v], x_[2][u] - x_[2][v]};
+          const double d[3] = {w[0][u] - w[0][v], w[1][u] - w[1][v], w[2][u] - w[2][v]};
+          const double b_dot_v = b[0] * d[0] + b[1] * d[1] + b[2] * d[2];
+          for (int a = 0; a < 3; ++a)
+            p[a] += pair_tangent<K>(c, d[a], b_dot_v, b[a], u_[a][u] - u_[a][v]);
+        }
+        for (int a = 0; a < 3; ++a) out(i, a) = p[a];
+      });
+    });
+    return out;
+  }
   const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators products(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {
@@ -451,6 +634,20 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
 }
 
 void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+  if (sparse()) {
+    std::vector<double> k1, k2;
+    listed_coefficients(&k1, &k2);
+    c1->setZero(n_, n_);
+    c2->setZero(n_, n_);
+    for (int i = 0; i < n_; ++i) {
+      const std::vector<int>& partners = mask_->neighbours(i);
+      for (size_t q = 0; q < partners.size(); ++q) {
+        (*c1)(i, partners[q]) = k1[offsets_[static_cast<size_t>(i)] + q];
+        (*c2)(i, partners[q]) = k2[offsets_[static_cast<size_t>(i)] + q];
+      }
+    }
+    return;
+  }
   c1->resize(n_, n_);
   c2->resize(n_, n_);
   advise_huge_pages(c1->data(), 8.0 * static_cast<double>(c1->size()));

@@ -11,7 +11,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <vector>
+
+#include "geom/fiber_mask.hpp"
 
 #include "model/fiber_law.hpp"
 #include "model/fiber_network.hpp"
@@ -37,6 +40,13 @@ class BulkPairs {
   // both matrices must outlive this object.
   void set_secant_law(const FiberLaw* law, const Eigen::MatrixXd* reference,
                       const Eigen::MatrixXd* strained);
+  // Each weight times the share of axis `axis` in the fiber's direction at
+  // `positions`, (d_a / |d|)^2 + kProjectionFloor: the axis block of a
+  // central fiber's stiffness a Y d d^T / |d|^2 without its coupling between
+  // axes (the separate displacement components of elasticity's
+  // preconditioners). `positions` must outlive this object.
+  void set_axis_projection(int axis, const Eigen::MatrixXd* positions);
+  static constexpr double kProjectionFloor = 0.01;
 
   int size() const { return n_; }
   // sum_j w_ij for each vertex i of the set.
@@ -46,6 +56,11 @@ class BulkPairs {
   // K(r, c) = -scale w_rc for r != c over the set (K: size() x size());
   // the diagonal is left as it was.
   void fill_off_diagonal(double scale, Eigen::MatrixXd* K) const;
+  // The same as triplets (r, c, -scale w_rc), one per kept pair and order:
+  // N times the neighbours for a mask stored sparse, N^2 otherwise.
+  void add_off_diagonal(double scale, std::vector<Eigen::Triplet<double>>* entries) const;
+  // Whether the pairs come from neighbour lists (a sparse mask).
+  bool sparse() const { return mask_ != nullptr && mask_->sparse(); }
 
   // The tile edge: a tile's vertex data (coordinates, area, count, three
   // columns in and out) is 11 arrays of 256 doubles, 22 KB: within L1.
@@ -63,15 +78,24 @@ class BulkPairs {
   // for_each_tile_pair with the tile's multipliers: visit(tile, multipliers, thread).
   template <class Visit>
   void for_each_tile(Visit&& visit) const;
+  // A sparse mask: visit(r, c, w_rc) for every kept pair of the set seen from
+  // each end (positions in the set), rows in parallel, each row's pairs in order.
+  template <class Visit>
+  void for_each_listed(Visit&& visit) const;
+  double listed_weight(int r, int c) const;  // w_rc of a kept pair
 
   int n_ = 0;
   std::vector<double> x_[3], area_, count_;
-  std::vector<int> vertex_;  // the set's vertices (mask and law lookups)
+  std::vector<int> vertex_;    // the set's vertices (mask and law lookups)
+  std::vector<int> position_;  // a vertex's position in the set, -1 if not in it (sparse)
   const geom::FiberMask* mask_ = nullptr;
   Influence influence_;                  // weighs each pair by its reference length
   Eigen::MatrixXd reference_positions_;  // for a weighing influence
   const FiberLaw* law_ = nullptr;
   const Eigen::MatrixXd *reference_ = nullptr, *strained_ = nullptr;
+  int projection_axis_ = -1;  // none
+  const Eigen::MatrixXd* projection_positions_ = nullptr;
+  double projection(int vi, int vj) const;
 };
 
 // The bulk fibers at a deformed state, for Newton's residual and tangent
@@ -98,12 +122,26 @@ class DeformedPairs {
   // c1 and c2 of every pair (N x N each, symmetric, zero diagonal).
   void coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
 
+  // A mask stored sparse (neighbour lists): the pairs are visited from both
+  // ends, row by row, and their coefficients can be kept in list order.
+  bool sparse() const { return mask_ != nullptr && mask_->sparse(); }
+  // Row i's coefficients start at offsets()[i] in list order (sparse only).
+  const std::vector<size_t>& offsets() const { return offsets_; }
+  // c1 and c2 of every kept pair in list order: vertex i's partners j
+  // (mask neighbours(i)) at offsets()[i] + k.
+  void listed_coefficients(std::vector<double>* c1, std::vector<double>* c2) const;
+
  private:
   struct RowScratch;
+  struct ListedRow;
   // Runs visit(tile, row r, first j, scratch, thread) with the row's lengths,
   // strains, Y, Y' and mask in the scratch.
   template <class Visit>
   void for_each_row(Visit&& visit) const;
+  // The sparse counterpart: visit(i, partners, row arrays) for each vertex,
+  // rows in parallel, the arrays indexed by the partner's place in the list.
+  template <class Visit>
+  void for_each_listed_row(Visit&& visit) const;
 
   int n_ = 0;
   std::vector<double> s_[3], x_[3], u_[3], count_;
@@ -112,6 +150,7 @@ class DeformedPairs {
   Influence influence_;
   const FiberLaw& law_;
   FiberKinematics kinematics_;
+  std::vector<size_t> offsets_;  // sparse: where each row's pairs start (N + 1)
 };
 
 }  // namespace fiberfluid::model

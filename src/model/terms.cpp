@@ -7,6 +7,7 @@
 #include <string>
 
 #include "geom/area_vectors.hpp"
+#include "geom/fiber_mask.hpp"
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
 #include "model/pair_kernels.hpp"
@@ -56,7 +57,7 @@ Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::Matr
 // geometric tangent c_i dS_i/dx_v = c_i C0 sum over faces f at i and v of
 // dA_f/dx_v. J += it.
 void add_area_vector_tangent(const TermContext& ctx, const Eigen::MatrixXd& X,
-                             const Eigen::VectorXd& c, Eigen::MatrixXd& J) {
+                             const Eigen::VectorXd& c, TangentSink& J) {
   const int n = ctx.model.num_vertices(), dim = ctx.model.dim();
   const Eigen::MatrixXi& F = ctx.model.surface.F;
   for (Eigen::Index f = 0; f < F.rows(); ++f)
@@ -66,7 +67,7 @@ void add_area_vector_tangent(const TermContext& ctx, const Eigen::MatrixXd& X,
       for (int corner = 0; corner < F.cols(); ++corner) {
         const int i = F(f, corner);
         for (int a = 0; a < dim; ++a)
-          for (int b = 0; b < dim; ++b) J(a * n + i, b * n + v) += c[i] * dA(a, b);
+          for (int b = 0; b < dim; ++b) J.add(a * n + i, b * n + v, c[i] * dA(a, b));
       }
     }
 }
@@ -118,13 +119,13 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
     if (paper_spring()) return add_rows(gamma() * (c_.surface * s.U), R);
     add_edge_forces(s, gamma(), R);
   }
-  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+  void add_tangent(const TermState& s, TangentSink& J) const override {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     if (paper_spring()) {
       for (int col = 0; col < c_.surface.outerSize(); ++col)
         for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it)
           for (int a = 0; a < dim; ++a)
-            J(a * n + it.row(), a * n + it.col()) += gamma() * it.value();
+            J.add(a * n + it.row(), a * n + it.col(), gamma() * it.value());
       return;
     }
     for_each_edge(s, gamma(),
@@ -134,8 +135,8 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
                     for (int a = 0; a < dim; ++a)
                       for (int e = 0; e < dim; ++e) {
                         const double entry = pair_tangent_entry<K>(c, a == e, b[a], d[a], b[e]);
-                        J(a * n + i, e * n + i) += entry;
-                        J(a * n + i, e * n + k) -= entry;
+                        J.add(a * n + i, e * n + i, entry);
+                        J.add(a * n + i, e * n + k, -(entry));
                       }
                   });
   }
@@ -215,13 +216,13 @@ class PressureVolumeTerm final : public EquilibriumTerm {
     R[c_.model.pressure_dof()] +=
         dim * c_.C0 * (geom::enclosed_volume(s.X, c_.model.surface.F) - c_.volume0);
   }
-  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+  void add_tangent(const TermState& s, TangentSink& J) const override {
     const int n = c_.model.num_vertices(), dim = c_.model.dim(), p = c_.model.pressure_dof();
     add_area_vector_tangent(c_, s.X, Eigen::VectorXd::Constant(n, s.P), J);
     for (int i = 0; i < n; ++i)
       for (int a = 0; a < dim; ++a) {
-        J(a * n + i, p) += s.S(i, a);  // dR_i/dP
-        J(p, a * n + i) += s.S(i, a);  // dg/dx_i = S_i(x)
+        J.add(a * n + i, p, s.S(i, a));  // dR_i/dP
+        J.add(p, a * n + i, s.S(i, a));  // dg/dx_i = S_i(x)
       }
   }
   void add_tangent_product(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
@@ -255,7 +256,7 @@ class PointLoadTerm final : public EquilibriumTerm {
     for (int a = 0; a < c_.model.dim(); ++a)
       R[c_.model.dof(load.vertex, a)] -= s.factors[index_] * load.force[a];
   }
-  void add_tangent(const TermState&, Eigen::MatrixXd&) const override {}
+  void add_tangent(const TermState&, TangentSink&) const override {}
   void add_tangent_product(const TermState&, const Eigen::VectorXd&, const Eigen::MatrixXd&,
                            Eigen::VectorXd&) const override {}
 
@@ -286,7 +287,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
     }
     for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) -= q.cwiseProduct(s.S.col(a));
   }
-  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override {
+  void add_tangent(const TermState& s, TangentSink& J) const override {
     if (inactive(s)) return;
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     if (exact()) return add_exact_tangent(s, J);
@@ -294,7 +295,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
     const Eigen::Vector3d gradient = pressure_gradient(s);
     for (int i = 0; i < n; ++i)
       for (int a = 0; a < dim; ++a)
-        for (int b = 0; b < dim; ++b) J(a * n + i, b * n + i) -= s.S(i, a) * gradient[b];
+        for (int b = 0; b < dim; ++b) J.add(a * n + i, b * n + i, -(s.S(i, a) * gradient[b]));
   }
   void add_tangent_product(const TermState& s, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
                            Eigen::VectorXd& out) const override {
@@ -326,7 +327,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
             geom::face_area_vectors(s.X, F)};
   }
   // J -= d(sum_f A_f w_if)/dx: the face's turning (dA_f/dx_v) and its pressures' change.
-  void add_exact_tangent(const TermState& s, Eigen::MatrixXd& J) const {
+  void add_exact_tangent(const TermState& s, TangentSink& J) const {
     const int n = c_.model.num_vertices(), dim = c_.model.dim();
     const Eigen::MatrixXi& F = c_.model.surface.F;
     const ExactState e = exact_state(s);
@@ -339,7 +340,7 @@ class HydrostaticLoadTerm final : public EquilibriumTerm {
           const double w = e.shares.w(i, f), dw = e.shares.per_pressure * (i == v ? 2.0 : 1.0);
           for (int a = 0; a < dim; ++a)
             for (int b = 0; b < dim; ++b)
-              J(a * n + i, b * n + v) -= w * dA(a, b) + e.A(f, a) * dw * e.g[b];
+              J.add(a * n + i, b * n + v, -(w * dA(a, b) + e.A(f, a) * dw * e.g[b]));
         }
       }
   }
@@ -471,10 +472,109 @@ void BulkFiberTerm::add_tangent_product(const TermState& s, const Eigen::VectorX
   for (int a = 0; a < c_.model.dim(); ++a) out.segment(a * n, n) += m[a] * bulk.col(a);
 }
 
-void BulkFiberTerm::add_tangent(const TermState& s, Eigen::MatrixXd& J) const {
+void BulkFiberTerm::add_tangent(const TermState& s, TangentSink& J) const {
+  if (sparse()) {
+    std::vector<double> c1, c2;
+    listed_coefficients(s.X, s.U, &c1, &c2);
+    return add_listed_blocks(s.X, s.U, c1, c2, J);
+  }
   Eigen::MatrixXd c1, c2;
   coefficients(s.X, s.U, &c1, &c2);
-  add_dense_blocks(s.X, s.U, c1, c2, J);
+  if (J.dense() != nullptr) return add_dense_blocks(s.X, s.U, c1, c2, *J.dense());
+  // Every pair kept (or a dense mask) into a sparse tangent: N^2 entries.
+  const int n = c_.model.num_vertices();
+  Eigen::MatrixXd bulk = Eigen::MatrixXd::Zero(c_.model.num_unknowns(), c_.model.num_unknowns());
+  add_dense_blocks(s.X, s.U, c1, c2, bulk);
+  for (Eigen::Index col = 0; col < c_.model.dim() * n; ++col)
+    for (Eigen::Index row = 0; row < c_.model.dim() * n; ++row)
+      if (bulk(row, col) != 0.0) J.add(row, col, bulk(row, col));
+}
+
+bool BulkFiberTerm::sparse() const {
+  return c_.pair_factors.mask() != nullptr && c_.pair_factors.mask()->sparse();
+}
+
+void BulkFiberTerm::listed_coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                        std::vector<double>* c1, std::vector<double>* c2) const {
+  deformed_pairs(c_, X, U).listed_coefficients(c1, c2);
+}
+
+template <class Body>
+void BulkFiberTerm::for_each_listed_row(const std::vector<double>& c1,
+                                        const std::vector<double>& c2, Body&& body) const {
+  const geom::FiberMask& mask = *c_.pair_factors.mask();
+  const int n = c_.model.num_vertices();
+  std::vector<size_t> offsets(static_cast<size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i)
+    offsets[static_cast<size_t>(i) + 1] =
+        offsets[static_cast<size_t>(i)] + mask.neighbours(i).size();
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i)
+    body(i, mask.neighbours(i), c1.data() + offsets[static_cast<size_t>(i)],
+         c2.data() + offsets[static_cast<size_t>(i)]);
+}
+
+void BulkFiberTerm::add_listed_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                      const std::vector<double>& C1, const std::vector<double>& C2,
+                                      TangentSink& J) const {
+  const int n = c_.model.num_vertices(), dim = c_.model.dim();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  // Row i's entries: -m_a T_ab(i, j) at (a i, b j) for each partner j, and
+  // their sum with the sign turned at (a i, b i); rows gathered per thread.
+  std::vector<std::vector<Eigen::Triplet<double>>> rows(static_cast<size_t>(n));
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_listed_row(
+        C1, C2, [&](int i, const std::vector<int>& partners, const double* c1, const double* c2) {
+          std::vector<Eigen::Triplet<double>>& out = rows[static_cast<size_t>(i)];
+          out.reserve(partners.size() * dim * dim + dim * dim);
+          double diagonal[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+          for (size_t q = 0; q < partners.size(); ++q) {
+            const int j = partners[q];
+            const PairCoefficients c{c1[q], c2[q]};
+            for (int a = 0; a < dim; ++a)
+              for (int b = 0; b < dim; ++b) {
+                const double t = pair_tangent_entry<K>(c, a == b, X(i, a) - X(j, a),
+                                                       U(i, a) - U(j, a), X(i, b) - X(j, b));
+                diagonal[a][b] += t;
+                out.emplace_back(a * n + i, b * n + j, -m[a] * t);
+              }
+          }
+          for (int a = 0; a < dim; ++a)
+            for (int b = 0; b < dim; ++b)
+              out.emplace_back(a * n + i, b * n + i, m[a] * diagonal[a][b]);
+        });
+  });
+  for (const auto& row : rows)
+    for (const Eigen::Triplet<double>& t : row) J.add(t.row(), t.col(), t.value());
+}
+
+void BulkFiberTerm::add_listed_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                                       const std::vector<double>& C1, const std::vector<double>& C2,
+                                       const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
+  const int n = c_.model.num_vertices(), dim = c_.model.dim();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_listed_row(
+        C1, C2, [&](int i, const std::vector<int>& partners, const double* c1, const double* c2) {
+          double product[3] = {0.0, 0.0, 0.0};
+          for (size_t q = 0; q < partners.size(); ++q) {
+            const int j = partners[q];
+            Eigen::Vector3d b = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(),
+                            d = Eigen::Vector3d::Zero();
+            for (int a = 0; a < dim; ++a) {
+              b[a] = X(i, a) - X(j, a);
+              v[a] = W(i, a) - W(j, a);
+              d[a] = U(i, a) - U(j, a);
+            }
+            const double b_dot_v = b.dot(v);
+            for (int a = 0; a < dim; ++a)
+              product[a] += pair_tangent<K>({c1[q], c2[q]}, v[a], b_dot_v, b[a], d[a]);
+          }
+          for (int a = 0; a < dim; ++a) out[a * n + i] += m[a] * product[a];
+        });
+  });
 }
 
 void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,

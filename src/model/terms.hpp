@@ -45,6 +45,25 @@ struct TermState {
   double P = 0.0;
 };
 
+// Where a term's tangent entries go: added into a dense matrix, or listed as
+// triplets for a sparse one (duplicates summed when it is built).
+class TangentSink {
+ public:
+  explicit TangentSink(Eigen::MatrixXd& dense) : dense_(&dense) {}
+  explicit TangentSink(std::vector<Eigen::Triplet<double>>& entries) : entries_(&entries) {}
+  void add(Eigen::Index row, Eigen::Index col, double value) {
+    if (dense_ != nullptr)
+      (*dense_)(row, col) += value;
+    else
+      entries_->emplace_back(static_cast<int>(row), static_cast<int>(col), value);
+  }
+  Eigen::MatrixXd* dense() const { return dense_; }  // null when sparse
+
+ private:
+  Eigen::MatrixXd* dense_ = nullptr;
+  std::vector<Eigen::Triplet<double>>* entries_ = nullptr;
+};
+
 class EquilibriumTerm {
  public:
   virtual ~EquilibriumTerm() = default;
@@ -57,8 +76,8 @@ class EquilibriumTerm {
   virtual Role role() const = 0;
   // R += this term's part at the state (full layout [u; P]).
   virtual void add_residual(const TermState& s, Eigen::VectorXd& R) const = 0;
-  // J += its dR/dx (dense, full layout).
-  virtual void add_tangent(const TermState& s, Eigen::MatrixXd& J) const = 0;
+  // J += its dR/dx (full layout), dense or sparse.
+  virtual void add_tangent(const TermState& s, TangentSink& J) const = 0;
   // out += its dR/dx v; W holds v's displacement rows (#V by dim).
   virtual void add_tangent_product(const TermState& s, const Eigen::VectorXd& v,
                                    const Eigen::MatrixXd& W, Eigen::VectorXd& out) const = 0;
@@ -76,7 +95,7 @@ class BulkFiberTerm final : public EquilibriumTerm {
   const char* name() const override { return "bulk fibers"; }
   Role role() const override { return Role::Fibers; }
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override;
-  void add_tangent(const TermState& s, Eigen::MatrixXd& J) const override;
+  void add_tangent(const TermState& s, TangentSink& J) const override;
   void add_tangent_product(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
                            Eigen::VectorXd& out) const override;
   void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
@@ -90,7 +109,24 @@ class BulkFiberTerm final : public EquilibriumTerm {
                           const Eigen::MatrixXd& c1, const Eigen::MatrixXd& c2,
                           const Eigen::MatrixXd& W, Eigen::VectorXd& out) const;
 
+  // The same two for fibers stored as neighbour lists (a sparse mask): the
+  // coefficients of the kept pairs in list order (DeformedPairs).
+  bool sparse() const;
+  void listed_coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                           std::vector<double>* c1, std::vector<double>* c2) const;
+  void add_listed_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                          const std::vector<double>& c1, const std::vector<double>& c2,
+                          const Eigen::MatrixXd& W, Eigen::VectorXd& out) const;
+
  private:
+  // The tangent's entries of the listed pairs (sparse masks).
+  void add_listed_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
+                         const std::vector<double>& c1, const std::vector<double>& c2,
+                         TangentSink& J) const;
+  // row(i, partners, c1, c2) for each vertex with its listed coefficients.
+  template <class Body>
+  void for_each_listed_row(const std::vector<double>& c1, const std::vector<double>& c2,
+                           Body&& body) const;
   void add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
                         const Eigen::MatrixXd& c1, const Eigen::MatrixXd& c2,
                         Eigen::MatrixXd& J) const;

@@ -2,6 +2,7 @@
 #include "solve/cost_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace fiberfluid::solve {
@@ -26,6 +27,7 @@ BlockShape block_shape(const model::Model& m, model::BoundaryMethod method) {
     equal = equal && s == supported[0] && m.material.axis_factors[a] == m.material.axis_factors[0];
   }
   b.factors = equal ? 1 : dim;
+  if (m.fibers && m.fibers->sparse()) b.neighbours = 2.0 * m.fibers->num_kept() / std::max(n, 1);
   return b;
 }
 
@@ -46,7 +48,21 @@ BackendCost backend_cost(SolverKind kind, const BlockShape& shape, double produc
       // The Schur complement's solves and each step's: forward and back per axis.
       c.solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;
       break;
-    case SolverKind::Cholmod:  // dense bulk blocks: every pair a nonzero
+    case SolverKind::Cholmod:
+      if (shape.neighbours > 0.0) {
+        // Sparse blocks of a horizon on a surface: nested dissection's top
+        // separator is a band of the horizon's width across the body, about
+        // 2 sqrt(neighbours / pi) sqrt(n) vertices; its dense front dominates.
+        const double separator =
+            std::min(n, 2.0 * std::sqrt(shape.neighbours / 3.14159) * std::sqrt(n));
+        const double entries = n * shape.neighbours + 2.0 * separator * separator;
+        c.factor_bytes = factors * 12.0 * entries;
+        c.factor_seconds =
+            factors * separator * separator * separator / speed.sparse_flops_per_second + product;
+        c.solve_seconds = 2.0 * d * 2.0 * entries / speed.triangular_flops_per_second;
+        break;
+      }
+      // Dense bulk blocks: every pair a nonzero.
       c.factor_bytes = factors * (12.0 * n * n + 4.0 * n * n);
       c.factor_seconds = factors * n * n * n / 3.0 / speed.sparse_flops_per_second + product;
       c.solve_seconds = 2.0 * d * 2.0 * n * n / speed.triangular_flops_per_second;

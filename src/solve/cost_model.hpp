@@ -37,6 +37,7 @@ struct BlockShape {
   double largest = 0.0;     // the largest axis block
   int factors = 1;          // distinct block factors
   int newton_unknowns = 1;  // the supports eliminated (as Newton always does), then P
+  double neighbours = 0.0;  // fibers per vertex of a horizon stored sparse (0: dense blocks)
 };
 BlockShape block_shape(const model::Model& model, model::BoundaryMethod method);
 

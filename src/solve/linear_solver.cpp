@@ -66,6 +66,9 @@ SolverKind choose_solver(double largest_block, int factors, double budget_bytes)
 }
 
 SolverKind choose_solver(const model::BorderedSystem& system, double budget_bytes) {
+  // Sparse blocks (a horizon's fibers): CHOLMOD, whose factor grows with the
+  // neighbours rather than N^2.
+  if (!system.dense_blocks() && system.largest_block() > 600) return SolverKind::Cholmod;
   return choose_solver(system.largest_block(), system.blocks_equal() ? 1 : system.num_blocks(),
                        budget_bytes);
 }

@@ -28,17 +28,20 @@ const char* to_string(Scheme scheme);
 
 // How each Newton step's linear system with the tangent is solved.
 enum class TangentSolver {
-  Auto,    // dense up to 600 unknowns (about 200 vertices; 4,000 for central fibers), krylov above
+  Auto,    // dense up to 600 unknowns (about 200 vertices; 4,000 for central fibers), then
+           // sparse for central fibers within a horizon up to 50,000, else krylov
   Dense,   // LU of the dense tangent (LAPACK)
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
+  Sparse,  // LU of the sparse tangent (UMFPACK): N times the neighbours entries
 };
 const char* to_string(TangentSolver solver);
 // What `requested` means for a Newton run with `reduced_unknowns` (the
 // unknowns left after the supports): Auto is dense up to 600 (4,000 for
-// central fibers, whose tangent the secant preconditioner fits poorly),
-// Krylov above.
+// central fibers, whose tangent the secant preconditioner fits poorly);
+// above, the sparse LU for central fibers stored as neighbour lists
+// (`sparse_fibers`, a horizon) up to 50,000 unknowns, else Krylov.
 TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
-                             model::FiberKinematics kinematics);
+                             model::FiberKinematics kinematics, bool sparse_fibers);
 
 struct NewtonOptions {
   // Converged when the relative residual (force rows over the largest of the

@@ -69,7 +69,8 @@ class NewtonSolver {
     const Eigen::MatrixXd& V = model.surface.V;
     diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
     const TangentSolver kind =
-        choose_tangent(newton_.tangent, supports_.num_reduced(), model.material.kinematics);
+        choose_tangent(newton_.tangent, supports_.num_reduced(), model.material.kinematics,
+                       equilibrium_->sparse_fibers());
     tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
     summary_.tangent = kind;
     summary_.solver = tangent_->preconditioner_kind();

@@ -31,15 +31,61 @@ void equilibrate(Eigen::MatrixXd& J, Eigen::VectorXd* rows, Eigen::VectorXd* col
   }
 }
 
+// The same for a sparse J, by its stored entries.
+void equilibrate(Eigen::SparseMatrix<double>& J, Eigen::VectorXd* rows, Eigen::VectorXd* columns) {
+  const auto power_of_two = [](double largest) {
+    return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest)))
+                                                   : 1.0;
+  };
+  Eigen::VectorXd largest = Eigen::VectorXd::Zero(J.rows());
+  for (int c = 0; c < J.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(J, c); it; ++it)
+      largest[it.row()] = std::max(largest[it.row()], std::abs(it.value()));
+  *rows = largest.unaryExpr(power_of_two);
+  *columns = Eigen::VectorXd::Ones(J.cols());
+  for (int c = 0; c < J.outerSize(); ++c) {
+    double column_largest = 0.0;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(J, c); it; ++it) {
+      it.valueRef() *= (*rows)[it.row()];
+      column_largest = std::max(column_largest, std::abs(it.value()));
+    }
+    (*columns)[c] = power_of_two(column_largest);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(J, c); it; ++it)
+      it.valueRef() *= (*columns)[c];
+  }
+}
+
+// The rows and columns of a full-layout sparse J that `dofs` leaves free.
+Eigen::SparseMatrix<double> reduce(const model::DofMap& dofs,
+                                   const Eigen::SparseMatrix<double>& J) {
+  std::vector<int> reduced(static_cast<size_t>(J.rows()), -1);
+  const std::vector<int>& full = dofs.full_index();
+  for (size_t k = 0; k < full.size(); ++k)
+    reduced[static_cast<size_t>(full[k])] = static_cast<int>(k);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(J.nonZeros()));
+  for (int c = 0; c < J.outerSize(); ++c) {
+    const int rc = reduced[static_cast<size_t>(c)];
+    if (rc < 0) continue;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(J, c); it; ++it) {
+      const int rr = reduced[static_cast<size_t>(it.row())];
+      if (rr >= 0) entries.emplace_back(rr, rc, it.value());
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(full.size());
+  Eigen::SparseMatrix<double> out(n, n);
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
 }  // namespace
 
 TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium,
                            const SteppingOptions& options, TangentSolver kind)
     : equilibrium_(std::move(equilibrium)), options_(options), kind_(kind) {
-  const model::Model& model = equilibrium_->model();
-  // The pair coefficients are stored when two N x N arrays fit in a
-  // quarter of the memory budget; else each product recomputes them.
-  store_ = model::TangentOperator::bytes_for(model.num_vertices()) < 0.25 * memory_budget_bytes();
+  // The pair coefficients are stored when they fit in a quarter of the
+  // memory budget; else each product recomputes them.
+  store_ = equilibrium_->stored_tangent_bytes() < 0.25 * memory_budget_bytes();
   preconditioner_kind_ = kind_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
 }
 
@@ -55,6 +101,13 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
     Eigen::MatrixXd J = dofs_.reduce(equilibrium_->tangent(x_, factors_));
     equilibrate(J, &row_scale_, &column_scale_);
     const Status status = lu_->factorize(J);
+    if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+  } else if (kind_ == TangentSolver::Sparse) {
+    if (!sparse_lu_) sparse_lu_ = std::make_unique<SparseLU>();
+    Eigen::SparseMatrix<double> J = reduce(dofs_, equilibrium_->sparse_tangent(x_, factors_));
+    equilibrate(J, &row_scale_, &column_scale_);
+    const Status status = sparse_lu_->factorize(J);
+    ++factorizations_;
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   } else {
     if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
@@ -98,6 +151,11 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   if (!ready_) return Status::failure("newton: the tangent was not prepared");
   if (kind_ == TangentSolver::Dense) {
     *y = column_scale_.cwiseProduct(lu_->solve(row_scale_.cwiseProduct(b)));
+    return {};
+  }
+  if (kind_ == TangentSolver::Sparse) {
+    *y = column_scale_.cwiseProduct(sparse_lu_->solve(row_scale_.cwiseProduct(b)));
+    if (!y->allFinite()) return Status::failure("newton: the sparse tangent's solve failed");
     return {};
   }
   const LinearOperator apply_tangent = [this](const Eigen::VectorXd& v) { return apply(v); };
@@ -145,6 +203,11 @@ Status TangentSolve::factor_preconditioner() {
   secant_ = std::make_unique<model::FiberSystem>(model, model.surface.V, preconditioner_dofs_,
                                                  model::BoundaryMethod::Elimination,
                                                  options_.penalty, &X);
+  // A central fiber resists only along itself: each axis block keeps the
+  // share of that axis in each fiber's current direction (separate
+  // displacement components; Blaheta 1994), not the vector spring's
+  // isotropic weight, which leaves GMRES stalling on a central tangent.
+  if (model.material.kinematics == model::FiberKinematics::Central) secant_->project_on_axes(X);
   if (!preconditioner_ || !(preconditioner_dofs_.held_flags() == preconditioned_held_)) {
     // By size as for the linear scheme, but never the dense LU of the whole
     // bordered system: block Cholesky does the same job in a fraction of the flops.

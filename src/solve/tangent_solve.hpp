@@ -11,15 +11,18 @@
 #include "solve/dense_lu.hpp"
 #include "solve/linear_solver.hpp"
 #include "solve/load_stepper.hpp"
+#include "solve/sparse_lu.hpp"
 #include "solve/status.hpp"
 
 namespace fiberfluid::solve {
 
 // Solves with the Newton tangent dR/dx at one state, over the unknowns a
-// DofMap leaves free: the dense LU of the reduced tangent, or GMRES on the
+// DofMap leaves free: the dense LU of the reduced tangent, the sparse LU of
+// it (fibers within a horizon: N times the neighbours entries), or GMRES on the
 // tangent as an operator (its pair coefficients stored), right-preconditioned
 // by the structured secant solve (the reference bordered system with each
-// bulk weight times Y(e_ij)). The preconditioner is kept between states and
+// bulk weight times Y(e_ij); for central fibers each axis block's weights
+// also times that axis's share of the fiber's direction). The preconditioner is kept between states and
 // refactored when its own held set changes or GMRES needs clearly more
 // iterations per decade than just after its last factorisation. Its held set
 // may be a subset of the tangent's (the supports without the paddle
@@ -72,6 +75,8 @@ class TangentSolve {
   bool ready_ = false;
   // Dense.
   std::unique_ptr<DenseLU> lu_;
+  // Sparse (its scaling in row_scale_, column_scale_ as the dense one's).
+  std::unique_ptr<SparseLU> sparse_lu_;
   // The dense tangent is equilibrated before its LU (rows, then columns, by
   // their largest entries): force rows of a stiff material and the volume
   // row differ by many orders, which would make a sound system look singular.

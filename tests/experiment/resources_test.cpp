@@ -117,6 +117,26 @@ TEST_F(ResourceGuards, AutoTakesPcgWhenTheDenseBlocksWouldNotFitTheBudget) {
   EXPECT_EQ(ex.cases[0].estimate.solver, "pcg");
 }
 
+// A horizon's fibers are found before the estimate, which then counts its
+// pairs and its sparse blocks, not N^2: 40,962 vertices within a tenth of
+// the radius (about 100 fibers each) plan for CHOLMOD's sparse blocks in
+// well under a gigabyte, where every pair's dense blocks (13 GB) leave only PCG.
+TEST_F(ResourceGuards, AHorizonsEstimateCountsItsPairsNotAllOfThem) {
+  json doc = sphere(6);
+  doc["fibers"] = {{"horizon", 0.005}};
+  doc["stepping"] = {{"scheme", "newton"}, {"steps", 1}};
+  const Case c = built(doc);
+  ASSERT_TRUE(c.model.fibers && c.model.fibers->sparse());
+  const ResourceEstimate e = estimate_resources(c.model, c.stepping, PruningWork::ConvexityCheck);
+  EXPECT_EQ(e.solver, "cholmod") << e.describe();
+  EXPECT_LT(e.peak_bytes, 1e9) << e.describe();
+  EXPECT_LT(e.seconds, 120.0) << e.describe();
+  // The same sphere with every pair: its dense blocks would not fit, so PCG.
+  model::Model every = c.model;
+  every.fibers = nullptr;
+  EXPECT_EQ(estimate_resources(every, c.stepping, PruningWork::ConvexityCheck).solver, "pcg");
+}
+
 TEST_F(ResourceGuards, ACaseBeyondTheMemoryBudgetIsRefusedBeforeItStarts) {
   set_memory_budget(40.0 * 1024 * 1024);
   Experiment ex = read(sphere(3, "dense-lu"));  // 28 MiB of dense LU beside the process's 21

@@ -78,6 +78,51 @@ TEST(SurfaceError, SurfacesThatBoundNoSolidAreNamed) {
                InputError);
 }
 
+// One file, two shells: a box with a box inside it. Oriented both outward, they
+// bound no solid (the inner shell would have to face inward to be a cavity), and
+// the Booleans' results on such a mesh are undefined: refused by name. Oriented
+// as a cavity, the solid is the shell between them.
+geom::Surface two_shells(bool inner_faces_inward) {
+  const geom::Surface outer = geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
+  geom::Surface inner = geom::box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}, {1, 1, 1});
+  if (inner_faces_inward) inner.F.col(1).swap(inner.F.col(2));
+  geom::Surface both = outer;
+  both.V.resize(outer.V.rows() + inner.V.rows(), 3);
+  both.V << outer.V, inner.V;
+  both.F.resize(outer.F.rows() + inner.F.rows(), 3);
+  both.F << outer.F, (inner.F.array() + static_cast<int>(outer.V.rows())).matrix();
+  return both;
+}
+
+TEST(SurfaceError, TwoShellsBoundASolidOnlyWhenTheInnerOneIsACavity) {
+  const geom::Surface unit = geom::box({0, 0, 0}, {1, 1, 1}, {1, 1, 1});
+  try {
+    symmetric_difference_measure(unit, two_shells(false), "unit", "shells.obj");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("shells.obj: the mesh bounds no volume"),
+              std::string::npos)
+        << e.what();
+  }
+  // The cavity is 0.5^3: the unit cube and the hollow one differ by it.
+  const geom::Surface hollow = two_shells(true);
+  EXPECT_NEAR(symmetric_difference_measure(unit, hollow, "unit", "hollow.obj"), 0.125, 1e-14);
+  EXPECT_NEAR(symmetric_difference_measure(hollow, unit, "hollow.obj", "unit"), 0.125, 1e-14);
+}
+
+// Vertices in no face (a file's unused points) take no part in the solid:
+// far away they would move the volume sums' centre and cost their digits,
+// and CGAL's volume predicates fail on them.
+TEST(SurfaceError, VerticesInNoFaceAreLeftOut) {
+  geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  const geom::Surface moved = translated(cube, Eigen::RowVector3d(0.1, 0.0, 0.0));
+  cube.V.conservativeResize(cube.V.rows() + 2, 3);
+  cube.V.row(cube.V.rows() - 2) << 1e12, -1e12, 3e11;
+  cube.V.row(cube.V.rows() - 1) << 0.5, 0.5, 0.5;
+  EXPECT_NEAR(surface_error(cube, moved), 0.2, 1e-12);
+  EXPECT_NEAR(surface_error(moved, cube), 0.2, 1e-12);
+}
+
 TEST(EnergyNorm, HandMadeCases) {
   Eigen::MatrixXd u(2, 2), v(2, 2);
   u << 1, 0, 0, 1;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "geom/area_vectors.hpp"
+#include "geom/horizon.hpp"
 #include "model/assembly.hpp"
 #include "model/equilibrium.hpp"
 #include "model/model_fixtures.hpp"
@@ -413,6 +414,39 @@ TEST(ArcLength, DisplacementDrivenRunsAreLeftToLoadControl) {
   const SteppingSummary pressed = solve_load_steps(pressed_sphere(false), arc_length(4));
   EXPECT_FALSE(pressed.success);
   EXPECT_NE(pressed.message.find("arc_length: paddles"), std::string::npos) << pressed.message;
+}
+
+// Fibers within a horizon stored as neighbour lists: the sparse LU of the
+// tangent (UMFPACK) gives the dense LU's path, and its final tangent the
+// same sensitivities; Auto takes it above the dense sizes.
+TEST(Newton, TheSparseTangentAgreesWithTheDenseOne) {
+  model::Model m = hanging_sphere(model::FiberLaw::exponential(20000.0, 5.0), 100.0);
+  m.material.kinematics = model::FiberKinematics::Central;
+  const double radius = 0.5 * (m.surface.V.col(0).maxCoeff() - m.surface.V.col(0).minCoeff());
+  m.fibers = std::make_shared<const geom::FiberMask>(
+      geom::horizon_fibers(m.surface, 0.6 * radius, geom::MaskStorage::Sparse));
+  SteppingOptions o = newton(2, TangentSolver::Dense);
+  o.keep_final_tangent = true;
+  const SteppingSummary dense = solve_load_steps(m, o);
+  o.newton.tangent = TangentSolver::Sparse;
+  const SteppingSummary sparse = solve_load_steps(m, o);
+  ASSERT_TRUE(dense.success && sparse.success) << dense.message << sparse.message;
+  EXPECT_EQ(sparse.tangent, TangentSolver::Sparse);
+  EXPECT_GT(sparse.factorizations, 0);
+  EXPECT_LT(displacement_norm(m, sparse.unknowns - dense.unknowns),
+            1e-9 * displacement_norm(m, dense.unknowns));
+  const Eigen::VectorXd dR = model::Equilibrium(m).parameter_derivatives(sparse.unknowns, {"beta"});
+  Eigen::VectorXd du_sparse, du_dense;
+  ASSERT_TRUE(sparse.final_tangent->solve_full(-dR, &du_sparse).ok);
+  ASSERT_TRUE(dense.final_tangent->solve_full(-dR, &du_dense).ok);
+  EXPECT_LT((du_sparse - du_dense).norm(), 1e-8 * du_dense.norm());
+  const auto central = model::FiberKinematics::Central;
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, true), TangentSolver::Sparse);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, false), TangentSolver::Krylov);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 60000, central, true), TangentSolver::Krylov);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, model::FiberKinematics::VectorSpring, true),
+            TangentSolver::Krylov);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 3000, central, true), TangentSolver::Dense);
 }
 
 }  // namespace
