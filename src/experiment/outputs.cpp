@@ -468,11 +468,18 @@ void OutputWriter::write_fibers() const {
   if (which == "none") return;
   const model::Model& m = c.model;
   std::vector<std::pair<int, int>> lines;
-  for (int i = 0; i < m.num_vertices(); ++i)
-    for (int j = i + 1; j < m.num_vertices(); ++j) {
-      const bool kept = !m.fibers || m.fibers->kept(i, j);
-      if (kept == (which == "kept")) lines.emplace_back(i, j);
-    }
+  if (which == "kept" && m.fibers && m.fibers->sparse()) {  // a horizon's lists: its pairs only
+    for (int i = 0; i < m.num_vertices(); ++i)
+      m.fibers->for_each_kept(i, [&](int j) {
+        if (j > i) lines.emplace_back(i, j);
+      });
+  } else {
+    for (int i = 0; i < m.num_vertices(); ++i)
+      for (int j = i + 1; j < m.num_vertices(); ++j) {
+        const bool kept = !m.fibers || m.fibers->kept(i, j);
+        if (kept == (which == "kept")) lines.emplace_back(i, j);
+      }
+  }
   geom::write_lines_vtu(staging_ / "fibers.vtu", m.surface.V, lines);
 }
 

@@ -497,6 +497,27 @@ void DeformedPairs::for_each_listed_row(Visit&& visit) const {
   }
 }
 
+template <class Term>
+Eigen::MatrixXd DeformedPairs::listed_sums(Term&& term) const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, 3);
+  const double *area = area_.data(), *count = count_.data();
+  with_kinematics(kinematics_, [&](auto policy) {
+    using K = decltype(policy);
+    for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
+      double sum[3] = {0.0, 0.0, 0.0};
+      for (size_t q = 0; q < partners.size(); ++q) {
+        const int j = partners[q];
+        const PairCoefficients c =
+            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+        for (int a = 0; a < 3; ++a)
+          sum[a] += term(policy, static_cast<size_t>(i), static_cast<size_t>(j), c, a);
+      }
+      for (int a = 0; a < 3; ++a) out(i, a) = sum[a];
+    });
+  });
+  return out;
+}
+
 void DeformedPairs::listed_coefficients(std::vector<double>* c1, std::vector<double>* c2) const {
   c1->assign(offsets_.back(), 0.0);
   c2->assign(offsets_.back(), 0.0);
@@ -557,27 +578,11 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
 }
 
 Eigen::MatrixXd DeformedPairs::forces() const {
-  if (sparse()) {
-    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, 3);
-    const double *area = area_.data(), *count = count_.data();
-    with_kinematics(kinematics_, [&](auto policy) {
+  if (sparse())
+    return listed_sums([&](auto policy, size_t i, size_t j, const PairCoefficients& c, int a) {
       using K = decltype(policy);
-      for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
-        const auto u = static_cast<size_t>(i);
-        double f[3] = {0.0, 0.0, 0.0};
-        for (size_t q = 0; q < partners.size(); ++q) {
-          const int j = partners[q];
-          const PairCoefficients c =
-              row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
-          for (int a = 0; a < 3; ++a)
-            f[a] += pair_force<K>(c, x_[a][u] - x_[a][static_cast<size_t>(j)],
-                                  u_[a][u] - u_[a][static_cast<size_t>(j)]);
-        }
-        for (int a = 0; a < 3; ++a) out(i, a) = f[a];
-      });
+      return pair_force<K>(c, x_[a][i] - x_[a][j], u_[a][i] - u_[a][j]);
     });
-    return out;
-  }
   const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators forces(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {
@@ -597,30 +602,14 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
     if (a < W.cols()) std::copy(W.col(a).data(), W.col(a).data() + n_, directions[a].begin());
     w[a] = directions[a].data();
   }
-  if (sparse()) {
-    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_, 3);
-    const double *area = area_.data(), *count = count_.data();
-    with_kinematics(kinematics_, [&](auto policy) {
+  if (sparse())
+    return listed_sums([&](auto policy, size_t i, size_t j, const PairCoefficients& c, int a) {
       using K = decltype(policy);
-      for_each_listed_row([&](int i, const std::vector<int>& partners, const RowArrays& row) {
-        const auto u = static_cast<size_t>(i);
-        double p[3] = {0.0, 0.0, 0.0};
-        for (size_t q = 0; q < partners.size(); ++q) {
-          const int j = partners[q];
-          const auto v = static_cast<size_t>(j);
-          const PairCoefficients c =
-              row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
-          const double b[3] = {x_[0][u] - x_[0][v], x_[1][u] - x_[1][v], x_[2][u] - x_[2][v]};
-          const double d[3] = {w[0][u] - w[0][v], w[1][u] - w[1][v], w[2][u] - w[2][v]};
-          const double b_dot_v = b[0] * d[0] + b[1] * d[1] + b[2] * d[2];
-          for (int a = 0; a < 3; ++a)
-            p[a] += pair_tangent<K>(c, d[a], b_dot_v, b[a], u_[a][u] - u_[a][v]);
-        }
-        for (int a = 0; a < 3; ++a) out(i, a) = p[a];
-      });
+      double b_dot_v = 0.0;
+      for (int k = 0; k < 3; ++k) b_dot_v += (x_[k][i] - x_[k][j]) * (w[k][i] - w[k][j]);
+      return pair_tangent<K>(c, w[a][i] - w[a][j], b_dot_v, x_[a][i] - x_[a][j],
+                             u_[a][i] - u_[a][j]);
     });
-    return out;
-  }
   const PairColumns p = columns_of(x_, u_);
   ThreadAccumulators products(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {

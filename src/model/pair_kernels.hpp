@@ -142,6 +142,10 @@ class DeformedPairs {
   // rows in parallel, the arrays indexed by the partner's place in the list.
   template <class Visit>
   void for_each_listed_row(Visit&& visit) const;
+  // Row i of the result, component a: the sum over i's partners j of
+  // term(policy, i, j, coefficients, a) (forces, tangent products).
+  template <class Term>
+  Eigen::MatrixXd listed_sums(Term&& term) const;
 
   int n_ = 0;
   std::vector<double> s_[3], x_[3], u_[3], count_;

@@ -424,6 +424,26 @@ TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
                       "surface.segments: expected a list of 2 whole numbers from 3 to 1000");
 }
 
+// A horizon that keeps few pairs is stored as neighbour lists; its kept
+// fibers are written from them, one VTK line each.
+TEST(ExperimentConfig, AHorizonsKeptFibersAreWrittenFromItsLists) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"]["subdivisions"] = 3;  // 642 vertices
+  c["fibers"] = {{"horizon", 0.2}, {"write", "kept"}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  ASSERT_TRUE(ex.cases[0].model.fibers && ex.cases[0].model.fibers->sparse());
+  const long long kept = ex.cases[0].fibers.kept;
+  EXPECT_GT(kept, 642);
+  OutputWriter writer(ex, dir.path() / "out");
+  writer.begin();
+  writer.finish(run_experiment(ex));
+  std::ifstream vtu(dir.path() / "out" / "fibers.vtu");
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(kept) + "\""), std::string::npos)
+      << text.substr(0, 300);
+}
+
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   ScratchDir dir;
   nlohmann::json c = base_config();
