@@ -113,20 +113,27 @@ FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) 
   report.min_per_vertex = report.max_per_vertex = n - 1;
   report.mean_per_vertex = n - 1;
   report.convex = report.pruning && !concave;
-  std::optional<geom::FiberMask> mask;
-  if (spec.horizon > 0.0) mask = m.fibers ? *m.fibers : horizon_fibers(spec, m.surface);
+  // The horizon's fibers (add_fibers found them for the estimate), then the pruning's.
+  std::shared_ptr<const geom::FiberMask> fibers;
+  if (spec.horizon > 0.0)
+    fibers = m.fibers ? m.fibers
+                      : std::make_shared<const geom::FiberMask>(horizon_fibers(spec, m.surface));
   if (report.pruning && concave) {
     geom::PruningResult pruned = geom::prune_fibers(m.surface, false);
     report.seconds = pruned.seconds;
     report.exact_fallbacks = pruned.exact_fallbacks;
-    if (mask)
-      mask->keep_only_where(pruned.mask);
-    else
-      mask = std::move(pruned.mask);
+    if (fibers) {
+      geom::FiberMask both = *fibers;
+      both.keep_only_where(pruned.mask);
+      fibers = std::make_shared<const geom::FiberMask>(std::move(both));
+    } else {
+      fibers = std::make_shared<const geom::FiberMask>(std::move(pruned.mask));
+    }
   }
-  if (!mask) return report;
-  report.kept = mask->num_kept();
-  const std::vector<int> per_vertex = mask->kept_per_vertex();
+  if (!fibers) return report;
+  const geom::FiberMask& mask = *fibers;
+  report.kept = mask.num_kept();
+  const std::vector<int> per_vertex = mask.kept_per_vertex();
   report.min_per_vertex = *std::min_element(per_vertex.begin(), per_vertex.end());
   report.max_per_vertex = *std::max_element(per_vertex.begin(), per_vertex.end());
   report.mean_per_vertex = 2.0 * report.kept / n;
@@ -143,7 +150,7 @@ FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) 
                         std::to_string(report.pairs - report.kept) +
                         " fibers; set \"connection_count\": \"global\" (pruned "
                         "fibers are then exact corrections) or \"product\": \"exact\"");
-  m.fibers = std::make_shared<const geom::FiberMask>(std::move(*mask));
+  m.fibers = std::move(fibers);
   return report;
 }
 

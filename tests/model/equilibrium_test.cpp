@@ -25,22 +25,7 @@ namespace {
 
 using namespace fiberfluid::model::reference;  // the oracle
 
-// A 42-vertex sphere with a cap held, gravity, a point load and surface tension.
-Model small_sphere(const FiberLaw& law, FiberKinematics kinematics = FiberKinematics::VectorSpring,
-                   Load::Integration integration = Load::Integration::Vertex) {
-  Model m = testing::paper_sphere_model();
-  m.surface = geom::icosphere(1, 1.0);
-  m.constraints.clear();
-  for (int v : select_half_space(m.surface.V, parse_half_space("z >= 0.8", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.material.law = law;
-  m.material.kinematics = kinematics;
-  m.material.axis_factors = {1.0, 0.8, 1.3};  // the factors enter every term
-  m.material.surface_tension = 500.0;
-  m.loads[1].vertex = 7;
-  m.loads[0].integration = integration;  // the hydrostatic load
-  return m;
-}
+using testing::small_sphere;
 
 std::vector<FiberLaw> every_law() {
   return {FiberLaw::constant(3000.0), FiberLaw::exponential(3000.0, 4.0),
@@ -49,15 +34,7 @@ std::vector<FiberLaw> every_law() {
                               {-900.0, -250.0, 0.0, 150.0, 800.0, 9000.0})};
 }
 
-// A random state: displacements of a few percent of the size, a pressure.
-Eigen::VectorXd random_state(const Model& m, unsigned seed, double size = 0.04) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd x(m.num_unknowns());
-  for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = size * uniform(rng);
-  x[m.pressure_dof()] = 800.0 * uniform(rng);
-  return x;
-}
+using testing::random_state;
 
 Eigen::MatrixXd finite_difference_tangent(const Equilibrium& eq, const Eigen::VectorXd& x,
                                           const std::vector<double>& factors) {

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Models used by several tests: the paper's rectangle and sphere.
+// Models used by several tests: the paper's rectangle and sphere, the small
+// sphere of the Newton equations' tests and random states of it.
 #pragma once
+
+#include <random>
 
 #include "geom/generators.hpp"
 #include "model/boundary_conditions.hpp"
@@ -43,6 +46,36 @@ inline model::Model paper_sphere_model() {
   pull.schedule.kind = model::Schedule::Kind::Final;
   m.loads = {gravity, pull};
   return m;
+}
+
+// A 42-vertex sphere with a cap held, gravity, a point load and surface
+// tension, with axis factors that enter every term.
+inline model::Model small_sphere(
+    const model::FiberLaw& law,
+    model::FiberKinematics kinematics = model::FiberKinematics::VectorSpring,
+    model::Load::Integration integration = model::Load::Integration::Vertex) {
+  model::Model m = paper_sphere_model();
+  m.surface = geom::icosphere(1, 1.0);
+  m.constraints.clear();
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.8", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  m.material.law = law;
+  m.material.kinematics = kinematics;
+  m.material.axis_factors = {1.0, 0.8, 1.3};
+  m.material.surface_tension = 500.0;
+  m.loads[1].vertex = 7;
+  m.loads[0].integration = integration;  // the hydrostatic load
+  return m;
+}
+
+// A random state: displacements of up to `size` in each coordinate, a pressure.
+inline Eigen::VectorXd random_state(const model::Model& m, unsigned seed, double size = 0.04) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd x(m.num_unknowns());
+  for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = size * uniform(rng);
+  x[m.pressure_dof()] = 800.0 * uniform(rng);
+  return x;
 }
 
 }  // namespace fiberfluid::testing

@@ -68,29 +68,13 @@ TEST(FiberMask, AHorizonThatKeepsFewPairsIsStoredAsNeighbourLists) {
 // load, surface tension, axis factors) with a horizon of 0.8 in each storage.
 Model sphere_with_horizon(const FiberLaw& law, FiberKinematics kinematics, bool conical,
                           geom::MaskStorage storage) {
-  Model m = testing::paper_sphere_model();
-  m.surface = geom::icosphere(1, 1.0);
-  m.constraints.clear();
-  for (int v : select_half_space(m.surface.V, parse_half_space("z >= 0.8", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.material.law = law;
-  m.material.kinematics = kinematics;
-  m.material.axis_factors = {1.0, 0.8, 1.3};
-  m.material.surface_tension = 500.0;
-  m.loads[1].vertex = 7;
+  Model m = testing::small_sphere(law, kinematics);
   m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, 0.8, storage));
   if (conical) m.influence = {Influence::Kind::Conical, 0.8};
   return m;
 }
 
-Eigen::VectorXd random_state(const Model& m, unsigned seed, double size) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd x(m.num_unknowns());
-  for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = size * uniform(rng);
-  x[m.pressure_dof()] = 800.0 * uniform(rng);
-  return x;
-}
+using testing::random_state;
 
 double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).norm() / b.norm();
