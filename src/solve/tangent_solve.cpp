@@ -12,13 +12,14 @@
 namespace fiberfluid::solve {
 namespace {
 
+// The power of two that brings `largest` nearest 1 (1 for zero or non-finite).
+double power_of_two(double largest) {
+  return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest))) : 1.0;
+}
+
 // J <- R J C with R, C diagonal powers of two (exact scaling): each row's
 // largest entry near 1, then each column's (LAPACK's dgeequ rule).
 void equilibrate(Eigen::MatrixXd& J, Eigen::VectorXd* rows, Eigen::VectorXd* columns) {
-  const auto power_of_two = [](double largest) {
-    return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest)))
-                                                   : 1.0;
-  };
   *rows = Eigen::VectorXd::Ones(J.rows());
   *columns = Eigen::VectorXd::Ones(J.cols());
   for (Eigen::Index i = 0; i < J.rows(); ++i) {
@@ -33,15 +34,11 @@ void equilibrate(Eigen::MatrixXd& J, Eigen::VectorXd* rows, Eigen::VectorXd* col
 
 // The same for a sparse J, by its stored entries.
 void equilibrate(Eigen::SparseMatrix<double>& J, Eigen::VectorXd* rows, Eigen::VectorXd* columns) {
-  const auto power_of_two = [](double largest) {
-    return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest)))
-                                                   : 1.0;
-  };
   Eigen::VectorXd largest = Eigen::VectorXd::Zero(J.rows());
   for (int c = 0; c < J.outerSize(); ++c)
     for (Eigen::SparseMatrix<double>::InnerIterator it(J, c); it; ++it)
       largest[it.row()] = std::max(largest[it.row()], std::abs(it.value()));
-  *rows = largest.unaryExpr(power_of_two);
+  *rows = largest.unaryExpr([](double v) { return power_of_two(v); });
   *columns = Eigen::VectorXd::Ones(J.cols());
   for (int c = 0; c < J.outerSize(); ++c) {
     double column_largest = 0.0;
