@@ -11,6 +11,8 @@
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "model/boundary_conditions.hpp"
+#include "model/mirror_layer.hpp"
+#include "solve/load_stepper.hpp"
 #include "util/error.hpp"
 #include "util/progress.hpp"
 #include "util/run_control.hpp"
@@ -212,6 +214,7 @@ class ModelBuilder {
     for (const LoadSpec& l : spec_.loads) c_.model.loads.push_back(load(l));
     c_.model.constraints.clear();
     c_.model.motions.clear();
+    c_.model.mirror_layers.clear();
     c_.model.constraint_groups.clear();
     for (const ConstraintSpec& k : spec_.constraints) add_group(k);
     c_.model.paddles.clear();
@@ -311,6 +314,25 @@ class ModelBuilder {
                                     "\", got \"" + axes + "\"");
     for (int v : vertices)
       for (char letter : axes) m.constraints.push_back({v, letter - 'x', 0.0, {}, group});
+    if (spec.mirror_layer) add_mirror_layer(spec, group, vertices, axes);
+  }
+
+  // A clamp's mirror layer: a full clamp on a plane, as deep as the horizon.
+  void add_mirror_layer(const ConstraintSpec& spec, int group, const std::vector<int>& vertices,
+                        const std::string& axes) {
+    if (static_cast<int>(axes.size()) != dim_)
+      spec.field.fail("layer", "a mirror layer clamps every axis: leave \"axes\" out");
+    if (!(spec_.fibers.horizon > 0.0))
+      spec.field.fail("layer",
+                      "a mirror layer is as deep as the fibers' horizon: set fibers.horizon");
+    model::MirrorLayer layer;
+    layer.group = group;
+    layer.depth = spec_.fibers.horizon;
+    const std::string why = model::find_clamp_plane(c_.model.surface.V, vertices, &layer);
+    if (!why.empty()) spec.field.fail("layer", "the support has no clamp plane: " + why);
+    c_.model.mirror_layers.push_back(layer);
+    const std::string problem = solve::mirror_layer_problem(c_.model, c_.stepping);
+    if (!problem.empty()) spec.field.fail("layer", problem);
   }
 
   model::Paddle paddle(const PaddleSpec& spec) const {

@@ -65,6 +65,7 @@ struct ConstraintSpec {
   std::string label;
   SelectionSpec selection;
   std::string axes;              // supports: the held axes, e.g. "xyz"
+  bool mirror_layer = false;     // supports: "layer": "mirror" (model::MirrorLayer)
   Eigen::VectorXd displacement;  // prescribed: one entry per axis (a rotation's translation)
   // prescribed "rotation": {"axis": [x, y, z] (3D), "angle_degrees": a,
   // "centre": [...]}: the group moves rigidly (model::RigidMotion).

@@ -293,7 +293,12 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
       spec.schedule = read_schedule(f, "ramp");
     } else {
       spec.axes = read_axes(f);
+      spec.mirror_layer = f.choice("layer", "none", {"none", "mirror"}) == "mirror";
     }
+    if (prescribed && f.has("layer"))
+      f.fail("layer",
+             "a mirror layer belongs to a fixed clamp (\"supports\"), not to a "
+             "prescribed group");
     f.finish();
     groups.push_back(spec);
   };

@@ -83,6 +83,21 @@ Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
   return Eigen::Map<const Eigen::MatrixXd>(R.data(), n, model_.dim());  // [u_x.., u_y.., ..]
 }
 
+std::vector<Eigen::Vector3d> Equilibrium::support_forces(const Eigen::VectorXd& x) const {
+  std::vector<Eigen::Vector3d> forces(model_.constraint_groups.size(), Eigen::Vector3d::Zero());
+  const std::vector<double> no_load(model_.loads.size(), 0.0);
+  const TermState s(context_, x, no_load);
+  const int n = model_.num_vertices();
+  for (const auto& term : terms_) {
+    const auto group = static_cast<size_t>(term->support_group());
+    if (term->role() != EquilibriumTerm::Role::Support || group >= forces.size()) continue;
+    Eigen::VectorXd R = Eigen::VectorXd::Zero(num_unknowns());
+    term->add_residual(s, R);
+    for (int a = 0; a < model_.dim(); ++a) forces[group][a] -= R.segment(a * n, n).sum();
+  }
+  return forces;
+}
+
 Eigen::VectorXd Equilibrium::external_forces(const Eigen::VectorXd& x,
                                              const std::vector<double>& factors) const {
   return -residual_of(EquilibriumTerm::Role::Load, x, factors);  // minus a load's residual

@@ -79,6 +79,10 @@ class Equilibrium {
                                   const std::vector<double>& factors) const;
   // The fiber forces alone (bulk and surface), #V by dim.
   Eigen::MatrixXd fiber_forces(const Eigen::VectorXd& x) const;
+  // The force each support group's own fibers (its mirror layer) exert on
+  // the body, one per Model::constraint_groups entry (zero without a layer):
+  // part of that group's reaction.
+  std::vector<Eigen::Vector3d> support_forces(const Eigen::VectorXd& x) const;
 
   // dR/dx, dense, full layout: the consistent tangent with the dY/de terms,
   // the pressure terms P dS/dx and the follower-load terms.

@@ -164,6 +164,20 @@ struct Influence {
   }
 };
 
+// A clamped support's mirror layer (Prudhomme and Diehl 2020, "On the
+// treatment of boundary conditions for bond-based peridynamic models"): a
+// fiber body held on a plane misses the fibers that would reach across it, so
+// it hinges at the clamp. The layer restores them as fibers from each vertex
+// i to the odd reflection of each vertex j through the plane, at
+// 2 q_j - x_j (q_j the foot of j's reference position on the plane): the
+// displacement field extended as an odd function, zero on the plane.
+struct MirrorLayer {
+  int group = 0;  // the support group (Model::constraint_groups) whose reaction it adds to
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    // on the clamp plane
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  // unit, into the body
+  double depth = 0.0;  // the horizon: only pairs with |s_i - mirror(s_j)| < depth are fibers
+};
+
 // Everything the equations need: the reference surface (every vertex used by
 // a face), the material, the loads and the constraints.
 struct Model {
@@ -172,7 +186,8 @@ struct Model {
   std::vector<Load> loads;
   std::vector<Constraint> constraints;
   std::vector<Paddle> paddles;
-  std::vector<RigidMotion> motions;  // of prescribed groups (Constraint::motion)
+  std::vector<RigidMotion> motions;        // of prescribed groups (Constraint::motion)
+  std::vector<MirrorLayer> mirror_layers;  // of clamped supports (Newton scheme)
   // Names of the support and prescribed groups (one per experiment entry), for
   // reporting the reaction force of each; constraints refer to them by index.
   std::vector<std::string> constraint_groups;

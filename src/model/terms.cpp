@@ -10,6 +10,7 @@
 #include "geom/fiber_mask.hpp"
 #include "model/assembly.hpp"
 #include "model/loads.hpp"
+#include "model/mirror_layer.hpp"
 #include "model/pair_kernels.hpp"
 #include "model/pair_stencil.hpp"
 
@@ -395,6 +396,8 @@ std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const 
   terms.push_back(std::make_unique<SurfaceTensionTerm>(c));
   terms.push_back(std::make_unique<PressureVolumeTerm>(c));
   for (size_t l = 0; l < c.model.loads.size(); ++l) terms.push_back(make_load_term(c, l));
+  for (const MirrorLayer& layer : c.model.mirror_layers)
+    terms.push_back(make_mirror_layer_term(c, layer));
   return terms;
 }
 

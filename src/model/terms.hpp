@@ -8,6 +8,7 @@
 //   pressure, volume  P S_i(x), and the row g = dim C0 (V(x) - V0)
 //   point load        -lambda F                     (one term per load)
 //   hydrostatic load  -q_i(x) S_i(x)                (one term per load)
+//   mirror layer      fibers to the body's image across a clamp (mirror_layer.hpp)
 //
 // A new load kind is one new term and its case in make_load_term. Contact
 // with the paddles is not a term: contacts are held unknowns of the stepper's
@@ -70,10 +71,13 @@ class EquilibriumTerm {
   // What a term stands for: the tissue's fibers (bulk and surface tension,
   // Equilibrium::fiber_forces), the fluid (pressure and volume), or a load,
   // whose residual is minus the external force it applies (reactions,
-  // Equilibrium::external_forces).
-  enum class Role { Fibers, Fluid, Load };
+  // Equilibrium::external_forces), or a support's own fibers (a clamp's
+  // mirror layer), whose forces add to that support's reaction.
+  enum class Role { Fibers, Fluid, Load, Support };
   virtual const char* name() const = 0;
   virtual Role role() const = 0;
+  // A Support term's group (Model::constraint_groups); -1 for the others.
+  virtual int support_group() const { return -1; }
   // R += this term's part at the state (full layout [u; P]).
   virtual void add_residual(const TermState& s, Eigen::VectorXd& R) const = 0;
   // J += its dR/dx (full layout), dense or sparse.
@@ -134,7 +138,8 @@ class BulkFiberTerm final : public EquilibriumTerm {
 };
 
 // The terms other than the bulk fibers, in the order they are summed:
-// surface tension, pressure and volume, then one per load of the model.
+// surface tension, pressure and volume, one per load of the model, then one
+// per mirror layer.
 // Throws std::invalid_argument for a load of an unknown kind.
 std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c);
 

@@ -197,6 +197,10 @@ std::string treecode_problem(const model::Model& model, const SteppingOptions& o
 // scheme (the incremental scheme's matrix is the vector spring's).
 std::string kinematics_problem(const model::Model& model, const SteppingOptions& options);
 
+// "" when the model's mirror layers (model::MirrorLayer) can run with these
+// options, else why not: they need the Newton scheme.
+std::string mirror_layer_problem(const model::Model& model, const SteppingOptions& options);
+
 // The backend SolverKind::Auto runs: pcg with the treecode, else
 // choose_solver's rule by size (the largest axis block, the distinct factors).
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,

@@ -625,6 +625,9 @@ class StepFinisher {
       record.reactions[static_cast<size_t>(constraint.group) % groups_][d / nv] += R[d];
       summary_.reaction_forces(d % nv, d / nv) = R[d];
     }
+    // A clamp's mirror layer holds the body through its fibers, not its rows.
+    const std::vector<Eigen::Vector3d> layers = solver_.equilibrium().support_forces(x);
+    for (size_t g = 0; g < layers.size(); ++g) record.reactions[g % groups_] += layers[g];
     record.paddles.resize(model_.paddles.size());
     for (size_t p = 0; p < model_.paddles.size(); ++p) {
       record.paddles[p].plane = at.planes[p];

@@ -67,6 +67,12 @@ std::string kinematics_problem(const model::Model& model, const SteppingOptions&
          "incremental scheme's matrix is the paper's vector spring";
 }
 
+std::string mirror_layer_problem(const model::Model& model, const SteppingOptions& options) {
+  if (model.mirror_layers.empty() || options.scheme == Scheme::Newton) return {};
+  return "a support's mirror layer needs the Newton scheme (stepping.scheme \"newton\"): the "
+         "incremental scheme's matrix has no layer fibers";
+}
+
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
                             double budget_bytes) {
   if (model.treecode_tolerance > 0.0) return SolverKind::PCG;  // the only matrix-free backend
@@ -81,6 +87,8 @@ std::string setup_problem(const model::Model& model, const SteppingOptions& opti
   why = treecode_problem(model, options);
   if (!why.empty()) return why;
   why = kinematics_problem(model, options);
+  if (!why.empty()) return why;
+  why = mirror_layer_problem(model, options);
   if (!why.empty()) return why;
   return model::singular_setup_reason(model);
 }

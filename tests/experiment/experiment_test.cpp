@@ -359,6 +359,53 @@ TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
   expect_config_error(dir, c, "fibers.kinematics");
 }
 
+// supports[].layer: "mirror" gives a clamp on a plane the fibers that reach
+// across it (model::MirrorLayer), as deep as the horizon; a clamp it cannot
+// mirror is named.
+TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"generator", "box"},
+                  {"min", {0, 0, 0}},
+                  {"max", {0.06, 0.02, 0.02}},
+                  {"segments", {6, 2, 2}}};
+  c["supports"] = {{{"label", "clamp"}, {"where", "x <= 0"}, {"layer", "mirror"}}};
+  c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.025}};
+  c["stepping"]["scheme"] = "newton";
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const model::Model& m = ex.cases[0].model;
+  ASSERT_EQ(m.mirror_layers.size(), 1u);
+  EXPECT_LT((m.mirror_layers[0].normal - Eigen::Vector3d::UnitX()).norm(), 1e-12);
+  EXPECT_EQ(m.mirror_layers[0].depth, 0.025);
+  const ExperimentResult r = run_experiment(ex);
+  ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+
+  nlohmann::json bad = c;
+  bad["supports"][0]["layer"] = "odd";
+  expect_config_error(dir, bad, "supports[0].layer");
+  bad = c;
+  bad["fibers"].erase("horizon");
+  expect_config_error(dir, bad,
+                      "supports[0].layer: a mirror layer is as deep as the fibers' horizon");
+  bad = c;
+  bad["supports"][0]["axes"] = "z";
+  expect_config_error(dir, bad, "supports[0].layer: a mirror layer clamps every axis");
+  bad = c;
+  bad["supports"][0]["where"] = "x <= 0.011";
+  expect_config_error(dir, bad,
+                      "supports[0].layer: the support has no clamp plane: its vertices are not "
+                      "on one plane");
+  bad = c;
+  bad["fibers"]["kinematics"] = "vector";
+  bad["stepping"]["scheme"] = "incremental";
+  expect_config_error(dir, bad,
+                      "supports[0].layer: a support's mirror layer needs the Newton scheme");
+  bad = c;
+  bad["prescribed"] = {
+      {{"where", "x >= 0.06"}, {"displacement", {0, 0, 0.001}}, {"layer", "mirror"}}};
+  expect_config_error(dir, bad, "prescribed[0].layer: a mirror layer belongs to a fixed clamp");
+}
+
 // A prescribed group may turn rigidly: "rotation" (axis, angle in degrees,
 // centre) with an optional translation, along its schedule.
 TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {

@@ -1,0 +1,217 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "model/mirror_layer.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "model/fiber_network.hpp"
+#include "model/pair_stencil.hpp"
+
+namespace fiberfluid::model {
+
+namespace {
+
+Eigen::Vector3d padded(const Eigen::MatrixXd& M, Eigen::Index row) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  v.head(M.cols()) = M.row(row).transpose();
+  return v;
+}
+
+std::string metres(double value) {
+  std::ostringstream out;
+  out.precision(3);
+  out << value << " m";
+  return out.str();
+}
+
+}  // namespace
+
+std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector<int>& held,
+                             MirrorLayer* layer) {
+  if (held.empty()) return "it holds no vertex";
+  const int dim = static_cast<int>(reference.cols());
+  const double size = (reference.colwise().maxCoeff() - reference.colwise().minCoeff()).norm();
+  const double tolerance = 1e-6 * size;
+  Eigen::MatrixXd points(static_cast<Eigen::Index>(held.size()), dim);
+  for (size_t k = 0; k < held.size(); ++k)
+    points.row(static_cast<Eigen::Index>(k)) = reference.row(held[k]);
+  const Eigen::RowVectorXd centre = points.colwise().mean();
+  const Eigen::MatrixXd centred = points.rowwise() - centre;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullV);
+  // A plane (3D) needs two spreading directions, a line (2D) one.
+  const Eigen::VectorXd spread = svd.singularValues();
+  if (spread.size() < dim - 1 || spread[dim - 2] <= tolerance * std::sqrt(double(held.size())))
+    return std::string("its vertices do not span a ") + (dim == 3 ? "plane" : "line");
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  normal.head(dim) = svd.matrixV().col(dim - 1);
+  const double off = (centred * normal.head(dim)).cwiseAbs().maxCoeff();
+  if (off > tolerance)
+    return std::string("its vertices are not on one ") + (dim == 3 ? "plane" : "line") +
+           " (one is " + metres(off) + " off their best one)";
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  point.head(dim) = centre.transpose();
+  const Eigen::VectorXd side = (reference.rowwise() - centre) * normal.head(dim);
+  const double above = side.maxCoeff(), below = -side.minCoeff();
+  if (above > tolerance && below > tolerance)
+    return "the body lies on both sides of its plane (" + metres(above) + " and " + metres(below) +
+           " away): a mirror layer needs the clamp on the body's boundary";
+  if (std::max(above, below) <= tolerance) return "the whole body lies on its plane";
+  layer->point = point;
+  layer->normal = above > below ? normal : Eigen::Vector3d(-normal);
+  return {};
+}
+
+std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLayer& layer,
+                                            const PairFactors& factors,
+                                            const Eigen::VectorXd& area0) {
+  const Eigen::MatrixXd& V = model.surface.V;
+  const int n = model.num_vertices();
+  const double size = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  // Vertices on the plane are their own images: their fibers are the bulk's.
+  std::vector<int> near;
+  std::vector<double> height(static_cast<size_t>(n), 0.0);
+  for (int v = 0; v < n; ++v) {
+    height[static_cast<size_t>(v)] = (padded(V, v) - layer.point).dot(layer.normal);
+    if (height[static_cast<size_t>(v)] > 1e-6 * size &&
+        height[static_cast<size_t>(v)] < layer.depth)
+      near.push_back(v);
+  }
+  const std::vector<double> counts = factors.vertex_counts();
+  const geom::FiberMask* mask = model.fibers.get();
+  std::vector<LayerFiber> fibers;
+  for (int i : near)
+    for (int j : near) {
+      if (i != j && mask != nullptr && !mask->kept(i, j)) continue;  // pruned or beyond the horizon
+      const Eigen::Vector3d foot = padded(V, j) - height[static_cast<size_t>(j)] * layer.normal;
+      const double length = (padded(V, i) + padded(V, j) - 2.0 * foot).norm();
+      if (length >= layer.depth) continue;
+      const auto a = static_cast<size_t>(i), b = static_cast<size_t>(j);
+      const double weight = 0.5 * model.influence(length) * (area0[i] + area0[j]) /
+                            ((counts[a] + counts[b]) * length);
+      fibers.push_back({i, j, 2.0 * foot, length, weight});
+    }
+  return fibers;
+}
+
+namespace {
+
+class MirrorLayerTerm final : public EquilibriumTerm {
+ public:
+  MirrorLayerTerm(const TermContext& c, const MirrorLayer& layer)
+      : c_(c),
+        group_(layer.group),
+        fibers_(mirror_layer_fibers(c.model, layer, c.pair_factors, c.area0)) {}
+
+  const char* name() const override { return "mirror layer"; }
+  Role role() const override { return Role::Support; }
+  int support_group() const override { return group_; }
+
+  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
+    const Eigen::Vector3d m = c_.model.material.axis_factors;
+    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
+      using K = decltype(policy);
+      for (int a = 0; a < dim(); ++a) {
+        const double force = m[a] * pair_force<K>(st.coefficients, st.b[a], st.d[a]);
+        R[dof(f.i, a)] += force;
+        R[dof(f.j, a)] += force;
+      }
+    });
+  }
+
+  void add_tangent(const TermState& s, TangentSink& J) const override {
+    const Eigen::Vector3d m = c_.model.material.axis_factors;
+    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
+      using K = decltype(policy);
+      // b and d move alike with x_i and x_j: four equal blocks.
+      for (int a = 0; a < dim(); ++a)
+        for (int e = 0; e < dim(); ++e) {
+          const double entry =
+              m[a] * pair_tangent_entry<K>(st.coefficients, a == e, st.b[a], st.d[a], st.b[e]);
+          for (int row : {f.i, f.j})
+            for (int col : {f.i, f.j}) J.add(dof(row, a), dof(col, e), entry);
+        }
+    });
+  }
+
+  void add_tangent_product(const TermState& s, const Eigen::VectorXd& /*v*/,
+                           const Eigen::MatrixXd& W, Eigen::VectorXd& out) const override {
+    const Eigen::Vector3d m = c_.model.material.axis_factors;
+    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
+      using K = decltype(policy);
+      const Eigen::Vector3d w = padded(W, f.i) + padded(W, f.j);
+      const double b_dot_w = st.b.dot(w);
+      for (int a = 0; a < dim(); ++a) {
+        const double value =
+            m[a] * pair_tangent<K>(st.coefficients, w[a], b_dot_w, st.b[a], st.d[a]);
+        out[dof(f.i, a)] += value;
+        out[dof(f.j, a)] += value;
+      }
+    });
+  }
+
+  void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
+                                Eigen::Ref<Eigen::VectorXd> column) const override {
+    if (p.kind == MaterialParameter::Kind::SurfaceTension) return;
+    const Eigen::Vector3d m = c_.model.material.axis_factors;
+    const FiberLaw& law = c_.model.material.law;
+    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
+      using K = decltype(policy);
+      for (int a = 0; a < dim(); ++a) {
+        double value = 0.0;
+        if (p.kind == MaterialParameter::Kind::AxisFactor) {  // the force over its factor
+          if (a != p.index) continue;
+          value = pair_force<K>(st.coefficients, st.b[a], st.d[a]);
+        } else {
+          value = m[a] * pair_parameter_force<K>(f.weight, law.modulus_derivative(p.index, st.e),
+                                                 st.r, f.length, st.b[a], st.d[a]);
+        }
+        column[dof(f.i, a)] += value;
+        column[dof(f.j, a)] += value;
+      }
+    });
+  }
+
+ private:
+  struct State {
+    Eigen::Vector3d b, d;  // x_i minus the image of j, and u_i minus the image's displacement
+    double r = 0.0, e = 0.0;
+    PairCoefficients coefficients{0.0, 0.0};
+  };
+
+  int dim() const { return c_.model.dim(); }
+  Eigen::Index dof(int vertex, int axis) const { return c_.model.dof(vertex, axis); }
+
+  // body(policy, fiber, state) for each fiber at the state s.
+  template <class Body>
+  void for_each_fiber(const TermState& s, Body&& body) const {
+    const FiberLaw& law = c_.model.material.law;
+    with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+      using K = decltype(policy);
+      State st;
+      for (const LayerFiber& f : fibers_) {
+        st.b = padded(s.X, f.i) + padded(s.X, f.j) - f.twice_foot;
+        st.d = padded(s.U, f.i) + padded(s.U, f.j);
+        st.r = st.b.norm();
+        st.e = fiber_strain(st.r, f.length);
+        st.coefficients =
+            K::coefficients(f.weight, law.modulus(st.e), law.slope(st.e), st.r, f.length);
+        body(policy, f, st);
+      }
+    });
+  }
+
+  const TermContext& c_;
+  int group_;
+  std::vector<LayerFiber> fibers_;
+};
+
+}  // namespace
+
+std::unique_ptr<EquilibriumTerm> make_mirror_layer_term(const TermContext& context,
+                                                        const MirrorLayer& layer) {
+  return std::make_unique<MirrorLayerTerm>(context, layer);
+}
+
+}  // namespace fiberfluid::model
