@@ -11,6 +11,7 @@ compared with the FEM's: the tip's drop and the tip face's rotation at every loa
   vector        the paper's vector spring over all pairs, constant law Y
   central       central fibers over all pairs, exponential law (Y0, beta)
   central_hXX   central fibers within a horizon of XX mm, exponential law
+  central_hXX_mirror   the same with the clamp's mirror layer (supports[].layer)
 
 Writes into OUT (default cantilever_large_out):
   cantilever_large.csv   one row per model: fitted parameters, sd share, E_s, tip drop, rotation
@@ -32,16 +33,17 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 LENGTH = 0.18
 
-MODELS = [  # name, fibers, law (its values the fit's start), fitted parameters
-    ("vector", {}, {"type": "constant", "Y": 60000}, [("Y", 100, 1e7)]),
+MODELS = [  # name, fibers, law (its values the fit's start), fitted parameters, mirror layer
+    ("vector", {}, {"type": "constant", "Y": 60000}, [("Y", 100, 1e7)], False),
     ("central", {"kinematics": "central"}, {"type": "exponential", "Y0": 120000, "beta": -2},
-     [("Y0", 1000, 1e7), ("beta", -20, 20)]),
+     [("Y0", 1000, 1e7), ("beta", -20, 20)], False),
 ]
-for horizon, start in ((0.035, 200000), (0.05, 170000), (0.07, 145000)):
-    MODELS.append(("central_h%d" % round(horizon * 1000),
-                   {"kinematics": "central", "horizon": horizon},
-                   {"type": "exponential", "Y0": start, "beta": -2},
-                   [("Y0", 1000, 1e7), ("beta", -20, 20)]))
+for layer in (False, True):  # the clamp bare, then with its mirror layer
+    for horizon, start in ((0.035, 200000), (0.05, 170000), (0.07, 145000)):
+        MODELS.append(("central_h%d%s" % (round(horizon * 1000), "_mirror" if layer else ""),
+                       {"kinematics": "central", "horizon": horizon},
+                       {"type": "exponential", "Y0": start * (0.6 if layer else 1.0), "beta": -2},
+                       [("Y0", 1000, 1e7), ("beta", -20, 20)], layer))
 
 
 def read_vtu(path):
@@ -113,9 +115,13 @@ def main():
     for key in ("fem_reference", "expected", "description"):
         base.pop(key, None)
     rows, paths, finals = [], {"FEM (neo-Hookean)": fem_path}, {}
-    for name, fibers, law, parameters in MODELS:
+    for name, fibers, law, parameters, layer in MODELS:
         spec = json.loads(json.dumps(base))
         spec["name"] = name
+        for support in spec["supports"]:
+            support.pop("layer", None)
+            if layer:
+                support["layer"] = "mirror"
         spec["fibers"] = fibers
         if not fibers:
             spec.pop("fibers")
