@@ -158,9 +158,21 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"final", final_figures}};
 }
 
+// The clamps' mirror layers: which support, its plane and depth.
+json mirror_layers_json(const model::Model& m) {
+  json layers = json::array();
+  for (const model::MirrorLayer& layer : m.mirror_layers)
+    layers.push_back({{"support", m.constraint_groups.at(static_cast<size_t>(layer.group))},
+                      {"point", {layer.point.x(), layer.point.y(), layer.point.z()}},
+                      {"normal", {layer.normal.x(), layer.normal.y(), layer.normal.z()}},
+                      {"depth", layer.depth}});
+  return layers;
+}
+
 json fibers_json(const Case& c) {
   const FiberReport& f = c.fibers;
   return {{"kinematics", model::kinematics_name(c.model.material.kinematics)},
+          {"mirror_layers", mirror_layers_json(c.model)},
           {"horizon", f.horizon > 0.0 ? json(f.horizon) : json(nullptr)},  // m; null: every pair
           {"pruning", f.pruning ? "auto" : "off"},
           {"convex", f.convex},

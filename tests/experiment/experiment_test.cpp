@@ -379,6 +379,11 @@ TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
   EXPECT_EQ(m.mirror_layers[0].depth, 0.025);
   const ExperimentResult r = run_experiment(ex);
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+  const nlohmann::json layers = summary_json(ex, r)["fibers"]["mirror_layers"];
+  ASSERT_EQ(layers.size(), 1u);
+  EXPECT_EQ(layers[0]["support"], "clamp");
+  EXPECT_EQ(layers[0]["depth"], 0.025);
+  EXPECT_EQ(layers[0]["normal"], nlohmann::json({1.0, 0.0, 0.0}));
 
   nlohmann::json bad = c;
   bad["supports"][0]["layer"] = "odd";
