@@ -108,10 +108,12 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   if (pruning != PruningWork::None)  // N x F tests when convex; a concave body stops early
     e.parts.push_back(
         {"convexity check", 0.0, N * surface.num_faces() / speed.orientation_tests_per_second});
-  // An N x N byte table, kept for the solvers, and per thread an AABB tree and
-  // the exact solid (about 12 kB a face in all: the bunny's peak).
+  // An N x N byte table (a horizon's lists: two ints a pair), kept for the
+  // solvers, and per thread an AABB tree and the exact solid (about 12 kB a
+  // face in all: the bunny's peak). Only the horizon's pairs are tested.
   if (pruning == PruningWork::Prune)
-    e.parts.push_back({"pruning", N * N + 12000.0 * surface.num_faces(),
+    e.parts.push_back({"pruning",
+                       (sparse_fibers ? 8.0 * pairs : N * N) + 12000.0 * surface.num_faces(),
                        pairs / speed.prune_pairs_per_second, true});
 
   const solve::BlockShape blocks = solve::block_shape(model, o.boundary_method);

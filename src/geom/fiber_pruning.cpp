@@ -205,8 +205,30 @@ bool keep_fiber(const Surface& s, const Tree& tree, TriangleIterator first,
   return exact.segment_inside(pe, qe, faces);
 }
 
-PruningResult prune_3d(const Surface& s) {
-  PruningResult result{FiberMask(s.num_vertices())};
+// body(j) for each partner j > i to test: the candidates' kept ones, or all.
+template <class Body>
+void for_each_later_partner(const FiberMask* candidates, int i, int n, Body&& body) {
+  if (candidates == nullptr) {
+    for (int j = i + 1; j < n; ++j) body(j);
+    return;
+  }
+  candidates->for_each_kept(i, [&](int j) {
+    if (j > i) body(j);
+  });
+}
+
+// The pairs to test: the candidates' kept ones, or all N (N - 1) / 2.
+double pairs_to_test(const FiberMask* candidates, int n) {
+  return candidates ? static_cast<double>(candidates->num_kept()) : 0.5 * n * (n - 1.0);
+}
+
+// The mask the pruning starts from: the candidates, or every pair.
+FiberMask starting_mask(const FiberMask* candidates, int n) {
+  return candidates ? *candidates : FiberMask(n);
+}
+
+PruningResult prune_3d(const Surface& s, const FiberMask* candidates) {
+  PruningResult result{starting_mask(candidates, s.num_vertices())};
   std::vector<Triangle> triangles;
   for (int f = 0; f < s.num_faces(); ++f)
     triangles.emplace_back(point3(s.V, s.F(f, 0)), point3(s.V, s.F(f, 1)), point3(s.V, s.F(f, 2)));
@@ -215,12 +237,16 @@ PruningResult prune_3d(const Surface& s) {
   const SegmentFilter filter(s, stars.star);
   const int n = s.num_vertices();
   long long fallbacks = 0, clear = 0, filtered = 0;
-  const double pairs = 0.5 * n * (n - 1.0);
+  const double pairs = pairs_to_test(candidates, n);
   std::atomic<long long> pairs_done{0};
   report_progress("pruning", 0.0, pairs);
   ThreadFailure failure;
+  // Pruned pairs are gathered per thread and applied after the loop: a
+  // sparse mask's lists may not be edited from two threads.
+  std::vector<std::vector<std::pair<int, int>>> pruned(static_cast<size_t>(omp_get_max_threads()));
 #pragma omp parallel reduction(+ : fallbacks, clear, filtered)
   {
+    std::vector<std::pair<int, int>>& mine = pruned[static_cast<size_t>(omp_get_thread_num())];
     // Every thread reaches the loop (its barrier waits for all), failed or not.
     std::optional<ExactSolid> solid;
     try {
@@ -234,8 +260,10 @@ PruningResult prune_3d(const Surface& s) {
       // No break out of an OpenMP loop: the rest is skipped.
       if (cancel_requested() || failure.happened() || !solid) continue;
       const ExactSolid& exact = *solid;
+      long long tested = 0;
       try {
-        for (int j = i + 1; j < n; ++j) {
+        for_each_later_partner(candidates, i, n, [&](int j) {
+          ++tested;
           bool keep = true;
           const SegmentVerdict verdict = filter.classify(i, j);
           filtered += verdict != SegmentVerdict::Clear && verdict != SegmentVerdict::Unsure;
@@ -254,17 +282,19 @@ PruningResult prune_3d(const Surface& s) {
               keep = keep_fiber(s, tree, triangles.cbegin(), stars, exact, i, j, faces, fallbacks);
               break;
           }
-          if (!keep) result.mask.prune(i, j);
-        }
+          if (!keep) mine.emplace_back(i, j);
+        });
       } catch (...) {
         failure.capture();
       }
-      const long long done = pairs_done += n - 1 - i;
+      const long long done = pairs_done += tested;
       if (omp_get_thread_num() == 0) report_progress("pruning", static_cast<double>(done), pairs);
     }
   }
   failure.rethrow_if_any();
   throw_if_cancelled("the fiber pruning");
+  for (const auto& list : pruned)
+    for (const auto& [i, j] : list) result.mask.prune(i, j);
   report_progress("pruning", pairs, pairs);
   result.exact_fallbacks = fallbacks + clear;
   result.decided_in_doubles = filtered;
@@ -275,8 +305,8 @@ PruningResult prune_3d(const Surface& s) {
 using ExactPoint2 = Epeck::Point_2;
 
 // A closed polygon: brute force over its edges (2D outlines are small).
-PruningResult prune_2d(const Surface& s) {
-  PruningResult result{FiberMask(s.num_vertices())};
+PruningResult prune_2d(const Surface& s, const FiberMask* candidates) {
+  PruningResult result{starting_mask(candidates, s.num_vertices())};
   const int n = s.num_vertices();
   std::vector<ExactPoint2> exact(static_cast<size_t>(n));
   std::vector<Epick::Point_2> point(static_cast<size_t>(n));
@@ -300,9 +330,10 @@ PruningResult prune_2d(const Surface& s) {
            CGAL::ON_UNBOUNDED_SIDE;
   };
   long long fallbacks = 0;
+  std::vector<std::pair<int, int>> pruned;  // applied after the loop, as in 3D
   for (int i = 0; i < n; ++i) {
     throw_if_cancelled("the fiber pruning");
-    for (int j = i + 1; j < n; ++j) {
+    for_each_later_partner(candidates, i, n, [&](int j) {
       const Epick::Point_2 &p = point[static_cast<size_t>(i)], &q = point[static_cast<size_t>(j)];
       bool degenerate = false, crossed = false;
       for (int f = 0; f < s.num_faces() && !crossed; ++f) {
@@ -362,9 +393,10 @@ PruningResult prune_2d(const Surface& s) {
           if (!covered && outside(pe + ((breaks[k] + breaks[k + 1]) / 2) * d)) keep = false;
         }
       }
-      if (!keep) result.mask.prune(i, j);
-    }
+      if (!keep) pruned.emplace_back(i, j);
+    });
   }
+  for (const auto& [i, j] : pruned) result.mask.prune(i, j);
   result.exact_fallbacks = fallbacks;
   return result;
 }
@@ -409,13 +441,14 @@ bool is_convex(const Surface& s) {
   return true;
 }
 
-PruningResult prune_fibers(const Surface& surface, bool convex_fast_path) {
+PruningResult prune_fibers(const Surface& surface, bool convex_fast_path,
+                           const FiberMask* candidates) {
   const auto start = std::chrono::steady_clock::now();
-  PruningResult result{FiberMask(surface.num_vertices())};
+  PruningResult result{starting_mask(candidates, surface.num_vertices())};
   if (convex_fast_path && is_convex(surface)) {
     result.convex = true;
   } else {
-    result = surface.dim == 3 ? prune_3d(surface) : prune_2d(surface);
+    result = surface.dim == 3 ? prune_3d(surface, candidates) : prune_2d(surface, candidates);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

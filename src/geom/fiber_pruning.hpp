@@ -28,6 +28,10 @@ bool is_convex(const Surface& surface);
 // into pieces and each piece is classified. 3D triangle meshes and 2D
 // polygons.
 // With convex_fast_path (the default), a convex body skips the pair tests.
-PruningResult prune_fibers(const Surface& surface, bool convex_fast_path = true);
+// With `candidates` (a horizon's fibers), only its kept pairs are tested and
+// the mask returned is those of them that stay inside, in the candidates'
+// storage: the work grows with the horizon's pairs, not N^2.
+PruningResult prune_fibers(const Surface& surface, bool convex_fast_path = true,
+                           const FiberMask* candidates = nullptr);
 
 }  // namespace fiberfluid::geom

@@ -9,6 +9,7 @@
 
 #include "geom/area_vectors.hpp"
 #include "geom/generators.hpp"
+#include "geom/horizon.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
 
@@ -245,6 +246,30 @@ TEST(FiberPruning, TorusPrunesTheFibersAcrossItsHole) {
   for (int i = 0; i < generic.num_vertices(); ++i)
     generic.V.row(i) *= 1.0 + 1e-3 * std::sin(12.9898 * i);
   expect_agreement(generic, prune_fibers(generic));
+}
+
+// Within a horizon only its pairs are tested: the mask is the horizon's
+// pairs that pruning every pair keeps, pair by pair, in the horizon's
+// storage (sparse lists or the table), in 3D and 2D.
+TEST(FiberPruning, AHorizonsPairsAloneAreTestedAndKeptAsPruningEveryPairKeepsThem) {
+  const Surface ring = torus(2.0, 0.5, 16, 8), outline = polygon(l_outline());
+  for (const auto& [s, horizon] : {std::pair<Surface, double>{ring, 2.5}, {outline, 2.1}})
+    for (MaskStorage storage : {MaskStorage::Sparse, MaskStorage::Dense}) {
+      const FiberMask within = horizon_fibers(s, horizon, storage);
+      ASSERT_LT(within.num_kept(), within.num_pairs());  // the horizon leaves pairs out
+      const PruningResult all = prune_fibers(s, false);
+      const PruningResult some = prune_fibers(s, false, &within);
+      EXPECT_EQ(some.mask.sparse(), within.sparse());
+      long long pruned = 0;
+      for (int i = 0; i < s.num_vertices(); ++i)
+        for (int j = 0; j < s.num_vertices(); ++j) {
+          if (i == j) continue;
+          ASSERT_EQ(some.mask.kept(i, j), within.kept(i, j) && all.mask.kept(i, j))
+              << i << " " << j;
+          pruned += within.kept(i, j) && !all.mask.kept(i, j);
+        }
+      EXPECT_GT(pruned, 0);  // the horizon reaches across the hole or the corner
+    }
 }
 
 TEST(FiberPruning, AgreesWithTheBruteForceOnSharedMeshes) {
