@@ -94,6 +94,12 @@ std::function<geom::Surface()> read_generator(Fields& f) {
 }
 
 // "file" (with "flip") or "generator", then "scale".
+// A file's path as the resolved experiment gives it: absolute, so that it
+// reads the same file from any folder.
+std::string absolute_path(const std::filesystem::path& path) {
+  return std::filesystem::absolute(path).lexically_normal().string();
+}
+
 SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
   SurfaceSpec spec;
   spec.field = f.field();
@@ -102,6 +108,7 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
   if (f.has("file")) {
     spec.file = f.string("file");
     if (spec.file.is_relative()) spec.file = folder / spec.file;
+    f.resolve("file", absolute_path(spec.file));
     spec.flip = f.boolean("flip", false);
   } else {
     spec.generate = read_generator(f);
@@ -161,7 +168,8 @@ SelectionSpec read_selection(Fields& f) {
 
 // The held axes: distinct letters of "xyz" ("" for all of the surface's axes).
 std::string read_axes(Fields& f) {
-  const std::string text = f.string("axes", "");
+  if (!f.has("axes")) return "";  // every axis of the surface, whose dimension is not known yet
+  const std::string text = f.string("axes");
   for (char c : text)
     if (c < 'x' || c > 'z' || std::count(text.begin(), text.end(), c) > 1)
       f.fail("axes", "expected distinct letters from \"xyz\", got \"" + text + "\"");
@@ -372,11 +380,10 @@ solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
   options.scheme = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton"
                        ? solve::Scheme::Newton
                        : solve::Scheme::Incremental;
-  if (f.has("newton")) {
-    if (options.scheme != solve::Scheme::Newton)
-      f.fail("newton", "Newton options need \"scheme\": \"newton\"");
-    options.newton = read_newton(f.object("newton"), options.newton);
-  }
+  if (f.has("newton") && options.scheme != solve::Scheme::Newton)
+    f.fail("newton", "Newton options need \"scheme\": \"newton\"");
+  if (options.scheme == solve::Scheme::Newton)
+    options.newton = read_newton(f.object_or_empty("newton"), options.newton);
   options.steps = f.integer("steps", options.steps, 1, 100000);
   if (f.has("control")) {
     const bool arc = f.choice("control", "load", {"load", "arc_length"}) == "arc_length";
@@ -455,8 +462,7 @@ std::vector<ExpectedFigure> read_expected(Fields& root) {
 FiberSpec read_fibers(Fields& root) {
   FiberSpec spec;
   spec.field = {root.file(), root.name("fibers")};
-  if (!root.has("fibers")) return spec;
-  Fields f = root.object("fibers");
+  Fields f = root.object_or_empty("fibers");
   spec.pruning = f.choice("pruning", "auto", {"auto", "off"}) == "auto";
   spec.count = f.choice("connection_count", "symmetric", {"symmetric", "global"}) == "global"
                    ? model::ConnectionCount::Global
@@ -556,6 +562,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     target.field = t.field();
     target.file = t.string("file");
     if (target.file.is_relative()) target.file = folder / target.file;
+    t.resolve("file", absolute_path(target.file));
     target.step = t.integer("step", 0, 1, 100000);
     if (t.has("scale") && t.has("units"))
       t.fail("units", "give the scan's units or its scale, not both");
@@ -586,6 +593,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   if (f.has("start_from")) {
     spec.start_from = f.string("start_from");
     if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;
+    f.resolve("start_from", absolute_path(*spec.start_from));
   }
   // The options' values are checked once, by fit::check_options, for every
   // front end alike (its messages begin with the option's name); here only
@@ -657,12 +665,15 @@ void read_simulation(Fields& root, const nlohmann::json& document,
   json base = document;
   for (const char* field : kExperimentFields) base.erase(field);
   if (!root.has("variants")) {
-    Fields f(base, "", root.file());
+    json resolved;
+    Fields f(base, "", root.file(), &resolved);
     ex.specs.push_back(read_case(f, folder, &ex.warnings));
+    ex.resolved.update(resolved);
   } else {
     const json& variants = root.raw("variants");
     if (!variants.is_array() || variants.empty())
       root.fail("variants", "expected a non-empty list of objects");
+    json resolved_variants = json::array();
     for (size_t k = 0; k < variants.size(); ++k) {
       Fields v(variants[k], "variants[" + std::to_string(k) + "]", root.file());
       const std::string name = v.string("name");
@@ -674,20 +685,22 @@ void read_simulation(Fields& root, const nlohmann::json& document,
           v.fail(field, "belongs to the whole experiment; a variant cannot change it");
       json patched = base;
       patched.merge_patch(patch);
-      Fields f(patched, "", root.file() + " [variant " + name + "]");
+      json resolved = {{"name", name}};
+      Fields f(patched, "", root.file() + " [variant " + name + "]", &resolved);
       CaseSpec c = read_case(f, folder, &ex.warnings);
       c.variant = name;
       c.patch = patch;
       ex.specs.push_back(std::move(c));
+      resolved_variants.push_back(std::move(resolved));
     }
+    // Each variant resolved whole: merged onto an empty base, it is its case.
+    ex.resolved["variants"] = std::move(resolved_variants);
   }
-  if (root.has("output")) {
-    Fields f = root.object("output");
-    ex.output.vtk = f.boolean("vtk", true);
-    ex.output.obj = f.boolean("obj", true);
-    ex.output.every = f.integer("every", 1, 1, 1000000);
-    f.finish();
-  }
+  Fields output = root.object_or_empty("output");
+  ex.output.vtk = output.boolean("vtk", true);
+  ex.output.obj = output.boolean("obj", true);
+  ex.output.every = output.integer("every", 1, 1, 1000000);
+  output.finish();
 }
 
 void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
@@ -705,8 +718,9 @@ void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& e
 
 Experiment read_experiment(const json& document, const std::filesystem::path& folder,
                            const std::string& label) {
-  Fields root(document, "", label);
   Experiment ex;
+  ex.document = document;
+  Fields root(document, "", label, &ex.resolved);
   ex.name = root.string("name", "experiment");
   if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
     root.fail("name", "expected " + problem);

@@ -51,6 +51,11 @@ struct Experiment {
   std::string name;
   std::string description;
   std::filesystem::path source;  // the JSON file ("" for a document built in a program)
+  // The document as read, and as the reader understood it: every default
+  // filled in, file paths absolute, each variant whole (experiment.json and
+  // experiment.resolved.json in the output folder; reading the resolved one
+  // gives the same experiment).
+  nlohmann::json document, resolved;
 
   // As parsed (read_experiment), and as built (build_experiment):
   std::vector<CaseSpec> specs;  // Simulate: one, or one per variant

@@ -26,12 +26,22 @@ inline std::string excerpt(const nlohmann::json& value) {
 }
 
 // Reads the fields of one JSON object, naming "file: path.to.field" in every
-// error, and rejects fields nobody asked for.
+// error, and rejects fields nobody asked for. With a `resolved` document it
+// also writes there every value it returns, defaults included: the object as
+// the reader understood it (an experiment's experiment.resolved.json).
 class Fields {
  public:
-  Fields(const nlohmann::json& object, std::string path, std::string file)
-      : object_(object), path_(std::move(path)), file_(std::move(file)) {
+  Fields(const nlohmann::json& object, std::string path, std::string file,
+         nlohmann::json* resolved = nullptr)
+      : object_(object), path_(std::move(path)), file_(std::move(file)), resolved_(resolved) {
     if (!object_.is_object()) fail("", "expected an object");
+    if (resolved_ != nullptr && !resolved_->is_object()) *resolved_ = nlohmann::json::object();
+  }
+
+  // Replaces what the resolved document says of `key` (e.g. a file's path,
+  // made absolute).
+  void resolve(const std::string& key, const nlohmann::json& value) {
+    if (resolved_ != nullptr) (*resolved_)[key] = value;
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
@@ -43,12 +53,36 @@ class Fields {
   }
   bool has(const std::string& key) const { return object_.contains(key); }
 
+  // A value as given (recorded as given unless a typed read records it).
   const nlohmann::json& raw(const std::string& key) {
     seen_.insert(key);
     if (!has(key)) fail(key, "missing (required)");
+    if (resolved_ != nullptr && !resolved_->contains(key)) (*resolved_)[key] = object_.at(key);
     return object_.at(key);
   }
-  Fields object(const std::string& key) { return Fields(raw(key), name(key), file_); }
+  Fields object(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    nlohmann::json* child = nullptr;
+    if (resolved_ != nullptr) {
+      child = &(*resolved_)[key];
+      *child = nlohmann::json::object();
+    }
+    return Fields(v, name(key), file_, child);
+  }
+
+  // An optional section: the object, or an empty one whose defaults are then
+  // read (and resolved) like the given fields.
+  Fields object_or_empty(const std::string& key) {
+    static const nlohmann::json kEmpty = nlohmann::json::object();
+    if (has(key)) return object(key);
+    seen_.insert(key);
+    nlohmann::json* child = nullptr;
+    if (resolved_ != nullptr) {
+      child = &(*resolved_)[key];
+      *child = nlohmann::json::object();
+    }
+    return Fields(kEmpty, name(key), file_, child);
+  }
 
   double number(const std::string& key) {
     const nlohmann::json& v = raw(key);
@@ -58,7 +92,7 @@ class Fields {
     return x;
   }
   double number(const std::string& key, double fallback) {
-    return has(key) ? number(key) : (seen_.insert(key), fallback);
+    return has(key) ? number(key) : (seen_.insert(key), record(key, fallback));
   }
   double positive(const std::string& key, double fallback) {
     const double x = number(key, fallback);
@@ -71,7 +105,9 @@ class Fields {
     return x;
   }
   int integer(const std::string& key, int fallback, int min, int max) {
-    if (!has(key)) return seen_.insert(key), fallback;
+    // A fallback outside [min, max] stands for "not given" (step 0: the last): not written out.
+    if (!has(key))
+      return seen_.insert(key), fallback < min || fallback > max ? fallback : record(key, fallback);
     const nlohmann::json& v = raw(key);
     const std::string range =
         "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
@@ -80,7 +116,7 @@ class Fields {
     return static_cast<int>(v.get<long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
-    if (!has(key)) return seen_.insert(key), fallback;
+    if (!has(key)) return seen_.insert(key), record(key, fallback);
     const nlohmann::json& v = raw(key);
     if (!v.is_boolean()) fail(key, "expected true or false, got " + excerpt(v));
     return v.get<bool>();
@@ -91,7 +127,7 @@ class Fields {
     return v.get<std::string>();
   }
   std::string string(const std::string& key, const std::string& fallback) {
-    return has(key) ? string(key) : (seen_.insert(key), fallback);
+    return has(key) ? string(key) : (seen_.insert(key), record(key, fallback));
   }
   std::string choice(const std::string& key, const std::string& fallback,
                      const std::vector<std::string>& allowed) {
@@ -145,11 +181,18 @@ class Fields {
   }
   std::vector<Fields> objects(const std::string& key) {
     std::vector<Fields> out;
-    if (!has(key)) return seen_.insert(key), out;
+    if (!has(key)) return seen_.insert(key), record(key, nlohmann::json::array()), out;
     const nlohmann::json& v = raw(key);
     if (!v.is_array()) fail(key, "expected a list of objects");
+    nlohmann::json* list = nullptr;
+    if (resolved_ != nullptr) {  // sized first: its elements' addresses then stay put
+      list = &(*resolved_)[key];
+      *list = nlohmann::json::array();
+      for (size_t k = 0; k < v.size(); ++k) list->push_back(nlohmann::json::object());
+    }
     for (size_t k = 0; k < v.size(); ++k)
-      out.emplace_back(v[k], name(key) + "[" + std::to_string(k) + "]", file_);
+      out.emplace_back(v[k], name(key) + "[" + std::to_string(k) + "]", file_,
+                       list != nullptr ? &(*list)[k] : nullptr);
     return out;
   }
 
@@ -176,6 +219,12 @@ class Fields {
     return x >= min && x <= max;
   }
   std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }
+  // Writes a default into the resolved document; returns it.
+  template <class T>
+  T record(const std::string& key, T value) {
+    if (resolved_ != nullptr) (*resolved_)[key] = value;
+    return value;
+  }
   static std::string join(const std::vector<std::string>& words) {
     std::string out;
     for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
@@ -185,6 +234,7 @@ class Fields {
   const nlohmann::json& object_;
   std::string path_, file_;
   std::set<std::string> seen_;
+  nlohmann::json* resolved_ = nullptr;  // not owned; null: nothing recorded
 };
 
 }  // namespace fiberfluid::experiment

@@ -579,6 +579,7 @@ void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& mo
   }
   geom::write_text_file(staging_ / "summary.json",
                         summary_json(experiment_, result).dump(2) + "\n");
+  write_experiment_files();
   if (more) more(staging_);
 
   if (result.runs_succeeded() && result.failure.empty()) {
@@ -590,6 +591,24 @@ void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& mo
     if (!run.summary.success)
       why += (run.variant.empty() ? "" : run.variant + ": ") + run.summary.message + "\n";
   set_aside("FAILED", "failed", "this run failed", why);
+}
+
+// The experiment as read (experiment.json) and as resolved
+// (experiment.resolved.json: `fiberfluid run` on it repeats this run). A
+// surface that a program gave is written beside them (input_surface.obj,
+// 17 digits), and the resolved file reads it from there.
+void OutputWriter::write_experiment_files() const {
+  if (experiment_.document.is_null()) return;  // built without a document
+  geom::write_text_file(staging_ / "experiment.json", experiment_.document.dump(2) + "\n");
+  nlohmann::json resolved = experiment_.resolved;
+  const bool given_surface = experiment_.kind == Experiment::Kind::Simulate &&
+                             !experiment_.cases.empty() && !resolved.contains("surface") &&
+                             !resolved.contains("variants");
+  if (given_surface) {
+    geom::write_obj(staging_ / "input_surface.obj", experiment_.cases.front().input_surface);
+    resolved["surface"] = {{"file", "input_surface.obj"}};
+  }
+  geom::write_text_file(staging_ / "experiment.resolved.json", resolved.dump(2) + "\n");
 }
 
 void OutputWriter::keep_interrupted(const std::string& why, const FolderFiller& more) {

@@ -88,7 +88,8 @@ class OutputWriter {
   void write_state(size_t run, int step, const Eigen::VectorXd& unknowns);
   // fem_reference_series.pvd: a nonlinear FEM's boundary after each load step.
   void write_fem_path(const FemReferenceResult& f);
-  void write_fibers() const;  // fibers.vtu: the kept or pruned fibers, if asked
+  void write_fibers() const;            // fibers.vtu: the kept or pruned fibers, if asked
+  void write_experiment_files() const;  // experiment.json and experiment.resolved.json
   void set_aside(const char* mark, const char* suffix, const std::string& what,
                  const std::string& why);
   void place(const std::filesystem::path& where);

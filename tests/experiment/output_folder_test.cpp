@@ -16,6 +16,7 @@
 #include "experiment/experiment.hpp"
 #include "experiment/outputs.hpp"
 #include "experiment/runner.hpp"
+#include "geom/generators.hpp"
 #include "test_support.hpp"
 #include "util/error.hpp"
 #include "util/run_control.hpp"
@@ -250,6 +251,79 @@ TEST(Threads, AnExceptionInAnOpenMPLoopIsRethrownAfterIt) {
   EXPECT_EQ(error_of([&] { failure.rethrow_if_any(); }), "item 7 failed");
   ThreadFailure none;
   EXPECT_NO_THROW(none.rethrow_if_any());
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+namespace {
+
+// Runs an experiment into DIR and returns DIR.
+fs::path run_into(const Experiment& ex, const fs::path& folder) {
+  OutputWriter writer(ex, folder);
+  writer.begin();
+  writer.finish(run_experiment(ex));
+  return folder;
+}
+
+// The output folder keeps the experiment as read and as resolved; running
+// the resolved one repeats the run bit for bit (every file but those that
+// hold wall times, whose figures are compared): a plain run, a Newton sweep
+// of variants, and a surface a program gave.
+TEST(OutputFolder, TheResolvedExperimentRepeatsTheRunBitForBit) {
+  ScratchDir dir;
+  for (const char* name : {"sphere.json", "round_trip.json"}) {
+    SCOPED_TRACE(name);
+    const Experiment first = load_experiment(testing::experiment_file(name));
+    const fs::path a = run_into(first, dir.path() / (std::string("a_") + name));
+    EXPECT_EQ(nlohmann::json::parse(read_text(a / "experiment.json")), first.document);
+    const Experiment again = load_experiment(a / "experiment.resolved.json");
+    EXPECT_EQ(again.resolved, first.resolved);  // resolving is idempotent
+    const fs::path b = run_into(again, dir.path() / (std::string("b_") + name));
+    for (const auto& entry : fs::recursive_directory_iterator(a)) {
+      const std::string file = entry.path().filename().string();
+      if (!entry.is_regular_file() || file == "summary.json" || file == kOutputMarker ||
+          file == "steps.csv" || file == "comparison.csv" ||  // these hold the wall time
+          file == "experiment.json")  // b's is a's resolved one
+        continue;
+      const fs::path other = b / fs::relative(entry.path(), a);
+      EXPECT_EQ(read_text(entry.path()), read_text(other)) << other;
+    }
+    const auto figures = [](const fs::path& folder) {
+      return nlohmann::json::parse(read_text(folder / "summary.json"))["figures"];
+    };
+    EXPECT_EQ(figures(a), figures(b));
+  }
+  // A program's surface is written beside the resolved file, which reads it.
+  nlohmann::json given = small_config();
+  const geom::Surface ball = geom::icosphere(1, 1.0);
+  given.erase("surface");
+  Experiment program = read_experiment(given, ".", "program");
+  build_experiment(program, &ball);
+  const fs::path c = run_into(program, dir.path() / "c");
+  EXPECT_TRUE(fs::exists(c / "input_surface.obj"));
+  const Experiment reread = load_experiment(c / "experiment.resolved.json");
+  const fs::path d = run_into(reread, dir.path() / "d");
+  EXPECT_EQ(read_text(c / "vertices.csv"), read_text(d / "vertices.csv"));
+}
+
+// Every shipped experiment resolves: reading its resolved form gives the
+// same resolved form (the defaults written out are read back as such).
+TEST(OutputFolder, EveryShippedExperimentResolvesToItself) {
+  int resolved = 0;
+  for (const auto& entry : fs::directory_iterator(testing::experiment_file("").parent_path())) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().filename().string());
+    std::ifstream in(entry.path());
+    nlohmann::json document = parse_json(in, entry.path().string());
+    if (!document.contains("name")) document["name"] = entry.path().stem().string();
+    const Experiment ex = read_experiment(document, entry.path().parent_path(), "shipped");
+    const Experiment again = read_experiment(ex.resolved, ".", "resolved");
+    EXPECT_EQ(again.resolved, ex.resolved);
+    ++resolved;
+  }
+  EXPECT_GT(resolved, 20);
 }
 
 }  // namespace
