@@ -13,8 +13,10 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <thread>
 
+#include "experiment/build_info.hpp"
 #include "experiment/compare.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/fitting.hpp"
@@ -462,9 +464,36 @@ void add_resource_limits(CLI::App* command, RunFlags& flags) {
 
 }  // namespace
 
+// `--version`: the version, then what the build is made of.
+std::string version_text() {
+  std::ostringstream out;
+  out << "fiberfluid " << fiberfluid::experiment::program_version() << "\n";
+  for (const auto& [name, value] : fiberfluid::experiment::build_info())
+    if (name != "version") out << "  " << name << ": " << value << "\n";
+  std::string text = out.str();
+  text.pop_back();  // CLI11 ends the line
+  return text;
+}
+
+// A first word that is no subcommand ("runn"): named, with the valid ones
+// (CLI11 alone would say only that a subcommand is required).
+bool unknown_subcommand(const CLI::App& cli, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return false;
+  const std::string word = argv[1];
+  std::string known;
+  for (const CLI::App* sub : cli.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->get_name() == word) return false;
+    known += (known.empty() ? "" : ", ") + sub->get_name();
+  }
+  std::cerr << "error: unknown command '" << word << "' (expected one of: " << known
+            << "; fiberfluid --help lists them)\n";
+  return true;
+}
+
 int main(int argc, char** argv) {
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);
+  cli.set_version_flag("--version", version_text());
 
   std::string experiment, mesh;
   RunFlags flags;
@@ -511,9 +540,12 @@ int main(int argc, char** argv) {
                       "The undeformed surface M0 (same vertices as both): adds E_n and E_i");
   compare->add_flag("--json", as_json, "Print JSON instead of text");
 
+  if (unknown_subcommand(cli, argc, argv)) return kUsage;
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return cli.exit(e);
   } catch (const CLI::ParseError& e) {
     // One status for every usage mistake (sysexits' EX_USAGE), distinct from bad input files.

@@ -530,12 +530,14 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
   c.surface_key = (root.has("surface") ? root.raw("surface").dump() : std::string()) + "|" +
                   (root.has("fibers") ? root.raw("fibers").dump() : std::string());
   c.material = read_material(root.object("material"));
+  if (warnings != nullptr && !root.raw("material").contains("gamma"))
+    warnings->push_back(root.file() + ": " + root.name("material.gamma") +
+                        ": not given, so 0 (no surface tension on the mesh edges)");
   c.loads = read_loads(root);
   c.constraints = read_constraints(root);
   c.paddles = read_paddles(root);
   c.paddles_field = {root.file(), root.name("paddles")};
-  c.stepping =
-      root.has("stepping") ? read_stepping(root.object("stepping"), {}) : solve::SteppingOptions{};
+  c.stepping = read_stepping(root.object_or_empty("stepping"), {});
   if (!c.paddles.empty() && c.stepping.scheme != solve::Scheme::Newton)
     root.fail("paddles",
               "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "

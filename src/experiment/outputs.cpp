@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "experiment/build_info.hpp"
 #include "experiment/output_folder.hpp"
 #include "fem/mesh_tools.hpp"
 #include "geom/area_vectors.hpp"
@@ -68,6 +69,8 @@ json law_json(const model::Material& material, int dim) {
   for (const model::LawModel::Setting& s : law.settings())
     out[s.name] = s.scalar && s.values.size() == 1 ? json(s.values[0]) : json(s.values);
   out["axis_factors"] = vector_json(material.axis_factors, dim);
+  out["gamma"] = material.surface_tension;
+  out["kinematics"] = model::kinematics_name(material.kinematics);
   return out;
 }
 
@@ -225,7 +228,10 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   doc["experiment"] = ex.name;
   doc["description"] = ex.description;
   doc["source"] = ex.source.string();
-  doc["fiberfluid_version"] = FIBERFLUID_VERSION;
+  doc["fiberfluid_version"] = program_version();
+  json build = json::object();
+  for (const auto& [name, value] : build_info()) build[name] = value;
+  doc["build"] = build;
   doc["kind"] = ex.kind == Experiment::Kind::Areas       ? "areas"
                 : ex.kind == Experiment::Kind::Benchmark ? "benchmark"
                                                          : "simulate";

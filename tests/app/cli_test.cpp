@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_support.hpp"
+#include "experiment/build_info.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
@@ -291,15 +292,28 @@ TEST(Cli, LongPhasesShowProgressUnlessQuiet) {
   EXPECT_EQ(o.output.find("step "), std::string::npos) << o.output;
 }
 
+// --version names the version and what the build's solvers are made of.
+TEST(Cli, VersionSaysWhatTheBuildIs) {
+  const Outcome o = run_cli("--version");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_EQ(o.output.rfind("fiberfluid " + experiment::program_version() + "\n", 0), 0u)
+      << o.output;
+  for (const char* part :
+       {"compiler: ", "lapack: ", "suitesparse: ", "cgal: ", "ceres: ", "nlopt: "})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
+}
+
 TEST(Cli, UsageErrors) {
   // Status 64 and CLI11's message, not just any failure (a missing binary exits 127).
   const struct {
     const char* arguments;
     const char* message;
-  } cases[] = {{"", "A subcommand is required"},
-               {"run", "experiment is required"},
-               {"frobnicate", "A subcommand is required"},
-               {"run x.json -j -3", "--jobs"}};
+  } cases[] = {
+      {"", "A subcommand is required"},
+      {"run", "experiment is required"},
+      {"frobnicate", "unknown command 'frobnicate' (expected one of: run, fit, check, compare"},
+      {"runn x.json", "unknown command 'runn'"},
+      {"run x.json -j -3", "--jobs"}};
   for (const auto& c : cases) {
     const Outcome o = run_cli(c.arguments);
     EXPECT_EQ(o.status, 64) << c.arguments << "\n" << o.output;

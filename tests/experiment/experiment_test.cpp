@@ -359,6 +359,20 @@ TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
   expect_config_error(dir, c, "fibers.kinematics");
 }
 
+// A material without gamma has no surface tension, and the reader says so.
+TEST(ExperimentConfig, AMissingGammaIsAWarningNamingItsDefault) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  EXPECT_TRUE(load_experiment(write_config(dir, c)).warnings.empty());
+  c["material"].erase("gamma");
+  const Experiment ex = load_experiment(write_config(dir, c));
+  ASSERT_EQ(ex.warnings.size(), 1u);
+  EXPECT_NE(ex.warnings[0].find("material.gamma: not given, so 0 (no surface tension"),
+            std::string::npos)
+      << ex.warnings[0];
+  EXPECT_EQ(ex.cases[0].model.material.surface_tension, 0.0);
+}
+
 // supports[].layer: "mirror" gives a clamp on a plane the fibers that reach
 // across it (model::MirrorLayer), as deep as the horizon; a clamp it cannot
 // mirror is named.

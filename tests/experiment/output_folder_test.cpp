@@ -285,7 +285,7 @@ TEST(OutputFolder, TheResolvedExperimentRepeatsTheRunBitForBit) {
       const std::string file = entry.path().filename().string();
       if (!entry.is_regular_file() || file == "summary.json" || file == kOutputMarker ||
           file == "steps.csv" || file == "comparison.csv" ||  // these hold the wall time
-          file == "experiment.json")  // b's is a's resolved one
+          file == "experiment.json")                          // b's is a's resolved one
         continue;
       const fs::path other = b / fs::relative(entry.path(), a);
       EXPECT_EQ(read_text(entry.path()), read_text(other)) << other;
@@ -295,6 +295,13 @@ TEST(OutputFolder, TheResolvedExperimentRepeatsTheRunBitForBit) {
     };
     EXPECT_EQ(figures(a), figures(b));
   }
+  // summary.json says what made the run: the whole material and the build.
+  const nlohmann::json summary =
+      nlohmann::json::parse(read_text(dir.path() / "a_sphere.json" / "summary.json"));
+  EXPECT_EQ(summary["runs"][0]["material"]["gamma"], 3000.0);
+  EXPECT_EQ(summary["runs"][0]["material"]["kinematics"], "vector");
+  EXPECT_EQ(summary["build"]["version"], summary["fiberfluid_version"]);
+  EXPECT_NE(summary["build"]["lapack"], "");
   // A program's surface is written beside the resolved file, which reads it.
   nlohmann::json given = small_config();
   const geom::Surface ball = geom::icosphere(1, 1.0);

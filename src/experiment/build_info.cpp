@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/build_info.hpp"
+
+#include <CGAL/version.h>
+#include <SuiteSparse_config.h>
+#include <nlopt.h>
+#include <omp.h>
+
+#include <ceres/version.h>
+#include <Eigen/Core>
+
+namespace fiberfluid::experiment {
+
+namespace {
+
+std::string dotted(int major, int minor, int patch) {
+  return std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(patch);
+}
+
+}  // namespace
+
+std::string program_version() { return FIBERFLUID_VERSION; }
+
+std::vector<std::pair<std::string, std::string>> build_info() {
+  int nlopt_major = 0, nlopt_minor = 0, nlopt_patch = 0;
+  nlopt_version(&nlopt_major, &nlopt_minor, &nlopt_patch);
+  return {
+      {"version", FIBERFLUID_VERSION},
+      {"compiler", FIBERFLUID_COMPILER},
+      {"build_type", FIBERFLUID_BUILD_TYPE},
+      {"sanitizers", FIBERFLUID_SANITIZERS},
+      {"openmp_threads", std::to_string(omp_get_max_threads())},
+      {"lapack", FIBERFLUID_LAPACK},
+      {"suitesparse",
+       dotted(SUITESPARSE_MAIN_VERSION, SUITESPARSE_SUB_VERSION, SUITESPARSE_SUBSUB_VERSION) +
+           " (CHOLMOD, UMFPACK)"},
+      {"eigen", dotted(EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION)},
+      {"cgal", CGAL_VERSION_STR},
+      {"ceres", CERES_VERSION_STRING},
+      {"nlopt", dotted(nlopt_major, nlopt_minor, nlopt_patch)},
+  };
+}
+
+}  // namespace fiberfluid::experiment
