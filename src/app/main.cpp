@@ -418,6 +418,7 @@ int compare_command(const std::string& reference, const std::string& approximati
   const experiment::Comparison c = experiment::compare_files(
       reference, approximation,
       undeformed.empty() ? std::nullopt : std::optional<std::filesystem::path>(undeformed));
+  for (const std::string& w : c.warnings) std::cerr << "warning: " << w << "\n";
   if (as_json)
     std::cout << experiment::comparison_json(c).dump(2) << "\n";
   else

@@ -9,6 +9,29 @@
 
 namespace fiberfluid::experiment {
 
+namespace {
+
+double diagonal(const geom::Surface& s) {
+  return s.num_vertices() == 0 ? 0.0 : (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).norm();
+}
+
+// A scan in mm beside a model in m gives metrics that mean nothing: say so.
+void warn_of_scale_mismatch(const geom::Surface& a, const geom::Surface& b,
+                            const std::string& a_label, const std::string& b_label, Comparison& c) {
+  const double size_a = diagonal(a), size_b = diagonal(b);
+  if (!(size_a > 0.0 && size_b > 0.0)) return;
+  const double ratio = std::max(size_a, size_b) / std::min(size_a, size_b);
+  if (ratio <= kScaleMismatch) return;
+  std::ostringstream out;
+  out.precision(3);
+  out << b_label << " is " << ratio << " times " << (size_b > size_a ? "larger" : "smaller")
+      << " than " << a_label << " (bounding-box diagonals " << size_b << " and " << size_a
+      << "): are they in the same units?";
+  c.warnings.push_back(out.str());
+}
+
+}  // namespace
+
 Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface& approximation,
                             const geom::Surface* undeformed, const std::string& reference_label,
                             const std::string& approximation_label,
@@ -20,6 +43,9 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
   c.dim = reference.dim;
   metrics::require_representable(reference, reference_label);
   metrics::require_representable(approximation, approximation_label);
+  warn_of_scale_mismatch(reference, approximation, reference_label, approximation_label, c);
+  if (undeformed)
+    warn_of_scale_mismatch(reference, *undeformed, reference_label, undeformed_label, c);
   try {
     c.surface_error =
         metrics::surface_error(reference, approximation, reference_label, approximation_label);
@@ -122,6 +148,7 @@ nlohmann::json comparison_json(const Comparison& c) {
                      {"length", d.length},
                      {"standard_deviation_share", d.share(d.standard_deviation)}};
   }
+  j["warnings"] = c.warnings;
   return j;
 }
 

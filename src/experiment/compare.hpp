@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "fit/target.hpp"
 #include "geom/surface.hpp"
@@ -28,7 +29,13 @@ struct Comparison {
   std::optional<double> interior_error;  // E_i, over the surface nodes weighted by |S_i|
   // 3D: each vertex of M' to the surface of M.
   std::optional<fit::DistanceStatistics> distances;
+  // Sizes that differ by more than kScaleMismatch (the bounding boxes'
+  // diagonals): likely another unit (a scan in mm, a model in m).
+  std::vector<std::string> warnings;
 };
+
+// Two surfaces whose sizes differ by more than this factor are warned about.
+constexpr double kScaleMismatch = 3.0;
 
 // Compares two surfaces (M the reference, M' the approximation; M0 the
 // undeformed one, optional). The labels name them in errors. In 3D, M and M'

@@ -378,5 +378,30 @@ TEST(Cli, CompareGivesTheMetricsAsTextAndJson) {
   EXPECT_NE(flat.output.find("b.obj"), std::string::npos) << flat.output;
 }
 
+// A scan in other units than the model (25 times larger: cm against mm, or
+// an M0 of another scale) gives metrics that mean nothing: compare says so.
+TEST(Cli, CompareWarnsOfSurfacesOfDifferentSizes) {
+  ScratchDir dir;
+  geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  const std::filesystem::path m = dir.path() / "m.obj", big = dir.path() / "big.obj";
+  geom::write_obj(m, cube);
+  cube.V *= 25.0;
+  geom::write_obj(big, cube);
+  const Outcome text = run_cli("compare " + m.string() + " " + big.string());
+  EXPECT_EQ(text.status, 0) << text.output;
+  EXPECT_NE(text.output.find("warning: " + big.string() + " is 25 times larger than " + m.string()),
+            std::string::npos)
+      << text.output;
+  const Outcome with_m0 = run_cli("compare " + m.string() + " " + m.string() + " --reference " +
+                                  big.string() + " --json");
+  ASSERT_EQ(with_m0.status, 0) << with_m0.output;
+  const nlohmann::json j = nlohmann::json::parse(with_m0.output.substr(with_m0.output.find('{')));
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("same units"), std::string::npos);
+  // Surfaces of one size: no warning.
+  const Outcome same = run_cli("compare " + m.string() + " " + m.string() + " --json");
+  EXPECT_TRUE(nlohmann::json::parse(same.output.substr(same.output.find('{')))["warnings"].empty());
+}
+
 }  // namespace
 }  // namespace fiberfluid
