@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/experiment.hpp"
 
+#include "experiment/figures.hpp"
 #include "experiment/json_fields.hpp"
 #include "experiment/output_folder.hpp"
 
@@ -716,6 +717,14 @@ void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& e
   if (ex.area_specs.empty()) root.fail("surfaces", "expected at least one surface");
 }
 
+// Every expected figure names a figure the experiment will have.
+void check_expected_names(const Fields& root, const Experiment& ex) {
+  for (size_t k = 0; k < ex.expected.size(); ++k) {
+    const std::string problem = figure_problem(ex, ex.expected[k].figure);
+    if (!problem.empty()) root.fail("expected[" + std::to_string(k) + "].figure", problem);
+  }
+}
+
 }  // namespace
 
 Experiment read_experiment(const json& document, const std::filesystem::path& folder,
@@ -757,6 +766,7 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
     read_areas(root, folder, ex);
     root.finish();
   }
+  check_expected_names(root, ex);
   return ex;
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "experiment/figures.hpp"
 #include "geom/area_vectors.hpp"
 #include "model/assembly.hpp"
 #include "model/boundary_conditions.hpp"
@@ -17,12 +18,6 @@
 
 namespace fiberfluid::experiment {
 namespace {
-
-const char* kRunFigures[] = {"max_displacement",       "final_pressure",
-                             "final_volume",           "initial_volume",
-                             "volume_change_relative", "mean_displacement_over_diagonal",
-                             "surface_area",           "steps",
-                             "factorizations"};
 
 // "position.12.y" -> (12, 1); nothing when the form does not match.
 std::optional<std::pair<int, int>> vertex_axis(const std::string& rest, int dim) {
@@ -286,7 +281,7 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
       const RunResult& run = result.runs[r];
       const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
       if (run.summary.success)
-        for (const char* name : kRunFigures)
+        for (const std::string& name : run_figure_names())
           result.figures[prefix + name] = *run_figure(ex.cases[r], run, name);
     }
   }

@@ -359,6 +359,37 @@ TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
   expect_config_error(dir, c, "fibers.kinematics");
 }
 
+// An expected figure is checked against the experiment's own figures when
+// the file is read: a misspelt name fails before the run, listing the names.
+TEST(ExperimentConfig, AnUnknownExpectedFigureIsAnErrorWhenTheFileIsRead) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["expected"] = {{{"figure", "max_displacement"}, {"at_most", 1.0}},
+                   {{"figure", "position.3.z"}, {"at_most", 1.0}},
+                   {{"figure", "fibers.kept"}, {"at_least", 1.0}}};
+  EXPECT_NO_THROW(load_experiment(write_config(dir, c)));
+  c["expected"][0]["figure"] = "max_displacment";
+  expect_config_error(dir, c,
+                      "expected[0].figure: no figure \"max_displacment\" in this experiment "
+                      "(expected one of fibers.in_all, fibers.kept, fibers.pruned, "
+                      "max_displacement, final_pressure");
+  c["expected"][0]["figure"] = "position.3.q";
+  expect_config_error(dir, c, "expected[0].figure: no figure \"position.3.q\"");
+  c["expected"][0]["figure"] = "paddle_force.top";  // no such paddle
+  expect_config_error(dir, c, "expected[0].figure: no figure \"paddle_force.top\"");
+  c["expected"][0]["figure"] = "fit.Y";  // no fit section
+  expect_config_error(dir, c, "expected[0].figure: no figure \"fit.Y\"");
+  // A sweep's figures carry their variant's name.
+  c["variants"] = {{{"name", "soft"}, {"material", {{"Y", 50000}}}},
+                   {{"name", "stiff"}, {"material", {{"Y", 200000}}}}};
+  c["expected"] = {{{"figure", "stiff.max_displacement"}, {"at_most", 1.0}}};
+  EXPECT_NO_THROW(load_experiment(write_config(dir, c)));
+  c["expected"][0]["figure"] = "max_displacement";  // which variant?
+  expect_config_error(dir, c, "soft.max_displacement, soft.final_pressure");
+  c["expected"][0]["figure"] = "hard.max_displacement";
+  expect_config_error(dir, c, "expected[0].figure: no figure \"hard.max_displacement\"");
+}
+
 // A material without gamma has no surface tension, and the reader says so.
 TEST(ExperimentConfig, AMissingGammaIsAWarningNamingItsDefault) {
   ScratchDir dir;

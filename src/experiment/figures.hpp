@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The figures an experiment's results hold, by name: what summary.json lists
+// under "figures" and what "expected" may check (README, "Figures"). An
+// expected figure is checked against this catalogue when the file is read,
+// so a misspelt name is an error before the run, not a silent miss after it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace fiberfluid::experiment {
+
+struct Experiment;
+
+// The figures of one run, computed from its final state (runner.cpp): the
+// names every run gives, in summary.json's order.
+const std::vector<std::string>& run_figure_names();
+
+// "" when `figure` names a figure this experiment will have; else why not,
+// with the valid names. Benchmarks name their figures after their solvers and
+// metrics: those are checked after the run only.
+std::string figure_problem(const Experiment& experiment, const std::string& figure);
+
+}  // namespace fiberfluid::experiment
