@@ -96,6 +96,15 @@ const std::vector<std::string>& run_figure_names() {
   return names;
 }
 
+std::vector<std::string> run_figure_names(const model::Model& model) {
+  std::vector<std::string> names = run_figure_names();
+  for (const model::Paddle& p : model.paddles) {
+    names.push_back("paddle_force." + p.label);
+    names.push_back("paddle_contacts." + p.label);
+  }
+  return names;
+}
+
 std::string figure_problem(const Experiment& ex, const std::string& figure) {
   std::vector<std::string> valid;
   switch (ex.kind) {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "model/model.hpp"
+
 namespace fiberfluid::experiment {
 
 struct Experiment;
@@ -15,6 +17,8 @@ struct Experiment;
 // The figures of one run, computed from its final state (runner.cpp): the
 // names every run gives, in summary.json's order.
 const std::vector<std::string>& run_figure_names();
+// Those and, for a model with paddles, each paddle's final force and contacts.
+std::vector<std::string> run_figure_names(const model::Model& model);
 
 // "" when `figure` names a figure this experiment will have; else why not,
 // with the valid names. Benchmarks name their figures after their solvers and

@@ -412,6 +412,11 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
   for (size_t g = 0; g < groups; ++g)
     for (int a = 0; a < first.dim(); ++a)
       t.header("reaction_" + group_name(first, g) + "_" + kAxes[a] + "_N");
+  // Paddles at the end (those of the first case, by label): force along the axis, contacts.
+  for (const model::Paddle& p : first.paddles) {
+    t.header("paddle_" + p.label + "_force_N");
+    t.header("paddle_" + p.label + "_contacts");
+  }
   t.header("seconds");
   t.header("message");
   t.header("patch");
@@ -434,6 +439,14 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
       for (int a = 0; a < first.dim(); ++a) {
         if (s.success && same_groups && !s.steps.empty())
           t.number(s.steps.back().reactions[g][a]);
+        else
+          t.text("");
+      }
+    for (const model::Paddle& p : first.paddles)
+      for (const std::string what : {"paddle_force.", "paddle_contacts."}) {
+        const auto value = result.figures.find(run.variant + "." + what + p.label);
+        if (value != result.figures.end())
+          t.number(value->second);
         else
           t.text("");
       }

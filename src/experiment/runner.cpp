@@ -281,8 +281,9 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
       const RunResult& run = result.runs[r];
       const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
       if (run.summary.success)
-        for (const std::string& name : run_figure_names())
-          result.figures[prefix + name] = *run_figure(ex.cases[r], run, name);
+        for (const std::string& name : run_figure_names(ex.cases[r].model))
+          if (const std::optional<double> value = run_figure(ex.cases[r], run, name))
+            result.figures[prefix + name] = *value;
     }
   }
   result.checks = check_expected(ex, result);

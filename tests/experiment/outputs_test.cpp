@@ -183,6 +183,44 @@ TEST(Outputs, CsvTablesOpenAsTables) {
   EXPECT_EQ(summary["runs"][0]["steps"][2]["reactions"]["top"].size(), 3u);
 }
 
+// A paddle's final force and contacts are figures of every run, and columns
+// of a sweep's comparison.csv.
+TEST(Outputs, APaddleSweepListsEachPaddlesForceAndContacts) {
+  ScratchDir dir;
+  json c = small_config();
+  c["supports"] = {{{"where", "z <= -0.04"}, {"label", "base"}}};
+  c["loads"] = json::array();
+  c["paddles"] = {{{"label", "press"}, {"axis", "z"}, {"side", "above"}, {"compression", 0.05}}};
+  c["stepping"] = {{"scheme", "newton"}, {"steps", 2}};
+  c["variants"] = {{{"name", "soft"}}, {{"name", "stiff"}, {"material", {{"Y", 40000}}}}};
+  const Experiment ex = parse(c);
+  const ExperimentResult result = run_experiment(ex);
+  ASSERT_TRUE(result.runs_succeeded());
+  for (const char* v : {"soft", "stiff"}) {
+    const double force = result.figures.at(std::string(v) + ".paddle_force.press");
+    EXPECT_LT(force, 0.0) << v;  // the paddle pushes the body down
+    EXPECT_GT(result.figures.at(std::string(v) + ".paddle_contacts.press"), 0.0) << v;
+    // The base holds what the paddle pushes.
+    const solve::StepRecord& last = result.runs[v[1] == 'o' ? 0 : 1].summary.steps.back();
+    EXPECT_NEAR(last.reactions[0][2] + force, 0.0, 1e-8 * std::abs(force)) << v;
+  }
+  EXPECT_NEAR(
+      result.figures.at("stiff.paddle_force.press") / result.figures.at("soft.paddle_force.press"),
+      2.0, 0.2);  // twice the modulus, about twice the force
+  {
+    OutputWriter writer(ex, dir.path() / "out");
+    writer.begin();
+    writer.finish(result);
+  }
+  const auto comparison = read_csv(dir.path() / "out" / "comparison.csv");
+  const auto& header = comparison[0];
+  const auto column = std::find(header.begin(), header.end(), "paddle_press_force_N");
+  ASSERT_NE(column, header.end());
+  EXPECT_EQ(*(column + 1), "paddle_press_contacts");
+  const size_t k = static_cast<size_t>(column - header.begin());
+  EXPECT_EQ(std::stod(comparison[1][k]), result.figures.at("soft.paddle_force.press"));
+}
+
 TEST(Outputs, AFailedRunIsKeptApartAndTheLastResultStays) {
   ScratchDir dir;
   const std::filesystem::path out = dir.path() / "out";
