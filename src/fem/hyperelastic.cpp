@@ -154,8 +154,9 @@ solve::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::V
 }
 
 LoadState interpolate(const LoadState& a, const LoadState& b, double s) {
-  LoadState out = b;
+  LoadState out;  // built, not copied then overwritten (GCC 12 warned of a use after free)
   out.forces = (1.0 - s) * a.forces + s * b.forces;
+  out.held = b.held;
   for (size_t k = 0; k < out.held.values.size(); ++k)
     out.held.values[k] = (1.0 - s) * a.held.values[k] + s * b.held.values[k];
   return out;
