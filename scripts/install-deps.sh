@@ -8,8 +8,10 @@ packages=(
   libeigen3-dev libopenblas-dev liblapack-dev libsuitesparse-dev libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev
   libceres-dev libnlopt-dev                  # calibration (src/fit)
+  zlib1g-dev                                 # compressed VTK output
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
   python3-dev pybind11-dev python3-pytest    # the Python module and its tests
+  python3-meshio                             # an independent reader of the .vtu files (tests)
   clang libclang-rt-14-dev libomp-dev        # the libFuzzer targets (scripts/fuzz.sh)
 )
 

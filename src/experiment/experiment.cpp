@@ -703,6 +703,7 @@ void read_simulation(Fields& root, const nlohmann::json& document,
   ex.output.vtk = output.boolean("vtk", true);
   ex.output.obj = output.boolean("obj", true);
   ex.output.every = output.integer("every", 1, 1, 1000000);
+  ex.output.vtk_format = output.choice("vtk_format", "auto", {"auto", "ascii", "compressed"});
   output.finish();
 }
 

@@ -31,7 +31,11 @@ struct OutputOptions {
   bool vtk = true;  // one .vtu per load step and a .pvd series
   bool obj = true;  // final.obj, the deformed surface in input vertex order
   int every = 1;    // write every k-th step's .vtu (the last always)
+  // "ascii", "compressed" (zlib, base64 inline) or "auto": compressed from
+  // kCompressedVtkVertices vertices on, where ASCII files grow large.
+  std::string vtk_format = "auto";
 };
+constexpr int kCompressedVtkVertices = 10000;
 
 // A named surface for an "areas" experiment (the paper's Table 1).
 struct NamedSurface {

@@ -489,7 +489,9 @@ void OutputWriter::begin() {
     fs::create_directories(run_folder(r));
     if (!experiment_.output.vtk) continue;
     fs::create_directories(run_folder(r) / "vtk");
-    write_state(r, 0, Eigen::VectorXd::Zero(experiment_.cases[r].model.num_unknowns()));
+    const model::Model& m = experiment_.cases[r].model;
+    write_state(r, 0, Eigen::VectorXd::Zero(m.num_unknowns()),
+                std::vector<double>(m.loads.size(), 0.0));
   }
 }
 
@@ -514,7 +516,13 @@ void OutputWriter::write_fibers() const {
   geom::write_lines_vtu(staging_ / "fibers.vtu", m.surface.V, lines);
 }
 
-void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns) {
+// One load step for ParaView: Points are the deformed positions (display the
+// reference with `reference_position`, or Warp By Vector `displacement` by -1);
+// point data displacement, its magnitude, the area vectors, the reference;
+// cell data each face's area over its rest area; field data the step, its
+// load factors (one per load, in the file's order) and the pressure.
+void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns,
+                               const std::vector<double>& load_factors) {
   const Case& c = experiment_.cases[run];
   const model::Model& m = c.model;
   geom::Surface deformed = c.input_surface;
@@ -527,11 +535,25 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
       geom::vertex_area_vectors(m.surface.V + model::displacements(m, unknowns), m.surface.F).S;
   for (size_t k = 0; k < c.model_to_input.size(); ++k)
     S.row(c.model_to_input[k]) = model_S.row(static_cast<Eigen::Index>(k));
+  const Eigen::VectorXd
+      rest = geom::face_area_vectors(c.input_surface.V, c.input_surface.F).rowwise().norm(),
+      now = geom::face_area_vectors(deformed.V, deformed.F).rowwise().norm();
+  geom::VtuContent content;
+  content.points = {{"displacement", U},
+                    {"displacement_magnitude", U.rowwise().norm()},
+                    {"area_vector", S},
+                    {"reference_position", c.input_surface.V}};
+  content.cells = {{"area_change", now.cwiseQuotient(rest)}};
+  content.field = {{"step", {static_cast<double>(step)}},
+                   {"load_factors", load_factors},
+                   {"pressure", {unknowns[m.pressure_dof()]}}};
+  const std::string& format = experiment_.output.vtk_format;
+  content.encoding = format == "compressed" || (format == "auto" && n >= kCompressedVtkVertices)
+                         ? geom::VtkEncoding::Compressed
+                         : geom::VtkEncoding::Ascii;
   char name[32];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
-  geom::write_vtu(
-      run_folder(run) / "vtk" / name, deformed,
-      {{"displacement", U}, {"displacement_magnitude", U.rowwise().norm()}, {"area_vector", S}});
+  geom::write_vtu(run_folder(run) / "vtk" / name, deformed, content);
   series_[run].emplace_back(step, std::string("vtk/") + name);
 }
 
@@ -539,7 +561,7 @@ void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
                            const Eigen::VectorXd& unknowns) {
   const bool last = record.step == experiment_.cases[run].stepping.steps;
   if (experiment_.output.vtk && (last || record.step % experiment_.output.every == 0))
-    write_state(run, record.step, unknowns);
+    write_state(run, record.step, unknowns, record.load_factors);
 }
 
 void OutputWriter::write_fem_path(const FemReferenceResult& f) {

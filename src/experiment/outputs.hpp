@@ -85,7 +85,8 @@ class OutputWriter {
 
  private:
   std::filesystem::path run_folder(size_t run) const;
-  void write_state(size_t run, int step, const Eigen::VectorXd& unknowns);
+  void write_state(size_t run, int step, const Eigen::VectorXd& unknowns,
+                   const std::vector<double>& load_factors);
   // fem_reference_series.pvd: a nonlinear FEM's boundary after each load step.
   void write_fem_path(const FemReferenceResult& f);
   void write_fibers() const;            // fibers.vtu: the kept or pruned fibers, if asked

@@ -1,66 +1,147 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "geom/vtk_writer.hpp"
 
+#include <zlib.h>
+
+#include <cstdint>
+#include <cstring>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "geom/mesh_io.hpp"
 #include "util/error.hpp"
 
 namespace fiberfluid::geom {
 
-void write_vtu(const std::filesystem::path& path, const Surface& s,
-               const std::vector<PointField>& fields) {
-  const int n = s.num_vertices();
-  std::ostringstream out;
-  out << std::setprecision(12);
-  out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "  <UnstructuredGrid>\n"
-      << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << s.num_faces() << "\">\n"
-      << "      <PointData>\n";
-  for (const PointField& field : fields) {
-    if (field.values.rows() != n)
-      throw std::invalid_argument("write_vtu: field " + field.name + " has the wrong row count");
-    const int components = field.values.cols() == 1 ? 1 : 3;
-    out << "        <DataArray type=\"Float64\" Name=\"" << field.name << "\" NumberOfComponents=\""
-        << components << "\" format=\"ascii\">\n";
-    for (int i = 0; i < n; ++i) {
-      out << "         ";
-      for (int k = 0; k < components; ++k)
-        out << ' ' << (k < field.values.cols() ? field.values(i, k) : 0.0);
-      out << '\n';
+namespace {
+
+std::string base64(const unsigned char* data, size_t size) {
+  static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (size_t k = 0; k < size; k += 3) {
+    const unsigned b0 = data[k], b1 = k + 1 < size ? data[k + 1] : 0,
+                   b2 = k + 2 < size ? data[k + 2] : 0;
+    out += kDigits[b0 >> 2];
+    out += kDigits[((b0 & 3) << 4) | (b1 >> 4)];
+    out += k + 1 < size ? kDigits[((b1 & 15) << 2) | (b2 >> 6)] : '=';
+    out += k + 2 < size ? kDigits[b2 & 63] : '=';
+  }
+  return out;
+}
+
+// One array's bytes as VTK's compressed inline binary: the header
+// [blocks, block size, last block size, compressed sizes] (UInt64) and the
+// zlib-compressed data, each base64-encoded on its own. One block.
+std::string compressed(const std::vector<unsigned char>& raw) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::vector<unsigned char> packed(size);
+  if (compress2(packed.data(), &size, raw.data(), static_cast<uLong>(raw.size()),
+                Z_DEFAULT_COMPRESSION) != Z_OK)
+    throw std::runtime_error("write_vtu: zlib could not compress an array");
+  const uint64_t header[4] = {1, raw.size(), raw.size(), size};
+  return base64(reinterpret_cast<const unsigned char*>(header), sizeof header) +
+         base64(packed.data(), size);
+}
+
+// A DataArray of values (written as `type`: Float64, Int64 or UInt8) with
+// `components` per tuple.
+template <class T>
+void data_array(std::ostringstream& out, const char* type, const std::string& name, int components,
+                const std::vector<T>& values, VtkEncoding encoding) {
+  const bool binary = encoding == VtkEncoding::Compressed && !values.empty();
+  out << "        <DataArray type=\"" << type << "\"";
+  if (!name.empty()) out << " Name=\"" << name << "\"";
+  if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
+  out << " format=\"" << (binary ? "binary" : "ascii") << "\">\n";
+  if (binary) {
+    std::vector<unsigned char> raw(values.size() * sizeof(T));
+    std::memcpy(raw.data(), values.data(), raw.size());
+    out << "          " << compressed(raw) << "\n";
+  } else {
+    for (size_t k = 0; k < values.size(); ++k) {
+      out << (k % static_cast<size_t>(components) == 0 ? "          " : " ");
+      if constexpr (sizeof(T) == 1)
+        out << static_cast<int>(values[k]);
+      else
+        out << values[k];
+      if ((k + 1) % static_cast<size_t>(components) == 0) out << '\n';
     }
-    out << "        </DataArray>\n";
   }
-  out << "      </PointData>\n"
-      << "      <Points>\n"
-      << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (int i = 0; i < n; ++i)
-    out << "          " << s.V(i, 0) << ' ' << s.V(i, 1) << ' '
-        << (s.V.cols() == 3 ? s.V(i, 2) : 0.0) << '\n';
-  out << "        </DataArray>\n"
-      << "      </Points>\n"
-      << "      <Cells>\n"
-      << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (int f = 0; f < s.num_faces(); ++f) {
-    out << "         ";
-    for (int k = 0; k < s.F.cols(); ++k) out << ' ' << s.F(f, k);
-    out << '\n';
+  out << "        </DataArray>\n";
+}
+
+// A field's rows as tuples of 1 or 3 doubles.
+std::vector<double> tuples(const PointField& field, Eigen::Index rows, const char* what) {
+  if (field.values.rows() != rows)
+    throw std::invalid_argument("write_vtu: " + std::string(what) + " field " + field.name +
+                                " has the wrong row count");
+  const int components = field.values.cols() == 1 ? 1 : 3;
+  std::vector<double> out;
+  out.reserve(static_cast<size_t>(rows * components));
+  for (Eigen::Index i = 0; i < rows; ++i)
+    for (int k = 0; k < components; ++k)
+      out.push_back(k < field.values.cols() ? field.values(i, k) : 0.0);
+  return out;
+}
+
+}  // namespace
+
+void write_vtu(const std::filesystem::path& path, const Surface& s, const VtuContent& content) {
+  const int n = s.num_vertices(), faces = s.num_faces();
+  const VtkEncoding e = content.encoding;
+  std::ostringstream out;
+  out << std::setprecision(17);
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
+      << " header_type=\"UInt64\""
+      << (e == VtkEncoding::Compressed ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
+      << "  <UnstructuredGrid>\n";
+  if (!content.field.empty()) {
+    out << "    <FieldData>\n";
+    for (const FieldValues& f : content.field) {
+      out << "        <DataArray type=\"Float64\" Name=\"" << f.name << "\" NumberOfTuples=\""
+          << f.values.size() << "\" format=\"ascii\">\n          ";
+      for (double v : f.values) out << v << ' ';
+      out << "\n        </DataArray>\n";
+    }
+    out << "    </FieldData>\n";
   }
-  out << "        </DataArray>\n"
-      << "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (int f = 0; f < s.num_faces(); ++f) out << "          " << (f + 1) * s.F.cols() << '\n';
-  out << "        </DataArray>\n"
-      << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  const int cell_type = s.F.cols() == 3 ? 5 : 3;  // VTK_TRIANGLE, VTK_LINE
-  for (int f = 0; f < s.num_faces(); ++f) out << "          " << cell_type << '\n';
-  out << "        </DataArray>\n"
-      << "      </Cells>\n"
+  out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << faces << "\">\n"
+      << "      <PointData>\n";
+  for (const PointField& field : content.points)
+    data_array(out, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
+               tuples(field, n, "point"), e);
+  out << "      </PointData>\n      <CellData>\n";
+  for (const PointField& field : content.cells)
+    data_array(out, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
+               tuples(field, faces, "cell"), e);
+  out << "      </CellData>\n      <Points>\n";
+  data_array(out, "Float64", "", 3, tuples({"points", s.V}, n, "point"), e);
+  out << "      </Points>\n      <Cells>\n";
+  std::vector<int64_t> connectivity, offsets;
+  for (int f = 0; f < faces; ++f) {
+    for (int k = 0; k < s.F.cols(); ++k) connectivity.push_back(s.F(f, k));
+    offsets.push_back(static_cast<int64_t>(f + 1) * s.F.cols());
+  }
+  const uint8_t cell_type = s.F.cols() == 3 ? 5 : 3;  // VTK_TRIANGLE, VTK_LINE
+  data_array(out, "Int64", "connectivity", 1, connectivity, e);
+  data_array(out, "Int64", "offsets", 1, offsets, e);
+  data_array(out, "UInt8", "types", 1, std::vector<uint8_t>(static_cast<size_t>(faces), cell_type),
+             e);
+  out << "      </Cells>\n"
       << "    </Piece>\n"
       << "  </UnstructuredGrid>\n"
       << "</VTKFile>\n";
   write_text_file(path, out.str());
+}
+
+void write_vtu(const std::filesystem::path& path, const Surface& s,
+               const std::vector<PointField>& fields) {
+  VtuContent content;
+  content.points = fields;
+  write_vtu(path, s, content);
 }
 
 void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X,
@@ -71,7 +152,7 @@ void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X
   segments.F.resize(static_cast<Eigen::Index>(lines.size()), 2);
   for (size_t k = 0; k < lines.size(); ++k)
     segments.F.row(static_cast<Eigen::Index>(k)) << lines[k].first, lines[k].second;
-  write_vtu(path, segments, {});
+  write_vtu(path, segments, VtuContent{});
 }
 
 void write_pvd(const std::filesystem::path& path,

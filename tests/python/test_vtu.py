@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The .vtu series read by an independent reader (meshio): ASCII and compressed files hold the
+same grid and data, and the data says what README says it does."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+import fiberfluid
+
+meshio = pytest.importorskip("meshio")  # scripts/install-deps.sh installs python3-meshio
+
+SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def sphere(vtk_format):
+    with open(os.path.join(SOURCE, "experiments", "sphere.json")) as f:
+        document = json.load(f)
+    document["expected"] = []
+    document["output"] = {"vtk_format": vtk_format, "every": 5}
+    document["name"] = "sphere_" + vtk_format
+    return document
+
+
+def test_ascii_and_compressed_series_hold_the_same_data(tmp_path):
+    grids = {}
+    for vtk_format in ("ascii", "compressed"):
+        out = tmp_path / vtk_format
+        fiberfluid.Experiment.from_dict(sphere(vtk_format)).run(output=str(out))
+        text = (out / "vtk" / "step_0010.vtu").read_text()
+        assert ('format="binary"' in text) == (vtk_format == "compressed")
+        grids[vtk_format] = meshio.read(str(out / "vtk" / "step_0010.vtu"))
+    a, c = grids["ascii"], grids["compressed"]
+    assert np.array_equal(a.points, c.points)  # 17 digits in ASCII: the same doubles
+    assert np.array_equal(a.cells_dict["triangle"], c.cells_dict["triangle"])
+    for name in ("displacement", "displacement_magnitude", "area_vector", "reference_position"):
+        assert np.array_equal(a.point_data[name], c.point_data[name]), name
+    assert np.array_equal(a.cell_data["area_change"][0], c.cell_data["area_change"][0])
+    # Points are the deformed positions: the reference plus the displacement.
+    assert np.allclose(c.point_data["reference_position"] + c.point_data["displacement"],
+                       c.points, rtol=0, atol=1e-15)
+    # Field data: the step, its load factors (gravity, the pull) and the pressure.
+    assert c.field_data["step"][0] == 10
+    assert np.allclose(c.field_data["load_factors"], [1.0, 1.0])
+    summary = json.loads((tmp_path / "compressed" / "summary.json").read_text())
+    assert c.field_data["pressure"][0] == pytest.approx(summary["figures"]["final_pressure"],
+                                                        rel=1e-15)
+    # The faces' area change is their area now over at rest.
+    tri = c.cells_dict["triangle"]
+
+    def areas(p):
+        return 0.5 * np.linalg.norm(np.cross(p[tri[:, 1]] - p[tri[:, 0]],
+                                             p[tri[:, 2]] - p[tri[:, 0]]), axis=1)
+    ratio = areas(c.points) / areas(c.point_data["reference_position"])
+    assert np.allclose(c.cell_data["area_change"][0], ratio, rtol=1e-12)
+    # The compressed file is smaller.
+    assert (tmp_path / "compressed" / "vtk" / "step_0010.vtu").stat().st_size < \
+        0.7 * (tmp_path / "ascii" / "vtk" / "step_0010.vtu").stat().st_size
