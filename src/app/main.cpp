@@ -429,7 +429,9 @@ int compare_command(const std::string& reference, const std::string& approximati
 int check_command(const std::string& path, bool flip) {
   fiberfluid::geom::ReadResult read = fiberfluid::geom::read_surface(path);
   if (flip) fiberfluid::geom::flip_orientation(read.surface);
-  const fiberfluid::geom::MeshReport report = fiberfluid::geom::inspect(read.surface);
+  // Vertices and faces counted as the file counts them (OBJ from 1).
+  const fiberfluid::geom::MeshReport report =
+      fiberfluid::geom::inspect(read.surface, read.index_base);
   for (const auto& w : read.warnings) std::cerr << "warning: " << w << "\n";
   std::cout << fiberfluid::geom::format_report(report, path);
   if (!report.ok()) {

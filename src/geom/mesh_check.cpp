@@ -15,8 +15,11 @@
 namespace fiberfluid::geom {
 namespace {
 
-std::string edge_name(int a, int b) {
-  return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
+// A vertex, face or edge as the report names it: counted from the file's own base.
+std::string id(const MeshReport& r, int index) { return std::to_string(index + r.index_base); }
+
+std::string edge_name(const MeshReport& r, int a, int b) {
+  return "(" + id(r, a) + ", " + id(r, b) + ")";
 }
 
 int find_root(std::vector<int>& parent, int i) {
@@ -64,17 +67,15 @@ int first_pinched_vertex(const Surface& s) {
 void check_coordinates_and_indices(const Surface& s, MeshReport& r) {
   for (int i = 0; i < s.num_vertices(); ++i) {
     if (!s.V.row(i).allFinite()) {
-      r.problems.push_back("vertex " + std::to_string(i) +
-                           " has a non-finite coordinate (NaN or infinity)");
+      r.problems.push_back("vertex " + id(r, i) + " has a non-finite coordinate (NaN or infinity)");
       return;
     }
   }
   for (int f = 0; f < s.num_faces(); ++f)
     for (int k = 0; k < s.F.cols(); ++k)
       if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices()) {
-        r.problems.push_back("face " + std::to_string(f) + " refers to vertex " +
-                             std::to_string(s.F(f, k)) + ", outside 0.." +
-                             std::to_string(s.num_vertices() - 1));
+        r.problems.push_back("face " + id(r, f) + " refers to vertex " + id(r, s.F(f, k)) +
+                             ", outside " + id(r, 0) + ".." + id(r, s.num_vertices() - 1));
         return;
       }
 }
@@ -90,7 +91,7 @@ void check_degenerate_faces(const Surface& s, MeshReport& r) {
     for (int k = 0; k < s.F.cols(); ++k)
       for (int m = k + 1; m < s.F.cols(); ++m) repeated |= s.F(f, k) == s.F(f, m);
     if (repeated || A.row(f).norm() <= tiny) {
-      r.problems.push_back("face " + std::to_string(f) + " is degenerate (" +
+      r.problems.push_back("face " + id(r, f) + " is degenerate (" +
                            (repeated ? "a repeated vertex" : "zero area") + ")");
       return;
     }
@@ -112,12 +113,12 @@ void check_triangle_topology(const Surface& s, MeshReport& r) {
   std::string first_boundary, first_nonmanifold, first_misoriented;
   for (const auto& [edge, count] : uses) {
     const int faces = count.first + count.second;
-    if (faces == 1 && boundary++ == 0) first_boundary = edge_name(edge.first, edge.second);
+    if (faces == 1 && boundary++ == 0) first_boundary = edge_name(r, edge.first, edge.second);
     if (faces > 2 && nonmanifold++ == 0)
-      first_nonmanifold =
-          edge_name(edge.first, edge.second) + " is shared by " + std::to_string(faces) + " faces";
+      first_nonmanifold = edge_name(r, edge.first, edge.second) + " is shared by " +
+                          std::to_string(faces) + " faces";
     if (faces == 2 && count.first != 1 && misoriented++ == 0)
-      first_misoriented = edge_name(edge.first, edge.second);
+      first_misoriented = edge_name(r, edge.first, edge.second);
   }
   r.closed = boundary == 0 && nonmanifold == 0;
   r.manifold = nonmanifold == 0;
@@ -141,7 +142,7 @@ void check_triangle_topology(const Surface& s, MeshReport& r) {
   const int pinched = first_pinched_vertex(s);
   if (pinched >= 0) {
     r.manifold = false;
-    r.problems.push_back("not a 2-manifold: the faces around vertex " + std::to_string(pinched) +
+    r.problems.push_back("not a 2-manifold: the faces around vertex " + id(r, pinched) +
                          " form more than one fan");
   }
 }
@@ -160,20 +161,19 @@ void check_polygon_topology(const Surface& s, MeshReport& r) {
     if (degree == 0) continue;
     if (degree > 2) {
       r.manifold = r.closed = false;
-      r.problems.push_back("not a simple closed polygon: vertex " + std::to_string(i) + " has " +
+      r.problems.push_back("not a simple closed polygon: vertex " + id(r, i) + " has " +
                            std::to_string(degree) + " edges");
       return;
     }
     if (degree == 1) {
       r.closed = false;
-      r.problems.push_back("not closed: vertex " + std::to_string(i) + " ends an open polyline");
+      r.problems.push_back("not closed: vertex " + id(r, i) + " ends an open polyline");
       return;
     }
     if (starts[i] != 1) {
       r.consistently_oriented = false;
-      r.problems.push_back("inconsistent orientation: the two edges at vertex " +
-                           std::to_string(i) + " both " + (starts[i] == 2 ? "start" : "end") +
-                           " there");
+      r.problems.push_back("inconsistent orientation: the two edges at vertex " + id(r, i) +
+                           " both " + (starts[i] == 2 ? "start" : "end") + " there");
       return;
     }
   }
@@ -181,8 +181,9 @@ void check_polygon_topology(const Surface& s, MeshReport& r) {
 
 }  // namespace
 
-MeshReport inspect(const Surface& s) {
+MeshReport inspect(const Surface& s, int index_base) {
   MeshReport r;
+  r.index_base = index_base;
   r.dim = s.dim;
   r.vertices = s.num_vertices();
   r.faces = s.num_faces();
@@ -225,7 +226,7 @@ MeshReport inspect(const Surface& s) {
     if (const auto crossing = find_self_intersection(s))
       r.problems.push_back(
           "the surface intersects itself: " + std::string(s.dim == 3 ? "triangles " : "segments ") +
-          std::to_string(crossing->first) + " and " + std::to_string(crossing->second) +
+          id(r, crossing->first) + " and " + id(r, crossing->second) +
           " cross (it bounds no solid, so its volume and the fiber pruning are meaningless)");
   if (r.ok() && !r.outward)
     r.problems.push_back(std::string("inverted: the faces point inward (enclosed ") +
@@ -254,6 +255,9 @@ std::string format_report(const MeshReport& r, const std::string& source) {
       << "  " << (r.dim == 3 ? "volume:        " : "area:          ") << r.volume << "\n";
   for (const auto& w : r.warnings) out << "  warning: " << w << "\n";
   for (const auto& p : r.problems) out << "  error: " << p << "\n";
+  if (!r.problems.empty())
+    out << "  (vertices and faces counted from " << r.index_base
+        << (r.index_base == 1 ? ", as the file counts them)\n" : ")\n");
   return out.str();
 }
 

@@ -12,6 +12,7 @@ namespace fiberfluid::geom {
 // problems is empty (warnings are informational).
 struct MeshReport {
   int dim = 3;
+  int index_base = 0;     // the problems count vertices and faces from this (OBJ: 1)
   int vertices = 0;       // as listed in the input
   int used_vertices = 0;  // referenced by a face
   int faces = 0;
@@ -31,8 +32,10 @@ struct MeshReport {
 };
 
 // Checks a surface: finite coordinates, indices in range, degenerate faces,
-// closed 2-manifold, consistent and outward orientation. Never throws.
-MeshReport inspect(const Surface& surface);
+// closed 2-manifold, consistent and outward orientation. Never throws. The
+// problems name vertices and faces counted from index_base: 0 as the
+// experiment files count them, or the mesh file's own (1 for OBJ).
+MeshReport inspect(const Surface& surface, int index_base = 0);
 
 // Human-readable multi-line report (the `fiberfluid check` output).
 std::string format_report(const MeshReport& report, const std::string& source);

@@ -496,7 +496,10 @@ ReadResult read_surface_bytes(const std::string& bytes, MeshFormat format,
       break;
   }
   std::istringstream in(bytes);
-  return format == MeshFormat::Obj ? read_obj(in, path) : read_off(in, path);
+  if (format == MeshFormat::Off) return read_off(in, path);
+  ReadResult obj = read_obj(in, path);
+  obj.index_base = 1;  // OBJ counts its vertices from 1
+  return obj;
 }
 
 ReadResult read_surface(const std::filesystem::path& path) {

@@ -13,6 +13,7 @@ namespace fiberfluid::geom {
 struct ReadResult {
   Surface surface;
   std::vector<std::string> warnings;  // e.g. polygons split into triangles
+  int index_base = 0;                 // how the file counts its vertices: OBJ from 1
 };
 
 // Reads a surface, choosing the format by extension:

@@ -47,6 +47,11 @@ TEST(Cli, CheckRejectsABadMesh) {
   const Outcome o = run_cli("check " + open_mesh.string());
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.output.find("open.obj: not closed"), std::string::npos) << o.output;
+  // OBJ counts its vertices from 1, and so does the report (the edge v2-v3 of the file).
+  EXPECT_NE(o.output.find("not closed: edge (2, 3) borders only one face"), std::string::npos)
+      << o.output;
+  EXPECT_NE(o.output.find("counted from 1, as the file counts them"), std::string::npos)
+      << o.output;
 }
 
 TEST(Cli, RunWritesItsOutputsAndChecksTheExpectedFigures) {
