@@ -16,6 +16,7 @@
 #include "model/assembly.hpp"
 #include "model/boundary_conditions.hpp"
 #include "model/equilibrium.hpp"
+#include "model/model_fixtures.hpp"
 #include "model/pair_stencil.hpp"
 #include "solve/load_stepper.hpp"
 
@@ -161,13 +162,7 @@ std::vector<double> bar_profile(int along, int across, double horizon, FiberKine
   EXPECT_EQ(run.tangent, tangent);
   EXPECT_TRUE(run.success) << run.message;
   const Eigen::MatrixXd U = displacements(m, run.unknowns);
-  auto deflection = [&](double x) {
-    double sum = 0.0;
-    int count = 0;
-    for (int v = 0; v < m.num_vertices(); ++v)
-      if (std::abs(m.surface.V(v, 0) - x) < 1e-9) sum += U(v, 2), ++count;
-    return sum / count;
-  };
+  auto deflection = [&](double x) { return testing::mean_deflection_at(m, U, x); };
   const double tip_deflection = deflection(length);
   EXPECT_LT(std::abs(tip_deflection), 0.05 * thickness);  // small: the linear regime
   return {deflection(0.25 * length) / tip_deflection, deflection(0.5 * length) / tip_deflection,

@@ -36,18 +36,7 @@ std::vector<FiberLaw> every_law() {
 
 using testing::random_state;
 
-Eigen::MatrixXd finite_difference_tangent(const Equilibrium& eq, const Eigen::VectorXd& x,
-                                          const std::vector<double>& factors) {
-  Eigen::MatrixXd J(x.size(), x.size());
-  for (Eigen::Index k = 0; k < x.size(); ++k) {
-    const double h = k == x.size() - 1 ? 1e-3 : 1e-6;
-    Eigen::VectorXd plus = x, minus = x;
-    plus[k] += h;
-    minus[k] -= h;
-    J.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
-  }
-  return J;
-}
+using testing::finite_difference_tangent;
 
 // The exact hydrostatic load's tangent (its faces turning and its pressures
 // changing with depth), with both kinematics.

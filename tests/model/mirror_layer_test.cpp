@@ -18,6 +18,7 @@
 #include "model/assembly.hpp"
 #include "model/equilibrium.hpp"
 #include "model/fiber_network.hpp"
+#include "model/model_fixtures.hpp"
 #include "solve/load_stepper.hpp"
 
 namespace fiberfluid::model {
@@ -34,6 +35,21 @@ std::vector<int> vertices_where(const Model& m,
   return chosen;
 }
 
+// Holds every vertex at x = 0 on every axis (the group "clamp"), with the
+// clamp's mirror layer as deep as the horizon when `layer`.
+void clamp_at_x_zero(Model& m, double horizon, bool layer) {
+  m.constraint_groups = {"clamp"};
+  const std::vector<int> held =
+      vertices_where(m, [](const Eigen::Vector3d& s) { return s.x() < 1e-9; });
+  for (int v : held)
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}, 0});
+  if (!layer) return;
+  MirrorLayer mirror;
+  mirror.depth = horizon;
+  EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
+  m.mirror_layers.push_back(mirror);
+}
+
 // A 6 x 2 x 2 cm block clamped at x = 0 with a mirror layer as deep as its
 // horizon (2.5 cm: across the block), gravity along z and y.
 Model clamped_block(const FiberLaw& law, FiberKinematics kinematics, bool layer = true) {
@@ -45,17 +61,7 @@ Model clamped_block(const FiberLaw& law, FiberKinematics kinematics, bool layer 
   m.material.surface_tension = 5.0;
   const double horizon = 0.025;
   m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, horizon));
-  m.constraint_groups = {"clamp"};
-  const std::vector<int> held =
-      vertices_where(m, [](const Eigen::Vector3d& s) { return s.x() < 1e-9; });
-  for (int v : held)
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}, 0});
-  if (layer) {
-    MirrorLayer mirror;
-    mirror.depth = horizon;
-    EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
-    m.mirror_layers.push_back(mirror);
-  }
+  clamp_at_x_zero(m, horizon, layer);
   Load gravity;
   gravity.kind = Load::Kind::Hydrostatic;
   gravity.acceleration = {0.0, -3.0, -9.81};
@@ -137,14 +143,9 @@ TEST(MirrorLayer, TangentAndParameterDerivativesMatchCentralDifferences) {
       const Eigen::VectorXd x = random_displacements(m, 3, 0.002);
       const std::vector<double> factors = {0.6};
       const Eigen::MatrixXd J = eq.tangent(x, factors);
-      Eigen::MatrixXd fd(x.size(), x.size());
-      for (Eigen::Index k = 0; k < x.size(); ++k) {
-        const double h = k == x.size() - 1 ? 1e-2 : 1e-7;
-        Eigen::VectorXd plus = x, minus = x;
-        plus[k] += h;
-        minus[k] -= h;
-        fd.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
-      }
+      const Eigen::MatrixXd fd =
+          testing::finite_difference_tangent(eq, x, factors, /*displacement_step=*/1e-7,
+                                             /*pressure_step=*/1e-2);
       EXPECT_LT((J - fd).norm() / fd.norm(), 1e-6);
       const Eigen::VectorXd v = random_displacements(m, 7, 1.0);
       EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm());
@@ -228,17 +229,7 @@ double worst_beam_error(bool layer) {
   m.material.law = FiberLaw::constant(1e5);
   m.material.kinematics = FiberKinematics::Central;
   m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, horizon));
-  m.constraint_groups = {"clamp"};
-  const std::vector<int> held =
-      vertices_where(m, [](const Eigen::Vector3d& s) { return s.x() < 1e-9; });
-  for (int v : held)
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}, 0});
-  if (layer) {
-    MirrorLayer mirror;
-    mirror.depth = horizon;
-    EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
-    m.mirror_layers.push_back(mirror);
-  }
+  clamp_at_x_zero(m, horizon, layer);
   Load gravity;
   gravity.kind = Load::Kind::Hydrostatic;
   gravity.acceleration = {0.0, 0.0, -9.81};
@@ -251,13 +242,7 @@ double worst_beam_error(bool layer) {
   const solve::SteppingSummary run = solve::solve_load_steps(m, newton);
   EXPECT_TRUE(run.success) << run.message;
   const Eigen::MatrixXd U = displacements(m, run.unknowns);
-  auto deflection = [&](double x) {
-    double sum = 0.0;
-    int count = 0;
-    for (int v = 0; v < m.num_vertices(); ++v)
-      if (std::abs(m.surface.V(v, 0) - x) < 1e-9) sum += U(v, 2), ++count;
-    return sum / count;
-  };
+  auto deflection = [&](double x) { return testing::mean_deflection_at(m, U, x); };
   const double tip = deflection(length);
   double worst = 0.0;
   for (int k = 1; k < 40; ++k) {

@@ -3,10 +3,13 @@
 // sphere of the Newton equations' tests and random states of it.
 #pragma once
 
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "geom/generators.hpp"
 #include "model/boundary_conditions.hpp"
+#include "model/equilibrium.hpp"
 #include "model/model.hpp"
 
 namespace fiberfluid::testing {
@@ -76,6 +79,33 @@ inline Eigen::VectorXd random_state(const model::Model& m, unsigned seed, double
   for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = size * uniform(rng);
   x[m.pressure_dof()] = 800.0 * uniform(rng);
   return x;
+}
+
+// dR/dx by central differences of the residual, column by column: a step
+// for the displacements and one for the pressure (the last unknown).
+inline Eigen::MatrixXd finite_difference_tangent(const model::Equilibrium& eq,
+                                                 const Eigen::VectorXd& x,
+                                                 const std::vector<double>& factors,
+                                                 double displacement_step = 1e-6,
+                                                 double pressure_step = 1e-3) {
+  Eigen::MatrixXd J(x.size(), x.size());
+  for (Eigen::Index k = 0; k < x.size(); ++k) {
+    const double h = k == x.size() - 1 ? pressure_step : displacement_step;
+    Eigen::VectorXd plus = x, minus = x;
+    plus[k] += h;
+    minus[k] -= h;
+    J.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
+  }
+  return J;
+}
+
+// The mean z displacement of the vertices at x (a bar's deflection at a station).
+inline double mean_deflection_at(const model::Model& m, const Eigen::MatrixXd& U, double x) {
+  double sum = 0.0;
+  int count = 0;
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (std::abs(m.surface.V(v, 0) - x) < 1e-9) sum += U(v, 2), ++count;
+  return sum / count;
 }
 
 }  // namespace fiberfluid::testing
