@@ -62,12 +62,7 @@ class Fields {
   }
   Fields object(const std::string& key) {
     const nlohmann::json& v = raw(key);
-    nlohmann::json* child = nullptr;
-    if (resolved_ != nullptr) {
-      child = &(*resolved_)[key];
-      *child = nlohmann::json::object();
-    }
-    return Fields(v, name(key), file_, child);
+    return Fields(v, name(key), file_, resolved_child(key, nlohmann::json::object()));
   }
 
   // An optional section: the object, or an empty one whose defaults are then
@@ -76,12 +71,7 @@ class Fields {
     static const nlohmann::json kEmpty = nlohmann::json::object();
     if (has(key)) return object(key);
     seen_.insert(key);
-    nlohmann::json* child = nullptr;
-    if (resolved_ != nullptr) {
-      child = &(*resolved_)[key];
-      *child = nlohmann::json::object();
-    }
-    return Fields(kEmpty, name(key), file_, child);
+    return Fields(kEmpty, name(key), file_, resolved_child(key, nlohmann::json::object()));
   }
 
   double number(const std::string& key) {
@@ -184,12 +174,9 @@ class Fields {
     if (!has(key)) return seen_.insert(key), record(key, nlohmann::json::array()), out;
     const nlohmann::json& v = raw(key);
     if (!v.is_array()) fail(key, "expected a list of objects");
-    nlohmann::json* list = nullptr;
-    if (resolved_ != nullptr) {  // sized first: its elements' addresses then stay put
-      list = &(*resolved_)[key];
-      *list = nlohmann::json::array();
-      for (size_t k = 0; k < v.size(); ++k) list->push_back(nlohmann::json::object());
-    }
+    // Sized first: its elements' addresses then stay put.
+    nlohmann::json* list = resolved_child(
+        key, nlohmann::json(std::vector<nlohmann::json>(v.size(), nlohmann::json::object())));
     for (size_t k = 0; k < v.size(); ++k)
       out.emplace_back(v[k], name(key) + "[" + std::to_string(k) + "]", file_,
                        list != nullptr ? &(*list)[k] : nullptr);
@@ -219,6 +206,14 @@ class Fields {
     return x >= min && x <= max;
   }
   std::vector<std::string> known() const { return {seen_.begin(), seen_.end()}; }
+  // Where the resolved form of a nested object or list goes, set to
+  // `initial`; null when nothing is recorded.
+  nlohmann::json* resolved_child(const std::string& key, nlohmann::json initial) {
+    if (resolved_ == nullptr) return nullptr;
+    nlohmann::json* child = &(*resolved_)[key];
+    *child = std::move(initial);
+    return child;
+  }
   // Writes a default into the resolved document; returns it.
   template <class T>
   T record(const std::string& key, T value) {
