@@ -8,8 +8,7 @@ scripts/build-release.sh
 
 experiment="${1:-experiments/sphere.json}"
 name="$(basename "$experiment" .json)"
-build-release/src/app/fiberfluid run "$experiment" -o "out/$name" --check
-/usr/bin/python3 experiments/plot.py "out/$name/summary.json" "out/$name/plot.png"
+build-release/src/app/fiberfluid run "$experiment" -o "out/$name" --check --plot
 if [[ -f "out/$name/series.pvd" ]]; then
   echo "plot: out/$name/plot.png; open out/$name/series.pvd in ParaView"
 else  # a sweep: one series per variant

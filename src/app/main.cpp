@@ -9,6 +9,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -174,6 +175,7 @@ struct RunFlags {
   std::string output;
   bool check_expected = false;
   bool quiet = false;
+  bool plot = false;  // draw DIR/plot.png after a successful run
   int jobs = 0;
   double max_memory = 0.0;  // bytes; 0: 80% of the machine's memory
   double max_time = 0.0;    // seconds of estimated time; 0: no limit
@@ -198,6 +200,52 @@ experiment::Experiment load_showing_progress(const std::string& path, bool quiet
   fiberfluid::set_note_sink({});
   for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
   return ex;
+}
+
+// Single quotes for a shell, with any quote inside closed and escaped.
+std::string shell_quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The plot script: installed beside the program (share/fiberfluid/plot.py),
+// or the source tree's when run from the build.
+std::filesystem::path plot_script() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const std::filesystem::path installed =
+        self.parent_path().parent_path() / "share" / "fiberfluid" / "plot.py";
+    if (std::filesystem::exists(installed)) return installed;
+  }
+  return FIBERFLUID_PLOT_SCRIPT;
+}
+
+// --plot: DIR/plot.png from DIR/summary.json, drawn by the plot script with
+// the first python3 that has matplotlib (the one on PATH, else Debian's). A
+// plot that cannot be drawn is a warning: the results are written already.
+void draw_plot(const std::filesystem::path& folder) {
+  const std::filesystem::path script = plot_script();
+  if (!std::filesystem::exists(script)) {
+    std::cerr << "warning: no plot: the plot script " << script.string() << " is missing\n";
+    return;
+  }
+  for (const char* python : {"python3", "/usr/bin/python3"}) {
+    if (std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0)
+      continue;
+    const std::filesystem::path png = folder / "plot.png";
+    const std::string command = std::string(python) + " " + shell_quoted(script.string()) + " " +
+                                shell_quoted((folder / "summary.json").string()) + " " +
+                                shell_quoted(png.string());
+    if (std::system(command.c_str()) == 0 && std::filesystem::exists(png))
+      std::cout << "  plot: " << png.string() << "\n";
+    else
+      std::cerr << "warning: no plot: " << command << " failed\n";
+    return;
+  }
+  std::cerr << "warning: no plot: no python3 with matplotlib (Debian: apt-get install "
+               "python3-matplotlib)\n";
 }
 
 int run_command(const std::string& path, const RunFlags& flags) {
@@ -254,6 +302,7 @@ int run_command(const std::string& path, const RunFlags& flags) {
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
+  if (flags.plot && ex.kind == experiment::Experiment::Kind::Simulate) draw_plot(writer.folder());
   if (flags.check_expected && !result.checks_passed()) {
     std::cerr << "error: some expected figures were not met (see above)\n";
     return kChecksFailed;
@@ -507,6 +556,9 @@ int main(int argc, char** argv) {
   run->add_flag("--check", flags.check_expected,
                 "Exit with status 3 when an expected figure of the file is not met");
   run->add_flag("-q,--quiet", flags.quiet, "No progress lines");
+  run->add_flag("--plot", flags.plot,
+                "Also draw DIR/plot.png (python3 with matplotlib; the deformed surface, and "
+                "per load step the displacement, pressure and reactions)");
   add_resource_limits(run, flags);
   run->add_option("-j,--jobs", flags.jobs,
                   "Variants of a sweep run at once (default: one per core); each gets "

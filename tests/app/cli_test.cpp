@@ -64,6 +64,18 @@ TEST(Cli, RunWritesItsOutputsAndChecksTheExpectedFigures) {
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "rect" / file)) << file;
 }
 
+// --plot draws DIR/plot.png with the plot script (Debian's python3 has matplotlib).
+TEST(Cli, RunDrawsItsPlotOnRequest) {
+  ScratchDir dir;
+  const Outcome o = run_cli("run " + testing::experiment_file("rectangle.json").string() + " -o " +
+                            (dir.path() / "rect").string() + " -q --plot");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("plot: " + (dir.path() / "rect" / "plot.png").string()),
+            std::string::npos)
+      << o.output;
+  EXPECT_GT(std::filesystem::file_size(dir.path() / "rect" / "plot.png"), 10000u);
+}
+
 TEST(Cli, FitCalibratesThenWritesTheRunAndTheFitFiles) {
   ScratchDir dir;
   const Outcome o = run_cli("fit " + testing::experiment_file("fit_sphere.json").string() + " -o " +

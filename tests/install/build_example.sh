@@ -19,3 +19,16 @@ awk '/^soft:/ {soft = $4; soft_r = $9} /^stiff:/ {stiff = $4; stiff_r = $9}
           if (!(ratio > 0.2 && ratio < 0.3 && soft_r > 4 && stiff_r > 4)) {
             print "unexpected figures: ratio " ratio ", reactions " soft_r " " stiff_r; exit 1 } }' \
     <<<"$output"
+
+# The installed command draws its plot with the installed script (run --plot),
+# and the script is a command of its own.
+cat > "$scratch/tiny.json" <<'JSON'
+{"name": "tiny", "surface": {"generator": "icosphere", "subdivisions": 1},
+ "material": {"Y": 3000, "gamma": 3000}, "supports": [{"where": "z >= 0.8"}],
+ "loads": [{"type": "gravity", "acceleration": [0, 0, -10]}], "stepping": {"steps": 2}}
+JSON
+test -x "$scratch/prefix/bin/fiberfluid-plot"
+test -f "$scratch/prefix/share/fiberfluid/plot.py"
+(cd "$scratch" && "$scratch/prefix/bin/fiberfluid" run tiny.json -o out -q --plot) | grep -q "plot: "
+test -s "$scratch/out/plot.png"
+echo "installed run --plot: $scratch/out/plot.png written"
