@@ -105,7 +105,8 @@ std::vector<std::string> run_figure_names(const model::Model& model) {
   return names;
 }
 
-std::string figure_problem(const Experiment& ex, const std::string& figure) {
+std::string figure_problem(const Experiment& ex, const std::string& figure, bool fit_figures) {
+  if (!fit_figures && ex.fit && figure.rfind("fit.", 0) == 0) return {};
   std::vector<std::string> valid;
   switch (ex.kind) {
     case Experiment::Kind::Benchmark:

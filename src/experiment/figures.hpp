@@ -22,7 +22,11 @@ std::vector<std::string> run_figure_names(const model::Model& model);
 
 // "" when `figure` names a figure this experiment will have; else why not,
 // with the valid names. Benchmarks name their figures after their solvers and
-// metrics: those are checked after the run only.
-std::string figure_problem(const Experiment& experiment, const std::string& figure);
+// metrics: those are checked after the run only. Without `fit_figures` a
+// fit's figures ("fit.*") pass: the reader checks them once the fit's
+// parameters are known good (setup_fit), so that a misnamed parameter is
+// the error a user sees first.
+std::string figure_problem(const Experiment& experiment, const std::string& figure,
+                           bool fit_figures = true);
 
 }  // namespace fiberfluid::experiment

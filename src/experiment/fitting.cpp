@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "experiment/figures.hpp"
 #include "geom/mesh_io.hpp"
 #include "geom/vtk_writer.hpp"
 #include "model/assembly.hpp"
@@ -131,6 +132,12 @@ FitSetup setup_fit(const Experiment& ex,
     } catch (const InputError& e) {
       p.field.fail("", e.what());
     }
+  }
+  // The fit's expected figures, now that its parameters are known good.
+  for (size_t k = 0; k < ex.expected.size(); ++k) {
+    const std::string problem = figure_problem(ex, ex.expected[k].figure);
+    if (!problem.empty())
+      FieldName{spec.field.file, ""}.fail("expected[" + std::to_string(k) + "].figure", problem);
   }
   fit::FitOptions options = spec.options;
   options.progress = std::move(progress);

@@ -66,6 +66,10 @@ TEST(FitConfig, BadFitSectionsAreNamed) {
   nlohmann::json d = sphere_fit_document();
   d["fit"]["parameters"][0]["name"] = "stiffness";
   expect_fit_error(d, "doc: fit.parameters[0].name: \"stiffness\" is not a parameter");
+  // A fit's figure that names no fitted parameter, once the parameters are good.
+  d = sphere_fit_document();
+  d["expected"][0]["figure"] = "fit.Yo";
+  expect_fit_error(d, "doc: expected[0].figure: no figure \"fit.Yo\" in this experiment");
   d = sphere_fit_document();
   d["fit"]["parameters"][0]["lower"] = 5000;
   expect_fit_error(d, "the start 1000 lies outside the bounds [5000, 1e+06]");
