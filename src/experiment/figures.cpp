@@ -47,31 +47,25 @@ bool vertex_and_axis(const std::string& rest) {
   return rest[dot + 1] >= 'x' && rest[dot + 1] <= 'z';
 }
 
-// The figures of one case's runs (no variant prefix), and the patterns.
-bool is_run_figure(const CaseSpec& spec, const std::string& name) {
-  const std::vector<std::string>& always = run_figure_names();
-  if (std::find(always.begin(), always.end(), name) != always.end()) return true;
-  if (std::find(kOptionalRunFigures.begin(), kOptionalRunFigures.end(), name) !=
-      kOptionalRunFigures.end())
-    return true;
-  for (const PaddleSpec& p : spec.paddles)
-    if (name == "paddle_force." + p.paddle.label || name == "paddle_contacts." + p.paddle.label)
-      return true;
-  for (const std::string prefix : {"position.", "displacement."})
-    if (name.rfind(prefix, 0) == 0 && vertex_and_axis(name.substr(prefix.size()))) return true;
-  return false;
-}
-
-std::vector<std::string> run_names(const CaseSpec& spec) {
+// The figures of one case's runs (no variant prefix); with `patterns`, the
+// vertex figures' forms (position.I.x) too, for messages.
+std::vector<std::string> run_names(const CaseSpec& spec, bool patterns) {
   std::vector<std::string> names = run_figure_names();
   names.insert(names.end(), kOptionalRunFigures.begin(), kOptionalRunFigures.end());
   for (const PaddleSpec& p : spec.paddles) {
     names.push_back("paddle_force." + p.paddle.label);
     names.push_back("paddle_contacts." + p.paddle.label);
   }
-  names.push_back("position.I.x");
-  names.push_back("displacement.I.x");
+  if (patterns) names.insert(names.end(), {"position.I.x", "displacement.I.x"});
   return names;
+}
+
+bool is_run_figure(const CaseSpec& spec, const std::string& name) {
+  const std::vector<std::string> names = run_names(spec, /*patterns=*/false);
+  if (std::find(names.begin(), names.end(), name) != names.end()) return true;
+  for (const std::string prefix : {"position.", "displacement."})
+    if (name.rfind(prefix, 0) == 0 && vertex_and_axis(name.substr(prefix.size()))) return true;
+  return false;
 }
 
 std::string listed(const std::vector<std::string>& names) {
@@ -140,7 +134,7 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
         const std::string prefix = spec.variant.empty() ? "" : spec.variant + ".";
         if (figure.rfind(prefix, 0) == 0 && is_run_figure(spec, figure.substr(prefix.size())))
           return {};
-        for (const std::string& f : run_names(spec)) valid.push_back(prefix + f);
+        for (const std::string& f : run_names(spec, /*patterns=*/true)) valid.push_back(prefix + f);
       }
       break;
     }

@@ -375,6 +375,8 @@ TEST(ExperimentConfig, AnUnknownExpectedFigureIsAnErrorWhenTheFileIsRead) {
                       "max_displacement, final_pressure");
   c["expected"][0]["figure"] = "position.3.q";
   expect_config_error(dir, c, "expected[0].figure: no figure \"position.3.q\"");
+  c["expected"][0]["figure"] = "position.I.x";  // the form the message shows, not a figure
+  expect_config_error(dir, c, "expected[0].figure: no figure \"position.I.x\"");
   c["expected"][0]["figure"] = "paddle_force.top";  // no such paddle
   expect_config_error(dir, c, "expected[0].figure: no figure \"paddle_force.top\"");
   c["expected"][0]["figure"] = "fit.Y";  // no fit section
