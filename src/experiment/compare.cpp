@@ -11,14 +11,10 @@ namespace fiberfluid::experiment {
 
 namespace {
 
-double diagonal(const geom::Surface& s) {
-  return s.num_vertices() == 0 ? 0.0 : (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).norm();
-}
-
 // A scan in mm beside a model in m gives metrics that mean nothing: say so.
 void warn_of_scale_mismatch(const geom::Surface& a, const geom::Surface& b,
                             const std::string& a_label, const std::string& b_label, Comparison& c) {
-  const double size_a = diagonal(a), size_b = diagonal(b);
+  const double size_a = geom::bounding_box_diagonal(a.V), size_b = geom::bounding_box_diagonal(b.V);
   if (!(size_a > 0.0 && size_b > 0.0)) return;
   const double ratio = std::max(size_a, size_b) / std::min(size_a, size_b);
   if (ratio <= kScaleMismatch) return;

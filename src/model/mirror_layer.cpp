@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "geom/surface.hpp"
 #include "model/fiber_network.hpp"
 #include "model/pair_stencil.hpp"
 
@@ -32,8 +33,7 @@ std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector
                              MirrorLayer* layer) {
   if (held.empty()) return "it holds no vertex";
   const int dim = static_cast<int>(reference.cols());
-  const double size = (reference.colwise().maxCoeff() - reference.colwise().minCoeff()).norm();
-  const double tolerance = 1e-6 * size;
+  const double tolerance = 1e-6 * geom::bounding_box_diagonal(reference);
   Eigen::MatrixXd points(static_cast<Eigen::Index>(held.size()), dim);
   for (size_t k = 0; k < held.size(); ++k)
     points.row(static_cast<Eigen::Index>(k)) = reference.row(held[k]);
@@ -68,7 +68,7 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
                                             const Eigen::VectorXd& area0) {
   const Eigen::MatrixXd& V = model.surface.V;
   const int n = model.num_vertices();
-  const double size = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  const double size = geom::bounding_box_diagonal(V);
   // Vertices on the plane are their own images: their fibers are the bulk's.
   std::vector<int> near;
   std::vector<double> height(static_cast<size_t>(n), 0.0);
