@@ -12,6 +12,7 @@
 #include <istream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <utility>
 
 #include "geom/generators.hpp"
@@ -770,6 +771,13 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   }
   check_expected_names(root, ex);
   return ex;
+}
+
+void require_built(const Experiment& experiment) {
+  if (!experiment.built())
+    throw std::logic_error("experiment " + experiment.name +
+                           " is not built: call build_experiment after read_experiment (or "
+                           "parse_experiment, load_experiment)");
 }
 
 void build_experiment(Experiment& ex, const geom::Surface* surface) {

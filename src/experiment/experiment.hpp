@@ -82,7 +82,14 @@ struct Experiment {
   std::vector<std::string> warnings;  // e.g. from the mesh reader
 
   bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
+  // Whether build_experiment has made what running needs (read_experiment leaves it unbuilt).
+  bool built() const {
+    return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
+  }
 };
+// Throws std::logic_error unless the experiment is built: a program that ran
+// read_experiment without build_experiment is told so instead of crashing.
+void require_built(const Experiment& experiment);
 
 // Reads and validates an experiment file, then builds it. Throws InputError
 // naming the file and the field (e.g. "sphere.json: material.Y: expected a

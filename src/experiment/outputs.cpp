@@ -460,6 +460,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
 
 OutputWriter::OutputWriter(const Experiment& experiment, fs::path folder)
     : experiment_(experiment), target_(std::move(folder)), result_folder_(target_) {
+  require_built(experiment_);
   check_replaceable(target_);
 }
 

@@ -235,6 +235,7 @@ static void for_each_case(size_t count, int jobs, const std::function<void(size_
 
 ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
                                 const RunOptions& options) {
+  require_built(ex);
   ExperimentResult result;
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
