@@ -235,7 +235,8 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
     if (m.options.symmetric) m.residuals += static_cast<int>(t.target.points.rows());
   }
   std::sort(m.target_steps.begin(), m.target_steps.end());
-  m.analytic = !m.options.finite_differences && m.stepping.scheme == solve::Scheme::Newton;
+  m.analytic = !m.options.finite_differences && m.stepping.scheme == solve::Scheme::Newton &&
+               solve::sensitivity_problem(m.model).empty();
   if (m.residuals < m.map.size())
     throw InputError("fewer distances (" + std::to_string(m.residuals) + ") than parameters (" +
                      std::to_string(m.map.size()) + ")");

@@ -135,11 +135,20 @@ struct StepRecord {
     double travel = 0.0;                              // how far it has moved
     Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the body
     int contacts = 0;                                 // vertices held on it
+    // At the steps SteppingOptions::sensitivities lists: d force / d theta,
+    // 3 x parameters.
+    Eigen::MatrixXd force_sensitivities;
   };
   std::vector<PaddleState> paddles;  // one per Model::paddles
   // At the steps SteppingOptions::sensitivities lists: du/dtheta, full
   // layout (zero at held unknowns), one column per parameter.
   Eigen::MatrixXd sensitivities;
+  // Newton: per support group, the mean displacement of its held unknowns
+  // along each axis (its travel, for a group moved as one), and at the
+  // sensitivities' steps d reaction / d theta (3 x parameters; NaN for a
+  // group with a mirror layer, whose fibers' share is not differentiated).
+  std::vector<Eigen::Vector3d> support_travel;
+  std::vector<Eigen::MatrixXd> reaction_sensitivities;
 };
 
 struct SteppingSummary {
@@ -196,6 +205,12 @@ std::string treecode_problem(const model::Model& model, const SteppingOptions& o
 // why not: every kinematics but the paper's vector spring needs the Newton
 // scheme (the incremental scheme's matrix is the vector spring's).
 std::string kinematics_problem(const model::Model& model, const SteppingOptions& options);
+
+// "" when the Newton stepper's analytic sensitivities (du/dtheta and the
+// forces' derivatives) are exact for this model, else why not: a sticking
+// paddle holds each vertex where it first touched, and that place moves with
+// the parameters, which the sensitivities take as fixed.
+std::string sensitivity_problem(const model::Model& model);
 
 // "" when the model's mirror layers (model::MirrorLayer) can run with these
 // options, else why not: they need the Newton scheme.

@@ -103,17 +103,23 @@ class NewtonSolver {
 
   // du/dtheta = -K_T^{-1} dR/dtheta at the solution x, one tangent solve per
   // parameter, the held set (supports and contacts) fixed. "" or why not.
+  // `residual_change` receives dR/dtheta along the solution's change,
+  // K_T du/dtheta + dR/dtheta: zero at the free rows, and at the held ones
+  // the change of the supports' and paddles' forces.
   std::string sensitivities(const PathPoint& at, const Eigen::VectorXd& x,
-                            const std::vector<std::string>& names, Eigen::MatrixXd* out) {
+                            const std::vector<std::string>& names, Eigen::MatrixXd* out,
+                            Eigen::MatrixXd* residual_change) {
     const std::shared_ptr<TangentSolve> tangent = final_tangent(at, x);
     if (!tangent) return "the tangent at the solution could not be factored";
     const Eigen::MatrixXd dR = equilibrium_->parameter_derivatives(x, names);
     out->resize(x.size(), dR.cols());
+    residual_change->resize(x.size(), dR.cols());
     for (Eigen::Index c = 0; c < dR.cols(); ++c) {
       Eigen::VectorXd du;
       const Status status = tangent->solve_full(-dR.col(c), &du);
       if (!status.ok) return names[static_cast<size_t>(c)] + ": " + status.message;
       out->col(c) = du;
+      residual_change->col(c) = equilibrium_->tangent_product(x, at.factors, du) + dR.col(c);
     }
     return {};
   }
@@ -562,6 +568,19 @@ bool partition_holds(const model::DofPartition& partition, int dof) {
   return std::binary_search(partition.constrained.begin(), partition.constrained.end(), dof);
 }
 
+}  // namespace
+
+std::string sensitivity_problem(const Model& model) {
+  for (const model::Paddle& paddle : model.paddles)
+    if (paddle.sticking)
+      return "paddle " + paddle.label +
+             " sticks: it holds each vertex where it touched, a place that moves with the "
+             "parameters (fit with finite differences)";
+  return {};
+}
+
+namespace {
+
 // Why a paddle setup cannot work, or "".
 std::string paddle_problem(const Model& model, int steps) {
   const Eigen::MatrixXd& V = model.surface.V;
@@ -652,16 +671,65 @@ class StepFinisher {
     record.volume_drift = (volume - reference_volume_) / reference_volume_;
     record.max_displacement = (X - model_.surface.V).rowwise().norm().maxCoeff();
     record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
+    record.support_travel.assign(groups_, Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector3i> held_per_axis(groups_, Eigen::Vector3i::Zero());
+    for (size_t c = 0; c < partition_.constrained.size(); ++c) {
+      const int d = partition_.constrained[c];
+      const size_t g =
+          static_cast<size_t>(
+              model_.constraints[static_cast<size_t>(partition_.constraint_of[c])].group) %
+          groups_;
+      record.support_travel[g][d / nv] += x[d];
+      ++held_per_axis[g][d / nv];
+    }
+    for (size_t g = 0; g < groups_; ++g)
+      for (int a = 0; a < 3; ++a)
+        if (held_per_axis[g][a] > 0) record.support_travel[g][a] /= held_per_axis[g][a];
     const std::vector<int>& wanted = options_.sensitivities.steps;
     if (!options_.sensitivities.parameters.empty() &&
         std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
-      why = solver_.sensitivities(at, x, options_.sensitivities.parameters, &record.sensitivities);
+      Eigen::MatrixXd residual_change;
+      why = solver_.sensitivities(at, x, options_.sensitivities.parameters, &record.sensitivities,
+                                  &residual_change);
       if (!why.empty()) return "step " + std::to_string(k) + ": sensitivities: " + why;
+      force_sensitivities(residual_change, record);
     }
     return {};
   }
 
  private:
+  // The reactions' and paddle forces' derivatives, read off the held rows of
+  // the residual's change (columns: the parameters). A group whose mirror
+  // layer carries part of its reaction gets NaN: the layer's fibers are not
+  // differentiated here.
+  void force_sensitivities(const Eigen::MatrixXd& residual_change, StepRecord& record) const {
+    const int nv = model_.num_vertices(), dim = model_.dim();
+    const Eigen::Index P = residual_change.cols();
+    record.reaction_sensitivities.assign(groups_, Eigen::MatrixXd::Zero(3, P));
+    for (size_t c = 0; c < partition_.constrained.size(); ++c) {
+      const int d = partition_.constrained[c];
+      const size_t g =
+          static_cast<size_t>(
+              model_.constraints[static_cast<size_t>(partition_.constraint_of[c])].group) %
+          groups_;
+      record.reaction_sensitivities[g].row(d / nv) += residual_change.row(d);
+    }
+    for (const model::MirrorLayer& layer : model_.mirror_layers)
+      record.reaction_sensitivities[static_cast<size_t>(layer.group) % groups_].setConstant(
+          std::numeric_limits<double>::quiet_NaN());
+    for (StepRecord::PaddleState& state : record.paddles)
+      state.force_sensitivities = Eigen::MatrixXd::Zero(3, P);
+    const model::DofMap held = solver_.held_map();
+    for (int v = 0; v < nv; ++v) {
+      const int p = solver_.contact_paddle()[static_cast<size_t>(v)];
+      if (p < 0) continue;
+      for (int a = 0; a < dim; ++a)
+        if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v))
+          record.paddles[static_cast<size_t>(p)].force_sensitivities.row(a) +=
+              residual_change.row(a * nv + v);
+    }
+  }
+
   const Model& model_;
   const SteppingOptions& options_;
   NewtonSolver& solver_;
@@ -703,6 +771,8 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   for (const std::string& name : options.sensitivities.parameters)
     if (!model.material.has_parameter(name, model.dim()))
       return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
+  if (!options.sensitivities.parameters.empty() && (why = sensitivity_problem(model)) != "")
+    return fail("sensitivities: " + why);
   model::DofPartition partition;
   std::unique_ptr<NewtonSolver> solver;
   try {

@@ -310,6 +310,61 @@ TEST(Newton, PaddleContactPushesHoldsAndBalances) {
   }
 }
 
+// The forces' sensitivities (the paddle's and the supports' reaction, read
+// off the held rows of K_T du/dtheta + dR/dtheta) against central
+// differences of whole runs; the supports' travel is their held displacement.
+TEST(Newton, ForceSensitivitiesMatchFiniteDifferences) {
+  {  // A sticking paddle holds vertices where they touched: a place that moves with the parameters.
+    SteppingOptions o = newton(2);
+    o.sensitivities = {{"gamma"}, {2}};
+    EXPECT_NE(solve_load_steps(pressed_sphere(true), o).message.find("paddle top sticks"),
+              std::string::npos);
+  }
+  for (bool sticking : {false}) {
+    model::Model m = pressed_sphere(sticking);
+    m.material.law = model::FiberLaw::exponential(3000.0, 5.0);
+    for (model::Constraint& c : m.constraints)
+      if (c.axis == 2) c.value = -0.05;  // the resting supports sink as the paddle comes down
+    const std::vector<std::string> names = {"Y0", "beta", "gamma"};
+    auto final_forces = [&](const std::string& name, double delta) {
+      model::Model changed = m;
+      if (name == "gamma")
+        changed.material.surface_tension += delta;
+      else
+        changed.material.law.set_parameter(name, changed.material.law.parameter(name) + delta);
+      SteppingOptions plain = newton(4);
+      plain.newton.residual_tolerance = 1e-13;
+      const SteppingSummary run = solve_load_steps(changed, plain);
+      EXPECT_TRUE(run.success) << run.message;
+      return std::make_pair(run.steps.back().paddles[0].force, run.steps.back().reactions[0]);
+    };
+    SteppingOptions o = newton(4);
+    o.newton.residual_tolerance = 1e-13;
+    o.sensitivities = {names, {4}};
+    const SteppingSummary s = solve_load_steps(m, o);
+    ASSERT_TRUE(s.success) << s.message;
+    const StepRecord& last = s.steps.back();
+    EXPECT_NEAR(last.support_travel[0].z(), -0.05, 1e-15);
+    EXPECT_NEAR(s.steps[1].support_travel[0].z(), -0.025, 1e-15);
+    EXPECT_EQ(last.support_travel[0].x(), 0.0);
+    ASSERT_EQ(last.reaction_sensitivities.size(), 1u);
+    for (size_t p = 0; p < names.size(); ++p) {
+      const double h = names[p] == "beta" ? 1e-4 : 0.1;
+      const auto plus = final_forces(names[p], h), minus = final_forces(names[p], -h);
+      const Eigen::Vector3d paddle = (plus.first - minus.first) / (2.0 * h);
+      const Eigen::Vector3d support = (plus.second - minus.second) / (2.0 * h);
+      const auto column = static_cast<Eigen::Index>(p);
+      EXPECT_GT(paddle.norm(), 0.0) << names[p];
+      EXPECT_LT((last.paddles[0].force_sensitivities.col(column) - paddle).norm(),
+                1e-5 * paddle.norm())
+          << names[p] << " sticking " << sticking;
+      EXPECT_LT((last.reaction_sensitivities[0].col(column) - support).norm(),
+                1e-5 * support.norm())
+          << names[p] << " sticking " << sticking;
+    }
+  }
+}
+
 // The predictor (the path extrapolated to each step's guess) and the active
 // set updated within Newton's iterations change the work, not the answer.
 TEST(Newton, ThePredictorSavesIterationsAndKeepsTheAnswer) {
