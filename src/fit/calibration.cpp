@@ -84,6 +84,15 @@ Eigen::Vector3d direction(const Eigen::Vector3d& q, const Eigen::Vector3d& c, co
   return (b - a).cross(e - a).normalized();
 }
 
+// The force a curve reads from a step's record: its paddle's or its
+// support group's (before the curve's sign convention).
+Eigen::Vector3d curve_force_vector(const ForceCurve& curve, const solve::StepRecord& record) {
+  const size_t i = static_cast<size_t>(curve.index);
+  if (curve.source == ForceCurve::Source::Paddle)
+    return i < record.paddles.size() ? record.paddles[i].force : Eigen::Vector3d::Zero();
+  return i < record.reactions.size() ? record.reactions[i] : Eigen::Vector3d::Zero();
+}
+
 Eigen::Vector3d bounding_low(const Eigen::MatrixXd& P) {
   return P.colwise().minCoeff().transpose();
 }
@@ -157,11 +166,23 @@ void check_options(const FitOptions& o) {
                      std::to_string(o.max_evaluations));
 }
 
+// Where a force curve's row reads the run: F = (1 - s) F(k0) + s F(k1),
+// with F(0) = 0 (the unloaded reference).
+struct CurveRow {
+  int k0 = 0, k1 = 0;
+  double s = 0.0;
+};
+
 struct Calibration::Impl {
   model::Model model;
   solve::SteppingOptions stepping;
   std::vector<MeasuredStep> targets;
-  std::vector<TargetDistance> distances;  // one per target
+  std::vector<ForceCurve> curves;
+  std::vector<std::vector<CurveRow>> curve_rows;  // per curve, per row
+  std::vector<double> curve_weights;              // m per N, as used
+  std::vector<int> force_steps;                   // the distinct steps the curves read (>= 1)
+  std::vector<int> state_steps;                   // target_steps and force_steps
+  std::vector<TargetDistance> distances;          // one per target
   ParameterMap map;
   FitOptions options;
   std::vector<int> counted;       // model vertices whose distances count
@@ -171,24 +192,79 @@ struct Calibration::Impl {
   int residuals = 0;
 
   Impl(model::Model m, solve::SteppingOptions s, std::vector<MeasuredStep> t,
-       std::vector<Parameter> p, FitOptions o)
+       std::vector<Parameter> p, FitOptions o, std::vector<ForceCurve> c)
       : model(std::move(m)),
         stepping(std::move(s)),
         targets(std::move(t)),
+        curves(std::move(c)),
         map(std::move(p), model.material, model.dim()),
         options(std::move(o)) {
     check_options(options);
   }
 };
 
+namespace {
+
+// The rows of a force curve: where each reads the run. Throws InputError
+// naming the curve for a step outside the run, a travel the run does not
+// reach, or a travel that does not change with every step.
+std::vector<CurveRow> plan_curve(const ForceCurve& curve, const model::Model& model, int steps) {
+  std::vector<CurveRow> rows;
+  if (curve.by_step) {
+    for (size_t r = 0; r < curve.at.size(); ++r) {
+      const double k = curve.at[r];
+      if (!(k >= 1 && k <= steps && k == std::floor(k))) {
+        std::ostringstream why;
+        why << curve.label << ": row " << r + 1 << ": step " << k
+            << " is not one of the run's steps 1.." << steps;
+        throw InputError(why.str());
+      }
+      rows.push_back({static_cast<int>(k), static_cast<int>(k), 0.0});
+    }
+    return rows;
+  }
+  std::vector<double> travel(static_cast<size_t>(steps) + 1);
+  for (int k = 0; k <= steps; ++k)
+    travel[static_cast<size_t>(k)] = curve_travel(curve, model, k, steps);
+  const double direction = travel[1] > travel[0] ? 1.0 : -1.0;  // as the first step goes
+  for (int k = 1; k <= steps; ++k) {
+    const double change = travel[static_cast<size_t>(k)] - travel[static_cast<size_t>(k) - 1];
+    if (!(direction * change > 0.0)) {
+      std::ostringstream why;
+      why << curve.label << ": the travel does not move on with every step (step " << k << ": from "
+          << travel[static_cast<size_t>(k) - 1] << " to " << travel[static_cast<size_t>(k)]
+          << " m): rows cannot be placed by travel; tie them to steps (a step column)";
+      throw InputError(why.str());
+    }
+  }
+  for (size_t r = 0; r < curve.at.size(); ++r) {
+    const double t = curve.at[r];
+    int k = 0;
+    while (k < steps && direction * (t - travel[static_cast<size_t>(k) + 1]) > 0.0) ++k;
+    const double low = travel[static_cast<size_t>(k)], high = travel[static_cast<size_t>(k) + 1];
+    if (k == steps || direction * (t - low) < 0.0) {
+      std::ostringstream why;
+      why << curve.label << ": row " << r + 1 << ": travel " << t
+          << " m is outside the run's, from " << travel.front() << " to " << travel.back() << " m";
+      throw InputError(why.str());
+    }
+    rows.push_back({k, k + 1, (t - low) / (high - low)});
+  }
+  return rows;
+}
+
+}  // namespace
+
 Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
                          std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
-                         FitOptions options)
+                         FitOptions options, std::vector<ForceCurve> force_curves)
     : impl_(std::make_unique<Impl>(std::move(model), std::move(stepping), std::move(targets),
-                                   std::move(parameters), std::move(options))) {
+                                   std::move(parameters), std::move(options),
+                                   std::move(force_curves))) {
   Impl& m = *impl_;
   if (m.model.dim() != 3) throw InputError("calibration fits 3D surfaces; this model is 2D");
-  if (m.targets.empty()) throw InputError("nothing to fit to: no target surface");
+  if (m.targets.empty() && m.curves.empty())
+    throw InputError("nothing to fit to: no target surface and no force curve");
   const int n = m.model.num_vertices();
   if (m.options.counted_vertices.empty()) {
     for (int i = 0; i < n; ++i) m.counted.push_back(i);
@@ -235,6 +311,25 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
     if (m.options.symmetric) m.residuals += static_cast<int>(t.target.points.rows());
   }
   std::sort(m.target_steps.begin(), m.target_steps.end());
+  for (const ForceCurve& curve : m.curves) {
+    const std::string why = force_curve_problem(curve, m.model);
+    if (!why.empty()) throw InputError(curve.label + ": " + why);
+    m.curve_rows.push_back(plan_curve(curve, m.model, m.stepping.steps));
+    for (const CurveRow& row : m.curve_rows.back())
+      for (int k : {row.k0, row.k1})
+        if (k >= 1) m.force_steps.push_back(k);
+    double largest = 0.0;
+    for (const double f : curve.force) largest = std::max(largest, std::abs(f));
+    if (curve.weight == 0.0 && largest == 0.0)
+      throw InputError(curve.label +
+                       ": every measured force is 0: give the curve a weight (m per N)");
+    m.curve_weights.push_back(curve.weight > 0.0 ? curve.weight : m.length / largest);
+    m.residuals += static_cast<int>(curve.force.size());
+  }
+  std::sort(m.force_steps.begin(), m.force_steps.end());
+  m.force_steps.erase(std::unique(m.force_steps.begin(), m.force_steps.end()), m.force_steps.end());
+  std::set_union(m.target_steps.begin(), m.target_steps.end(), m.force_steps.begin(),
+                 m.force_steps.end(), std::back_inserter(m.state_steps));
   m.analytic = !m.options.finite_differences && m.stepping.scheme == solve::Scheme::Newton &&
                solve::sensitivity_problem(m.model).empty();
   if (m.residuals < m.map.size())
@@ -255,6 +350,8 @@ bool Calibration::analytic_jacobian() const { return impl_->analytic; }
 int Calibration::num_residuals() const { return impl_->residuals; }
 int Calibration::num_counted_vertices() const { return static_cast<int>(impl_->counted.size()); }
 double Calibration::body_length() const { return impl_->length; }
+const std::vector<ForceCurve>& Calibration::force_curves() const { return impl_->curves; }
+double Calibration::force_weight(size_t curve) const { return impl_->curve_weights.at(curve); }
 
 double Calibration::cost(const Eigen::VectorXd& r) const {
   const double d = impl_->options.loss_scale, d2 = d * d;
@@ -294,14 +391,22 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   const bool sensitivities_wanted = with_jacobian && !map.material_names().empty();
   solve::SteppingOptions stepping = m.stepping;
   if (sensitivities_wanted && m.analytic)
-    stepping.sensitivities = {map.material_names(), m.target_steps};
-  std::map<int, Eigen::VectorXd> states;
+    stepping.sensitivities = {map.material_names(), m.state_steps};
+  // Per step read: the state, and each force curve's force.
+  struct StepState {
+    Eigen::VectorXd x;
+    std::vector<double> forces;
+  };
+  std::map<int, StepState> states;
   auto run = [&](const model::Model& model, const solve::SteppingOptions& options,
-                 std::map<int, Eigen::VectorXd>& at) {
+                 std::map<int, StepState>& at) {
     return solve::solve_load_steps(
         model, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
-          if (std::binary_search(m.target_steps.begin(), m.target_steps.end(), r.step))
-            at[r.step] = x;
+          if (!std::binary_search(m.state_steps.begin(), m.state_steps.end(), r.step)) return;
+          StepState& state = at[r.step];
+          state.x = x;
+          for (const ForceCurve& curve : m.curves)
+            state.forces.push_back(curve_force(curve, model, curve_force_vector(curve, r)));
         });
   };
   e.summary = run(changed, stepping, states);
@@ -311,19 +416,37 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     return e;
   }
   const Eigen::VectorXd dvalue = map.value_derivatives(phi);
+  const int nm = static_cast<int>(map.material_names().size());
   std::map<int, Eigen::MatrixXd> sensitivity;  // per target step: #unknowns x material parameters
+  // Per step read, per force curve: dF/dtheta (material parameters).
+  std::map<int, std::vector<Eigen::RowVectorXd>> force_sensitivity;
   if (sensitivities_wanted && m.analytic) {
-    for (int step : m.target_steps) {
-      sensitivity[step] = e.summary.steps[static_cast<size_t>(step - 1)].sensitivities;
+    for (int step : m.state_steps) {
+      const solve::StepRecord& record = e.summary.steps[static_cast<size_t>(step - 1)];
+      sensitivity[step] = record.sensitivities;
       e.sensitivity_solves += static_cast<int>(sensitivity[step].cols());
+      for (const ForceCurve& curve : m.curves) {
+        const Eigen::MatrixXd& d =
+            curve.source == ForceCurve::Source::Paddle
+                ? record.paddles[static_cast<size_t>(curve.index)].force_sensitivities
+                : record.reaction_sensitivities[static_cast<size_t>(curve.index)];
+        Eigen::RowVectorXd row(nm);
+        for (int j = 0; j < nm; ++j) {
+          Eigen::Vector3d column = d.col(j);
+          row[j] = curve_force(curve, changed, column);
+        }
+        force_sensitivity[step].push_back(row);
+      }
     }
   } else if (sensitivities_wanted) {
-    const int nm = static_cast<int>(map.material_names().size());
-    for (int step : m.target_steps) sensitivity[step].resize(states.at(step).size(), nm);
+    for (int step : m.state_steps) {
+      sensitivity[step].resize(states.at(step).x.size(), nm);
+      force_sensitivity[step].assign(m.curves.size(), Eigen::RowVectorXd(nm));
+    }
     for (int j = 0; j < nm; ++j) {
       const int k = map.material_indices()[static_cast<size_t>(j)];
       const double h = m.options.difference_step * std::max(1.0, std::abs(phi[k]));
-      std::map<int, Eigen::VectorXd> plus, minus;
+      std::map<int, StepState> plus, minus;
       for (double sign : {1.0, -1.0}) {
         Eigen::VectorXd shifted = phi;
         shifted[k] += sign * h;
@@ -336,8 +459,13 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
           return e;
         }
       }
-      for (int step : m.target_steps)  // du/dtheta, as the stepper gives it
-        sensitivity[step].col(j) = (plus.at(step) - minus.at(step)) / (2.0 * h * dvalue[k]);
+      for (int step : m.state_steps) {  // du/dtheta, as the stepper gives it
+        const double denominator = 2.0 * h * dvalue[k];
+        sensitivity[step].col(j) = (plus.at(step).x - minus.at(step).x) / denominator;
+        for (size_t c = 0; c < m.curves.size(); ++c)
+          force_sensitivity[step][c][j] =
+              (plus.at(step).forces[c] - minus.at(step).forces[c]) / denominator;
+      }
     }
   }
   // The chain through the closest points is the same for both kinds of sensitivity.
@@ -374,7 +502,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   Eigen::Index row = 0;
   for (size_t t = 0; t < m.targets.size(); ++t) {
     const int step = m.targets[t].step;
-    const Eigen::MatrixXd X = model::positions(changed, states.at(step));
+    const Eigen::MatrixXd X = model::positions(changed, states.at(step).x);
     e.positions.push_back(X);
     const Eigen::MatrixXd* S = sensitivity.count(step) ? &sensitivity.at(step) : nullptr;
     const Target& target = m.targets[t].target;
@@ -432,8 +560,32 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
     }
   }
 
+  // The force curves: w (F(t) - F_measured), F between the steps around t.
+  for (size_t c = 0; c < m.curves.size(); ++c) {
+    const ForceCurve& curve = m.curves[c];
+    const double w = m.curve_weights[c];
+    e.forces.emplace_back();
+    for (size_t r = 0; r < curve.force.size(); ++r, ++row) {
+      const CurveRow& at = m.curve_rows[c][r];
+      double force = 0.0;
+      Eigen::RowVectorXd gradient = Eigen::RowVectorXd::Zero(nm);
+      for (const auto& [k, share] : {std::pair{at.k0, 1.0 - at.s}, std::pair{at.k1, at.s}}) {
+        if (k == 0 || share == 0.0) continue;  // the unloaded reference: no force
+        force += share * states.at(k).forces[c];
+        if (with_jacobian && nm > 0) gradient += share * force_sensitivity.at(k)[c];
+      }
+      e.forces.back().push_back(force);
+      e.residuals[row] = w * (force - curve.force[r]);
+      if (!with_jacobian) continue;
+      for (int j = 0; j < nm; ++j) {
+        const int k = map.material_indices()[static_cast<size_t>(j)];
+        e.jacobian(row, k) = w * gradient[j] * dvalue[k];
+      }
+    }
+  }
+
   e.ok = e.residuals.allFinite() && (!with_jacobian || e.jacobian.allFinite());
-  if (!e.ok) e.message = "non-finite distances";
+  if (!e.ok) e.message = "non-finite distances or forces";
   return e;
 }
 
@@ -640,6 +792,20 @@ FitResult Calibration::run() const {
   result.overall = distance_statistics(
       Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())),
       m.length);
+  for (size_t c = 0; c < m.curves.size(); ++c) {
+    ForceMisfit misfit;
+    misfit.simulated = best.forces[c];
+    misfit.weight = m.curve_weights[c];
+    double squares = 0.0;
+    for (size_t r = 0; r < misfit.simulated.size(); ++r) {
+      const double miss = misfit.simulated[r] - m.curves[c].force[r];
+      squares += miss * miss;
+      misfit.largest = std::max(misfit.largest, std::abs(miss));
+      misfit.scale = std::max(misfit.scale, std::abs(m.curves[c].force[r]));
+    }
+    misfit.rms = std::sqrt(squares / static_cast<double>(misfit.simulated.size()));
+    result.force_misfits.push_back(misfit);
+  }
   // The parameters on a bound, said whatever the ending (a fit that ran out
   // of iterations against a bound is the usual sign of a wrong model).
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/force_curve.hpp"
 #include "fit/parameters.hpp"
 #include "fit/target.hpp"
 #include "model/model.hpp"
@@ -118,12 +119,22 @@ void check_options(const FitOptions& options);
 struct Evaluation {
   bool ok = false;
   std::string message;        // why the forward run failed
-  Eigen::VectorXd residuals;  // m: the forward distances, then the symmetric ones
+  Eigen::VectorXd residuals;  // m: the forward distances, the symmetric ones, the force misfits
   Eigen::MatrixXd jacobian;   // d residual / d phi (phi: the fitted variables)
   solve::SteppingSummary summary;
-  std::vector<Eigen::MatrixXd> positions;  // per target: the model's positions at its step
+  std::vector<Eigen::MatrixXd> positions;   // per target: the model's positions at its step
+  std::vector<std::vector<double>> forces;  // per force curve: the simulated force per row (N)
   int forward_runs = 0;
   int sensitivity_solves = 0;
+};
+
+// How a fitted force curve misses its measurement.
+struct ForceMisfit {
+  std::vector<double> simulated;    // per row (N), at the fitted values
+  double rms = 0.0, largest = 0.0;  // of simulated - measured (N)
+  double scale = 0.0;               // the largest measured |force| (N): the shares' reference
+  double weight = 0.0;              // m per N, as used
+  double share(double value) const { return scale > 0.0 ? value / scale : 0.0; }
 };
 
 struct FitResult {
@@ -163,18 +174,21 @@ struct FitResult {
   std::vector<Eigen::VectorXd> vertex_distances;
   std::vector<DistanceStatistics> statistics;
   DistanceStatistics overall;
+  std::vector<ForceMisfit> force_misfits;  // per force curve, at the fitted values
 };
 
 class Calibration {
  public:
   // The model's material holds the values of the parameters that are not
-  // fitted; the parameters' starts replace the fitted ones. Throws InputError
+  // fitted; the parameters' starts replace the fitted ones. The residuals
+  // are the surfaces' distances (m), then the force curves' weighted misfits
+  // (m; either kind of target may be absent, not both). Throws InputError
   // (naming the parameter or the target) for a bad parameter, a target step
-  // outside the run, a counted vertex that does not exist, or a target that
-  // does not overlap the body.
+  // outside the run, a counted vertex that does not exist, a target that
+  // does not overlap the body, or a force curve beyond the run's travel.
   Calibration(model::Model model, solve::SteppingOptions stepping,
               std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
-              FitOptions options = {});
+              FitOptions options = {}, std::vector<ForceCurve> force_curves = {});
   ~Calibration();
 
   const ParameterMap& parameters() const;
@@ -185,6 +199,9 @@ class Calibration {
   int num_counted_vertices() const;
   // The body's length the distance shares refer to: its largest extent.
   double body_length() const;
+  // The force curves, and each one's weight as used (m per N).
+  const std::vector<ForceCurve>& force_curves() const;
+  double force_weight(size_t curve) const;
 
   // The residuals (and with_jacobian, their Jacobian) at the fitted variables phi.
   Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian) const;

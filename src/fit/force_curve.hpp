@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// A measured force curve as a fit target: the force a paddle (or a support
+// group) exerts on the body, against its travel or at load steps. The most
+// common measurement of a compression or indentation test; with a surface
+// scan it also fixes the scale that shapes alone cannot (under paddles
+// alone a modulus and the surface tension act only through their ratio).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "model/model.hpp"
+
+namespace fiberfluid::fit {
+
+struct ForceCurve {
+  std::string label;  // for messages: the file, or a name given by the program
+  enum class Source {
+    Paddle,   // Model::paddles[index]: its push on the body along its axis (positive)
+    Support,  // Model::constraint_groups[index]: its reaction's component `axis`
+  };
+  Source source = Source::Paddle;
+  int index = 0;
+  int axis = 0;  // Support: 0, 1, 2 = x, y, z (a paddle's is its own)
+  // Rows at load steps (1..steps), or at the travel: a paddle's distance
+  // from its start, a support group's mean held displacement along `axis`
+  // (m), interpolated linearly between the steps around it.
+  bool by_step = false;
+  std::vector<double> at;     // per row: the travel (m) or the step
+  std::vector<double> force;  // per row (N)
+  // How a force misfit counts against the surface distances: a misfit of
+  // 1 N is a residual of `weight` m. 0: the body's length over the largest
+  // measured force (a misfit of the whole force weighs as one body length).
+  double weight = 0.0;
+};
+
+// Reads a curve from CSV: a header naming the columns, `force` and either
+// `travel` or `step` (other columns are ignored); '#' starts a comment line.
+// Travel and force are multiplied by the scales (mm: 1e-3). Throws
+// InputError naming the file, and the line for a bad value.
+ForceCurve read_force_curve(const std::filesystem::path& path, double travel_scale = 1.0,
+                            double force_scale = 1.0);
+
+// A curve's force at a step from the run's record, by the curve's
+// convention: a paddle's push into the body, a support's reaction component.
+double curve_force(const ForceCurve& curve, const model::Model& model,
+                   const Eigen::Vector3d& paddle_or_reaction_force);
+
+// The travel of the curve's paddle or support group after step k of n, by
+// the schedules alone (it does not depend on the material).
+double curve_travel(const ForceCurve& curve, const model::Model& model, int step, int steps);
+
+// "" when the curve fits the model (its paddle or group exists, the axis is
+// one of the model's, a mirror layer does not carry the group's reaction),
+// else why not.
+std::string force_curve_problem(const ForceCurve& curve, const model::Model& model);
+
+}  // namespace fiberfluid::fit

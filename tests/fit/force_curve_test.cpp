@@ -1,0 +1,258 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Force curves as fit targets: the CSV reader, the rows' placement by travel
+// or step, their residuals' Jacobian against central differences, and what
+// a force curve adds: under paddles alone a modulus and the surface tension
+// act through their ratio (a surface cannot tell them apart); the force
+// fixes the scale.
+#include "fit/force_curve.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "fit/calibration.hpp"
+#include "geom/generators.hpp"
+#include "model/assembly.hpp"
+#include "model/boundary_conditions.hpp"
+#include "test_support.hpp"
+#include "util/error.hpp"
+
+namespace fiberfluid::fit {
+namespace {
+
+void expect_input_error(const std::function<void()>& action, const std::string& part) {
+  try {
+    action();
+    ADD_FAILURE() << "no error; expected one with: " << part;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+TEST(ForceCurve, TheReaderTakesTravelOrStepAndNamesWhatIsWrong) {
+  testing::ScratchDir dir;
+  const ForceCurve curve = read_force_curve(
+      dir.write("a.csv", "# a compression test\ntime, travel ,force\n0,0,0\n1, 2.5, -1.5\n\n"),
+      1e-3, 2.0);
+  EXPECT_FALSE(curve.by_step);
+  ASSERT_EQ(curve.at.size(), 2u);
+  EXPECT_DOUBLE_EQ(curve.at[1], 2.5e-3);
+  EXPECT_DOUBLE_EQ(curve.force[1], -3.0);
+  const ForceCurve by_step = read_force_curve(dir.write("b.csv", "step,force\n3,1.25\n"));
+  EXPECT_TRUE(by_step.by_step);
+  EXPECT_EQ(by_step.at[0], 3.0);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"", "empty"},
+      {"travel,load\n1,2\n", "line 1: expected a header with the columns force and travel"},
+      {"travel,step,force\n", "give a travel or a step column, not both"},
+      {"travel,force\n", "a header but no rows"},
+      {"travel,force\n1,abc\n", "line 2: expected a finite number in column 2, got \"abc\""},
+      {"travel,force\n1,nan\n", "line 2: expected a finite number"},
+      {"travel,force\n1,2,3\n", "line 2: expected 2 values as in the header, got 3"},
+      {"step,force\n2.5,1\n", "line 2: expected a load step"},
+      {"step,force\n0,1\n", "expected a load step"}};
+  for (const auto& [text, part] : bad) {
+    const auto file = dir.write("bad.csv", text);
+    expect_input_error([&] { read_force_curve(file); }, part);
+    expect_input_error([&] { read_force_curve(file); }, file.string());
+  }
+  expect_input_error([&] { read_force_curve(dir.path() / "missing.csv"); }, "cannot open");
+}
+
+// A small sphere (42 vertices) on supports that sink along z as a paddle
+// comes down on it from above, with gravity when asked.
+model::Model pressed_sphere(bool gravity, const model::FiberLaw& law) {
+  model::Model m;
+  m.surface = geom::icosphere(1, 0.05);
+  m.material.law = law;
+  m.material.surface_tension = 5.0;
+  m.constraint_groups = {"resting"};
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.04", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, a == 2 ? -0.002 : 0.0, {}, 0});
+  model::Paddle paddle;
+  paddle.label = "upper";
+  paddle.axis = 2;
+  paddle.above = true;
+  paddle.position = m.surface.V.col(2).maxCoeff();
+  paddle.travel = -0.02;
+  m.paddles = {paddle};
+  if (gravity) {
+    model::Load weight;
+    weight.kind = model::Load::Kind::Hydrostatic;
+    weight.acceleration = {0.0, 0.0, -9.81};
+    weight.density = 1000.0;
+    m.loads = {weight};
+  }
+  return m;
+}
+
+solve::SteppingOptions newton(int steps) {
+  solve::SteppingOptions o;
+  o.scheme = solve::Scheme::Newton;
+  o.steps = steps;
+  o.newton.residual_tolerance = 1e-13;
+  return o;
+}
+
+// The run's paddle push (into the body) and the supports' z reaction per step,
+// and its surfaces at `steps` as targets.
+struct Measured {
+  std::vector<double> paddle, support;
+  std::vector<MeasuredStep> surfaces;
+};
+Measured measure(const model::Model& m, int steps, const std::vector<int>& surface_steps) {
+  Measured out;
+  const solve::SteppingSummary s = solve::solve_load_steps(
+      m, newton(steps), [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+        out.paddle.push_back(-r.paddles[0].force.z());
+        out.support.push_back(r.reactions[0].z());
+        if (std::find(surface_steps.begin(), surface_steps.end(), r.step) != surface_steps.end())
+          out.surfaces.push_back(
+              {make_target("step " + std::to_string(r.step), model::positions(m, x), m.surface.F),
+               r.step});
+      });
+  EXPECT_TRUE(s.success) << s.message;
+  return out;
+}
+
+Parameter parameter(const std::string& name, double start, bool log = true) {
+  Parameter p;
+  p.name = name;
+  p.initial = start;
+  p.log_scale = log;
+  return p;
+}
+
+ForceCurve paddle_curve(const std::vector<double>& travel, const std::vector<double>& force) {
+  ForceCurve c;
+  c.label = "paddle curve";
+  c.at = travel;
+  c.force = force;
+  return c;
+}
+
+// Rows between steps read the force interpolated by travel; the Jacobian of
+// the force rows (Newton sensitivities of the held rows) matches central
+// differences of whole runs, and the finite-difference mode agrees.
+TEST(ForceCurve, ItsResidualsAndJacobianMatchTheRunAndFiniteDifferences) {
+  const model::Model m = pressed_sphere(true, model::FiberLaw::exponential(3000.0, 5.0));
+  const Measured truth = measure(m, 4, {4});
+  // The paddle travels 5 mm a step: 7.5 mm lies halfway between steps 1 and 2.
+  ForceCurve paddle = paddle_curve({0.0, 0.0075, 0.02}, {0.0, 1.0, 2.0});
+  ForceCurve support;
+  support.label = "support curve";
+  support.source = ForceCurve::Source::Support;
+  support.axis = 2;
+  support.by_step = true;
+  support.at = {2, 4};
+  support.force = {0.5, 1.5};
+  support.weight = 0.01;
+  const std::vector<Parameter> parameters = {parameter("Y0", 2500.0), parameter("beta", 4.0, false),
+                                             parameter("gamma", 7.0)};
+  const Calibration c(m, newton(4), truth.surfaces, parameters, {}, {paddle, support});
+  EXPECT_TRUE(c.analytic_jacobian());
+  EXPECT_DOUBLE_EQ(c.force_weight(0), c.body_length() / 2.0);  // the default: length / largest
+  EXPECT_DOUBLE_EQ(c.force_weight(1), 0.01);
+  EXPECT_EQ(c.num_residuals(), 42 + 3 + 2);
+  const Eigen::VectorXd phi = c.parameters().initial_phi();
+  const Evaluation e = c.evaluate(phi, true);
+  ASSERT_TRUE(e.ok) << e.message;
+  // At the truth's parameters the rows read the truth's forces.
+  const Calibration at_truth(
+      m, newton(4), truth.surfaces,
+      {parameter("Y0", 3000.0), parameter("beta", 5.0, false), parameter("gamma", 5.0)}, {},
+      {paddle, support});
+  const Evaluation t = at_truth.evaluate(at_truth.parameters().initial_phi(), false);
+  ASSERT_TRUE(t.ok) << t.message;
+  EXPECT_EQ(t.forces[0][0], 0.0);
+  EXPECT_NEAR(t.forces[0][1], 0.5 * (truth.paddle[0] + truth.paddle[1]), 1e-12);
+  EXPECT_NEAR(t.forces[0][2], truth.paddle[3], 1e-12);
+  EXPECT_NEAR(t.forces[1][1], truth.support[3], 1e-12);
+  EXPECT_NEAR(t.residuals[42 + 1], at_truth.force_weight(0) * (t.forces[0][1] - 1.0), 1e-15);
+  for (int k = 0; k < phi.size(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd plus = phi, minus = phi;
+    plus[k] += h;
+    minus[k] -= h;
+    const Eigen::VectorXd fd =
+        (c.evaluate(plus, false).residuals - c.evaluate(minus, false).residuals) / (2.0 * h);
+    const Eigen::VectorXd forces = fd.tail(5), analytic = e.jacobian.col(k).tail(5);
+    EXPECT_GT(forces.norm(), 0.0);
+    EXPECT_LT((analytic - forces).norm(), 1e-5 * forces.norm())
+        << c.parameters().parameters()[static_cast<size_t>(k)].name;
+  }
+  FitOptions differences;
+  differences.finite_differences = true;
+  const Calibration by_differences(m, newton(4), truth.surfaces, parameters, differences,
+                                   {paddle, support});
+  const Evaluation d = by_differences.evaluate(phi, true);
+  ASSERT_TRUE(d.ok) << d.message;
+  EXPECT_LT((d.jacobian.bottomRows(5) - e.jacobian.bottomRows(5)).norm(),
+            1e-6 * e.jacobian.bottomRows(5).norm());
+}
+
+TEST(ForceCurve, ACurveTheRunCannotPlaceIsNamed) {
+  const model::Model m = pressed_sphere(false, model::FiberLaw::constant(3000.0));
+  const std::vector<Parameter> y = {parameter("Y", 2000.0)};
+  auto build = [&](const model::Model& model, const ForceCurve& curve) {
+    return [=] { Calibration(model, newton(4), {}, y, {}, {curve}); };
+  };
+  expect_input_error(build(m, paddle_curve({0.0, 0.03}, {0.0, 1.0})),
+                     "paddle curve: row 2: travel 0.03 m is outside the run's, from 0 to 0.02 m");
+  expect_input_error(build(m, paddle_curve({-0.001}, {1.0})), "row 1: travel -0.001 m is outside");
+  ForceCurve step = paddle_curve({5}, {1.0});
+  step.by_step = true;
+  expect_input_error(build(m, step), "row 1: step 5 is not one of the run's steps 1..4");
+  expect_input_error(build(m, paddle_curve({0.01}, {0.0})),
+                     "every measured force is 0: give the curve a weight");
+  model::Model up_down = m;
+  up_down.paddles[0].schedule.kind = model::Schedule::Kind::UpDown;
+  expect_input_error(build(up_down, paddle_curve({0.01}, {1.0})),
+                     "the travel does not move on with every step (step 3");
+  ForceCurve missing = paddle_curve({0.01}, {1.0});
+  missing.index = 1;
+  expect_input_error(build(m, missing), "paddle 1 does not exist (the model has 1)");
+  ForceCurve sideways = missing;
+  sideways.source = ForceCurve::Source::Support;
+  sideways.index = 0;
+  sideways.axis = 2;
+  sideways.by_step = true;
+  sideways.at = {1};
+  model::Model held_in_x = m;
+  for (model::Constraint& constraint : held_in_x.constraints) constraint.axis = 0;
+  expect_input_error(build(held_in_x, sideways), "support resting holds no vertex along axis z");
+  expect_input_error([&] { Calibration(m, newton(4), {}, y, {}, {}); },
+                     "nothing to fit to: no target surface and no force curve");
+}
+
+// Under paddles alone (no weight) the shape depends on Y and gamma only
+// through their ratio: a surface fit is not identifiable and says which
+// parameters it cannot tell apart. The force curve fixes the scale: the
+// same fit with it recovers both.
+TEST(ForceCurve, APaddlesOnlySurfaceFitCannotTellYFromGammaAndTheForceCurveCan) {
+  const model::Model m = pressed_sphere(false, model::FiberLaw::constant(3000.0));
+  const Measured truth = measure(m, 4, {4});
+  const std::vector<Parameter> start = {parameter("Y", 6000.0), parameter("gamma", 2.0)};
+  const FitResult shapes = Calibration(m, newton(4), truth.surfaces, start).run();
+  EXPECT_EQ(shapes.status, FitStatus::NotIdentifiable) << to_string(shapes.status);
+  EXPECT_NE(shapes.status_detail.find("cannot tell \"Y\", \"gamma\" apart"), std::string::npos)
+      << shapes.status_detail;
+  const ForceCurve curve =
+      paddle_curve({0.005, 0.01, 0.015, 0.02},
+                   {truth.paddle[0], truth.paddle[1], truth.paddle[2], truth.paddle[3]});
+  const FitResult both = Calibration(m, newton(4), truth.surfaces, start, {}, {curve}).run();
+  ASSERT_EQ(both.status, FitStatus::Converged) << both.message << both.status_detail;
+  EXPECT_NEAR(both.values[0] / 3000.0, 1.0, 1e-6);
+  EXPECT_NEAR(both.values[1] / 5.0, 1.0, 1e-6);
+  ASSERT_EQ(both.force_misfits.size(), 1u);
+  EXPECT_LT(both.force_misfits[0].rms, 1e-8 * both.force_misfits[0].scale);
+  EXPECT_DOUBLE_EQ(both.force_misfits[0].scale, truth.paddle[3]);
+  // The force curve alone fixes the scale too, and the ratio with it.
+  const FitResult force_only = Calibration(m, newton(4), {}, start, {}, {curve}).run();
+  ASSERT_EQ(force_only.status, FitStatus::Converged) << force_only.status_detail;
+  EXPECT_NEAR(force_only.values[0] / 3000.0, 1.0, 1e-5);
+  EXPECT_EQ(force_only.overall.count, 0);
+}
+
+}  // namespace
+}  // namespace fiberfluid::fit
