@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Makes the synthetic scans of fit_synthetic_liver (data/targets/).
+"""Makes the synthetic scans of fit_synthetic_liver and fit_remeshed_liver (data/targets/).
 
 Runs experiments/fit_synthetic_liver_truth.json (known parameters), takes its
 deformed surfaces at load steps 4, 7 and 10, and writes for each:
@@ -10,6 +10,13 @@ deformed surfaces at load steps 4, 7 and 10, and writes for each:
                                surface is the same), the vertices shuffled, and
                                Gaussian noise of 0.5 mm (standard deviation per
                                coordinate) added, as a scanner would.
+It also runs fit_remeshed_liver_truth.json (the same liver on a finer mesh) and
+writes its deformed surfaces (liver_fine_step{K}.obj) and its upper paddle's
+force curve (liver_fine_force.csv); and fit_paddles_liver_truth.json (the
+liver between paddles alone) for a scan of its last step
+(liver_paddles_step10_scan.obj, resampled with 0.5 mm noise as above) and its
+upper paddle's force curve with 0.1 N of noise (liver_paddles_force.csv, travel
+in mm).
 Usage: /usr/bin/python3 experiments/make_synthetic_targets.py [build-release/src/app/fiberfluid]
 """
 import os
@@ -23,6 +30,8 @@ import numpy as np
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 NOISE = 0.5e-3  # m
 SEED = 20161122
+PADDLES_SEED = 20261126  # its own stream: the older targets keep theirs
+FORCE_NOISE = 0.1  # N
 
 
 def read_vtu(path):
@@ -112,6 +121,40 @@ def main():
             points, triangles = read_vtu(os.path.join(tmp, "fine", "vtk", "step_%04d.vtu" % step))
             write_obj(os.path.join(out_dir, f"liver_fine_step{step}.obj"), points, triangles,
                       f"fit_remeshed_liver_truth.json at load step {step} (the finer liver): exact")
+        # Its upper paddle's force curve: the distance travelled and the push on the liver.
+        with open(os.path.join(tmp, "fine", "steps.csv")) as f:
+            header = f.readline().strip().split(",")
+            rows = [dict(zip(header, l.strip().split(","))) for l in f if l.strip()]
+        with open(os.path.join(out_dir, "liver_fine_force.csv"), "w") as f:
+            f.write("# fit_remeshed_liver_truth.json (the finer liver): the upper paddle's travel "
+                    "(m, downwards) and its push on the liver (N), per load step: exact\n")
+            f.write("step,travel,force\n")
+            for r in rows:
+                f.write("%s,%.17g,%.17g\n" % (r["step"], -float(r["paddle_upper_travel_m"]),
+                                             -float(r["paddle_upper_force_y_N"])))
+        # The liver between paddles alone: a scan of its last step and a noisy force curve.
+        paddles = np.random.default_rng(PADDLES_SEED)
+        subprocess.run([binary, "run", os.path.join(ROOT, "experiments/fit_paddles_liver_truth.json"),
+                        "-o", os.path.join(tmp, "paddles"), "-q"], check=True, stdout=subprocess.DEVNULL)
+        points, triangles = read_vtu(os.path.join(tmp, "paddles", "vtk", "step_0010.vtu"))
+        fine, fine_faces = subdivide(points, triangles)
+        order = paddles.permutation(len(fine))
+        inverse = np.empty_like(order)
+        inverse[order] = np.arange(len(order))
+        scan = fine[order] + paddles.normal(0.0, NOISE, fine.shape)
+        write_obj(os.path.join(out_dir, "liver_paddles_step10_scan.obj"), scan, inverse[fine_faces],
+                  "fit_paddles_liver_truth.json at load step 10: resampled (midpoint subdivision, "
+                  f"shuffled), Gaussian noise {NOISE * 1e3} mm per coordinate")
+        with open(os.path.join(tmp, "paddles", "steps.csv")) as f:
+            header = f.readline().strip().split(",")
+            rows = [dict(zip(header, l.strip().split(","))) for l in f if l.strip()]
+        with open(os.path.join(out_dir, "liver_paddles_force.csv"), "w") as f:
+            f.write("# fit_paddles_liver_truth.json: the upper paddle's travel (mm, downwards) and "
+                    f"its push on the liver (N) with Gaussian noise of {FORCE_NOISE} N, per load step\n")
+            f.write("step,travel,force\n")
+            for r in rows:
+                push = -float(r["paddle_upper_force_y_N"]) + paddles.normal(0.0, FORCE_NOISE)
+                f.write("%s,%.6f,%.4f\n" % (r["step"], -1e3 * float(r["paddle_upper_travel_m"]), push))
         subprocess.run([binary, "run", os.path.join(ROOT, "experiments/sphere.json"), "-o",
                         os.path.join(tmp, "sphere"), "-q"], check=True, stdout=subprocess.DEVNULL)
         with open(os.path.join(tmp, "sphere", "final.obj")) as f:

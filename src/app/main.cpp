@@ -349,6 +349,10 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
               << 100.0 * d.share(d.standard_deviation) << "% of the body's length " << d.length
               << "), largest " << d.largest << " m\n";
   }
+  for (const fit::ForceMisfit& m : fitted.force_misfits)
+    std::cout << "  force misfit (" << m.simulated.size() << " rows): rms " << m.rms << " N ("
+              << 100.0 * m.share(m.rms) << "% of the largest measured force " << m.scale
+              << " N), largest " << m.largest << " N\n";
   std::cout << "  " << fitted.forward_runs << " forward runs";
   if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed)";
   std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds
@@ -388,15 +392,28 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   for (const auto& t : setup.targets)
     std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
               << "\n";
-  const int counted = setup.calibration->num_counted_vertices();
+  const fit::Calibration& calibration = *setup.calibration;
+  int force_rows = 0;
+  for (size_t k = 0; k < setup.force_curves.size(); ++k) {
+    const fit::ForceCurve& f = setup.force_curves[k];
+    force_rows += static_cast<int>(f.force.size());
+    std::cout << "force curve " << f.label << ": " << f.force.size() << " rows at "
+              << (f.by_step ? "load steps" : "travels") << ", weight "
+              << calibration.force_weight(k) << " m per N\n";
+  }
+  const int counted = calibration.num_counted_vertices();
   const int forward = counted * static_cast<int>(setup.targets.size());
-  std::cout << "fitting " << setup.calibration->parameters().size() << " parameters to "
-            << setup.calibration->num_residuals() << " distances (" << counted
-            << " model vertices to each of " << setup.targets.size() << " target(s)";
-  if (setup.calibration->num_residuals() > forward)
-    std::cout << ", and " << setup.calibration->num_residuals() - forward
-              << " target points to the simulated surface";
-  std::cout << "; " << fit::to_string(ex.fit->options.method) << ", "
+  const int distances = calibration.num_residuals() - force_rows;
+  std::cout << "fitting " << calibration.parameters().size() << " parameters to ";
+  if (!setup.targets.empty()) {
+    std::cout << distances << " distances (" << counted << " model vertices to each of "
+              << setup.targets.size() << " target(s)";
+    if (distances > forward)
+      std::cout << ", and " << distances - forward << " target points to the simulated surface";
+    std::cout << ")" << (force_rows > 0 ? " and " : "");
+  }
+  if (force_rows > 0) std::cout << force_rows << " force misfits";
+  std::cout << " (" << fit::to_string(ex.fit->options.method) << ", "
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
             << ")\n";
   const fit::FitResult fitted = setup.calibration->run();

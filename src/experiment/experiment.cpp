@@ -558,10 +558,43 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
 }
 
 // ------------------------------------------------------------ fit
+// A target of "type": "force": a CSV curve of a paddle's or a support's force.
+FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
+  FitForceSpec curve;
+  curve.field = t.field();
+  curve.file = t.string("file");
+  if (curve.file.is_relative()) curve.file = folder / curve.file;
+  t.resolve("file", absolute_path(curve.file));
+  if (t.has("paddle") == t.has("support"))
+    t.fail("paddle",
+           "expected the label of a paddle, or a support (\"support\"), whose force "
+           "the curve measured: one of them");
+  if (t.has("paddle")) {
+    curve.paddle = t.string("paddle");
+  } else {
+    curve.support = t.string("support");
+    curve.axis = t.choice("axis", "", {"x", "y", "z"})[0] - 'x';  // the reaction's component
+  }
+  if (t.has("paddle") && t.has("axis"))
+    t.fail("axis", "a paddle's force is along its own axis: give axis only with a support");
+  if (t.has("weight")) curve.weight = t.positive("weight", 1.0);
+  if (t.has("rows_at")) curve.rows_at = t.choice("rows_at", "", {"travel", "step"});
+  const std::string travel = t.choice("travel_units", "m", {"m", "cm", "mm", "um"});
+  curve.travel_scale = travel == "cm" ? 1e-2 : travel == "mm" ? 1e-3 : travel == "um" ? 1e-6 : 1.0;
+  const std::string force = t.choice("force_units", "N", {"N", "mN", "kN"});
+  curve.force_scale = force == "mN" ? 1e-3 : force == "kN" ? 1e3 : 1.0;
+  t.finish();
+  return curve;
+}
+
 FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   FitSpec spec;
   spec.field = f.field();
   for (Fields t : f.objects("targets")) {
+    if (t.choice("type", "surface", {"surface", "force"}) == "force") {
+      spec.force_curves.push_back(read_force_target(t, folder));
+      continue;
+    }
     FitTargetSpec target;
     target.field = t.field();
     target.file = t.string("file");
@@ -578,7 +611,8 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     t.finish();
     spec.targets.push_back(target);
   }
-  if (spec.targets.empty()) f.fail("targets", "expected at least one target surface");
+  if (spec.targets.empty() && spec.force_curves.empty())
+    f.fail("targets", "expected at least one target (a surface, or a force curve)");
   for (Fields p : f.objects("parameters")) {
     FitParameterSpec parameter;
     parameter.field = p.field();

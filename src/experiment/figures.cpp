@@ -125,6 +125,8 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
       if (ex.fit) {
         std::vector<std::string> fitted = kFitFigures;
         for (const FitParameterSpec& p : ex.fit->parameters) fitted.push_back(p.request.name);
+        if (!ex.fit->force_curves.empty())
+          fitted.insert(fitted.end(), {"force_rms", "force_largest", "force_rms_share"});
         for (const std::string& f : fitted) {
           if (figure == "fit." + f) return {};
           valid.push_back("fit." + f);

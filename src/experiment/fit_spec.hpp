@@ -19,6 +19,17 @@ struct FitTargetSpec {
   double scale = 1.0;  // the scan's coordinates times this are in m ("units": "mm" is 1e-3)
 };
 
+// A measured force curve (a target of "type": "force"), as parsed.
+struct FitForceSpec {
+  FieldName field;
+  std::filesystem::path file;
+  std::string paddle, support;  // the label of one of them
+  int axis = -1;                // a support's force component (0, 1, 2); -1 for a paddle
+  double weight = 0.0;          // m per N; 0: the default (fit::ForceCurve::weight)
+  std::string rows_at;          // "travel", "step", or "": as the file's columns allow
+  double travel_scale = 1.0, force_scale = 1.0;  // the file's units to m and N
+};
+
 struct FitParameterSpec {
   FieldName field;
   fit::ParameterRequest request;
@@ -26,7 +37,8 @@ struct FitParameterSpec {
 
 struct FitSpec {
   FieldName field;
-  std::vector<FitTargetSpec> targets;
+  std::vector<FitTargetSpec> targets;      // surfaces
+  std::vector<FitForceSpec> force_curves;  // and force curves (either may be empty, not both)
   std::vector<FitParameterSpec> parameters;
   // A fit.json whose parameters' values are the starts (an interrupted or
   // earlier fit, continued).

@@ -48,6 +48,58 @@ json iteration_json(const fit::IterationRecord& it, const std::vector<std::strin
   return out;
 }
 
+// A force target read and tied to its paddle or support group; the
+// curve's own problems (rows the run cannot place) are the calibration's.
+fit::ForceCurve force_curve(const FitForceSpec& spec, const Case& c) {
+  fit::ForceCurve curve;
+  try {
+    curve = fit::read_force_curve(spec.file, spec.travel_scale, spec.force_scale, spec.rows_at);
+  } catch (const InputError& e) {
+    spec.field.fail("file", e.what());
+  }
+  curve.weight = spec.weight;
+  const std::vector<std::string>& names = c.model.constraint_groups;
+  std::vector<std::string> paddles;
+  for (const model::Paddle& p : c.model.paddles) paddles.push_back(p.label);
+  const bool paddle = !spec.paddle.empty();
+  const std::vector<std::string>& labels = paddle ? paddles : names;
+  const std::string& wanted = paddle ? spec.paddle : spec.support;
+  const auto found = std::find(labels.begin(), labels.end(), wanted);
+  if (found == labels.end()) {
+    std::string known;
+    for (const std::string& l : labels) known += (known.empty() ? "" : ", ") + l;
+    spec.field.fail(paddle ? "paddle" : "support",
+                    "no " + std::string(paddle ? "paddle" : "support") + " is labelled \"" +
+                        wanted + "\" (" + (known.empty() ? "there is none" : "labels: " + known) +
+                        ")");
+  }
+  curve.source = paddle ? fit::ForceCurve::Source::Paddle : fit::ForceCurve::Source::Support;
+  curve.index = static_cast<int>(found - labels.begin());
+  curve.axis = paddle ? c.model.paddles[static_cast<size_t>(curve.index)].axis : spec.axis;
+  const std::string why = fit::force_curve_problem(curve, c.model);
+  if (!why.empty()) spec.field.fail("", why);
+  return curve;
+}
+
+// The force curves' misfits together: root mean square and largest (N),
+// and the rms as a share of the largest measured force.
+struct OverallForceMisfit {
+  double rms = 0.0, largest = 0.0, scale = 0.0;
+};
+OverallForceMisfit overall_force_misfit(const fit::FitResult& r) {
+  OverallForceMisfit o;
+  double squares = 0.0;
+  size_t rows = 0;
+  for (const fit::ForceMisfit& m : r.force_misfits) {
+    squares += m.rms * m.rms * static_cast<double>(m.simulated.size());
+    rows += m.simulated.size();
+    o.largest = std::max(o.largest, m.largest);
+    o.scale = std::max(o.scale, m.scale);
+  }
+  if (rows > 0) o.rms = std::sqrt(squares / static_cast<double>(rows));
+  return o;
+}
+
 }  // namespace
 
 std::map<std::string, double> fitted_values(const std::filesystem::path& fit_json_file) {
@@ -110,6 +162,7 @@ FitSetup setup_fit(const Experiment& ex,
                                std::to_string(c.stepping.steps) + " steps");
     setup.targets.push_back({target, step});
   }
+  for (const FitForceSpec& f : spec.force_curves) setup.force_curves.push_back(force_curve(f, c));
   // The starts of an earlier fit (an interrupted one, continued).
   std::map<std::string, double> earlier;
   if (spec.start_from) earlier = fitted_values(*spec.start_from);
@@ -151,8 +204,8 @@ FitSetup setup_fit(const Experiment& ex,
       spec.exclude->field.fail("", "excludes every vertex: no distance would count");
   }
   try {
-    setup.calibration =
-        std::make_unique<fit::Calibration>(c.model, c.stepping, setup.targets, parameters, options);
+    setup.calibration = std::make_unique<fit::Calibration>(c.model, c.stepping, setup.targets,
+                                                           parameters, options, setup.force_curves);
   } catch (const InputError& e) {
     spec.field.fail("", e.what());
   }
@@ -170,6 +223,12 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
   figures["fit.distance_sd"] = r.overall.standard_deviation;
   figures["fit.distance_largest"] = r.overall.largest;
   figures["fit.distance_sd_share"] = r.overall.share(r.overall.standard_deviation);
+  if (!r.force_misfits.empty()) {
+    const OverallForceMisfit force = overall_force_misfit(r);
+    figures["fit.force_rms"] = force.rms;
+    figures["fit.force_largest"] = force.largest;
+    figures["fit.force_rms_share"] = force.scale > 0.0 ? force.rms / force.scale : 0.0;
+  }
   return figures;
 }
 
@@ -219,6 +278,34 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     if (t < r.statistics.size()) target["distance"] = statistics_json(r.statistics[t]);
     targets.push_back(target);
   }
+  json curves = json::array();
+  for (size_t k = 0; k < setup.force_curves.size(); ++k) {
+    const fit::ForceCurve& f = setup.force_curves[k];
+    const bool paddle = f.source == fit::ForceCurve::Source::Paddle;
+    const model::Model& model = ex.cases.front().model;
+    json curve = {
+        {"file", f.label},
+        {paddle ? "paddle" : "support",
+         paddle ? model.paddles[static_cast<size_t>(f.index)].label
+                : model.constraint_groups[static_cast<size_t>(f.index)]},
+        {"axis", std::string(1, "xyz"[f.axis])},
+        {"force_is", paddle ? "the paddle's push into the body along its axis (N)"
+                            : "the support's reaction on the body along the axis (N)"},
+        {"rows", f.force.size()},
+        {"rows_at", f.by_step ? "load steps" : "travel (m), between the steps around it"},
+        {"weight", c.force_weight(k)},
+        {"weight_is", "m per N: a force misfit of 1 N counts as a distance of this many m"}};
+    if (k < r.force_misfits.size()) {
+      const fit::ForceMisfit& m = r.force_misfits[k];
+      curve["misfit"] = {
+          {"rms", number(m.rms)},
+          {"largest", number(m.largest)},
+          {"largest_measured", number(m.scale)},
+          {"share_of_largest_measured",
+           {{"rms", number(m.share(m.rms))}, {"largest", number(m.share(m.largest))}}}};
+    }
+    curves.push_back(curve);
+  }
   json checks = json::array();
   for (const FigureCheck& check : run.checks)
     checks.push_back({{"figure", check.expected.figure},
@@ -238,6 +325,8 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
   int target_points = 0;
   for (const fit::MeasuredStep& t : setup.targets)
     target_points += static_cast<int>(t.target.points.rows());
+  size_t force_rows = 0;
+  for (const fit::ForceCurve& f : setup.force_curves) force_rows += f.force.size();
   json doc = {
       {"experiment", ex.name},
       {"status", fit::to_string(r.status)},
@@ -271,12 +360,15 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
         {"target_points", target_points},
         {"forward_distances", counted * static_cast<int>(setup.targets.size())},
         {"symmetric_distances", ex.fit->options.symmetric ? target_points : 0},
+        {"force_curves", setup.force_curves.size()},
+        {"force_rows", force_rows},
         {"residuals", c.num_residuals()},
         {"what_distance_counts",
          "distance.count and targets[].distance.count are forward distances: one per counted "
          "model vertex and target. The symmetric distances (each target point to the simulated "
          "surface), when asked, enter the cost and the residuals, not these statistics"}}},
       {"targets", targets},
+      {"force_curves", curves},
       {"checks", checks}};
   if (!r.statistics.empty()) doc["distance"] = statistics_json(r.overall);
   return doc;
@@ -298,6 +390,18 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
   }
   geom::write_text_file(folder / "fit_iterations.csv", iterations.str());
   if (r.positions.size() != setup.targets.size()) return;  // no run at the fitted values
+  for (size_t k = 0; k < r.force_misfits.size() && k < setup.force_curves.size(); ++k) {
+    const fit::ForceCurve& f = setup.force_curves[k];
+    std::ostringstream rows;
+    rows.precision(12);
+    rows << (f.by_step ? "step" : "travel_m") << ",measured_N,simulated_N,misfit_N\n";
+    for (size_t i = 0; i < f.force.size(); ++i) {
+      const double simulated = r.force_misfits[k].simulated[i];
+      rows << f.at[i] << "," << f.force[i] << "," << simulated << "," << simulated - f.force[i]
+           << "\n";
+    }
+    geom::write_text_file(folder / ("fit_force_" + std::to_string(k) + ".csv"), rows.str());
+  }
 
   const Case& c = ex.cases.front();
   std::ostringstream distances;

@@ -16,6 +16,7 @@ namespace fiberfluid::experiment {
 // calibration built on the experiment's (single) case.
 struct FitSetup {
   std::vector<fit::MeasuredStep> targets;
+  std::vector<fit::ForceCurve> force_curves;
   std::unique_ptr<fit::Calibration> calibration;
 };
 // Throws InputError naming the file and field. `progress` is called after

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Levenberg-Marquardt (Ceres) and the covariance at the optimum.
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include <chrono>
 #include <memory>
@@ -193,7 +194,12 @@ bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
   o.num_threads = 1;
   ceres::Covariance c(o);
   const std::vector<std::pair<const double*, const double*>> blocks = {{phi.data(), phi.data()}};
+  // A rank-deficient J is an answer here (the fit says "not identifiable"
+  // and why), not an error for glog to print on stderr.
+  const int log_level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
   const bool ok = c.Compute(blocks, &p.problem);
+  FLAGS_minloglevel = log_level;
   if (!ok) return false;
   const int P = evaluations.calibration().parameters().size();
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(P, P);

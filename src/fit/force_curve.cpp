@@ -31,7 +31,7 @@ std::vector<std::string> cells(const std::string& line) {
 }  // namespace
 
 ForceCurve read_force_curve(const std::filesystem::path& path, double travel_scale,
-                            double force_scale) {
+                            double force_scale, const std::string& rows_at) {
   const std::string file = path.string();
   std::ifstream in(path);
   if (!in) throw InputError(file + ": cannot open (expected a CSV force curve)");
@@ -46,21 +46,20 @@ ForceCurve read_force_curve(const std::filesystem::path& path, double travel_sca
     if (text.empty() || text[0] == '#') continue;
     const std::vector<std::string> row = cells(text);
     if (force_column < 0) {  // the header
+      int travel_column = -1, step_column = -1;
       for (size_t c = 0; c < row.size(); ++c) {
         const int column = static_cast<int>(c);
         if (row[c] == "force") force_column = column;
-        if (row[c] == "travel" || row[c] == "step") {
-          if (at_column >= 0)
-            throw InputError(file + ": line " + std::to_string(number) +
-                             ": give a travel or a step column, not both");
-          at_column = column;
-          curve.by_step = row[c] == "step";
-        }
+        if (row[c] == "travel") travel_column = column;
+        if (row[c] == "step") step_column = column;
       }
+      curve.by_step = rows_at == "step" || (rows_at.empty() && travel_column < 0);
+      at_column = curve.by_step ? step_column : travel_column;
       if (force_column < 0 || at_column < 0)
         throw InputError(file + ": line " + std::to_string(number) + ": expected a header with " +
-                         "the columns force and travel (m) or step, got \"" + text.substr(0, 80) +
-                         "\"");
+                         "the columns force and " +
+                         (rows_at.empty() ? std::string("travel or step") : rows_at) + ", got \"" +
+                         text.substr(0, 80) + "\"");
       columns = row.size();
       continue;
     }

@@ -36,12 +36,14 @@ struct ForceCurve {
   double weight = 0.0;
 };
 
-// Reads a curve from CSV: a header naming the columns, `force` and either
+// Reads a curve from CSV: a header naming the columns, `force` and
 // `travel` or `step` (other columns are ignored); '#' starts a comment line.
-// Travel and force are multiplied by the scales (mm: 1e-3). Throws
-// InputError naming the file, and the line for a bad value.
+// The rows are placed by `rows_at` ("travel" or "step"; "": by travel when
+// the file has that column, else by step). Travel and force are multiplied
+// by the scales (mm: 1e-3). Throws InputError naming the file, and the line
+// for a bad value.
 ForceCurve read_force_curve(const std::filesystem::path& path, double travel_scale = 1.0,
-                            double force_scale = 1.0);
+                            double force_scale = 1.0, const std::string& rows_at = "");
 
 // A curve's force at a step from the run's record, by the curve's
 // convention: a paddle's push into the body, a support's reaction component.

@@ -8,6 +8,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -150,6 +152,51 @@ py::dict run(const ff::experiment::Experiment& ex, int jobs, const std::string& 
   return out;
 }
 
+// A force target from Python: force with travel (m) or step, and paddle
+// (a label) or support (a label) with axis; the same checks as a file's.
+ff::fit::ForceCurve force_curve_from(const py::dict& t, const std::string& label,
+                                     const ff::model::Model& model) {
+  ff::fit::ForceCurve curve;
+  curve.label = label;
+  curve.force = t["force"].cast<std::vector<double>>();
+  if (t.contains("travel") == t.contains("step"))
+    throw ff::InputError(label + ": expected travel (m) or step with the force, one of them");
+  curve.by_step = t.contains("step");
+  curve.at = t[curve.by_step ? "step" : "travel"].cast<std::vector<double>>();
+  if (t.contains("weight")) curve.weight = t["weight"].cast<double>();
+  if (t.contains("paddle") == t.contains("support"))
+    throw ff::InputError(label + ": expected paddle or support (a label), one of them");
+  const bool paddle = t.contains("paddle");
+  const std::string wanted = t[paddle ? "paddle" : "support"].cast<std::string>();
+  std::vector<std::string> labels;
+  if (paddle)
+    for (const ff::model::Paddle& p : model.paddles) labels.push_back(p.label);
+  else
+    labels = model.constraint_groups;
+  const auto found = std::find(labels.begin(), labels.end(), wanted);
+  if (found == labels.end())
+    throw ff::InputError(label + ": no " + (paddle ? "paddle" : "support") + " is labelled \"" +
+                         wanted + "\"");
+  curve.source =
+      paddle ? ff::fit::ForceCurve::Source::Paddle : ff::fit::ForceCurve::Source::Support;
+  curve.index = static_cast<int>(found - labels.begin());
+  if (paddle) {
+    curve.axis = model.paddles[static_cast<size_t>(curve.index)].axis;
+  } else {
+    const std::string axis = t.contains("axis") ? t["axis"].cast<std::string>() : "";
+    if (axis != "x" && axis != "y" && axis != "z")
+      throw ff::InputError(label + ": axis: expected x, y or z (the reaction's component)");
+    curve.axis = axis[0] - 'x';
+  }
+  for (const double x : curve.at)
+    if (!std::isfinite(x)) throw ff::InputError(label + ": a travel or step is not finite");
+  for (const double x : curve.force)
+    if (!std::isfinite(x)) throw ff::InputError(label + ": a force is not finite");
+  const std::string why = ff::fit::force_curve_problem(curve, model);
+  if (!why.empty()) throw ff::InputError(label + ": " + why);
+  return curve;
+}
+
 }  // namespace
 
 // A fit of an experiment's material to measured surfaces given as numpy
@@ -161,9 +208,14 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
   if (ex.cases.size() != 1) throw ff::InputError("fit: the experiment must be one simulation");
   const ff::experiment::Case& c = ex.cases.front();
   std::vector<ff::fit::MeasuredStep> measured;
+  std::vector<ff::fit::ForceCurve> curves;
   for (size_t k = 0; k < targets.size(); ++k) {
     const py::dict t = targets[k].cast<py::dict>();
     const std::string label = "targets[" + std::to_string(k) + "]";
+    if (t.contains("force")) {
+      curves.push_back(force_curve_from(t, label, c.model));
+      continue;
+    }
     const double scale = t.contains("scale") ? t["scale"].cast<double>() : 1.0;
     if (!(scale > 0.0) || !std::isfinite(scale))
       throw ff::InputError(label + ": scale: expected a positive finite number");
@@ -197,7 +249,7 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
   options.loss = ff::fit::loss_from_string(loss);
   options.loss_scale = loss_scale;
   options.max_iterations = max_iterations;
-  const ff::fit::Calibration calibration(c.model, c.stepping, measured, fitted, options);
+  const ff::fit::Calibration calibration(c.model, c.stepping, measured, fitted, options, curves);
   ff::fit::FitResult r;
   {
     py::gil_scoped_release release;
@@ -232,6 +284,17 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
   distance["largest"] = r.overall.largest;
   distance["share_of_length"] = r.overall.share(r.overall.standard_deviation);
   out["distance"] = distance;
+  py::list forces;
+  for (const ff::fit::ForceMisfit& f : r.force_misfits) {
+    py::dict misfit;
+    misfit["simulated"] = f.simulated;
+    misfit["rms"] = f.rms;
+    misfit["largest"] = f.largest;
+    misfit["share_of_largest_measured"] = f.share(f.rms);
+    misfit["weight"] = f.weight;
+    forces.append(misfit);
+  }
+  out["force_misfits"] = forces;
   out["forward_runs"] = r.forward_runs;
   out["sensitivity_solves"] = r.sensitivity_solves;
   out["seconds"] = r.seconds;
@@ -343,14 +406,17 @@ PYBIND11_MODULE(fiberfluid, m) {
       py::arg("max_iterations") = 50,
       "Fits the material (and optionally a rigid alignment) of a one-run experiment to measured "
       "surfaces. targets: a list of dicts with vertices (#P x 3), faces (#T x 3, omit for a point "
-      "cloud), step (default: the last) and scale (the vertices times it are in m); parameters: "
+      "cloud), step (default: the last) and scale (the vertices times it are in m), or force "
+      "curves: force (N) with travel (m) or step, and paddle (its push into the body) or "
+      "support with axis (its reaction), optionally weight (m per N); parameters: "
       "dicts with name (Y0, beta, gamma, factor_x, rotation_y, scale, ...), and optionally start, "
       "lower, upper, log_scale. Options are checked as a file's fit section is (ValueError naming "
       "the option). Returns a dict: status (converged, converged_at_bounds, iteration_limit, "
       "not_identifiable, forward_runs_failed, start_failed, interrupted), status_detail, "
       "success, message, failed_runs, values, standard_errors, interval_95, correlation, "
       "cost_per_iteration, "
-      "distance (mean, rms, standard_deviation, largest, share_of_length), forward_runs, "
+      "distance (mean, rms, standard_deviation, largest, share_of_length), force_misfits (per "
+      "curve: simulated, rms, largest, share_of_largest_measured, weight), forward_runs, "
       "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
 
   m.def(

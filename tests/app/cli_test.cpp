@@ -95,6 +95,26 @@ TEST(Cli, FitCalibratesThenWritesTheRunAndTheFitFiles) {
       << none.output;
 }
 
+// Issue 24's must-show: under paddles alone a scan cannot tell Y0 from
+// gamma; the fit says so with its documented status (exit 2, DIR.failed)
+// and names both, with no solver log on the way.
+TEST(Cli, APaddlesOnlyFitIsNotIdentifiableAndNamesY0AndGamma) {
+  ScratchDir dir;
+  const std::filesystem::path out = dir.path() / "shape";
+  const Outcome o =
+      run_cli("fit " + testing::experiment_file("fit_paddles_liver_shape.json").string() +
+              " -q -o " + out.string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  for (const char* part :
+       {"fit_paddles_liver_shape: not_identifiable", "shape.failed",
+        "the distances cannot tell \"Y0\", \"gamma\" apart (the Jacobian is rank deficient)"})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << "\n" << o.output;
+  for (const char* absent : {"+- nan", "covariance_impl", "InitGoogleLogging"})
+    EXPECT_EQ(o.output.find(absent), std::string::npos) << absent << "\n" << o.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "shape.failed" / "fit.json"));
+}
+
 TEST(Cli, BadExperimentWritesNothing) {
   ScratchDir dir;
   const auto config = dir.write("bad.json", R"({"name": "bad",

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <map>
 
 #include "experiment/outputs.hpp"
 #include "geom/mesh_io.hpp"
@@ -44,7 +46,54 @@ TEST_P(FitExperiment, RecoversItsParametersAndMeetsItsExpectedFigures) {
 
 INSTANTIATE_TEST_SUITE_P(Experiments, FitExperiment,
                          ::testing::Values("fit_sphere.json", "fit_synthetic_liver_exact.json",
-                                           "fit_liver_fem.json", "fit_cantilever_large.json"));
+                                           "fit_liver_fem.json", "fit_cantilever_large.json",
+                                           "fit_liver_force.json"));
+
+// A compression test's scan and force curve (noisy, issue 24): the fit's 95%
+// intervals hold the truth, both misfits are reported, and the curve's rows
+// are written beside the distances. Without the curve (the scan alone) the
+// same fit cannot tell Y0 from gamma.
+TEST(ForceCurveFit, RecoversTheTruthWithinItsIntervalsAndTheScanAloneCannot) {
+  const Experiment ex = load_experiment(testing::experiment_file("fit_paddles_liver_force.json"));
+  const FitSetup setup = setup_fit(ex);
+  ASSERT_EQ(setup.force_curves.size(), 1u);
+  EXPECT_TRUE(setup.calibration->analytic_jacobian());
+  const fit::FitResult fitted = setup.calibration->run();
+  ASSERT_EQ(fitted.status, fit::FitStatus::Converged) << fitted.message << fitted.status_detail;
+  const std::map<std::string, double> truth = {{"Y0", 20000.0}, {"beta", 3.0}, {"gamma", 200.0}};
+  for (size_t k = 0; k < fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    EXPECT_LE(fitted.lower_95[i], truth.at(fitted.names[k])) << fitted.names[k];
+    EXPECT_GE(fitted.upper_95[i], truth.at(fitted.names[k])) << fitted.names[k];
+    EXPECT_LT(fitted.upper_95[i] - fitted.lower_95[i], 0.3 * truth.at(fitted.names[k]))
+        << fitted.names[k];  // and they are informative
+  }
+  ASSERT_EQ(fitted.force_misfits.size(), 1u);
+  // The misfit is the curve's 0.1 N of noise.
+  EXPECT_GT(fitted.force_misfits[0].rms, 0.05);
+  EXPECT_LT(fitted.force_misfits[0].rms, 0.15);
+  const Experiment at_fit = with_fitted_material(ex, *setup.calibration, fitted);
+  ExperimentResult result = run_experiment(at_fit);
+  for (const auto& [name, value] : fit_figures(fitted)) result.figures[name] = value;
+  result.checks = check_expected(at_fit, result);
+  EXPECT_FALSE(result.checks.empty());
+  for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
+  EXPECT_NEAR(result.figures.at("fit.force_rms"), fitted.force_misfits[0].rms, 1e-15);
+  testing::ScratchDir dir;
+  write_fit_files(dir.path(), at_fit, setup, fitted, result);
+  std::ifstream in(dir.path() / "fit.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["force_curves"][0]["paddle"], "upper");
+  EXPECT_EQ(report["counts"]["force_rows"], 10);
+  EXPECT_NEAR(report["force_curves"][0]["misfit"]["rms"].get<double>(), fitted.force_misfits[0].rms,
+              1e-15);
+  std::ifstream rows(dir.path() / "fit_force_0.csv");
+  std::string header, first;
+  std::getline(rows, header);
+  std::getline(rows, first);
+  EXPECT_EQ(header, "travel_m,measured_N,simulated_N,misfit_N");
+  EXPECT_EQ(first.rfind("0.005927138,4.1991,", 0), 0u) << first;  // mm read as m
+}
 
 nlohmann::json sphere_fit_document() {
   std::ifstream in(testing::experiment_file("fit_sphere.json"));
@@ -295,6 +344,51 @@ TEST(FitStatus, StartFromTakesTheValuesOfAnEarlierFit) {
   expect_fit_error(d, "fit.start_from: " + partial.string() + " has no value for \"gamma\"");
   d["fit"]["start_from"] = (dir.path() / "none.json").string();
   expect_fit_error(d, "none.json: cannot open");
+}
+
+TEST(FitConfig, BadForceTargetsAreNamed) {
+  nlohmann::json d;
+  {
+    std::ifstream in(testing::experiment_file("fit_paddles_liver_force.json"));
+    d = nlohmann::json::parse(in);
+  }
+  auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json changed = d;
+    edit(changed["fit"]["targets"][1]);
+    return changed;
+  };
+  expect_fit_error(with([](nlohmann::json& t) { t["paddle"] = "top"; }),
+                   "doc: fit.targets[1].paddle: no paddle is labelled \"top\" (labels: upper, "
+                   "lower)");
+  expect_fit_error(with([](nlohmann::json& t) { t["support"] = "resting"; }),
+                   "fit.targets[1].paddle: expected the label of a paddle, or a support");
+  expect_fit_error(with([](nlohmann::json& t) { t["axis"] = "y"; }),
+                   "fit.targets[1].axis: a paddle's force is along its own axis");
+  expect_fit_error(with([](nlohmann::json& t) {
+                     t.erase("paddle");
+                     t["support"] = "resting";
+                   }),
+                   "fit.targets[1].axis: expected one of");
+  expect_fit_error(with([](nlohmann::json& t) {
+                     t.erase("paddle");
+                     t["support"] = "clamp";
+                     t["axis"] = "y";
+                   }),
+                   "fit.targets[1].support: no support is labelled \"clamp\" (labels: resting)");
+  expect_fit_error(with([](nlohmann::json& t) { t["travel_units"] = "inch"; }),
+                   "fit.targets[1].travel_units: expected one of");
+  expect_fit_error(with([](nlohmann::json& t) { t["rows_at"] = "time"; }),
+                   "fit.targets[1].rows_at: expected one of");
+  expect_fit_error(with([](nlohmann::json& t) { t["weight"] = -1; }),
+                   "fit.targets[1].weight: expected a positive number");
+  expect_fit_error(with([](nlohmann::json& t) { t["file"] = "missing.csv"; }),
+                   "fit.targets[1].file: ");
+  expect_fit_error(with([](nlohmann::json& t) { t["type"] = "pressure"; }),
+                   "fit.targets[1].type: expected one of");
+  expect_fit_error(with([](nlohmann::json& t) { t["travel_units"] = "m"; }),
+                   "row 1: travel 5.92714 m is outside the run's, from 0 to 0.0592714 m");  // mm read as m
+  expect_fit_error(with([](nlohmann::json& t) { t["colour"] = "red"; }),
+                   "fit.targets[1].colour: unknown field");
 }
 
 }  // namespace

@@ -41,10 +41,18 @@ TEST(ForceCurve, TheReaderTakesTravelOrStepAndNamesWhatIsWrong) {
   const ForceCurve by_step = read_force_curve(dir.write("b.csv", "step,force\n3,1.25\n"));
   EXPECT_TRUE(by_step.by_step);
   EXPECT_EQ(by_step.at[0], 3.0);
+  // With both columns the travel places the rows, unless the step is asked for.
+  const auto both = dir.write("c.csv", "step,travel,force\n3,0.01,1\n");
+  EXPECT_FALSE(read_force_curve(both).by_step);
+  EXPECT_TRUE(read_force_curve(both, 1.0, 1.0, "step").by_step);
+  EXPECT_EQ(read_force_curve(both, 1.0, 1.0, "step").at[0], 3.0);
+  expect_input_error(
+      [&] { read_force_curve(dir.write("d.csv", "travel,force\n1,1\n"), 1, 1, "step"); },
+      "expected a header with the columns force and step");
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"", "empty"},
-      {"travel,load\n1,2\n", "line 1: expected a header with the columns force and travel"},
-      {"travel,step,force\n", "give a travel or a step column, not both"},
+      {"travel,load\n1,2\n", "line 1: expected a header with the columns force and travel or step"},
+
       {"travel,force\n", "a header but no rows"},
       {"travel,force\n1,abc\n", "line 2: expected a finite number in column 2, got \"abc\""},
       {"travel,force\n1,nan\n", "line 2: expected a finite number"},

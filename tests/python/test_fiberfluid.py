@@ -133,6 +133,32 @@ def test_a_program_gives_its_own_surface():
         fiberfluid.Experiment.from_dict(document)
 
 
+def test_a_force_curve_fit_without_json():
+    """The liver between paddles: its scan alone cannot tell Y0 from gamma; with the force, it can."""
+    with open(os.path.join(EXPERIMENTS, "fit_paddles_liver_force.json")) as f:
+        document = json.load(f)
+    del document["fit"], document["expected"]
+    document["surface"]["file"] = os.path.join(EXPERIMENTS, document["surface"]["file"])
+    scan = fiberfluid.read_mesh(os.path.join(SOURCE, "data", "targets", "liver_paddles_step10_scan.obj"))
+    rows = np.loadtxt(os.path.join(SOURCE, "data", "targets", "liver_paddles_force.csv"),
+                      delimiter=",", skiprows=2)
+    start = fiberfluid.Experiment.from_dict(document)
+    parameters = [{"name": "Y0"}, {"name": "beta", "lower": -10, "upper": 20}, {"name": "gamma"}]
+    surface = {"vertices": scan["vertices"], "faces": scan["faces"], "step": 10}
+    alone = fiberfluid.fit(start, targets=[surface], parameters=parameters)
+    assert alone["status"] == "not_identifiable"
+    assert '"Y0", "gamma"' in alone["status_detail"]
+    force = {"force": rows[:, 2], "travel": rows[:, 1] * 1e-3, "paddle": "upper"}
+    both = fiberfluid.fit(start, targets=[surface, force], parameters=parameters)
+    assert both["status"] == "converged", both["status_detail"]
+    for name, truth in (("Y0", 20000.0), ("beta", 3.0), ("gamma", 200.0)):
+        low, high = both["interval_95"][name]
+        assert low <= truth <= high, name
+    assert 0.05 < both["force_misfits"][0]["rms"] < 0.15
+    with pytest.raises(ValueError, match="no paddle is labelled \"top\""):
+        fiberfluid.fit(start, targets=[dict(force, paddle="top")], parameters=parameters)
+
+
 def test_a_fit_without_json():
     """The paper's sphere: its deformed surface as numpy arrays, Y and gamma from a factor 3 away."""
     with open(os.path.join(EXPERIMENTS, "sphere.json")) as f:
