@@ -12,6 +12,7 @@ packages=(
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
   python3-dev pybind11-dev python3-pytest    # the Python module and its tests
   python3-meshio                             # an independent reader of the .vtu files (tests)
+  python3-jsonschema                         # an independent validator of the experiment schema (tests)
   clang libclang-rt-14-dev libomp-dev        # the libFuzzer targets (scripts/fuzz.sh)
 )
 

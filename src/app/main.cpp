@@ -24,6 +24,7 @@
 #include "experiment/output_folder.hpp"
 #include "experiment/outputs.hpp"
 #include "experiment/runner.hpp"
+#include "experiment/schema.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
 #include "util/error.hpp"
@@ -612,6 +613,10 @@ int main(int argc, char** argv) {
                       "The undeformed surface M0 (same vertices as both): adds E_n and E_i");
   compare->add_flag("--json", as_json, "Print JSON instead of text");
 
+  CLI::App* schema = cli.add_subcommand(
+      "schema",
+      "Print the JSON Schema of experiment files (for an editor: \"$schema\" or its settings)");
+
   if (unknown_subcommand(cli, argc, argv)) return kUsage;
   try {
     cli.parse(argc, argv);
@@ -628,6 +633,10 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(experiment, flags);
     if (fit->parsed()) return fit_command(experiment, fit_flags);
+    if (schema->parsed()) {
+      std::cout << fiberfluid::experiment::experiment_schema().dump(2) << "\n";
+      return 0;
+    }
     if (compare->parsed())
       return compare_command(compared_reference, compared, undeformed, as_json);
     return check_command(mesh, flip);

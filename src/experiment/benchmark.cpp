@@ -60,9 +60,9 @@ std::vector<Integrator> read_solvers(Fields& f, const std::string& key, bool wit
 
 // "MP1" (a preset) or {"E", "nu", "density", "alpha", "beta"}.
 fem::MaterialPreset read_material(Fields& f, const std::string& key, std::string* label) {
-  const json& value = f.raw(key);
-  if (value.is_string()) {
-    const std::string name = value.get<std::string>();
+  const json* given = f.peek(key);
+  if (given == nullptr || given->is_string()) {  // missing: the string's message names the key
+    const std::string name = f.string(key);
     if (name != "MP1" && name != "MP2" && name != "MP3")
       f.fail(key,
              "expected a preset (MP1, MP2, MP3) or an object {E, nu, density, alpha, beta}, "

@@ -232,7 +232,7 @@ MaterialSpec read_material(Fields f) {
       spec.per_axis = per_axis_vector(f, "axis_factors");
       if (!(spec.per_axis.array() > 0).all()) f.fail("axis_factors", "expected positive numbers");
     }
-  } else if (f.raw("Y").is_array()) {
+  } else if (f.peek("Y") != nullptr && f.peek("Y")->is_array()) {
     // The paper's per-axis moduli: the constant law 1 times exact factors.
     spec.per_axis = per_axis_vector(f, "Y");
     if ((spec.per_axis.array() < 0).any()) f.fail("Y", "expected numbers >= 0");
@@ -529,10 +529,10 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
     c.surface.field = {root.file(), root.name("surface")};
   }
   c.fibers = read_fibers(root);
-  c.surface_key = (root.has("surface") ? root.raw("surface").dump() : std::string()) + "|" +
-                  (root.has("fibers") ? root.raw("fibers").dump() : std::string());
+  c.surface_key = (root.peek("surface") ? root.peek("surface")->dump() : std::string()) + "|" +
+                  (root.peek("fibers") ? root.peek("fibers")->dump() : std::string());
   c.material = read_material(root.object("material"));
-  if (warnings != nullptr && !root.raw("material").contains("gamma"))
+  if (warnings != nullptr && !root.peek("material")->contains("gamma"))
     warnings->push_back(root.file() + ": " + root.name("material.gamma") +
                         ": not given, so 0 (no surface tension on the mesh edges)");
   c.loads = read_loads(root);
@@ -805,6 +805,12 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   }
   check_expected_names(root, ex);
   return ex;
+}
+
+const std::vector<std::string>& experiment_wide_fields() {
+  static const std::vector<std::string> fields(std::begin(kExperimentFields),
+                                               std::end(kExperimentFields));
+  return fields;
 }
 
 void require_built(const Experiment& experiment) {

@@ -87,6 +87,10 @@ struct Experiment {
     return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
   }
 };
+// The fields of an experiment file that belong to the whole experiment
+// (name, variants, fit, ...): a variant cannot change them.
+const std::vector<std::string>& experiment_wide_fields();
+
 // Throws std::logic_error unless the experiment is built: a program that ran
 // read_experiment without build_experiment is told so instead of crashing.
 void require_built(const Experiment& experiment);

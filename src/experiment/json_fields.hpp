@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "experiment/case_spec.hpp"
+#include "experiment/schema.hpp"
 #include "util/error.hpp"
 
 namespace fiberfluid::experiment {
@@ -51,17 +52,23 @@ class Fields {
     if (key.empty()) return path_;
     return path_.empty() ? key : path_ + "." + key;
   }
-  bool has(const std::string& key) const { return object_.contains(key); }
+  bool has(const std::string& key) const {
+    note(key, [] { return nlohmann::json(); });  // asked for: its type, if any, comes with its read
+    return object_.contains(key);
+  }
 
   // A value as given (recorded as given unless a typed read records it).
   const nlohmann::json& raw(const std::string& key) {
-    seen_.insert(key);
-    if (!has(key)) fail(key, "missing (required)");
-    if (resolved_ != nullptr && !resolved_->contains(key)) (*resolved_)[key] = object_.at(key);
-    return object_.at(key);
+    note(key, [] { return nlohmann::json::object(); });  // any value: the caller checks it
+    return value_of(key);
+  }
+  // A value to look at, if given, without reading it (nothing is recorded).
+  const nlohmann::json* peek(const std::string& key) const {
+    return object_.contains(key) ? &object_.at(key) : nullptr;
   }
   Fields object(const std::string& key) {
-    const nlohmann::json& v = raw(key);
+    note(key, [] { return nlohmann::json{{"type", "object"}}; });
+    const nlohmann::json& v = value_of(key);
     return Fields(v, name(key), file_, resolved_child(key, nlohmann::json::object()));
   }
 
@@ -69,36 +76,44 @@ class Fields {
   // read (and resolved) like the given fields.
   Fields object_or_empty(const std::string& key) {
     static const nlohmann::json kEmpty = nlohmann::json::object();
+    note(key, [] { return nlohmann::json{{"type", "object"}}; });
     if (has(key)) return object(key);
     seen_.insert(key);
     return Fields(kEmpty, name(key), file_, resolved_child(key, nlohmann::json::object()));
   }
 
   double number(const std::string& key) {
-    const nlohmann::json& v = raw(key);
+    note(key, [] { return nlohmann::json{{"type", "number"}}; });
+    const nlohmann::json& v = value_of(key);
     if (!v.is_number()) fail(key, "expected a number, got " + excerpt(v));
     const double x = v.get<double>();
     if (!std::isfinite(x)) fail(key, "expected a finite number");
     return x;
   }
   double number(const std::string& key, double fallback) {
+    note(key, [] { return nlohmann::json{{"type", "number"}}; });
     return has(key) ? number(key) : (seen_.insert(key), record(key, fallback));
   }
   double positive(const std::string& key, double fallback) {
-    const double x = number(key, fallback);
+    note(key, [] { return nlohmann::json{{"type", "number"}, {"exclusiveMinimum", 0}}; });
+    const double x = muted([&] { return number(key, fallback); });
     if (!(x > 0.0)) fail(key, "expected a positive number, got " + std::to_string(x));
     return x;
   }
   double non_negative(const std::string& key, double fallback) {
-    const double x = number(key, fallback);
+    note(key, [] { return nlohmann::json{{"type", "number"}, {"minimum", 0}}; });
+    const double x = muted([&] { return number(key, fallback); });
     if (x < 0.0) fail(key, "expected a number >= 0, got " + std::to_string(x));
     return x;
   }
   int integer(const std::string& key, int fallback, int min, int max) {
+    note(key, [&] {
+      return nlohmann::json{{"type", "integer"}, {"minimum", min}, {"maximum", max}};
+    });
     // A fallback outside [min, max] stands for "not given" (step 0: the last): not written out.
     if (!has(key))
       return seen_.insert(key), fallback < min || fallback > max ? fallback : record(key, fallback);
-    const nlohmann::json& v = raw(key);
+    const nlohmann::json& v = value_of(key);
     const std::string range =
         "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
     if (!v.is_number_integer() || !fits(v, min, max))
@@ -106,13 +121,15 @@ class Fields {
     return static_cast<int>(v.get<long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
+    note(key, [] { return nlohmann::json{{"type", "boolean"}}; });
     if (!has(key)) return seen_.insert(key), record(key, fallback);
-    const nlohmann::json& v = raw(key);
+    const nlohmann::json& v = value_of(key);
     if (!v.is_boolean()) fail(key, "expected true or false, got " + excerpt(v));
     return v.get<bool>();
   }
   std::string string(const std::string& key) {
-    const nlohmann::json& v = raw(key);
+    note(key, [] { return nlohmann::json{{"type", "string"}}; });
+    const nlohmann::json& v = value_of(key);
     if (!v.is_string()) fail(key, "expected a string, got " + excerpt(v));
     return v.get<std::string>();
   }
@@ -121,14 +138,20 @@ class Fields {
   }
   std::string choice(const std::string& key, const std::string& fallback,
                      const std::vector<std::string>& allowed) {
-    const std::string s = string(key, fallback);
+    if (SchemaRecorder* recorder = active_schema_recorder()) recorder->choice(path_, key, allowed);
+    const std::string s = muted([&] { return string(key, fallback); });
     if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
       fail(key, "expected one of " + join(allowed) + ", got " + excerpt(s));
     return s;
   }
   // A list of `size` numbers (any size when size < 0).
   Eigen::VectorXd vector(const std::string& key, int size) {
-    const nlohmann::json& v = raw(key);
+    note(key, [&] {
+      nlohmann::json list = {{"type", "array"}, {"items", {{"type", "number"}}}};
+      if (size >= 0) list["minItems"] = list["maxItems"] = size;
+      return list;
+    });
+    const nlohmann::json& v = value_of(key);
     const std::string want =
         size < 0 ? "a list of numbers" : "a list of " + std::to_string(size) + " numbers";
     if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size))
@@ -143,7 +166,13 @@ class Fields {
   }
   // A list of `size` whole numbers from min to max (counts such as segments).
   Eigen::VectorXi counts(const std::string& key, int size, int min, int max) {
-    const nlohmann::json& v = raw(key);
+    note(key, [&] {
+      return nlohmann::json{{"type", "array"},
+                            {"items", {{"type", "integer"}, {"minimum", min}, {"maximum", max}}},
+                            {"minItems", size},
+                            {"maxItems", size}};
+    });
+    const nlohmann::json& v = value_of(key);
     const std::string want = "a list of " + std::to_string(size) + " whole numbers from " +
                              std::to_string(min) + " to " + std::to_string(max);
     if (!v.is_array() || static_cast<int>(v.size()) != size)
@@ -158,7 +187,11 @@ class Fields {
     return out;
   }
   std::vector<int> indices(const std::string& key) {
-    const nlohmann::json& v = raw(key);
+    note(key, [] {
+      return nlohmann::json{
+          {"type", "array"}, {"items", {{"type", "integer"}, {"minimum", 0}}}, {"minItems", 1}};
+    });
+    const nlohmann::json& v = value_of(key);
     if (!v.is_array() || v.empty()) fail(key, "expected a non-empty list of vertex indices");
     std::vector<int> out;
     for (const nlohmann::json& item : v) {
@@ -170,9 +203,10 @@ class Fields {
     return out;
   }
   std::vector<Fields> objects(const std::string& key) {
+    note(key, [] { return nlohmann::json{{"type", "array"}, {"items", {{"type", "object"}}}}; });
     std::vector<Fields> out;
     if (!has(key)) return seen_.insert(key), record(key, nlohmann::json::array()), out;
-    const nlohmann::json& v = raw(key);
+    const nlohmann::json& v = value_of(key);
     if (!v.is_array()) fail(key, "expected a list of objects");
     // Sized first: its elements' addresses then stay put.
     nlohmann::json* list = resolved_child(
@@ -195,6 +229,37 @@ class Fields {
   FieldName field() const { return {file_, path_}; }
 
  private:
+  // The value of a field that must be given (recorded as given unless a
+  // typed read records it).
+  const nlohmann::json& value_of(const std::string& key) {
+    seen_.insert(key);
+    if (!object_.contains(key)) {
+      if (SchemaRecorder* recorder = active_schema_recorder()) recorder->missing(path_, key);
+      fail(key, "missing (required)");
+    }
+    if (resolved_ != nullptr && !resolved_->contains(key)) (*resolved_)[key] = object_.at(key);
+    return object_.at(key);
+  }
+  // Tells an active schema recorder (experiment_schema) how `key` is read;
+  // the fragment is made only then.
+  template <class MakeFragment>
+  void note(const std::string& key, const MakeFragment& fragment) const {
+    if (SchemaRecorder* recorder = active_schema_recorder(); recorder != nullptr && !muted_)
+      recorder->note(path_, key, fragment());
+  }
+  // Runs a read whose own notes would be less exact than the caller's
+  // (positive reads a number; a choice, a string).
+  template <class Read>
+  auto muted(const Read& read) -> decltype(read()) {
+    const bool was = muted_;
+    muted_ = true;
+    struct Restore {
+      bool& flag;
+      bool value;
+      ~Restore() { flag = value; }
+    } restore{muted_, was};
+    return read();
+  }
   // Whether a JSON integer lies in [min, max] (an unsigned one may exceed long long).
   static bool fits(const nlohmann::json& v, long long min, long long max) {
     if (v.is_number_unsigned()) {
@@ -229,6 +294,7 @@ class Fields {
   const nlohmann::json& object_;
   std::string path_, file_;
   std::set<std::string> seen_;
+  bool muted_ = false;                  // the schema recorder hears the caller, not this read
   nlohmann::json* resolved_ = nullptr;  // not owned; null: nothing recorded
 };
 

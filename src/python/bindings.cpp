@@ -17,6 +17,7 @@
 #include "experiment/output_folder.hpp"
 #include "experiment/outputs.hpp"
 #include "experiment/runner.hpp"
+#include "experiment/schema.hpp"
 #include "fit/calibration.hpp"
 #include "geom/mesh_check.hpp"
 #include "geom/mesh_io.hpp"
@@ -418,6 +419,14 @@ PYBIND11_MODULE(fiberfluid, m) {
       "distance (mean, rms, standard_deviation, largest, share_of_length), force_misfits (per "
       "curve: simulated, rms, largest, share_of_largest_measured, weight), forward_runs, "
       "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
+
+  m.def(
+      "schema",
+      [] {
+        return py::module_::import("json").attr("loads")(
+            ff::experiment::experiment_schema().dump());
+      },
+      "The JSON Schema of experiment files (what `fiberfluid schema` prints), as a dict.");
 
   m.def(
       "summary",

@@ -15,6 +15,7 @@
 
 #include "app/cli_support.hpp"
 #include "experiment/build_info.hpp"
+#include "experiment/schema.hpp"
 #include "geom/generators.hpp"
 #include "geom/mesh_io.hpp"
 #include "test_support.hpp"
@@ -113,6 +114,23 @@ TEST(Cli, APaddlesOnlyFitIsNotIdentifiableAndNamesY0AndGamma) {
     EXPECT_EQ(o.output.find(absent), std::string::npos) << absent << "\n" << o.output;
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "shape.failed" / "fit.json"));
+}
+
+// `fiberfluid schema` prints the schema the reader makes of itself
+// (tests/python/test_schema.py validates the shipped experiments with it).
+TEST(Cli, SchemaPrintsTheExperimentFilesJsonSchema) {
+  const Outcome o = run_cli("schema");
+  EXPECT_EQ(o.status, 0) << o.output;
+  const nlohmann::json printed = nlohmann::json::parse(o.output);
+  EXPECT_EQ(printed, experiment::experiment_schema());
+  EXPECT_EQ(printed["$schema"], "https://json-schema.org/draft/2020-12/schema");
+  EXPECT_FALSE(printed["additionalProperties"].get<bool>());
+  for (const char* section : {"surface", "material", "supports", "prescribed", "loads", "paddles",
+                              "stepping", "fibers", "fit", "fem_reference", "output", "expected",
+                              "variants", "surfaces", "scene"})
+    EXPECT_TRUE(printed["properties"].contains(section)) << section;
+  EXPECT_EQ(printed["properties"]["stepping"]["properties"]["scheme"]["enum"],
+            nlohmann::json({"incremental", "newton"}));
 }
 
 TEST(Cli, BadExperimentWritesNothing) {

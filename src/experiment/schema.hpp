@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+// The experiment file's JSON Schema, generated from the reader itself: while
+// a SchemaRecorder is active on a thread, every Fields accessor reports the
+// field it reads (its name, type, range, allowed values). experiment_schema()
+// runs the reader over a document that has every section and then over every
+// alternative of every choice it met, so that each branch's fields are read,
+// and turns what was recorded into a schema (draft 2020-12). The schema is
+// therefore as strict as the reader (unknown fields are refused) and cannot
+// fall behind it.
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace fiberfluid::experiment {
+
+class SchemaRecorder {
+ public:
+  // A field `key` of the object at `path` ("fit.targets[1]"), read as
+  // `fragment` (a JSON Schema for its value; {} for any value).
+  void note(const std::string& path, const std::string& key, const nlohmann::json& fragment);
+  // A field with a fixed set of values: recorded, and kept for exploring.
+  void choice(const std::string& path, const std::string& key,
+              const std::vector<std::string>& allowed);
+
+  // A required field that was not given: the explorer gives it a value.
+  void missing(const std::string& path, const std::string& key);
+  // The field missing in the last read, if any (path, key), and what it was read as.
+  bool take_missing(std::string* path, std::string* key, nlohmann::json* fragment);
+
+  struct Choice {
+    std::string path, key;
+    std::vector<std::string> allowed;
+  };
+  // The choices met since the last call.
+  std::vector<Choice> take_choices();
+
+  // The schema of everything recorded: objects closed to unknown fields.
+  nlohmann::json schema() const;
+
+ private:
+  // Per object path pattern ("fit.targets[]"), per field: its schema.
+  std::map<std::string, std::map<std::string, nlohmann::json>> fields_;
+  std::vector<Choice> choices_;
+  std::string missing_path_, missing_key_;
+  bool missing_ = false;
+};
+
+// The recorder Fields reports to on this thread, or null (the usual case).
+SchemaRecorder*& active_schema_recorder();
+
+// The experiment file's JSON Schema (what `fiberfluid schema` prints).
+nlohmann::json experiment_schema();
+
+}  // namespace fiberfluid::experiment

@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The experiment file's JSON Schema (`fiberfluid schema`), checked by an
+independent validator (jsonschema, Debian's python3-jsonschema): every shipped
+experiment and every experiment the fuzzer starts from is valid; a misspelt
+field, a wrong type and a value outside a choice are not, as the reader refuses them."""
+import glob
+import json
+import os
+
+import jsonschema
+import pytest
+
+import fiberfluid
+
+SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
+                        os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+
+
+@pytest.fixture(scope="module")
+def validator():
+    schema = fiberfluid.schema()
+    jsonschema.Draft202012Validator.check_schema(schema)
+    return jsonschema.Draft202012Validator(schema)
+
+
+def documents():
+    files = sorted(glob.glob(os.path.join(SOURCE, "experiments", "*.json")))
+    files += sorted(glob.glob(os.path.join(SOURCE, "tests", "fuzz", "seeds", "experiment", "*.json")))
+    for name in files:
+        with open(name) as f:
+            try:
+                yield name, json.load(f)
+            except (ValueError, RecursionError):
+                continue  # a seed that is not JSON on purpose (nested too deep)
+
+
+def test_every_shipped_and_seed_experiment_is_valid(validator):
+    checked = 0
+    for name, document in documents():
+        errors = [f"{list(e.absolute_path)}: {e.message[:200]}" for e in validator.iter_errors(document)]
+        assert not errors, f"{name}: {errors}"
+        checked += 1
+    assert checked >= 30
+
+
+def test_what_the_reader_refuses_the_schema_refuses(validator):
+    with open(os.path.join(SOURCE, "experiments", "liver_paddles.json")) as f:
+        good = json.load(f)
+    assert validator.is_valid(good)
+    for path, value in ((("material", "colour"), "red"),       # an unknown field
+                        (("material", "gamma"), "high"),        # a string for a number
+                        (("material", "gamma"), -1),            # below its minimum
+                        (("stepping", "steps"), 2.5),           # a number for a whole number
+                        (("stepping", "scheme"), "implicit"),   # outside the choices
+                        (("paddles", 0, "side"), "left"),
+                        (("variants", 0, "colour"), 1)):
+        bad = json.loads(json.dumps(good))
+        where = bad
+        for key in path[:-1]:
+            where = where[key]
+        where[path[-1]] = value
+        assert not validator.is_valid(bad), path
+    # A variant may remove a field with null (a JSON merge patch).
+    patched = json.loads(json.dumps(good))
+    patched["variants"][0]["fibers"] = None
+    assert patched["variants"][1]["material"]["law"]["Y"] is None  # as shipped
+    assert validator.is_valid(patched)
+    # The law types are the reader's, the force targets' fields are there.
+    laws = validator.schema["properties"]["material"]["anyOf"][0]["properties"]["law"]
+    assert set(laws["properties"]["type"]["enum"]) >= {"constant", "exponential", "bilinear", "tabulated"}
+    targets = validator.schema["properties"]["fit"]["properties"]["targets"]["items"]["properties"]
+    assert {"paddle", "support", "axis", "travel_units", "force_units", "weight"} <= set(targets)
