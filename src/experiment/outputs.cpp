@@ -519,11 +519,13 @@ void OutputWriter::write_fibers() const {
 
 // One load step for ParaView: Points are the deformed positions (display the
 // reference with `reference_position`, or Warp By Vector `displacement` by -1);
-// point data displacement, its magnitude, the area vectors, the reference;
-// cell data each face's area over its rest area; field data the step, its
+// point data displacement, its magnitude, the area vectors, the reference,
+// the supports' reactions and the paddles' contact forces on the vertices
+// they hold; cell data each face's area over its rest area; field data the step, its
 // load factors (one per load, in the file's order) and the pressure.
 void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns,
-                               const std::vector<double>& load_factors) {
+                               const std::vector<double>& load_factors,
+                               const std::vector<solve::StepRecord::HeldForce>& held_forces) {
   const Case& c = experiment_.cases[run];
   const model::Model& m = c.model;
   geom::Surface deformed = c.input_surface;
@@ -539,11 +541,19 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
   const Eigen::VectorXd
       rest = geom::face_area_vectors(c.input_surface.V, c.input_surface.F).rowwise().norm(),
       now = geom::face_area_vectors(deformed.V, deformed.F).rowwise().norm();
+  // The supports' and the paddles' forces on the vertices they hold.
+  Eigen::MatrixXd support = Eigen::MatrixXd::Zero(n, dim), contact = support;
+  for (const solve::StepRecord::HeldForce& h : held_forces) {
+    Eigen::MatrixXd& to = h.paddle < 0 ? support : contact;
+    to.row(c.model_to_input[static_cast<size_t>(h.vertex)]) = h.force.head(dim).transpose();
+  }
   geom::VtuContent content;
   content.points = {{"displacement", U},
                     {"displacement_magnitude", U.rowwise().norm()},
                     {"area_vector", S},
-                    {"reference_position", c.input_surface.V}};
+                    {"reference_position", c.input_surface.V},
+                    {"support_reaction", support},
+                    {"contact_force", contact}};
   content.cells = {{"area_change", now.cwiseQuotient(rest)}};
   content.field = {{"step", {static_cast<double>(step)}},
                    {"load_factors", load_factors},
@@ -562,7 +572,7 @@ void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
                            const Eigen::VectorXd& unknowns) {
   const bool last = record.step == experiment_.cases[run].stepping.steps;
   if (experiment_.output.vtk && (last || record.step % experiment_.output.every == 0))
-    write_state(run, record.step, unknowns, record.load_factors);
+    write_state(run, record.step, unknowns, record.load_factors, record.held_forces);
 }
 
 void OutputWriter::write_fem_path(const FemReferenceResult& f) {

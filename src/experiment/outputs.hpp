@@ -86,7 +86,8 @@ class OutputWriter {
  private:
   std::filesystem::path run_folder(size_t run) const;
   void write_state(size_t run, int step, const Eigen::VectorXd& unknowns,
-                   const std::vector<double>& load_factors);
+                   const std::vector<double>& load_factors,
+                   const std::vector<solve::StepRecord::HeldForce>& held_forces = {});
   // fem_reference_series.pvd: a nonlinear FEM's boundary after each load step.
   void write_fem_path(const FemReferenceResult& f);
   void write_fibers() const;            // fibers.vtu: the kept or pruned fibers, if asked

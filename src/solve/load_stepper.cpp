@@ -184,6 +184,16 @@ SteppingSummary solve_load_steps(const model::Model& model, const SteppingOption
     record.volume = volume;
     record.applied_force = applied;
     record.reactions = reactions->per_group();
+    const Eigen::MatrixXd per_vertex = reactions->per_vertex();
+    std::vector<char> held(static_cast<size_t>(nv), 0);
+    for (const model::Constraint& c : model.constraints) held[static_cast<size_t>(c.vertex)] = 1;
+    for (int v = 0; v < nv; ++v)
+      if (held[static_cast<size_t>(v)]) {
+        StepRecord::HeldForce force;
+        force.vertex = v;
+        force.force.head(model.dim()) = per_vertex.row(v).transpose();
+        record.held_forces.push_back(force);
+      }
     record.max_displacement = (X_now - reference).rowwise().norm().maxCoeff();
     if (options.measure_residual)
       record.residual = residual_gauge.measure(*problem, dofs, summary.unknowns, now);

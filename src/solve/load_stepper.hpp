@@ -122,6 +122,15 @@ struct StepRecord {
   // body, and the sum of the external loads; they sum to zero at equilibrium.
   std::vector<Eigen::Vector3d> reactions;
   Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();
+  // The force on each vertex a support or a paddle holds (the reactions and
+  // paddle forces above, vertex by vertex; a clamp's mirror layer's fibers
+  // are not in it). Only held vertices are listed.
+  struct HeldForce {
+    int vertex = -1;  // model index
+    int paddle = -1;  // the paddle (Model::paddles) in contact; -1: a support
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  };
+  std::vector<HeldForce> held_forces;
 
   // Newton scheme only.
   int newton_iterations = 0;           // over the step's pieces

@@ -665,6 +665,16 @@ class StepFinisher {
         }
     }
     for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
+    for (int v = 0; v < nv; ++v) {
+      bool any = false;
+      for (int a = 0; a < dim; ++a) any = any || held.held(a * nv + v);
+      if (!any) continue;
+      StepRecord::HeldForce force;
+      force.vertex = v;
+      force.paddle = solver_.contact_paddle()[static_cast<size_t>(v)];
+      force.force.head(dim) = summary_.reaction_forces.row(v).transpose();
+      record.held_forces.push_back(force);
+    }
     record.load_factors = at.factors;
     record.pressure = x[model_.pressure_dof()];
     record.volume = volume;

@@ -58,3 +58,35 @@ def test_ascii_and_compressed_series_hold_the_same_data(tmp_path):
     # The compressed file is smaller.
     assert (tmp_path / "compressed" / "vtk" / "step_0010.vtu").stat().st_size < \
         0.7 * (tmp_path / "ascii" / "vtk" / "step_0010.vtu").stat().st_size
+
+
+def test_reactions_and_contact_forces_sum_to_the_steps_forces(tmp_path):
+    # The sphere's support: its vertices' reactions sum to the group's reaction in summary.json.
+    out = tmp_path / "sphere"
+    fiberfluid.Experiment.from_dict(sphere("ascii")).run(output=str(out))
+    grid = meshio.read(str(out / "vtk" / "step_0010.vtu"))
+    summary = json.loads((out / "summary.json").read_text())
+    last = summary["runs"][0]["steps"][-1]
+    (group, reaction), = last["reactions"].items()
+    assert np.allclose(grid.point_data["support_reaction"].sum(axis=0), reaction, rtol=1e-12,
+                       atol=1e-9)
+    assert not grid.point_data["contact_force"].any()  # no paddle
+    # The liver between paddles: each paddle's contact forces sum to its force.
+    with open(os.path.join(SOURCE, "experiments", "liver_paddles.json")) as f:
+        document = json.load(f)
+    document["variants"] = document["variants"][:1]
+    document["expected"] = []
+    document["stepping"]["steps"] = 3
+    document["surface"]["file"] = os.path.join(SOURCE, "experiments", document["surface"]["file"])
+    out = tmp_path / "liver"
+    fiberfluid.Experiment.from_dict(document).run(output=str(out))
+    grid = meshio.read(str(out / "constant" / "vtk" / "step_0003.vtu"))
+    summary = json.loads((out / "summary.json").read_text())
+    figures = summary["figures"]
+    contact = grid.point_data["contact_force"]
+    assert contact[:, 1].sum() == pytest.approx(figures["constant.paddle_force.upper"] +
+                                                figures["constant.paddle_force.lower"], rel=1e-12)
+    pressed = contact[:, 1] < 0  # the upper paddle pushes down on the vertices it holds
+    assert contact[pressed, 1].sum() == pytest.approx(figures["constant.paddle_force.upper"],
+                                                      rel=1e-12)
+    assert np.abs(grid.point_data["support_reaction"]).sum() > 0  # the resting vertices
