@@ -32,3 +32,15 @@ test -f "$scratch/prefix/share/fiberfluid/plot.py"
 (cd "$scratch" && "$scratch/prefix/bin/fiberfluid" run tiny.json -o out -q --plot) | grep -q "plot: "
 test -s "$scratch/out/plot.png"
 echo "installed run --plot: $scratch/out/plot.png written"
+
+# The installed Python module, found by the interpreter under the prefix.
+if [ -n "${FIBERFLUID_PYTHON:-}" ]; then
+  # Where this interpreter looks under /usr/local (Debian: lib/python3.X/dist-packages),
+  # taken under the scratch prefix.
+  local_dir="$("$FIBERFLUID_PYTHON" -c \
+    "import sys; print([p for p in sys.path if p.startswith('/usr/local/')][0][len('/usr/local/'):])")"
+  module_dir="$scratch/prefix/$local_dir"
+  ls "$module_dir"/fiberfluid*.so >/dev/null
+  PYTHONPATH="$module_dir" "$FIBERFLUID_PYTHON" -c \
+    "import fiberfluid; s = fiberfluid.schema(); assert s['title'] == 'fiberfluid experiment'; print('installed module:', fiberfluid.__file__)"
+fi
