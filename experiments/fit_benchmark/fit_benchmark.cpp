@@ -13,9 +13,9 @@
 #include <iostream>
 #include <vector>
 
-#include "experiment/experiment.hpp"
-#include "fit/calibration.hpp"
-#include "model/assembly.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/model/assembly.hpp"
 
 namespace ff = fiberfluid;
 

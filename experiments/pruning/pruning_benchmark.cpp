@@ -10,9 +10,9 @@
 #include <iostream>
 #include <string>
 
-#include "geom/fiber_pruning.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 
 namespace {
 

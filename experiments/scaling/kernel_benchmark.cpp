@@ -26,13 +26,13 @@
 #include <string>
 #include <vector>
 
-#include "experiment/experiment.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/vector_clones.hpp"
+#include "fiberfluid/util/run_control.hpp"
 #include "gemm_peak.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_system.hpp"
-#include "model/loads.hpp"
-#include "model/vector_clones.hpp"
-#include "util/run_control.hpp"
 
 namespace {
 

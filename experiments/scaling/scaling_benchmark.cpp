@@ -16,8 +16,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
 #include "gemm_peak.hpp"
 
 namespace {

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "model/bulk_treecode.hpp"
-#include "model/pair_kernels.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/bulk_treecode.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 
 namespace {
 

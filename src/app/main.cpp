@@ -17,19 +17,19 @@
 #include <sstream>
 #include <thread>
 
-#include "experiment/build_info.hpp"
-#include "experiment/compare.hpp"
-#include "experiment/experiment.hpp"
-#include "experiment/fitting.hpp"
-#include "experiment/output_folder.hpp"
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "experiment/schema.hpp"
-#include "geom/mesh_check.hpp"
-#include "geom/mesh_io.hpp"
-#include "util/error.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/experiment/build_info.hpp"
+#include "fiberfluid/experiment/compare.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/fitting.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace {
 

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "bridge/fem_bridge.hpp"
+#include "fiberfluid/bridge/fem_bridge.hpp"
 
 #include <chrono>
 #include <functional>
 #include <map>
 #include <vector>
 
-#include "fem/mesh_tools.hpp"
-#include "fit/target.hpp"
-#include "geom/area_vectors.hpp"
-#include "model/boundary_conditions.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::bridge {
 namespace {

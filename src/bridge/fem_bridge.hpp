@@ -18,11 +18,11 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "fem/fem.hpp"
-#include "fem/hyperelastic.hpp"
-#include "fem/tet_mesher.hpp"
-#include "geom/surface.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/fem/hyperelastic.hpp"
+#include "fiberfluid/fem/tet_mesher.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::bridge {
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "bridge/scene_model.hpp"
+#include "fiberfluid/bridge/scene_model.hpp"
 
 #include <algorithm>
 #include <memory>
 
-#include "geom/fiber_pruning.hpp"
-#include "geom/surface.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::bridge {
 namespace {

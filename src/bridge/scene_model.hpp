@@ -7,9 +7,9 @@
 // prescribed displacement along -x, the rod's gravity a hydrostatic load of
 // the scene's density. Every load and displacement is ramped over the steps.
 
-#include "fem/mesh_tools.hpp"
-#include "fem/scenes.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/fem/scenes.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::bridge {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/benchmark.hpp"
+#include "fiberfluid/experiment/benchmark.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,14 +9,14 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "bridge/scene_model.hpp"
-#include "experiment/json_fields.hpp"
-#include "fem/mesh_tools.hpp"
-#include "fit/calibration.hpp"
-#include "fit/golden_section.hpp"
-#include "metrics/metrics.hpp"
-#include "model/assembly.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/bridge/scene_model.hpp"
+#include "fiberfluid/experiment/json_fields.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/golden_section.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "fem/dynamics.hpp"
-#include "fem/scenes.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/fem/dynamics.hpp"
+#include "fiberfluid/fem/scenes.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::experiment {
 

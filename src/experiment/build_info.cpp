@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/build_info.hpp"
+#include "fiberfluid/experiment/build_info.hpp"
 
 #include <CGAL/version.h>
 #include <SuiteSparse_config.h>

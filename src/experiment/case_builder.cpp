@@ -5,17 +5,17 @@
 #include <sstream>
 #include <string>
 
-#include "experiment/case_spec.hpp"
-#include "geom/fiber_pruning.hpp"
-#include "geom/horizon.hpp"
-#include "geom/mesh_check.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/boundary_conditions.hpp"
-#include "model/mirror_layer.hpp"
-#include "solve/load_stepper.hpp"
-#include "util/error.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "experiment/resources.hpp"
-#include "geom/surface.hpp"
-#include "model/model.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/experiment/resources.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::experiment {
 

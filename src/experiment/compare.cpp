@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/compare.hpp"
+#include "fiberfluid/experiment/compare.hpp"
 
 #include <sstream>
 
-#include "geom/mesh_io.hpp"
-#include "metrics/metrics.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 

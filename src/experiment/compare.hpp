@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "fit/target.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::experiment {
 

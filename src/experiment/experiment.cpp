@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/experiment.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
 
-#include "experiment/figures.hpp"
-#include "experiment/json_fields.hpp"
-#include "experiment/output_folder.hpp"
+#include "fiberfluid/experiment/figures.hpp"
+#include "fiberfluid/experiment/json_fields.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "geom/generators.hpp"
-#include "model/boundary_conditions.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "experiment/benchmark.hpp"
-#include "experiment/case_spec.hpp"
-#include "experiment/fem_reference.hpp"
-#include "experiment/fit_spec.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/experiment/benchmark.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/experiment/fem_reference.hpp"
+#include "fiberfluid/experiment/fit_spec.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/fem_reference.hpp"
+#include "fiberfluid/experiment/fem_reference.hpp"
 
 #include <limits>
 
-#include "bridge/fem_bridge.hpp"
-#include "experiment/case_spec.hpp"
-#include "experiment/json_fields.hpp"
-#include "experiment/runner.hpp"
-#include "fit/target.hpp"
-#include "metrics/metrics.hpp"
-#include "model/assembly.hpp"
-#include "model/model.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/bridge/fem_bridge.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/experiment/json_fields.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "fem/fem.hpp"
-#include "fem/hyperelastic.hpp"
-#include "fem/tet_mesher.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/fem/hyperelastic.hpp"
+#include "fiberfluid/fem/tet_mesher.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/figures.hpp"
+#include "fiberfluid/experiment/figures.hpp"
 
 #include <algorithm>
 #include <cctype>
 
-#include "experiment/experiment.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
 
 namespace fiberfluid::experiment {
 

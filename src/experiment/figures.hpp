@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "model/model.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "experiment/case_spec.hpp"
-#include "fit/calibration.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/fit/calibration.hpp"
 
 namespace fiberfluid::experiment {
 

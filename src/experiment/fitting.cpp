@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/fitting.hpp"
+#include "fiberfluid/experiment/fitting.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <map>
 #include <sstream>
 
-#include "experiment/figures.hpp"
-#include "geom/mesh_io.hpp"
-#include "geom/vtk_writer.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/experiment/figures.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/geom/vtk_writer.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
-#include "fit/calibration.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/fit/calibration.hpp"
 
 namespace fiberfluid::experiment {
 

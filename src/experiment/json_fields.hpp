@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "experiment/case_spec.hpp"
-#include "experiment/schema.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 

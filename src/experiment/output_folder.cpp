@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/output_folder.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -14,8 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "geom/mesh_io.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -1,19 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/outputs.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
 
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
 #include <utility>
 
-#include "experiment/build_info.hpp"
-#include "experiment/output_folder.hpp"
-#include "fem/mesh_tools.hpp"
-#include "geom/area_vectors.hpp"
-#include "geom/mesh_io.hpp"
-#include "geom/vtk_writer.hpp"
-#include "model/assembly.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/experiment/build_info.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/geom/vtk_writer.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/resources.hpp"
+#include "fiberfluid/experiment/resources.hpp"
 
 #include <sys/resource.h>
 
@@ -8,12 +8,12 @@
 #include <cstdio>
 #include <sstream>
 
-#include "experiment/case_spec.hpp"
-#include "geom/fiber_mask.hpp"
-#include "model/treecode.hpp"
-#include "solve/cost_model.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/model/treecode.hpp"
+#include "fiberfluid/solve/cost_model.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

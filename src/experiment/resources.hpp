@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "model/model.hpp"
-#include "solve/cost_model.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/cost_model.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/runner.hpp"
+#include "fiberfluid/experiment/runner.hpp"
 
 #include <omp.h>
 #include <algorithm>
@@ -10,11 +10,11 @@
 #include <sstream>
 #include <thread>
 
-#include "experiment/figures.hpp"
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "model/boundary_conditions.hpp"
-#include "util/progress.hpp"
+#include "fiberfluid/experiment/figures.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/progress.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "experiment/experiment.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::experiment {
 

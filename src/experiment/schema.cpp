@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/schema.hpp"
+#include "fiberfluid/experiment/schema.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <deque>
 
-#include "experiment/experiment.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/dynamics.hpp"
+#include "fiberfluid/fem/dynamics.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "fem/free_unknowns.hpp"
-#include "solve/sparse_cholesky.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/fem/free_unknowns.hpp"
+#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "fem/fem.hpp"
+#include "fiberfluid/fem/fem.hpp"
 
 namespace fiberfluid::fem {
 

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/fem.hpp"
+#include "fiberfluid/fem/fem.hpp"
 
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
 
-#include "fem/free_unknowns.hpp"
-#include "solve/sparse_cholesky.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/fem/free_unknowns.hpp"
+#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -12,7 +12,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "solve/status.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::fem {
 

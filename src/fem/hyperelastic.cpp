@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/hyperelastic.hpp"
+#include "fiberfluid/fem/hyperelastic.hpp"
 
 #include <Eigen/LU>
 #include <Eigen/SparseLU>
@@ -8,9 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fem/free_unknowns.hpp"
-#include "solve/sparse_cholesky.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/fem/free_unknowns.hpp"
+#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "fem/fem.hpp"
-#include "solve/status.hpp"
+#include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::fem {
 

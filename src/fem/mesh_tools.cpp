@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/mesh_tools.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <map>
 
-#include "util/error.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

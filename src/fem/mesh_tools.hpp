@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "fem/fem.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::fem {
 

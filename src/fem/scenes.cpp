@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/scenes.hpp"
+#include "fiberfluid/fem/scenes.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "fem/mesh_tools.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 

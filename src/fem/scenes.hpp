@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "fem/dynamics.hpp"
-#include "fem/fem.hpp"
+#include "fiberfluid/fem/dynamics.hpp"
+#include "fiberfluid/fem/fem.hpp"
 
 namespace fiberfluid::fem {
 

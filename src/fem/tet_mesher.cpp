@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // CGAL stays in this file (and it compiles slowly: -g0, see CMakeLists.txt).
-#include "fem/tet_mesher.hpp"
+#include "fiberfluid/fem/tet_mesher.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -14,7 +14,7 @@
 #include <map>
 #include <vector>
 
-#include "util/error.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -7,8 +7,8 @@
 // The boundary of the result approximates the surface (within
 // facet_distance); its nodes are not the surface's vertices.
 
-#include "fem/fem.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::fem {
 

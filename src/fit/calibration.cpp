@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/calibration.hpp"
+#include "fiberfluid/fit/calibration.hpp"
 
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
@@ -13,11 +13,11 @@
 #include <map>
 #include <sstream>
 
-#include "fit/optimizers.hpp"
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -241,13 +241,13 @@ std::vector<CurveRow> plan_curve(const ForceCurve& curve, const model::Model& mo
     const double t = curve.at[r];
     int k = 0;
     while (k < steps && direction * (t - travel[static_cast<size_t>(k) + 1]) > 0.0) ++k;
-    const double low = travel[static_cast<size_t>(k)], high = travel[static_cast<size_t>(k) + 1];
-    if (k == steps || direction * (t - low) < 0.0) {
+    if (k == steps || direction * (t - travel[static_cast<size_t>(k)]) < 0.0) {
       std::ostringstream why;
       why << curve.label << ": row " << r + 1 << ": travel " << t
           << " m is outside the run's, from " << travel.front() << " to " << travel.back() << " m";
       throw InputError(why.str());
     }
+    const double low = travel[static_cast<size_t>(k)], high = travel[static_cast<size_t>(k) + 1];
     rows.push_back({k, k + 1, (t - low) / (high - low)});
   }
   return rows;

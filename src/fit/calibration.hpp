@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "fit/force_curve.hpp"
-#include "fit/parameters.hpp"
-#include "fit/target.hpp"
-#include "model/model.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/fit/force_curve.hpp"
+#include "fiberfluid/fit/parameters.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::fit {
 

@@ -6,8 +6,8 @@
 #include <chrono>
 #include <memory>
 
-#include "fit/optimizers.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/force_curve.hpp"
+#include "fiberfluid/fit/force_curve.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/fiber_system.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {

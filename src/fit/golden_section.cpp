@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/golden_section.hpp"
+#include "fiberfluid/fit/golden_section.hpp"
 
 #include <cmath>
 #include <limits>

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <limits>
 
-#include "fit/optimizers.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {

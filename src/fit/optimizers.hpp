@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fit/calibration.hpp"
+#include "fiberfluid/fit/calibration.hpp"
 
 namespace fiberfluid::fit {
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/parameters.hpp"
+#include "fiberfluid/fit/parameters.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "model/equilibrium.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {

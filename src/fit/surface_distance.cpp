@@ -13,8 +13,8 @@
 #include <boost/iterator/counting_iterator.hpp>
 #include <optional>
 
-#include "fit/target.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {

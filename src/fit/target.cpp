@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/target.hpp"
+#include "fiberfluid/fit/target.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "geom/mesh_io.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fit {
 

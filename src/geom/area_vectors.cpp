@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/area_vectors.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/convexity_filter.hpp"
+#include "fiberfluid/geom/convexity_filter.hpp"
 
 #include <omp.h>
 
@@ -8,9 +8,9 @@
 #include <cmath>
 #include <numeric>
 
-#include "geom/certified_sign.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/certified_sign.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::geom {
 

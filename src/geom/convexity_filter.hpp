@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

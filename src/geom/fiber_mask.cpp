@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/fiber_mask.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
 
 #include <algorithm>
 #include <numeric>

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Exact pruning of the fibers that leave a concave body (model.md section 3;
 // the method paper's "Concave objects"). CGAL stays in this file.
-#include "geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
 
 #include <omp.h>
 
 #include <atomic>
 
-#include "geom/convexity_filter.hpp"
-#include "geom/segment_filter.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/convexity_filter.hpp"
+#include "fiberfluid/geom/segment_filter.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
-#include "geom/fiber_mask.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/generators.hpp"
+#include "fiberfluid/geom/generators.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "geom/area_vectors.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <Eigen/Core>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

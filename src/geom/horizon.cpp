@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/horizon.hpp"
+#include "fiberfluid/geom/horizon.hpp"
 
 #include <algorithm>
 #include <array>

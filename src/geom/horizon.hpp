@@ -7,8 +7,8 @@
 // about the body's thickness makes a slender body bend as a beam does
 // (model.md, the fiber kinematics).
 
-#include "geom/fiber_mask.hpp"
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/mesh_check.hpp"
-#include "geom/self_intersection.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/geom/self_intersection.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <sstream>
 #include <utility>
 
-#include "geom/area_vectors.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

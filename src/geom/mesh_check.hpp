@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

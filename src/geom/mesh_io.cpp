@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include <map>
 #include <sstream>
 
-#include "util/error.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

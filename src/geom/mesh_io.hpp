@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/segment_filter.hpp"
+#include "fiberfluid/geom/segment_filter.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <optional>
 
-#include "geom/certified_sign.hpp"
+#include "fiberfluid/geom/certified_sign.hpp"
 
 namespace fiberfluid::geom {
 

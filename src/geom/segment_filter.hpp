@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // CGAL stays in this file (see CMakeLists.txt: -g0).
-#include "geom/self_intersection.hpp"
+#include "fiberfluid/geom/self_intersection.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>

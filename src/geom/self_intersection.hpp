@@ -4,7 +4,7 @@
 #include <optional>
 #include <utility>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::geom {
 

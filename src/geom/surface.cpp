@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 #include <algorithm>
 #include <utility>

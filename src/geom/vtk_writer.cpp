@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/vtk_writer.hpp"
+#include "fiberfluid/geom/vtk_writer.hpp"
 
 #include <zlib.h>
 
@@ -9,8 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "geom/mesh_io.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
 

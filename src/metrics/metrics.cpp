@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "metrics/metrics.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
 
 #include <cmath>
 
-#include "geom/area_vectors.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::metrics {
 

@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "geom/surface.hpp"
+#include "fiberfluid/geom/surface.hpp"
 
 namespace fiberfluid::metrics {
 

@@ -18,8 +18,8 @@
 #include <iterator>
 #include <vector>
 
-#include "metrics/metrics.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::metrics {
 namespace {

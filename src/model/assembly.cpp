@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/assembly.hpp"
+#include "fiberfluid/model/assembly.hpp"
 
-#include "geom/area_vectors.hpp"
-#include "model/loads.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/loads.hpp"
 
 namespace fiberfluid::model {
 

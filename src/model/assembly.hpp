@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "model/model.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/bordered_system.hpp"
+#include "fiberfluid/model/bordered_system.hpp"
 
 #include <algorithm>
 

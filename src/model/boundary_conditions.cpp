@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/boundary_conditions.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
 
 #include <Eigen/Geometry>
 
@@ -10,7 +10,7 @@
 #include <regex>
 #include <set>
 
-#include "util/error.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::model {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "model/model.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
 

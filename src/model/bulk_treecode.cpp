@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/bulk_treecode.hpp"
+#include "fiberfluid/model/bulk_treecode.hpp"
 
 #include <stdexcept>
 
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 

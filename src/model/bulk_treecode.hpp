@@ -11,8 +11,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "model/fiber_network.hpp"
-#include "model/treecode.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/treecode.hpp"
 
 namespace fiberfluid::model {
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/dof_map.hpp"
+#include "fiberfluid/model/dof_map.hpp"
 
-#include "model/boundary_conditions.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
 

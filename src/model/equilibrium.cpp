@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/equilibrium.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
 
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

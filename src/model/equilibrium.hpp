@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "model/dof_map.hpp"
-#include "model/fiber_network.hpp"
-#include "model/fiber_system.hpp"
-#include "model/model.hpp"
-#include "model/pair_kernels.hpp"
-#include "model/terms.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
+#include "fiberfluid/model/terms.hpp"
 
 namespace fiberfluid::model {
 

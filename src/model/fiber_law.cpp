@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/fiber_law.hpp"
+#include "fiberfluid/model/fiber_law.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/fiber_network.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 #include <string>
 
-#include "model/pair_stencil.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::model {
 

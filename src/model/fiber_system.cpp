@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/fiber_system.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "geom/area_vectors.hpp"
-#include "model/fiber_network.hpp"
-#include "model/pair_stencil.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::model {
 namespace {

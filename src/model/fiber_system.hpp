@@ -5,13 +5,13 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "model/bordered_system.hpp"
-#include "model/boundary_conditions.hpp"
-#include "model/bulk_treecode.hpp"
-#include "model/dof_map.hpp"
-#include "model/fiber_network.hpp"
-#include "model/model.hpp"
-#include "model/pair_kernels.hpp"
+#include "fiberfluid/model/bordered_system.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/bulk_treecode.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 
 namespace fiberfluid::model {
 

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/loads.hpp"
+#include "fiberfluid/model/loads.hpp"
 
 #include <cassert>
 #include <stdexcept>
 #include <string>
 
-#include "geom/area_vectors.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
 
 namespace fiberfluid::model {
 

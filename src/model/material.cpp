@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "model/model.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
 

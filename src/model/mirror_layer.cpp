@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/mirror_layer.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
 
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "geom/surface.hpp"
-#include "model/fiber_network.hpp"
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 

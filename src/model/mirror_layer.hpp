@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "model/model.hpp"
-#include "model/terms.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/model/terms.hpp"
 
 namespace fiberfluid::model {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "geom/fiber_mask.hpp"
-#include "geom/surface.hpp"
-#include "model/fiber_law.hpp"
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/model/fiber_law.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/pair_kernels.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 
 #include <omp.h>
 
@@ -7,10 +7,10 @@
 #include <array>
 #include <cmath>
 
-#include "geom/fiber_mask.hpp"
-#include "model/pair_stencil.hpp"
-#include "model/vector_clones.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/model/vector_clones.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::model {
 namespace {

@@ -14,11 +14,11 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "geom/fiber_mask.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
 
-#include "model/fiber_law.hpp"
-#include "model/fiber_network.hpp"
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/model/fiber_law.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 

@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/terms.hpp"
+#include "fiberfluid/model/terms.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "geom/area_vectors.hpp"
-#include "geom/fiber_mask.hpp"
-#include "model/assembly.hpp"
-#include "model/loads.hpp"
-#include "model/mirror_layer.hpp"
-#include "model/pair_kernels.hpp"
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 

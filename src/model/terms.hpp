@@ -20,8 +20,8 @@
 #include <memory>
 #include <vector>
 
-#include "model/fiber_network.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
 

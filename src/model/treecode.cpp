@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/treecode.hpp"
+#include "fiberfluid/model/treecode.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
 
-#include "model/vector_clones.hpp"
+#include "fiberfluid/model/vector_clones.hpp"
 
 namespace fiberfluid::model {
 

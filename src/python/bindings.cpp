@@ -13,17 +13,17 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "experiment/experiment.hpp"
-#include "experiment/output_folder.hpp"
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "experiment/schema.hpp"
-#include "fit/calibration.hpp"
-#include "geom/mesh_check.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/equilibrium.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace py = pybind11;
 namespace ff = fiberfluid;

@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 

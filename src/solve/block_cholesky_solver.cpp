@@ -4,8 +4,8 @@
 #include <chrono>
 #include <vector>
 
-#include "solve/backends.hpp"
-#include "solve/schur_solver.hpp"
+#include "fiberfluid/solve/backends.hpp"
+#include "fiberfluid/solve/schur_solver.hpp"
 
 extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info, std::size_t);

@@ -5,9 +5,9 @@
 // bulk fibers make a block dense, which it handles, at dense cost.
 #include <vector>
 
-#include "solve/backends.hpp"
-#include "solve/schur_solver.hpp"
-#include "solve/sparse_cholesky.hpp"
+#include "fiberfluid/solve/backends.hpp"
+#include "fiberfluid/solve/schur_solver.hpp"
+#include "fiberfluid/solve/sparse_cholesky.hpp"
 
 namespace fiberfluid::solve {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/cost_model.hpp"
+#include "fiberfluid/solve/cost_model.hpp"
 
 #include <algorithm>
 #include <cmath>

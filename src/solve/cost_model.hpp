@@ -6,9 +6,9 @@
 // run (experiment/resources) composes these with the pruning and the steps.
 #pragma once
 
-#include "model/boundary_conditions.hpp"
-#include "model/model.hpp"
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 

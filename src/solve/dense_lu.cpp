@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/dense_lu.hpp"
+#include "fiberfluid/solve/dense_lu.hpp"
 
 #include <cstddef>
 #include <cstdio>

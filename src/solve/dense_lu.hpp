@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "solve/status.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::solve {
 

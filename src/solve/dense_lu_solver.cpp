@@ -2,8 +2,8 @@
 // dense-lu: the paper's method, LU of the whole reduced bordered system.
 #include <chrono>
 
-#include "solve/backends.hpp"
-#include "solve/dense_lu.hpp"
+#include "fiberfluid/solve/backends.hpp"
+#include "fiberfluid/solve/dense_lu.hpp"
 
 namespace fiberfluid::solve {
 namespace {

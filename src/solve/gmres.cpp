@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/gmres.hpp"
+#include "fiberfluid/solve/gmres.hpp"
 
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <vector>
 
-#include "util/run_control.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 

@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <functional>
 
-#include "solve/status.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::solve {
 

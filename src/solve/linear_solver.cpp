@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 #include <sstream>
 
-#include "solve/backends.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/solve/backends.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 

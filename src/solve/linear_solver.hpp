@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "model/bordered_system.hpp"
-#include "solve/status.hpp"
+#include "fiberfluid/model/bordered_system.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::solve {
 

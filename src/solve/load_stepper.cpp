@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -8,15 +8,15 @@
 #include <optional>
 #include <sstream>
 
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_system.hpp"
-#include "model/loads.hpp"
-#include "solve/stepping_common.hpp"
-#include "util/error.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/solve/stepping_common.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {

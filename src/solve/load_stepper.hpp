@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "model/boundary_conditions.hpp"
-#include "model/fiber_system.hpp"
-#include "model/model.hpp"
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 

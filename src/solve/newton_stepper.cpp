@@ -11,18 +11,18 @@
 #include <optional>
 #include <sstream>
 
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "model/dof_map.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_system.hpp"
-#include "model/loads.hpp"
-#include "solve/load_stepper.hpp"
-#include "solve/stepping_common.hpp"
-#include "solve/tangent_solve.hpp"
-#include "util/error.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping_common.hpp"
+#include "fiberfluid/solve/tangent_solve.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {

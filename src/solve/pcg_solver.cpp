@@ -7,11 +7,11 @@
 #include <sstream>
 #include <vector>
 
-#include "solve/backends.hpp"
-#include "solve/schur_solver.hpp"
-#include "solve/sparse_cholesky.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/solve/backends.hpp"
+#include "fiberfluid/solve/schur_solver.hpp"
+#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {

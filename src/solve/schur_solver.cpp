@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/schur_solver.hpp"
+#include "fiberfluid/solve/schur_solver.hpp"
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 

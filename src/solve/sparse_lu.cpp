@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/sparse_lu.hpp"
+#include "fiberfluid/solve/sparse_lu.hpp"
 
 #include <umfpack.h>
 

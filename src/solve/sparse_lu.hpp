@@ -4,7 +4,7 @@
 #include <Eigen/SparseCore>
 #include <memory>
 
-#include "solve/status.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::solve {
 

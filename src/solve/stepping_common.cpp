@@ -3,15 +3,15 @@
 // the options' validation and names, and the summary's report. Its own file
 // so that newton_stepper.cpp does not call into load_stepper.cpp (which
 // hands the Newton scheme to it).
-#include "solve/stepping_common.hpp"
+#include "fiberfluid/solve/stepping_common.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "geom/area_vectors.hpp"
-#include "model/boundary_conditions.hpp"
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
 

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "model/dof_map.hpp"
-#include "model/equilibrium.hpp"
-#include "model/model.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::solve {
 

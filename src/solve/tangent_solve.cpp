@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/tangent_solve.hpp"
+#include "fiberfluid/solve/tangent_solve.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "model/assembly.hpp"
-#include "solve/dense_lu.hpp"
-#include "solve/gmres.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/solve/dense_lu.hpp"
+#include "fiberfluid/solve/gmres.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 namespace {

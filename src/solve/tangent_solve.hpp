@@ -5,14 +5,14 @@
 #include <memory>
 #include <vector>
 
-#include "model/dof_map.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_system.hpp"
-#include "solve/dense_lu.hpp"
-#include "solve/linear_solver.hpp"
-#include "solve/load_stepper.hpp"
-#include "solve/sparse_lu.hpp"
-#include "solve/status.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/solve/dense_lu.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/sparse_lu.hpp"
+#include "fiberfluid/solve/status.hpp"
 
 namespace fiberfluid::solve {
 

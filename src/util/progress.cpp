@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "util/progress.hpp"
+#include "fiberfluid/util/progress.hpp"
 
 #include <utility>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "util/run_control.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 #include <sys/mman.h>
 #include <unistd.h>

@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_support.hpp"
-#include "experiment/build_info.hpp"
-#include "experiment/schema.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/experiment/build_info.hpp"
+#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {
@@ -125,9 +125,9 @@ TEST(Cli, SchemaPrintsTheExperimentFilesJsonSchema) {
   EXPECT_EQ(printed, experiment::experiment_schema());
   EXPECT_EQ(printed["$schema"], "https://json-schema.org/draft/2020-12/schema");
   EXPECT_FALSE(printed["additionalProperties"].get<bool>());
-  for (const char* section : {"surface", "material", "supports", "prescribed", "loads", "paddles",
-                              "stepping", "fibers", "fit", "fem_reference", "output", "expected",
-                              "variants", "surfaces", "scene"})
+  for (const char* section :
+       {"surface", "material", "supports", "prescribed", "loads", "paddles", "stepping", "fibers",
+        "fit", "fem_reference", "output", "expected", "variants", "surfaces", "scene"})
     EXPECT_TRUE(printed["properties"].contains(section)) << section;
   EXPECT_EQ(printed["properties"]["stepping"]["properties"]["scheme"]["enum"],
             nlohmann::json({"incremental", "newton"}));

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "bridge/fem_bridge.hpp"
+#include "fiberfluid/bridge/fem_bridge.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "geom/generators.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::bridge {
 namespace {

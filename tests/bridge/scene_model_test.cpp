@@ -2,16 +2,16 @@
 // A FEM benchmark scene as a fiber model (bridge::fiber_model_of_scene): the
 // scene's held nodes, needle and gravity on the boundary, and the same model
 // as an experiment file describes it.
-#include "bridge/scene_model.hpp"
+#include "fiberfluid/bridge/scene_model.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "experiment/experiment.hpp"
-#include "model/assembly.hpp"
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::bridge {
 namespace {

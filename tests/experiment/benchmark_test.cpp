@@ -2,7 +2,7 @@
 // Benchmark experiments: their fields, their runs and their files. The
 // paper's findings themselves are the expected figures of
 // experiments/benchmark_*.json (run by ExperimentFile) and fem_test.cpp.
-#include "experiment/benchmark.hpp"
+#include "fiberfluid/experiment/benchmark.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "experiment/experiment.hpp"
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "geom/mesh_io.hpp"
-#include "metrics/metrics.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

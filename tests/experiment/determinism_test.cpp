@@ -6,8 +6,8 @@
 
 #include <cstring>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::experiment {

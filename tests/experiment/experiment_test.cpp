@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/experiment.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,13 +8,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/boundary_conditions.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The FEM reference of a simulation: the same supports and loads on
 // tetrahedra, checked against exact solutions.
-#include "experiment/fem_reference.hpp"
+#include "fiberfluid/experiment/fem_reference.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,13 +10,13 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
-#include "fit/target.hpp"
-#include "metrics/metrics.hpp"
-#include "model/assembly.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "experiment/fitting.hpp"
+#include "fiberfluid/experiment/fitting.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <functional>
 #include <map>
 
-#include "experiment/outputs.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {
@@ -385,8 +385,9 @@ TEST(FitConfig, BadForceTargetsAreNamed) {
                    "fit.targets[1].file: ");
   expect_fit_error(with([](nlohmann::json& t) { t["type"] = "pressure"; }),
                    "fit.targets[1].type: expected one of");
-  expect_fit_error(with([](nlohmann::json& t) { t["travel_units"] = "m"; }),
-                   "row 1: travel 5.92714 m is outside the run's, from 0 to 0.0592714 m");  // mm read as m
+  expect_fit_error(
+      with([](nlohmann::json& t) { t["travel_units"] = "m"; }),
+      "row 1: travel 5.92714 m is outside the run's, from 0 to 0.0592714 m");  // mm read as m
   expect_fit_error(with([](nlohmann::json& t) { t["colour"] = "red"; }),
                    "fit.targets[1].colour: unknown field");
 }

@@ -3,7 +3,7 @@
 // file never leave the output root, only fiberfluid's own folders are
 // replaced, concurrent writers never mix or lose a result, and an exception
 // in a worker reaches the caller.
-#include "experiment/output_folder.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,13 +14,13 @@
 #include <fstream>
 #include <thread>
 
-#include "experiment/experiment.hpp"
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "geom/generators.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Sweeps, reactions, CSV tables and output folders, through the library.
-#include "experiment/outputs.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "experiment/experiment.hpp"
-#include "experiment/runner.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -8,14 +8,14 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "experiment/experiment.hpp"
-#include "experiment/outputs.hpp"
-#include "experiment/runner.hpp"
-#include "solve/gmres.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/solve/gmres.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
-#include "util/progress.hpp"
-#include "util/run_control.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The finite elements verified without the benchmarks paper: the patch
 // test, the mass, and a cantilever against beam theory under refinement.
-#include "fem/fem.hpp"
+#include "fiberfluid/fem/fem.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <map>
 
-#include "fem/dynamics.hpp"
-#include "fem/mesh_tools.hpp"
-#include "fem/scenes.hpp"
-#include "metrics/metrics.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/fem/dynamics.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/fem/scenes.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fem/hyperelastic.hpp"
+#include "fiberfluid/fem/hyperelastic.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "fem/mesh_tools.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
 
 namespace fiberfluid::fem {
 namespace {

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The tetrahedral mesher: it fills the surface, its tetrahedra pass the
 // patch test, and it is deterministic.
-#include "fem/tet_mesher.hpp"
+#include "fiberfluid/fem/tet_mesher.hpp"
 
 #include <gtest/gtest.h>
 
-#include "fem/mesh_tools.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
-#include "metrics/metrics.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::fem {
 namespace {

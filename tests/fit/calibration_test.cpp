@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/calibration.hpp"
+#include "fiberfluid/fit/calibration.hpp"
 
 #include <gtest/gtest.h>
 
-#include "fit/optimizers.hpp"
+#include "fiberfluid/fit/optimizers.hpp"
 
 #include <ceres/rotation.h>
 
-#include "geom/generators.hpp"
-#include "model/assembly.hpp"
-#include "model/boundary_conditions.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {

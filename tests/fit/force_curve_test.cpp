@@ -4,18 +4,18 @@
 // a force curve adds: under paddles alone a modulus and the surface tension
 // act through their ratio (a surface cannot tell them apart); the force
 // fixes the scale.
-#include "fit/force_curve.hpp"
+#include "fiberfluid/fit/force_curve.hpp"
 
 #include <gtest/gtest.h>
 
 #include <functional>
 
-#include "fit/calibration.hpp"
-#include "geom/generators.hpp"
-#include "model/assembly.hpp"
-#include "model/boundary_conditions.hpp"
+#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fit/target.hpp"
+#include "fiberfluid/fit/target.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "geom/generators.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -122,7 +122,7 @@ TEST(DistanceStatistics, MeanRmsDeviationAndShare) {
 }  // namespace
 }  // namespace fiberfluid::fit
 
-#include "fit/golden_section.hpp"
+#include "fiberfluid/fit/golden_section.hpp"
 
 namespace fiberfluid::fit {
 namespace {

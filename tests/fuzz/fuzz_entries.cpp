@@ -6,17 +6,17 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "experiment/compare.hpp"
-#include "experiment/experiment.hpp"
-#include "experiment/fitting.hpp"
-#include "experiment/output_folder.hpp"
-#include "experiment/runner.hpp"
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_check.hpp"
-#include "geom/mesh_io.hpp"
-#include "util/error.hpp"
-#include "util/run_control.hpp"
+#include "fiberfluid/experiment/compare.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/fitting.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fuzz {
 namespace {

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/area_vectors.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::geom {

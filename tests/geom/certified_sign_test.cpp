@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/certified_sign.hpp"
+#include "fiberfluid/geom/certified_sign.hpp"
 
 #include <gtest/gtest.h>
 

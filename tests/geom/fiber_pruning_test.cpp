@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <set>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "geom/horizon.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::geom {

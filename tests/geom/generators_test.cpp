@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/generators.hpp"
+#include "fiberfluid/geom/generators.hpp"
 
 #include <gtest/gtest.h>
 
-#include "geom/area_vectors.hpp"
-#include "geom/mesh_check.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

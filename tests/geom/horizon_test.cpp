@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Fibers within a horizon: the grid search against every pair.
-#include "geom/horizon.hpp"
+#include "fiberfluid/geom/horizon.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "geom/generators.hpp"
+#include "fiberfluid/geom/generators.hpp"
 
 namespace fiberfluid::geom {
 namespace {

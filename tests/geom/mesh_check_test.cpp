@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/mesh_check.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

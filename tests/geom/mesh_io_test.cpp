@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "geom/mesh_io.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,11 +7,11 @@
 #include <cstring>
 #include <sstream>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_check.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_check.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::geom {
 namespace {

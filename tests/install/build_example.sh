@@ -7,6 +7,11 @@ build="$1" source="$2"
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
 cmake --install "$build" --prefix "$scratch/prefix" >/dev/null
+# Only PREFIX/include is on the include path: headers are <fiberfluid/...>, and a
+# generic name such as util/error.hpp cannot clash with another library's.
+if grep -q 'include/fiberfluid' "$scratch"/prefix/lib*/cmake/fiberfluid/fiberfluidTargets.cmake; then
+  echo "the installed package puts include/fiberfluid on the include path"; exit 1
+fi
 cmake -S "$source/examples/cpp" -B "$scratch/build" -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_PREFIX_PATH="$scratch/prefix" >/dev/null
 cmake --build "$scratch/build" -j2 >/dev/null

@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The benchmarks paper's metrics on cases with known answers.
-#include "metrics/metrics.hpp"
+#include "fiberfluid/metrics/metrics.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::metrics {
 namespace {

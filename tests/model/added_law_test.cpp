@@ -9,11 +9,11 @@
 #include <memory>
 #include <random>
 
-#include "experiment/experiment.hpp"
-#include "model/equilibrium.hpp"
+#include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/tangent_solve.hpp"
 #include "model/model_fixtures.hpp"
-#include "solve/load_stepper.hpp"
-#include "solve/tangent_solve.hpp"
 
 namespace fiberfluid {
 namespace {

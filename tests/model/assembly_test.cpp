@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/assembly.hpp"
+#include "fiberfluid/model/assembly.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "geom/area_vectors.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/fiber_network.hpp"
-#include "model/loads.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/boundary_conditions.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
 
 #include <gtest/gtest.h>
 
+#include "fiberfluid/model/reference/dense_assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

@@ -11,14 +11,14 @@
 #include <memory>
 #include <vector>
 
-#include "geom/generators.hpp"
-#include "geom/horizon.hpp"
-#include "model/assembly.hpp"
-#include "model/boundary_conditions.hpp"
-#include "model/equilibrium.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/pair_stencil.hpp"
-#include "solve/load_stepper.hpp"
 
 namespace fiberfluid::model {
 namespace {

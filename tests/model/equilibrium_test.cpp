@@ -2,23 +2,23 @@
 // The Newton scheme's equations: the tangent against central finite
 // differences for every law, the reference tangent against the paper's A, and
 // the parameter derivatives.
-#include "model/equilibrium.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "geom/area_vectors.hpp"
-#include "geom/horizon.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/assembly.hpp"
-#include "model/fiber_network.hpp"
-#include "model/fiber_system.hpp"
-#include "model/loads.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
 #include "test_support.hpp"
-#include "util/error.hpp"
 
 namespace fiberfluid::model {
 namespace {

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/fiber_system.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
 
 #include <gtest/gtest.h>
 
-#include "geom/fiber_pruning.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/assembly.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::model {
@@ -148,7 +148,7 @@ TEST(FiberSystem, PrescribedDisplacementsMoveToTheRightHandSide) {
 }  // namespace
 }  // namespace fiberfluid::model
 
-#include "solve/cost_model.hpp"
+#include "fiberfluid/solve/cost_model.hpp"
 
 namespace fiberfluid::model {
 namespace {

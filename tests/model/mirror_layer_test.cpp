@@ -3,7 +3,7 @@
 // direct count, its tangent and parameter derivatives against central
 // differences, no force at the reference, the clamp's reaction balancing the
 // load, and a clamped bar that no longer hinges at its clamp.
-#include "model/mirror_layer.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,14 +12,14 @@
 #include <functional>
 #include <memory>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "geom/horizon.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_network.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 #include "model/model_fixtures.hpp"
-#include "solve/load_stepper.hpp"
 
 namespace fiberfluid::model {
 namespace {

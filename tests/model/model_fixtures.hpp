@@ -7,10 +7,10 @@
 #include <random>
 #include <vector>
 
-#include "geom/generators.hpp"
-#include "model/boundary_conditions.hpp"
-#include "model/equilibrium.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::testing {
 

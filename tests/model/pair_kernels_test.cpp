@@ -3,7 +3,7 @@
 // pair (PairFactors::row and bulk_weight), on a set large enough for whole,
 // partial and off-diagonal tiles: unpruned, pruned with both connection
 // counts, with a strain-dependent law, and over a subset of the vertices.
-#include "model/pair_kernels.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -11,10 +11,10 @@
 #include <cstring>
 #include <random>
 
-#include "geom/area_vectors.hpp"
-#include "geom/fiber_pruning.hpp"
-#include "geom/generators.hpp"
-#include "model/pair_stencil.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
 namespace {

@@ -6,12 +6,12 @@
 
 #include <random>
 
-#include "geom/fiber_mask.hpp"
-#include "geom/generators.hpp"
-#include "geom/horizon.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
-#include "model/fiber_system.hpp"
+#include "fiberfluid/geom/fiber_mask.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::model {

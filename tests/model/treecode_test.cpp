@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/treecode.hpp"
+#include "fiberfluid/model/treecode.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <random>
 
-#include "geom/area_vectors.hpp"
-#include "geom/fiber_pruning.hpp"
-#include "geom/generators.hpp"
-#include "geom/mesh_io.hpp"
-#include "geom/surface.hpp"
-#include "model/bulk_treecode.hpp"
-#include "model/pair_kernels.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/model/bulk_treecode.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::model {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // GMRES solves, and each way it can fail is a status with a message, never
 // a NaN in x passed on as an answer (issue 11).
-#include "solve/gmres.hpp"
+#include "fiberfluid/solve/gmres.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,20 +1,20 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/linear_solver.hpp"
+#include "fiberfluid/solve/linear_solver.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
 #include <cmath>
 
-#include "geom/fiber_pruning.hpp"
-#include "geom/mesh_io.hpp"
-#include "model/assembly.hpp"
-#include "model/boundary_conditions.hpp"
-#include "model/fiber_system.hpp"
-#include "model/loads.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
+#include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/fiber_system.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
-#include "solve/load_stepper.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::solve {

@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "solve/load_stepper.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
 
-#include "geom/area_vectors.hpp"
-#include "geom/generators.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
-#include "model/loads.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
+#include "fiberfluid/solve/dense_lu.hpp"
 #include "model/model_fixtures.hpp"
-#include "model/reference/dense_assembly.hpp"
-#include "solve/dense_lu.hpp"
 
 namespace fiberfluid::solve {
 namespace {

@@ -5,13 +5,13 @@
 
 #include <cmath>
 
-#include "geom/area_vectors.hpp"
-#include "geom/horizon.hpp"
-#include "model/assembly.hpp"
-#include "model/equilibrium.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/horizon.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/tangent_solve.hpp"
 #include "model/model_fixtures.hpp"
-#include "solve/load_stepper.hpp"
-#include "solve/tangent_solve.hpp"
 
 namespace fiberfluid::solve {
 namespace {

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "model/reference/dense_assembly.hpp"
+#include "fiberfluid/model/reference/dense_assembly.hpp"
 
 #include <string>
 
-#include "geom/area_vectors.hpp"
-#include "model/assembly.hpp"
-#include "model/fiber_network.hpp"
-#include "model/pair_stencil.hpp"
-#include "util/error.hpp"
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::model::reference {
 namespace {

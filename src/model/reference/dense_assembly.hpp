@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "model/boundary_conditions.hpp"
-#include "model/model.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model::reference {
 
