@@ -79,6 +79,23 @@ def subdivide(vertices, faces):
     return np.array(out), np.array(new_faces)
 
 
+def resampled_scan(points, triangles, rng):
+    """A scan of a surface: every triangle split in four at its edge midpoints (the same
+    surface), the vertices shuffled (no correspondence) and Gaussian noise added."""
+    fine, fine_faces = subdivide(points, triangles)
+    order = rng.permutation(len(fine))
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(len(order))
+    return fine[order] + rng.normal(0.0, NOISE, fine.shape), inverse[fine_faces]
+
+
+def read_steps(folder):
+    """steps.csv of a run: one dict per load step."""
+    with open(os.path.join(folder, "steps.csv")) as f:
+        header = f.readline().strip().split(",")
+        return [dict(zip(header, l.strip().split(","))) for l in f if l.strip()]
+
+
 def main():
     binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build-release/src/app/fiberfluid")
     truth = os.path.join(ROOT, "experiments/fit_synthetic_liver_truth.json")
@@ -98,12 +115,8 @@ def main():
                 points = exact
             write_obj(os.path.join(out_dir, f"liver_step{step}_exact.obj"), points, triangles,
                       f"fit_synthetic_liver_truth.json at load step {step}: same mesh, exact")
-            fine, fine_faces = subdivide(points, triangles)
-            order = rng.permutation(len(fine))
-            inverse = np.empty_like(order)
-            inverse[order] = np.arange(len(order))
-            scan = fine[order] + rng.normal(0.0, NOISE, fine.shape)
-            write_obj(os.path.join(out_dir, f"liver_step{step}_scan.obj"), scan, inverse[fine_faces],
+            scan, scan_faces = resampled_scan(points, triangles, rng)
+            write_obj(os.path.join(out_dir, f"liver_step{step}_scan.obj"), scan, scan_faces,
                       f"fit_synthetic_liver_truth.json at load step {step}: resampled (midpoint "
                       f"subdivision, shuffled), Gaussian noise {NOISE * 1e3} mm per coordinate")
         # The same liver on a finer mesh, and its own deformed surfaces.
@@ -122,9 +135,7 @@ def main():
             write_obj(os.path.join(out_dir, f"liver_fine_step{step}.obj"), points, triangles,
                       f"fit_remeshed_liver_truth.json at load step {step} (the finer liver): exact")
         # Its upper paddle's force curve: the distance travelled and the push on the liver.
-        with open(os.path.join(tmp, "fine", "steps.csv")) as f:
-            header = f.readline().strip().split(",")
-            rows = [dict(zip(header, l.strip().split(","))) for l in f if l.strip()]
+        rows = read_steps(os.path.join(tmp, "fine"))
         with open(os.path.join(out_dir, "liver_fine_force.csv"), "w") as f:
             f.write("# fit_remeshed_liver_truth.json (the finer liver): the upper paddle's travel "
                     "(m, downwards) and its push on the liver (N), per load step: exact\n")
@@ -137,17 +148,11 @@ def main():
         subprocess.run([binary, "run", os.path.join(ROOT, "experiments/fit_paddles_liver_truth.json"),
                         "-o", os.path.join(tmp, "paddles"), "-q"], check=True, stdout=subprocess.DEVNULL)
         points, triangles = read_vtu(os.path.join(tmp, "paddles", "vtk", "step_0010.vtu"))
-        fine, fine_faces = subdivide(points, triangles)
-        order = paddles.permutation(len(fine))
-        inverse = np.empty_like(order)
-        inverse[order] = np.arange(len(order))
-        scan = fine[order] + paddles.normal(0.0, NOISE, fine.shape)
-        write_obj(os.path.join(out_dir, "liver_paddles_step10_scan.obj"), scan, inverse[fine_faces],
+        scan, scan_faces = resampled_scan(points, triangles, paddles)
+        write_obj(os.path.join(out_dir, "liver_paddles_step10_scan.obj"), scan, scan_faces,
                   "fit_paddles_liver_truth.json at load step 10: resampled (midpoint subdivision, "
                   f"shuffled), Gaussian noise {NOISE * 1e3} mm per coordinate")
-        with open(os.path.join(tmp, "paddles", "steps.csv")) as f:
-            header = f.readline().strip().split(",")
-            rows = [dict(zip(header, l.strip().split(","))) for l in f if l.strip()]
+        rows = read_steps(os.path.join(tmp, "paddles"))
         with open(os.path.join(out_dir, "liver_paddles_force.csv"), "w") as f:
             f.write("# fit_paddles_liver_truth.json: the upper paddle's travel (mm, downwards) and "
                     f"its push on the liver (N) with Gaussian noise of {FORCE_NOISE} N, per load step\n")

@@ -558,6 +558,12 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
 }
 
 // ------------------------------------------------------------ fit
+// A file's length unit ("m", "cm", "mm", "um"; default m) as the factor to m.
+double length_units(Fields& f, const std::string& key) {
+  const std::string units = f.choice(key, "m", {"m", "cm", "mm", "um"});
+  return units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
+}
+
 // A target of "type": "force": a CSV curve of a paddle's or a support's force.
 FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
   FitForceSpec curve;
@@ -579,8 +585,7 @@ FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
     t.fail("axis", "a paddle's force is along its own axis: give axis only with a support");
   if (t.has("weight")) curve.weight = t.positive("weight", 1.0);
   if (t.has("rows_at")) curve.rows_at = t.choice("rows_at", "", {"travel", "step"});
-  const std::string travel = t.choice("travel_units", "m", {"m", "cm", "mm", "um"});
-  curve.travel_scale = travel == "cm" ? 1e-2 : travel == "mm" ? 1e-3 : travel == "um" ? 1e-6 : 1.0;
+  curve.travel_scale = length_units(t, "travel_units");
   const std::string force = t.choice("force_units", "N", {"N", "mN", "kN"});
   curve.force_scale = force == "mN" ? 1e-3 : force == "kN" ? 1e3 : 1.0;
   t.finish();
@@ -603,10 +608,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     target.step = t.integer("step", 0, 1, 100000);
     if (t.has("scale") && t.has("units"))
       t.fail("units", "give the scan's units or its scale, not both");
-    if (t.has("units")) {
-      const std::string units = t.choice("units", "m", {"m", "cm", "mm", "um"});
-      target.scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
-    }
+    if (t.has("units")) target.scale = length_units(t, "units");
     target.scale = t.positive("scale", target.scale);
     t.finish();
     spec.targets.push_back(target);

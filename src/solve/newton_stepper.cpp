@@ -685,10 +685,7 @@ class StepFinisher {
     std::vector<Eigen::Vector3i> held_per_axis(groups_, Eigen::Vector3i::Zero());
     for (size_t c = 0; c < partition_.constrained.size(); ++c) {
       const int d = partition_.constrained[c];
-      const size_t g =
-          static_cast<size_t>(
-              model_.constraints[static_cast<size_t>(partition_.constraint_of[c])].group) %
-          groups_;
+      const size_t g = group_of(c);
       record.support_travel[g][d / nv] += x[d];
       ++held_per_axis[g][d / nv];
     }
@@ -708,6 +705,12 @@ class StepFinisher {
   }
 
  private:
+  // The support group (an index into StepRecord::reactions) of the c-th held unknown.
+  size_t group_of(size_t c) const {
+    const int constraint = partition_.constraint_of[c];
+    return static_cast<size_t>(model_.constraints[static_cast<size_t>(constraint)].group) % groups_;
+  }
+
   // The reactions' and paddle forces' derivatives, read off the held rows of
   // the residual's change (columns: the parameters). A group whose mirror
   // layer carries part of its reaction gets NaN: the layer's fibers are not
@@ -718,10 +721,7 @@ class StepFinisher {
     record.reaction_sensitivities.assign(groups_, Eigen::MatrixXd::Zero(3, P));
     for (size_t c = 0; c < partition_.constrained.size(); ++c) {
       const int d = partition_.constrained[c];
-      const size_t g =
-          static_cast<size_t>(
-              model_.constraints[static_cast<size_t>(partition_.constraint_of[c])].group) %
-          groups_;
+      const size_t g = group_of(c);
       record.reaction_sensitivities[g].row(d / nv) += residual_change.row(d);
     }
     for (const model::MirrorLayer& layer : model_.mirror_layers)

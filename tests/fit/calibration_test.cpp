@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fit/fit_fixtures.hpp"
+
 #include "fiberfluid/fit/optimizers.hpp"
 
 #include <ceres/rotation.h>
@@ -14,6 +16,9 @@
 
 namespace fiberfluid::fit {
 namespace {
+
+using testing::newton;
+using testing::parameter;
 
 // A small hanging sphere (42 vertices, cap held) with a stiffening law.
 model::Model hanging_sphere() {
@@ -31,14 +36,6 @@ model::Model hanging_sphere() {
   return m;
 }
 
-solve::SteppingOptions newton(int steps) {
-  solve::SteppingOptions o;
-  o.scheme = solve::Scheme::Newton;
-  o.steps = steps;
-  o.newton.residual_tolerance = 1e-13;
-  return o;
-}
-
 // The deformed surfaces of a run at every step, as targets on the same mesh.
 std::vector<MeasuredStep> synthetic_targets(const model::Model& m, const solve::SteppingOptions& o,
                                             const std::vector<int>& steps) {
@@ -52,14 +49,6 @@ std::vector<MeasuredStep> synthetic_targets(const model::Model& m, const solve::
       });
   EXPECT_TRUE(s.success) << s.message;
   return targets;
-}
-
-Parameter parameter(const std::string& name, double start, bool log = true) {
-  Parameter p;
-  p.name = name;
-  p.initial = start;
-  p.log_scale = log;
-  return p;
 }
 
 // The residuals' Jacobian (Newton sensitivities chained through the closest

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fit/fit_fixtures.hpp"
+
 #include <functional>
 
 #include "fiberfluid/fit/calibration.hpp"
@@ -19,6 +21,9 @@
 
 namespace fiberfluid::fit {
 namespace {
+
+using testing::newton;
+using testing::parameter;
 
 void expect_input_error(const std::function<void()>& action, const std::string& part) {
   try {
@@ -94,14 +99,6 @@ model::Model pressed_sphere(bool gravity, const model::FiberLaw& law) {
   return m;
 }
 
-solve::SteppingOptions newton(int steps) {
-  solve::SteppingOptions o;
-  o.scheme = solve::Scheme::Newton;
-  o.steps = steps;
-  o.newton.residual_tolerance = 1e-13;
-  return o;
-}
-
 // The run's paddle push (into the body) and the supports' z reaction per step,
 // and its surfaces at `steps` as targets.
 struct Measured {
@@ -121,14 +118,6 @@ Measured measure(const model::Model& m, int steps, const std::vector<int>& surfa
       });
   EXPECT_TRUE(s.success) << s.message;
   return out;
-}
-
-Parameter parameter(const std::string& name, double start, bool log = true) {
-  Parameter p;
-  p.name = name;
-  p.initial = start;
-  p.log_scale = log;
-  return p;
 }
 
 ForceCurve paddle_curve(const std::vector<double>& travel, const std::vector<double>& force) {
