@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <deque>
+#include <functional>
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/util/error.hpp"
