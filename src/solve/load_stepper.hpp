@@ -152,11 +152,9 @@ struct StepRecord {
   // At the steps SteppingOptions::sensitivities lists: du/dtheta, full
   // layout (zero at held unknowns), one column per parameter.
   Eigen::MatrixXd sensitivities;
-  // Newton: per support group, the mean displacement of its held unknowns
-  // along each axis (its travel, for a group moved as one), and at the
-  // sensitivities' steps d reaction / d theta (3 x parameters; NaN for a
-  // group with a mirror layer, whose fibers' share is not differentiated).
-  std::vector<Eigen::Vector3d> support_travel;
+  // Newton, at the sensitivities' steps: per support group, d reaction /
+  // d theta (3 x parameters; NaN for a group with a mirror layer, whose
+  // fibers' share is not differentiated).
   std::vector<Eigen::MatrixXd> reaction_sensitivities;
 };
 

@@ -681,17 +681,6 @@ class StepFinisher {
     record.volume_drift = (volume - reference_volume_) / reference_volume_;
     record.max_displacement = (X - model_.surface.V).rowwise().norm().maxCoeff();
     record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
-    record.support_travel.assign(groups_, Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector3i> held_per_axis(groups_, Eigen::Vector3i::Zero());
-    for (size_t c = 0; c < partition_.constrained.size(); ++c) {
-      const int d = partition_.constrained[c];
-      const size_t g = group_of(c);
-      record.support_travel[g][d / nv] += x[d];
-      ++held_per_axis[g][d / nv];
-    }
-    for (size_t g = 0; g < groups_; ++g)
-      for (int a = 0; a < 3; ++a)
-        if (held_per_axis[g][a] > 0) record.support_travel[g][a] /= held_per_axis[g][a];
     const std::vector<int>& wanted = options_.sensitivities.steps;
     if (!options_.sensitivities.parameters.empty() &&
         std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "fit/fit_fixtures.hpp"
+#include "model/model_fixtures.hpp"
 
 #include "fiberfluid/fit/optimizers.hpp"
 
@@ -28,11 +29,7 @@ model::Model hanging_sphere() {
   m.material.surface_tension = 300.0;
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.5", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  model::Load gravity;
-  gravity.kind = model::Load::Kind::Hydrostatic;
-  gravity.acceleration = {0.0, 0.0, -10.0};
-  gravity.density = 300.0;
-  m.loads = {gravity};
+  m.loads = {testing::hydrostatic_load({0.0, 0.0, -10.0}, 300.0)};
   return m;
 }
 

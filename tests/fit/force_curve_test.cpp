@@ -17,6 +17,7 @@
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "model/model_fixtures.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::fit {
@@ -82,20 +83,8 @@ model::Model pressed_sphere(bool gravity, const model::FiberLaw& law) {
   m.constraint_groups = {"resting"};
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.04", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, a == 2 ? -0.002 : 0.0, {}, 0});
-  model::Paddle paddle;
-  paddle.label = "upper";
-  paddle.axis = 2;
-  paddle.above = true;
-  paddle.position = m.surface.V.col(2).maxCoeff();
-  paddle.travel = -0.02;
-  m.paddles = {paddle};
-  if (gravity) {
-    model::Load weight;
-    weight.kind = model::Load::Kind::Hydrostatic;
-    weight.acceleration = {0.0, 0.0, -9.81};
-    weight.density = 1000.0;
-    m.loads = {weight};
-  }
+  m.paddles = {testing::paddle_on_top(m, "upper", -0.02)};
+  if (gravity) m.loads = {testing::hydrostatic_load({0.0, 0.0, -9.81}, 1000.0)};
   return m;
 }
 
@@ -144,6 +133,14 @@ TEST(ForceCurve, ItsResidualsAndJacobianMatchTheRunAndFiniteDifferences) {
   support.at = {2, 4};
   support.force = {0.5, 1.5};
   support.weight = 0.01;
+  // Travel by the schedules: the paddle's distance from its start, the
+  // supports' mean held displacement (they sink 2 mm along z, not along x).
+  EXPECT_NEAR(curve_travel(paddle, m, 1, 4), 0.005, 1e-15);
+  EXPECT_NEAR(curve_travel(support, m, 2, 4), -0.001, 1e-15);
+  EXPECT_NEAR(curve_travel(support, m, 4, 4), -0.002, 1e-15);
+  ForceCurve sideways = support;
+  sideways.axis = 0;
+  EXPECT_EQ(curve_travel(sideways, m, 4, 4), 0.0);
   const std::vector<Parameter> parameters = {parameter("Y0", 2500.0), parameter("beta", 4.0, false),
                                              parameter("gamma", 7.0)};
   const Calibration c(m, newton(4), truth.surfaces, parameters, {}, {paddle, support});

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fiberfluid/geom/generators.hpp"
@@ -13,6 +14,26 @@
 #include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::testing {
+
+// The fluid's weight under an acceleration (a hydrostatic load).
+inline model::Load hydrostatic_load(const Eigen::Vector3d& acceleration, double density) {
+  model::Load load;
+  load.kind = model::Load::Kind::Hydrostatic;
+  load.acceleration = acceleration;
+  load.density = density;
+  return load;
+}
+
+// A paddle above the body along z, touching its top, that moves by `travel`.
+inline model::Paddle paddle_on_top(const model::Model& m, const std::string& label, double travel) {
+  model::Paddle paddle;
+  paddle.label = label;
+  paddle.axis = 2;
+  paddle.above = true;
+  paddle.position = m.surface.V.col(2).maxCoeff();
+  paddle.travel = travel;
+  return paddle;
+}
 
 // model.md section 8: v3 fixed, v2 held in y, 1680 upward on v1 and v4.
 inline model::Model paper_rectangle_model() {

@@ -268,14 +268,8 @@ model::Model pressed_sphere(bool sticking) {
   m.constraints.clear();
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  model::Paddle paddle;
-  paddle.label = "top";
-  paddle.axis = 2;
-  paddle.above = true;
-  paddle.position = m.surface.V.col(2).maxCoeff();
-  paddle.travel = -0.3;
-  paddle.sticking = sticking;
-  m.paddles = {paddle};
+  m.paddles = {testing::paddle_on_top(m, "top", -0.3)};
+  m.paddles[0].sticking = sticking;
   return m;
 }
 
@@ -312,7 +306,7 @@ TEST(Newton, PaddleContactPushesHoldsAndBalances) {
 
 // The forces' sensitivities (the paddle's and the supports' reaction, read
 // off the held rows of K_T du/dtheta + dR/dtheta) against central
-// differences of whole runs; the supports' travel is their held displacement.
+// differences of whole runs.
 TEST(Newton, ForceSensitivitiesMatchFiniteDifferences) {
   {  // A sticking paddle holds vertices where they touched: a place that moves with the parameters.
     SteppingOptions o = newton(2);
@@ -344,9 +338,6 @@ TEST(Newton, ForceSensitivitiesMatchFiniteDifferences) {
     const SteppingSummary s = solve_load_steps(m, o);
     ASSERT_TRUE(s.success) << s.message;
     const StepRecord& last = s.steps.back();
-    EXPECT_NEAR(last.support_travel[0].z(), -0.05, 1e-15);
-    EXPECT_NEAR(s.steps[1].support_travel[0].z(), -0.025, 1e-15);
-    EXPECT_EQ(last.support_travel[0].x(), 0.0);
     ASSERT_EQ(last.reaction_sensitivities.size(), 1u);
     for (size_t p = 0; p < names.size(); ++p) {
       const double h = names[p] == "beta" ? 1e-4 : 0.1;
