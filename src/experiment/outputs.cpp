@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/experiment/outputs.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/geom/vtk_writer.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
@@ -485,6 +487,12 @@ void OutputWriter::begin() {
                         "these are not the results of a complete run.\n");
   if (experiment_.kind != Experiment::Kind::Simulate) return;
   series_.assign(experiment_.cases.size(), {});
+  // The equations each run's fiber readings come from (surface tension per
+  // face, fibers_final.vtu).
+  equilibria_.clear();
+  if (experiment_.output.vtk || experiment_.cases.front().fibers.write != "none")
+    for (const Case& c : experiment_.cases)
+      equilibria_.push_back(std::make_unique<const model::Equilibrium>(c.model));
   write_fibers();
   for (size_t r = 0; r < experiment_.cases.size(); ++r) {
     fs::create_directories(run_folder(r));
@@ -496,13 +504,14 @@ void OutputWriter::begin() {
   }
 }
 
-void OutputWriter::write_fibers() const {
-  const Case& c = experiment_.cases.front();
-  const std::string& which = c.fibers.write;
-  if (which == "none") return;
+namespace {
+
+// The fibers that fibers.write names, as pairs (i, j) of the model's
+// vertices, i < j.
+std::vector<std::pair<int, int>> written_fibers(const Case& c) {
   const model::Model& m = c.model;
   std::vector<std::pair<int, int>> lines;
-  if (which == "kept" && m.fibers && m.fibers->sparse()) {  // a horizon's lists: its pairs only
+  if (c.fibers.write == "kept" && m.fibers && m.fibers->sparse()) {  // a horizon's lists
     for (int i = 0; i < m.num_vertices(); ++i)
       m.fibers->for_each_kept(i, [&](int j) {
         if (j > i) lines.emplace_back(i, j);
@@ -511,10 +520,83 @@ void OutputWriter::write_fibers() const {
     for (int i = 0; i < m.num_vertices(); ++i)
       for (int j = i + 1; j < m.num_vertices(); ++j) {
         const bool kept = !m.fibers || m.fibers->kept(i, j);
-        if (kept == (which == "kept")) lines.emplace_back(i, j);
+        if (kept == (c.fibers.write == "kept")) lines.emplace_back(i, j);
       }
   }
-  geom::write_lines_vtu(staging_ / "fibers.vtu", m.surface.V, lines);
+  return lines;
+}
+
+// How a file of `size` rows is stored (output.vtk_format).
+geom::VtkEncoding vtk_encoding(const std::string& format, size_t size) {
+  return format == "compressed" ||
+                 (format == "auto" && size >= static_cast<size_t>(kCompressedVtkVertices))
+             ? geom::VtkEncoding::Compressed
+             : geom::VtkEncoding::Ascii;
+}
+
+// Each face's surface tension: the mean size of the forces of its edges'
+// fibers (N); `edges` sorted by their ends, as Equilibrium gives them.
+Eigen::VectorXd face_surface_tension(const geom::Surface& s,
+                                     const std::vector<model::FiberReading>& edges) {
+  const auto force_of = [&](int i, int j) {
+    const std::pair<int, int> ends = std::minmax(i, j);
+    const auto at = std::lower_bound(edges.begin(), edges.end(), ends,
+                                     [](const model::FiberReading& e, std::pair<int, int> key) {
+                                       return std::make_pair(e.i, e.j) < key;
+                                     });
+    return at != edges.end() && at->i == ends.first && at->j == ends.second ? at->force.norm()
+                                                                            : 0.0;
+  };
+  Eigen::VectorXd out(s.num_faces());
+  for (int f = 0; f < s.num_faces(); ++f) {
+    if (s.F.cols() == 2) {  // 2D: the face is its edge
+      out[f] = force_of(s.F(f, 0), s.F(f, 1));
+      continue;
+    }
+    out[f] = (force_of(s.F(f, 0), s.F(f, 1)) + force_of(s.F(f, 1), s.F(f, 2)) +
+              force_of(s.F(f, 2), s.F(f, 0))) /
+             3.0;
+  }
+  return out;
+}
+
+}  // namespace
+
+void OutputWriter::write_fibers() const {
+  const Case& c = experiment_.cases.front();
+  if (c.fibers.write == "none") return;
+  const std::vector<std::pair<int, int>> lines = written_fibers(c);
+  const Eigen::MatrixXd& S = c.model.surface.V;
+  Eigen::VectorXd rest(static_cast<Eigen::Index>(lines.size()));
+  for (size_t k = 0; k < lines.size(); ++k)
+    rest[static_cast<Eigen::Index>(k)] = (S.row(lines[k].first) - S.row(lines[k].second)).norm();
+  geom::VtuContent content;
+  content.cells = {{"rest_length", rest}};
+  content.encoding = vtk_encoding(experiment_.output.vtk_format, lines.size());
+  geom::write_lines_vtu(staging_ / "fibers.vtu", S, lines, content);
+}
+
+// RUN/fibers_final.vtu: the written fibers at the run's last state, each
+// with its strain, its tension and the size of its force (the equilibrium
+// equations' fiber forces, model.md section 7).
+void OutputWriter::write_final_fibers(size_t run, const Eigen::VectorXd& unknowns) const {
+  const Case& c = experiment_.cases[run];
+  const std::vector<std::pair<int, int>> lines = written_fibers(c);
+  const std::vector<model::FiberReading> readings =
+      equilibria_[run]->bulk_fiber_readings(unknowns, lines);
+  const auto size = static_cast<Eigen::Index>(lines.size());
+  Eigen::VectorXd strain(size), tension(size), force(size);
+  for (Eigen::Index k = 0; k < size; ++k) {
+    const model::FiberReading& f = readings[static_cast<size_t>(k)];
+    strain[k] = f.strain;
+    tension[k] = f.tension;
+    force[k] = f.force.norm();
+  }
+  geom::VtuContent content;
+  content.cells = {{"strain", strain}, {"tension", tension}, {"force", force}};
+  content.encoding = vtk_encoding(experiment_.output.vtk_format, lines.size());
+  geom::write_lines_vtu(run_folder(run) / "fibers_final.vtu", model::positions(c.model, unknowns),
+                        lines, content);
 }
 
 // One load step for ParaView: Points are the deformed positions (display the
@@ -554,14 +636,14 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
                     {"reference_position", c.input_surface.V},
                     {"support_reaction", support},
                     {"contact_force", contact}};
-  content.cells = {{"area_change", now.cwiseQuotient(rest)}};
+  content.cells = {
+      {"area_change", now.cwiseQuotient(rest)},
+      {"surface_tension_force",
+       face_surface_tension(m.surface, equilibria_[run]->surface_fiber_readings(unknowns))}};
   content.field = {{"step", {static_cast<double>(step)}},
                    {"load_factors", load_factors},
                    {"pressure", {unknowns[m.pressure_dof()]}}};
-  const std::string& format = experiment_.output.vtk_format;
-  content.encoding = format == "compressed" || (format == "auto" && n >= kCompressedVtkVertices)
-                         ? geom::VtkEncoding::Compressed
-                         : geom::VtkEncoding::Ascii;
+  content.encoding = vtk_encoding(experiment_.output.vtk_format, static_cast<size_t>(n));
   char name[32];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
   geom::write_vtu(run_folder(run) / "vtk" / name, deformed, content);
@@ -603,6 +685,7 @@ void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& mo
     geom::write_text_file(run_folder(r) / "load_displacement.csv", load_displacement_csv(c, run));
     if (!run.summary.success) continue;
     geom::write_text_file(run_folder(r) / "vertices.csv", vertices_csv(c, run));
+    if (c.fibers.write != "none") write_final_fibers(r, run.summary.unknowns);
     if (experiment_.output.obj) {
       geom::Surface deformed = c.input_surface;
       deformed.V = input_positions(c, run.summary.unknowns);

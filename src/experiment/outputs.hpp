@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -10,6 +11,10 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/runner.hpp"
+
+namespace fiberfluid::model {
+class Equilibrium;
+}
 
 namespace fiberfluid::experiment {
 
@@ -90,7 +95,8 @@ class OutputWriter {
                    const std::vector<solve::StepRecord::HeldForce>& held_forces = {});
   // fem_reference_series.pvd: a nonlinear FEM's boundary after each load step.
   void write_fem_path(const FemReferenceResult& f);
-  void write_fibers() const;            // fibers.vtu: the kept or pruned fibers, if asked
+  void write_fibers() const;  // fibers.vtu: the kept or pruned fibers, if asked
+  void write_final_fibers(size_t run, const Eigen::VectorXd& unknowns) const;
   void write_experiment_files() const;  // experiment.json and experiment.resolved.json
   void set_aside(const char* mark, const char* suffix, const std::string& what,
                  const std::string& why);
@@ -98,7 +104,8 @@ class OutputWriter {
 
   const Experiment& experiment_;
   std::filesystem::path target_, staging_, result_folder_;
-  std::vector<std::vector<std::pair<double, std::string>>> series_;  // per run
+  std::vector<std::vector<std::pair<double, std::string>>> series_;    // per run
+  std::vector<std::unique_ptr<const model::Equilibrium>> equilibria_;  // per run, if written
   std::vector<std::string> warnings_;
 };
 

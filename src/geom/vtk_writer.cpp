@@ -145,14 +145,14 @@ void write_vtu(const std::filesystem::path& path, const Surface& s,
 }
 
 void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X,
-                     const std::vector<std::pair<int, int>>& lines) {
+                     const std::vector<std::pair<int, int>>& lines, const VtuContent& content) {
   Surface segments;
   segments.dim = static_cast<int>(X.cols());
   segments.V = X;
   segments.F.resize(static_cast<Eigen::Index>(lines.size()), 2);
   for (size_t k = 0; k < lines.size(); ++k)
     segments.F.row(static_cast<Eigen::Index>(k)) << lines[k].first, lines[k].second;
-  write_vtu(path, segments, VtuContent{});
+  write_vtu(path, segments, content);
 }
 
 void write_pvd(const std::filesystem::path& path,

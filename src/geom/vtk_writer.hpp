@@ -47,9 +47,10 @@ void write_vtu(const std::filesystem::path& path, const Surface& surface,
                const std::vector<PointField>& fields);
 
 // Writes line segments between vertices of X (#V by dim) as a .vtu of
-// VTK_LINE cells: the bulk fibers, for a look in ParaView.
+// VTK_LINE cells, with the content's data (cell data one row per line): the
+// bulk fibers, for a look in ParaView.
 void write_lines_vtu(const std::filesystem::path& path, const Eigen::MatrixXd& X,
-                     const std::vector<std::pair<int, int>>& lines);
+                     const std::vector<std::pair<int, int>>& lines, const VtuContent& content = {});
 
 // Writes a ParaView collection (.pvd) listing (time, file) pairs; file names
 // are written relative to the .pvd's folder.

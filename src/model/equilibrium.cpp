@@ -83,6 +83,17 @@ Eigen::MatrixXd Equilibrium::fiber_forces(const Eigen::VectorXd& x) const {
   return Eigen::Map<const Eigen::MatrixXd>(R.data(), n, model_.dim());  // [u_x.., u_y.., ..]
 }
 
+std::vector<FiberReading> Equilibrium::bulk_fiber_readings(
+    const Eigen::VectorXd& x, const std::vector<std::pair<int, int>>& pairs) const {
+  const std::vector<double> no_load(model_.loads.size(), 0.0);
+  return bulk_.readings(TermState(context_, x, no_load), pairs);
+}
+
+std::vector<FiberReading> Equilibrium::surface_fiber_readings(const Eigen::VectorXd& x) const {
+  const std::vector<double> no_load(model_.loads.size(), 0.0);
+  return model::surface_fiber_readings(context_, TermState(context_, x, no_load));
+}
+
 std::vector<Eigen::Vector3d> Equilibrium::support_forces(const Eigen::VectorXd& x) const {
   std::vector<Eigen::Vector3d> forces(model_.constraint_groups.size(), Eigen::Vector3d::Zero());
   const std::vector<double> no_load(model_.loads.size(), 0.0);

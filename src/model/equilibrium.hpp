@@ -79,6 +79,12 @@ class Equilibrium {
                                   const std::vector<double>& factors) const;
   // The fiber forces alone (bulk and surface), #V by dim.
   Eigen::MatrixXd fiber_forces(const Eigen::VectorXd& x) const;
+  // The fibers at x one by one, for reports: the bulk fibers of `pairs`
+  // (i < j; a pruned pair reads no force) and the surface-tension fibers,
+  // one per mesh edge sorted by its ends. Their forces sum to fiber_forces(x).
+  std::vector<FiberReading> bulk_fiber_readings(
+      const Eigen::VectorXd& x, const std::vector<std::pair<int, int>>& pairs) const;
+  std::vector<FiberReading> surface_fiber_readings(const Eigen::VectorXd& x) const;
   // The force each support group's own fibers (its mirror layer) exert on
   // the body, one per Model::constraint_groups entry (zero without a layer):
   // part of that group's reaction.

@@ -2,6 +2,7 @@
 #include "fiberfluid/model/terms.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -104,6 +105,24 @@ Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixX
   return out;
 }
 
+// A fiber's reading from its force coefficients (pair_stencil.hpp): the
+// residual's part on i is m (c1 g), the force the fiber exerts on i its
+// opposite. b = x_i - x_j, d = u_i - u_j, L its reference length.
+template <class K>
+FiberReading read_fiber(int i, int j, const PairCoefficients& c, const Eigen::Vector3d& b,
+                        const Eigen::Vector3d& d, double L, const Eigen::Vector3d& m) {
+  FiberReading out;
+  out.i = i;
+  out.j = j;
+  const double r = b.norm();
+  out.strain = fiber_strain(r, L);
+  Eigen::Vector3d residual;
+  for (int a = 0; a < 3; ++a) residual[a] = m[a] * pair_force<K>(c, b[a], d[a]);
+  out.force = -residual;
+  out.tension = residual.dot(b) / r;  // the force on i along x_j - x_i
+  return out;
+}
+
 // ---- Surface tension -----------------------------------------------------------
 
 // The surface fibers: each mesh edge i-k a fiber of weight gamma b_ik (paper
@@ -164,6 +183,23 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
     else
       add_edge_forces(s, 1.0, R);  // the forces are linear in gamma
     column += R;
+  }
+  // Each edge's reading (i < k), sorted by its ends.
+  std::vector<FiberReading> readings(const TermState& s) const {
+    std::vector<FiberReading> out;
+    const Eigen::Vector3d no_factors = Eigen::Vector3d::Ones();
+    const Eigen::MatrixXd& V0 = c_.model.surface.V;
+    for_each_edge(s, gamma(),
+                  [&](auto policy, int i, int k, const PairCoefficients& c,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
+                    if (i > k) return;
+                    const double L = (row3(V0, i) - row3(V0, k)).norm();
+                    out.push_back(read_fiber<decltype(policy)>(i, k, c, b, d, L, no_factors));
+                  });
+    std::sort(out.begin(), out.end(), [](const FiberReading& p, const FiberReading& q) {
+      return std::make_pair(p.i, p.j) < std::make_pair(q.i, q.j);
+    });
+    return out;
   }
 
  private:
@@ -391,6 +427,10 @@ std::unique_ptr<EquilibriumTerm> make_load_term(const TermContext& c, size_t ind
   throw std::invalid_argument("load " + std::to_string(index) + " is of an unknown kind");
 }
 
+std::vector<FiberReading> surface_fiber_readings(const TermContext& c, const TermState& s) {
+  return SurfaceTensionTerm(c).readings(s);
+}
+
 std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c) {
   std::vector<std::unique_ptr<EquilibriumTerm>> terms;
   terms.push_back(std::make_unique<SurfaceTensionTerm>(c));
@@ -500,6 +540,46 @@ bool BulkFiberTerm::sparse() const {
 void BulkFiberTerm::listed_coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
                                         std::vector<double>* c1, std::vector<double>* c2) const {
   deformed_pairs(c_, X, U).listed_coefficients(c1, c2);
+}
+
+std::vector<FiberReading> BulkFiberTerm::readings(
+    const TermState& s, const std::vector<std::pair<int, int>>& pairs) const {
+  // Each pair's c1, from the kernels that the residual uses.
+  std::vector<double> force_coefficient(pairs.size(), 0.0);
+  std::vector<double> c1, c2;
+  if (sparse()) {
+    listed_coefficients(s.X, s.U, &c1, &c2);
+    const geom::FiberMask& mask = *c_.pair_factors.mask();
+    std::vector<size_t> offsets(static_cast<size_t>(c_.model.num_vertices()) + 1, 0);
+    for (int i = 0; i < c_.model.num_vertices(); ++i)
+      offsets[static_cast<size_t>(i) + 1] =
+          offsets[static_cast<size_t>(i)] + mask.neighbours(i).size();
+    for (size_t p = 0; p < pairs.size(); ++p) {
+      const auto [i, j] = pairs[p];
+      const std::vector<int>& partners = mask.neighbours(i);
+      const auto at = std::lower_bound(partners.begin(), partners.end(), j);
+      if (at != partners.end() && *at == j)  // not listed: pruned
+        force_coefficient[p] =
+            c1[offsets[static_cast<size_t>(i)] + static_cast<size_t>(at - partners.begin())];
+    }
+  } else {
+    Eigen::MatrixXd dense_c1, dense_c2;
+    coefficients(s.X, s.U, &dense_c1, &dense_c2);
+    for (size_t p = 0; p < pairs.size(); ++p)
+      force_coefficient[p] = dense_c1(pairs[p].first, pairs[p].second);
+  }
+  std::vector<FiberReading> out(pairs.size());
+  const Eigen::MatrixXd& V0 = c_.model.surface.V;
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
+    using K = decltype(policy);
+    for (size_t p = 0; p < pairs.size(); ++p) {
+      const auto [i, j] = pairs[p];
+      out[p] = read_fiber<K>(i, j, {force_coefficient[p], 0.0}, row3(s.X, i) - row3(s.X, j),
+                             row3(s.U, i) - row3(s.U, j), (row3(V0, i) - row3(V0, j)).norm(), m);
+    }
+  });
+  return out;
 }
 
 template <class Body>

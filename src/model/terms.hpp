@@ -18,12 +18,26 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "fiberfluid/model/fiber_network.hpp"
 #include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
+
+// One fiber at a state, for reports (a fibers .vtu, a face's surface
+// tension): its ends i < j, its strain e = r / L - 1, the force it exerts on
+// its end i (axis factors applied; on j the opposite) and that force's
+// component along the fiber towards j, its tension (positive when it pulls
+// its ends together). A vector spring's force also has a part across the
+// fiber, so |force| can exceed |tension|; a central fiber's cannot.
+struct FiberReading {
+  int i = 0, j = 0;
+  double strain = 0.0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  double tension = 0.0;
+};
 
 // What the terms read of the reference configuration (Equilibrium owns it).
 struct TermContext {
@@ -122,6 +136,10 @@ class BulkFiberTerm final : public EquilibriumTerm {
                           const std::vector<double>& c1, const std::vector<double>& c2,
                           const Eigen::MatrixXd& W, Eigen::VectorXd& out) const;
 
+  // The readings of the given pairs (i < j; a pruned pair reads no force).
+  std::vector<FiberReading> readings(const TermState& s,
+                                     const std::vector<std::pair<int, int>>& pairs) const;
+
  private:
   // The tangent's entries of the listed pairs (sparse masks).
   void add_listed_blocks(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
@@ -142,6 +160,10 @@ class BulkFiberTerm final : public EquilibriumTerm {
 // per mirror layer.
 // Throws std::invalid_argument for a load of an unknown kind.
 std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c);
+
+// The readings of the surface-tension fibers, one per mesh edge (i < k), in
+// the order of geom::unique_edges.
+std::vector<FiberReading> surface_fiber_readings(const TermContext& c, const TermState& s);
 
 // The term of one load (the model's load `index`).
 std::unique_ptr<EquilibriumTerm> make_load_term(const TermContext& c, size_t index);

@@ -537,10 +537,17 @@ TEST(ExperimentConfig, AHorizonsKeptFibersAreWrittenFromItsLists) {
   OutputWriter writer(ex, dir.path() / "out");
   writer.begin();
   writer.finish(run_experiment(ex));
-  std::ifstream vtu(dir.path() / "out" / "fibers.vtu");
-  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(kept) + "\""), std::string::npos)
-      << text.substr(0, 300);
+  for (const char* name : {"fibers.vtu", "fibers_final.vtu"}) {
+    std::ifstream vtu(dir.path() / "out" / name);
+    const std::string text((std::istreambuf_iterator<char>(vtu)),
+                           std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(kept) + "\""), std::string::npos)
+        << name << ": " << text.substr(0, 300);
+    for (const char* field : {"rest_length", "strain", "tension", "force"})
+      EXPECT_EQ(text.find(std::string("Name=\"") + field + "\"") != std::string::npos,
+                (std::string(name) == "fibers.vtu") == (std::string(field) == "rest_length"))
+          << name << " " << field;
+  }
 }
 
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {

@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <random>
 
 #include "fiberfluid/geom/area_vectors.hpp"
@@ -325,6 +328,66 @@ TEST(ExactHydrostaticLoad, SumsToTheWeightOnEveryShippedMesh) {
     const Eigen::Vector3d weight = density * geom::enclosed_volume(s.V, s.F) * a;
     EXPECT_LT((total - weight).norm(), 1e-12 * weight.norm());
   }
+}
+
+// The fibers one by one (the fibers .vtu): every pair's and every edge's force,
+// added on its two ends, gives fiber_forces at each vertex, for both
+// kinematics, every pair kept or a horizon's (as a table and as lists), with
+// the axis factors.
+TEST(FiberReadings, EachFibersForceAddsUpToTheFiberForces) {
+  for (FiberKinematics kinematics : kAllKinematics)
+    for (int storage : {-1, 0, 1}) {  // no horizon, a table, lists
+      const bool horizon = storage >= 0;
+      SCOPED_TRACE(std::string(kinematics_name(kinematics)) + " " + std::to_string(storage));
+      Model m = small_sphere(FiberLaw::exponential(3000.0, 4.0), kinematics);
+      if (horizon)
+        m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(
+            m.surface, 0.8, storage == 0 ? geom::MaskStorage::Dense : geom::MaskStorage::Sparse));
+      const Equilibrium eq(m);
+      EXPECT_EQ(eq.sparse_fibers(), storage == 1);
+      const Eigen::VectorXd x = random_state(m, 21, 0.2);
+      const int n = m.num_vertices();
+      std::vector<std::pair<int, int>> pairs;
+      for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) pairs.emplace_back(i, j);
+      const std::vector<FiberReading> bulk = eq.bulk_fiber_readings(x, pairs),
+                                      edges = eq.surface_fiber_readings(x);
+      EXPECT_EQ(edges.size(), static_cast<size_t>(geom::unique_edges(m.surface).rows()));
+      Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, 3);
+      int unloaded = 0;
+      for (const std::vector<FiberReading>* readings : {&bulk, &edges})
+        for (const FiberReading& f : *readings) {
+          sum.row(f.i) += f.force.transpose();
+          sum.row(f.j) -= f.force.transpose();
+          unloaded += f.force.isZero(0.0);
+        }
+      const Eigen::MatrixXd expected = -eq.fiber_forces(x);
+      EXPECT_LT((sum - expected).norm(), 1e-12 * expected.norm());
+      // A horizon's pairs beyond it read no force (and every kept one does).
+      if (horizon)
+        EXPECT_EQ(unloaded, static_cast<int>(pairs.size() - m.fibers->num_kept()));
+      else
+        EXPECT_EQ(unloaded, 0);
+      // The strain and the tension of one fiber, by hand: a central fiber
+      // pulls along itself, a vector spring also across.
+      const auto loaded = std::find_if(bulk.begin(), bulk.end(),
+                                       [](const FiberReading& r) { return !r.force.isZero(0.0); });
+      ASSERT_NE(loaded, bulk.end());
+      const FiberReading& f = *loaded;
+      const Eigen::MatrixXd X = positions(m, x);
+      const Eigen::Vector3d towards_j = (X.row(f.j) - X.row(f.i)).transpose();
+      const double L = (m.surface.V.row(f.i) - m.surface.V.row(f.j)).norm();
+      EXPECT_NEAR(f.strain, towards_j.norm() / L - 1.0, 1e-14);
+      EXPECT_NEAR(f.tension, f.force.dot(towards_j.normalized()), 1e-12 * f.force.norm());
+      if (kinematics == FiberKinematics::Central) {
+        EXPECT_NEAR(f.force.cwiseQuotient(m.material.axis_factors)
+                        .normalized()
+                        .cross(towards_j.normalized())
+                        .norm(),
+                    0.0, 1e-12);
+        EXPECT_EQ(f.tension > 0.0, f.strain > 0.0);
+      }
+    }
 }
 
 }  // namespace

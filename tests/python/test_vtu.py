@@ -90,3 +90,38 @@ def test_reactions_and_contact_forces_sum_to_the_steps_forces(tmp_path):
     assert contact[pressed, 1].sum() == pytest.approx(figures["constant.paddle_force.upper"],
                                                       rel=1e-12)
     assert np.abs(grid.point_data["support_reaction"]).sum() > 0  # the resting vertices
+
+
+def test_fibers_are_written_with_their_strain_and_force(tmp_path):
+    # The sphere's 13,041 fibers (every pair kept: a convex body) at the reference and at the end.
+    document = sphere("ascii")
+    document["fibers"] = {"write": "kept"}
+    out = tmp_path / "fibers"
+    fiberfluid.Experiment.from_dict(document).run(output=str(out))
+    rest = meshio.read(str(out / "fibers.vtu"))
+    final = meshio.read(str(out / "fibers_final.vtu"))
+    lines = rest.cells_dict["line"]
+    assert len(lines) == 162 * 161 // 2
+    assert np.array_equal(final.cells_dict["line"], lines)
+
+    def lengths(grid):
+        return np.linalg.norm(grid.points[lines[:, 0]] - grid.points[lines[:, 1]], axis=1)
+    assert np.allclose(rest.cell_data["rest_length"][0], lengths(rest), rtol=1e-14)
+    # The last state's points are the last step's, and each strain is r / L - 1.
+    step = meshio.read(str(out / "vtk" / "step_0010.vtu"))
+    assert np.array_equal(final.points, step.points)
+    strain = final.cell_data["strain"][0]
+    assert np.allclose(strain, lengths(final) / lengths(rest) - 1.0, rtol=0, atol=1e-13)
+    # A vector spring's force is a Y (u_i - u_j): its tension along the fiber is at most its size.
+    force, tension = final.cell_data["force"][0], final.cell_data["tension"][0]
+    assert np.all(force >= np.abs(tension) * (1 - 1e-12))
+    assert np.all(np.isfinite(force)) and force.max() > 0
+    # Stretched fibers mostly pull (their ends' displacements differ mostly along them).
+    stretched = strain > 1e-3
+    assert np.mean(tension[stretched] > 0) > 0.9
+    # Each face's surface-tension force: positive where the surface is strained.
+    per_face = step.cell_data["surface_tension_force"][0]
+    assert per_face.shape == (len(step.cells_dict["triangle"]),)
+    assert np.all(np.isfinite(per_face)) and per_face.min() >= 0 and per_face.max() > 0
+    first = meshio.read(str(out / "vtk" / "step_0000.vtu"))
+    assert not first.cell_data["surface_tension_force"][0].any()  # nothing moved yet
