@@ -16,24 +16,9 @@ namespace fiberfluid::geom {
 
 namespace {
 
-std::string base64(const unsigned char* data, size_t size) {
-  static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((size + 2) / 3 * 4);
-  for (size_t k = 0; k < size; k += 3) {
-    const unsigned b0 = data[k], b1 = k + 1 < size ? data[k + 1] : 0,
-                   b2 = k + 2 < size ? data[k + 2] : 0;
-    out += kDigits[b0 >> 2];
-    out += kDigits[((b0 & 3) << 4) | (b1 >> 4)];
-    out += k + 1 < size ? kDigits[((b1 & 15) << 2) | (b2 >> 6)] : '=';
-    out += k + 2 < size ? kDigits[b2 & 63] : '=';
-  }
-  return out;
-}
-
-// One array's bytes as VTK's compressed inline binary: the header
-// [blocks, block size, last block size, compressed sizes] (UInt64) and the
-// zlib-compressed data, each base64-encoded on its own. One block.
+// One array's bytes as VTK compresses them: the header [blocks, block size,
+// last block size, compressed sizes] (UInt64) and the zlib-compressed data.
+// One block.
 std::string compressed(const std::vector<unsigned char>& raw) {
   uLongf size = compressBound(static_cast<uLong>(raw.size()));
   std::vector<unsigned char> packed(size);
@@ -41,35 +26,45 @@ std::string compressed(const std::vector<unsigned char>& raw) {
                 Z_DEFAULT_COMPRESSION) != Z_OK)
     throw std::runtime_error("write_vtu: zlib could not compress an array");
   const uint64_t header[4] = {1, raw.size(), raw.size(), size};
-  return base64(reinterpret_cast<const unsigned char*>(header), sizeof header) +
-         base64(packed.data(), size);
+  std::string out(reinterpret_cast<const char*>(header), sizeof header);
+  out.append(reinterpret_cast<const char*>(packed.data()), size);
+  return out;
 }
+
+// The XML and, for compressed files, the arrays' bytes appended after it
+// (VTK's raw appended data: each DataArray names its offset into them).
+struct VtuText {
+  std::ostringstream xml;
+  std::string appended;
+  VtkEncoding encoding = VtkEncoding::Ascii;
+};
 
 // A DataArray of values (written as `type`: Float64, Int64 or UInt8) with
 // `components` per tuple.
 template <class T>
-void data_array(std::ostringstream& out, const char* type, const std::string& name, int components,
-                const std::vector<T>& values, VtkEncoding encoding) {
-  const bool binary = encoding == VtkEncoding::Compressed && !values.empty();
-  out << "        <DataArray type=\"" << type << "\"";
-  if (!name.empty()) out << " Name=\"" << name << "\"";
-  if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
-  out << " format=\"" << (binary ? "binary" : "ascii") << "\">\n";
+void data_array(VtuText& out, const char* type, const std::string& name, int components,
+                const std::vector<T>& values) {
+  const bool binary = out.encoding == VtkEncoding::Compressed && !values.empty();
+  out.xml << "        <DataArray type=\"" << type << "\"";
+  if (!name.empty()) out.xml << " Name=\"" << name << "\"";
+  if (components > 1) out.xml << " NumberOfComponents=\"" << components << "\"";
   if (binary) {
+    out.xml << " format=\"appended\" offset=\"" << out.appended.size() << "\"/>\n";
     std::vector<unsigned char> raw(values.size() * sizeof(T));
     std::memcpy(raw.data(), values.data(), raw.size());
-    out << "          " << compressed(raw) << "\n";
-  } else {
-    for (size_t k = 0; k < values.size(); ++k) {
-      out << (k % static_cast<size_t>(components) == 0 ? "          " : " ");
-      if constexpr (sizeof(T) == 1)
-        out << static_cast<int>(values[k]);
-      else
-        out << values[k];
-      if ((k + 1) % static_cast<size_t>(components) == 0) out << '\n';
-    }
+    out.appended += compressed(raw);
+    return;
   }
-  out << "        </DataArray>\n";
+  out.xml << " format=\"ascii\">\n";
+  for (size_t k = 0; k < values.size(); ++k) {
+    out.xml << (k % static_cast<size_t>(components) == 0 ? "          " : " ");
+    if constexpr (sizeof(T) == 1)
+      out.xml << static_cast<int>(values[k]);
+    else
+      out.xml << values[k];
+    if ((k + 1) % static_cast<size_t>(components) == 0) out.xml << '\n';
+  }
+  out.xml << "        </DataArray>\n";
 }
 
 // A field's rows as tuples of 1 or 3 doubles.
@@ -90,13 +85,15 @@ std::vector<double> tuples(const PointField& field, Eigen::Index rows, const cha
 
 void write_vtu(const std::filesystem::path& path, const Surface& s, const VtuContent& content) {
   const int n = s.num_vertices(), faces = s.num_faces();
-  const VtkEncoding e = content.encoding;
-  std::ostringstream out;
+  VtuText text;
+  text.encoding = content.encoding;
+  std::ostringstream& out = text.xml;
   out << std::setprecision(17);
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
       << " header_type=\"UInt64\""
-      << (e == VtkEncoding::Compressed ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
+      << (text.encoding == VtkEncoding::Compressed ? " compressor=\"vtkZLibDataCompressor\"" : "")
+      << ">\n"
       << "  <UnstructuredGrid>\n";
   if (!content.field.empty()) {
     out << "    <FieldData>\n";
@@ -111,14 +108,14 @@ void write_vtu(const std::filesystem::path& path, const Surface& s, const VtuCon
   out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << faces << "\">\n"
       << "      <PointData>\n";
   for (const PointField& field : content.points)
-    data_array(out, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
-               tuples(field, n, "point"), e);
+    data_array(text, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
+               tuples(field, n, "point"));
   out << "      </PointData>\n      <CellData>\n";
   for (const PointField& field : content.cells)
-    data_array(out, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
-               tuples(field, faces, "cell"), e);
+    data_array(text, "Float64", field.name, field.values.cols() == 1 ? 1 : 3,
+               tuples(field, faces, "cell"));
   out << "      </CellData>\n      <Points>\n";
-  data_array(out, "Float64", "", 3, tuples({"points", s.V}, n, "point"), e);
+  data_array(text, "Float64", "", 3, tuples({"points", s.V}, n, "point"));
   out << "      </Points>\n      <Cells>\n";
   std::vector<int64_t> connectivity, offsets;
   for (int f = 0; f < faces; ++f) {
@@ -126,14 +123,16 @@ void write_vtu(const std::filesystem::path& path, const Surface& s, const VtuCon
     offsets.push_back(static_cast<int64_t>(f + 1) * s.F.cols());
   }
   const uint8_t cell_type = s.F.cols() == 3 ? 5 : 3;  // VTK_TRIANGLE, VTK_LINE
-  data_array(out, "Int64", "connectivity", 1, connectivity, e);
-  data_array(out, "Int64", "offsets", 1, offsets, e);
-  data_array(out, "UInt8", "types", 1, std::vector<uint8_t>(static_cast<size_t>(faces), cell_type),
-             e);
+  data_array(text, "Int64", "connectivity", 1, connectivity);
+  data_array(text, "Int64", "offsets", 1, offsets);
+  data_array(text, "UInt8", "types", 1,
+             std::vector<uint8_t>(static_cast<size_t>(faces), cell_type));
   out << "      </Cells>\n"
       << "    </Piece>\n"
-      << "  </UnstructuredGrid>\n"
-      << "</VTKFile>\n";
+      << "  </UnstructuredGrid>\n";
+  if (!text.appended.empty())  // raw bytes after an underscore, as VTK reads them
+    out << "  <AppendedData encoding=\"raw\">\n   _" << text.appended << "\n  </AppendedData>\n";
+  out << "</VTKFile>\n";
   write_text_file(path, out.str());
 }
 

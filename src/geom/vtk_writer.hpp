@@ -26,8 +26,8 @@ struct FieldValues {
 };
 
 // How the arrays are stored: ASCII text, or binary compressed with zlib and
-// base64-encoded inline (VTK's vtkZLibDataCompressor, UInt64 headers), which
-// ParaView and meshio read and which is several times smaller.
+// appended raw after the XML (VTK's vtkZLibDataCompressor, UInt64 headers),
+// which ParaView and meshio read and which is several times smaller.
 enum class VtkEncoding { Ascii, Compressed };
 
 struct VtuContent {

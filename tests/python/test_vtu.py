@@ -29,8 +29,9 @@ def test_ascii_and_compressed_series_hold_the_same_data(tmp_path):
     for vtk_format in ("ascii", "compressed"):
         out = tmp_path / vtk_format
         fiberfluid.Experiment.from_dict(sphere(vtk_format)).run(output=str(out))
-        text = (out / "vtk" / "step_0010.vtu").read_text()
-        assert ('format="binary"' in text) == (vtk_format == "compressed")
+        text = (out / "vtk" / "step_0010.vtu").read_bytes()
+        assert (b'format="appended"' in text) == (vtk_format == "compressed")
+        assert (b'<AppendedData encoding="raw">' in text) == (vtk_format == "compressed")
         grids[vtk_format] = meshio.read(str(out / "vtk" / "step_0010.vtu"))
     a, c = grids["ascii"], grids["compressed"]
     assert np.array_equal(a.points, c.points)  # 17 digits in ASCII: the same doubles
