@@ -560,6 +560,26 @@ bool unknown_subcommand(const CLI::App& cli, int argc, char** argv) {
   return true;
 }
 
+// An argument the command does not take ("--plott"): named, with the
+// command's options (CLI11 alone says only that it was not expected).
+void report_unexpected_arguments(const CLI::App& cli, const CLI::ExtrasError& e, int argc,
+                                 char** argv) {
+  const CLI::App* command = nullptr;
+  for (const CLI::App* sub : cli.get_subcommands([](const CLI::App*) { return true; }))
+    if (argc > 1 && sub->get_name() == argv[1]) command = sub;
+  if (command == nullptr) {
+    std::cerr << "error: " << e.what() << "\n";
+    return;
+  }
+  std::string options;
+  for (const CLI::Option* option : command->get_options())
+    if (option->nonpositional())
+      options += (options.empty() ? "" : ", ") + option->get_name(false, true);
+  std::cerr << "error: " << e.what() << " ('" << command->get_name()
+            << "' takes the options: " << options << "; fiberfluid " << command->get_name()
+            << " --help describes them)\n";
+}
+
 int main(int argc, char** argv) {
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);
@@ -624,6 +644,9 @@ int main(int argc, char** argv) {
     return cli.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return cli.exit(e);
+  } catch (const CLI::ExtrasError& e) {
+    report_unexpected_arguments(cli, e, argc, argv);
+    return kUsage;
   } catch (const CLI::ParseError& e) {
     // One status for every usage mistake (sysexits' EX_USAGE), distinct from bad input files.
     cli.exit(e);

@@ -368,6 +368,8 @@ TEST(Cli, UsageErrors) {
       {"run", "experiment is required"},
       {"frobnicate", "unknown command 'frobnicate' (expected one of: run, fit, check, compare"},
       {"runn x.json", "unknown command 'runn'"},
+      {"run x.json --plott", "--plott ('run' takes the options: -h,--help, -o,--output, --check"},
+      {"check a.obj b.obj", "b.obj ('check' takes the options: -h,--help, --flip;"},
       {"run x.json -j -3", "--jobs"}};
   for (const auto& c : cases) {
     const Outcome o = run_cli(c.arguments);
