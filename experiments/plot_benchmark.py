@@ -15,7 +15,12 @@ import os
 import sys
 from collections import OrderedDict
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:  # another python3 first on PATH (pyenv, a venv): Debian's has it (install-deps)
+    if os.path.exists("/usr/bin/python3") and os.path.realpath(sys.executable) != "/usr/bin/python3":
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+    sys.exit("needs matplotlib (Debian: apt-get install python3-matplotlib)")
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -11,7 +11,12 @@ import os
 import re
 import sys
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:  # another python3 first on PATH (pyenv, a venv): Debian's has it (install-deps)
+    if os.path.exists("/usr/bin/python3") and os.path.realpath(sys.executable) != "/usr/bin/python3":
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+    sys.exit("needs matplotlib (Debian: apt-get install python3-matplotlib)")
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -87,6 +92,8 @@ def distance(folder, fit, path):
 
 
 def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
     folder = sys.argv[1]
     fit = json.load(open(os.path.join(folder, "fit.json")))
     convergence(fit, os.path.join(folder, "fit_convergence.png"))

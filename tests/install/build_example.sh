@@ -37,6 +37,11 @@ test -f "$scratch/prefix/share/fiberfluid/plot.py"
 (cd "$scratch" && "$scratch/prefix/bin/fiberfluid" run tiny.json -o out -q --plot) | grep -q "plot: "
 test -s "$scratch/out/plot.png"
 echo "installed run --plot: $scratch/out/plot.png written"
+# A fit's and a benchmark's plot scripts are commands too (with any python3 first on PATH).
+for command in fiberfluid-plot-fit fiberfluid-plot-benchmark; do
+  { "$scratch/prefix/bin/$command" 2>&1 || true; } | grep -q "Usage:" ||
+    { echo "$command does not start"; exit 1; }
+done
 
 # The installed Python module, found by the interpreter under the prefix.
 if [ -n "${FIBERFLUID_PYTHON:-}" ]; then
