@@ -3,6 +3,7 @@
 
 #include <CGAL/version.h>
 #include <SuiteSparse_config.h>
+#include <dlfcn.h>
 #include <nlopt.h>
 #include <omp.h>
 
@@ -15,6 +16,20 @@ namespace {
 
 std::string dotted(int major, int minor, int patch) {
   return std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(patch);
+}
+
+// The BLAS this process runs, asked at run time (the library the loader
+// found, not the one the build saw): OpenBLAS names its version and its
+// threading (openblas_get_parallel: 0 none, 1 pthreads, 2 OpenMP).
+std::string blas_in_use() {
+  using Config = char* (*)();
+  using Parallel = int (*)();
+  const auto config = reinterpret_cast<Config>(dlsym(RTLD_DEFAULT, "openblas_get_config"));
+  const auto parallel = reinterpret_cast<Parallel>(dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+  if (config == nullptr || parallel == nullptr) return "not OpenBLAS (threading unknown)";
+  static const char* const kThreading[] = {"serial", "pthreads", "OpenMP"};
+  const int p = parallel();
+  return std::string(config()) + " (threading: " + (p >= 0 && p <= 2 ? kThreading[p] : "?") + ")";
 }
 
 }  // namespace
@@ -31,6 +46,8 @@ std::vector<std::pair<std::string, std::string>> build_info() {
       {"sanitizers", FIBERFLUID_SANITIZERS},
       {"openmp_threads", std::to_string(omp_get_max_threads())},
       {"lapack", FIBERFLUID_LAPACK},
+      {"blas", blas_in_use()},
+      {"blas_threading_at_build", FIBERFLUID_BLAS_THREADING},
       {"suitesparse",
        dotted(SUITESPARSE_MAIN_VERSION, SUITESPARSE_SUB_VERSION, SUITESPARSE_SUBSUB_VERSION) +
            " (CHOLMOD, UMFPACK)"},

@@ -316,6 +316,14 @@ TEST(OutputFolder, TheResolvedExperimentRepeatsTheRunBitForBit) {
   EXPECT_EQ(summary["runs"][0]["material"]["kinematics"], "vector");
   EXPECT_EQ(summary["build"]["version"], summary["fiberfluid_version"]);
   EXPECT_NE(summary["build"]["lapack"], "");
+  // The BLAS the run loaded has the threading the build checked for (one
+  // thread pool: OpenBLAS's OpenMP build, selected by scripts/install-deps.sh).
+  const std::string threading = summary["build"]["blas_threading_at_build"];
+  if (threading != "unknown") {
+    EXPECT_NE(summary["build"]["blas"].get<std::string>().find("(threading: " + threading + ")"),
+              std::string::npos)
+        << summary["build"];
+  }
   // A program's surface is written beside the resolved file, which reads it.
   nlohmann::json given = small_config();
   const geom::Surface ball = geom::icosphere(1, 1.0);
