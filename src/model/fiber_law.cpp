@@ -8,6 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fiberfluid/model/vector_clones.hpp"
+#include "fiberfluid/model/vector_math.hpp"
+
 namespace fiberfluid::model {
 
 void LawModel::evaluate(const double* p, const double* strain, size_t n, double* Y,
@@ -83,25 +86,45 @@ class ConstantLaw final : public LawModel {
   bool is_constant() const override { return true; }
 };
 
+// Y0 exp(beta e) and its slope at n strains, vectorised (vector_exp): the
+// Newton kernels call this once per row of pairs.
+FIBERFLUID_VECTOR_CLONES
+void exponential_moduli(double Y0, double beta, const double* strain, size_t n, double* Y,
+                        double* Yp) {
+#pragma omp simd
+  for (size_t k = 0; k < n; ++k) {
+    Y[k] = Y0 * vector_exp(beta * strain[k]);
+    Yp[k] = beta * Y[k];
+  }
+}
+
+FIBERFLUID_VECTOR_CLONES
+void exponential_derivatives(double Y0, double beta, int parameter, const double* strain, size_t n,
+                             double* dY) {
+#pragma omp simd
+  for (size_t k = 0; k < n; ++k) {
+    const double growth = vector_exp(beta * strain[k]);
+    dY[k] = parameter == 0 ? growth : Y0 * strain[k] * growth;
+  }
+}
+
 class ExponentialLaw final : public LawModel {
  public:
   std::string name() const override { return "exponential"; }
   std::vector<std::string> parameter_names() const override { return {"Y0", "beta"}; }
-  double modulus(const double* p, double e) const override { return p[0] * std::exp(p[1] * e); }
-  double slope(const double* p, double e) const override {
-    return p[0] * p[1] * std::exp(p[1] * e);
-  }
+  double modulus(const double* p, double e) const override { return p[0] * vector_exp(p[1] * e); }
+  double slope(const double* p, double e) const override { return p[1] * modulus(p, e); }
   double modulus_derivative(const double* p, int k, double e) const override {
-    return k == 0 ? std::exp(p[1] * e) : p[0] * e * std::exp(p[1] * e);
+    return k == 0 ? vector_exp(p[1] * e) : p[0] * e * vector_exp(p[1] * e);
   }
   bool is_positive(int k) const override { return k == 0; }  // beta takes either sign
   void evaluate(const double* p, const double* strain, size_t n, double* Y,
                 double* Yp) const override {
-    const double Y0 = p[0], beta = p[1];
-    for (size_t k = 0; k < n; ++k) {
-      Y[k] = Y0 * std::exp(beta * strain[k]);
-      Yp[k] = beta * Y[k];
-    }
+    exponential_moduli(p[0], p[1], strain, n, Y, Yp);
+  }
+  void evaluate_derivative(const double* p, int k, const double* strain, size_t n,
+                           double* dY) const override {
+    exponential_derivatives(p[0], p[1], k, strain, n, dY);
   }
   std::string check(const double* p, double lowest, double highest) const override {
     if (std::string why = finite_parameters(*this, p); !why.empty()) return why;

@@ -4,6 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "fiberfluid/model/vector_math.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -30,6 +35,60 @@ TEST(FiberLaw, ValuesOfEachLaw) {
   EXPECT_DOUBLE_EQ(table.modulus(0.2), 1500.0);
   EXPECT_DOUBLE_EQ(table.modulus(0.5), 900.0 / 0.5);
   EXPECT_DOUBLE_EQ(table.modulus(-0.5), 1000.0);
+}
+
+// The vectorised exponential (vector_math.hpp) against the library's, in
+// units in the last place: over the whole range, over the strains a law
+// meets, at the ends of the reduction's intervals (k ln2 / 2), and its
+// special values.
+TEST(FiberLaw, TheVectorExponentialIsWithinTwoUlp) {
+  const auto ulps = [](double x) {
+    const double exact = std::exp(x), ours = vector_exp(x);
+    const double ulp = std::nextafter(exact, std::numeric_limits<double>::infinity()) - exact;
+    return std::abs(ours - exact) / ulp;
+  };
+  std::mt19937_64 rng(7);
+  double worst = 0.0;
+  for (const double range : {708.0, 20.0, 1.0}) {
+    std::uniform_real_distribution<double> x(-range, range);
+    for (int k = 0; k < 200000; ++k) worst = std::max(worst, ulps(x(rng)));
+  }
+  for (int k = -2040; k <= 2040; ++k)
+    for (const double nudge : {-1e-15, 0.0, 1e-15})
+      worst = std::max(worst, ulps(k * 0.34657359027997264 + nudge));
+  for (const double x : {709.0, 709.5, 709.78}) worst = std::max(worst, ulps(x));  // k = 1024
+  EXPECT_LE(worst, 2.0);
+  EXPECT_EQ(vector_exp(0.0), 1.0);
+  EXPECT_TRUE(std::isnan(vector_exp(std::nan(""))));
+  EXPECT_EQ(vector_exp(709.8), HUGE_VAL);  // an overflow stays visible
+  EXPECT_EQ(vector_exp(1e6), HUGE_VAL);
+  EXPECT_EQ(vector_exp(-1e6), 0.0);
+}
+
+// A law's block evaluation (the kernels') gives its pointwise values.
+TEST(FiberLaw, TheBlockEvaluationGivesThePointwiseValues) {
+  const std::vector<FiberLaw> laws = {
+      FiberLaw::exponential(2000.0, 5.0), FiberLaw::exponential(1500.0, -3.0),
+      FiberLaw::bilinear(3000.0, 1000.0),
+      FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0})};
+  std::vector<double> strain;
+  for (int k = 0; k <= 400; ++k) strain.push_back(-0.9 + k * 0.007);
+  for (const FiberLaw& law : laws) {
+    SCOPED_TRACE(law.name());
+    std::vector<double> Y(strain.size()), Yp(strain.size()), dY(strain.size());
+    law.evaluate(strain.data(), strain.size(), Y.data(), Yp.data());
+    for (size_t k = 0; k < strain.size(); ++k) {
+      EXPECT_NEAR(Y[k], law.modulus(strain[k]), 1e-15 * std::abs(law.modulus(strain[k])));
+      EXPECT_NEAR(Yp[k], law.slope(strain[k]), 1e-15 * std::abs(law.slope(strain[k])) + 1e-300);
+    }
+    for (int p = 0; p < static_cast<int>(law.parameter_names().size()); ++p) {
+      law.evaluate_derivative(p, strain.data(), strain.size(), dY.data());
+      for (size_t k = 0; k < strain.size(); ++k) {
+        const double expected = law.modulus_derivative(p, strain[k]);
+        EXPECT_NEAR(dY[k], expected, 1e-15 * std::abs(expected) + 1e-300);
+      }
+    }
+  }
 }
 
 // Issue 29: a table 17.5 kPa below zero strain and 20 kPa above. Sharp, its
