@@ -73,8 +73,11 @@ double best_seconds(int repeat, const std::function<void()>& kernel) {
 int main(int argc, char** argv) {
   CLI::App cli{"fiberfluid pair kernels: time and GFLOP/s against the dgemm peak"};
   int subdivisions = 4, repeat = 3;
-  std::string only;
+  std::string only, law = "constant";
   cli.add_option("--subdivisions", subdivisions, "icosphere subdivisions (4: 2,562 vertices)");
+  cli.add_option("--law", law,
+                 "the Newton kernels' law: constant (Y 3000) or exponential (Y0 3000, beta 4)")
+      ->check(CLI::IsMember({"constant", "exponential"}));
   cli.add_option("--repeat", repeat, "timings per kernel (the best is kept)");
   cli.add_option("--only", only, "time only the kernels whose name starts with this");
   CLI11_PARSE(cli, argc, argv);
@@ -85,7 +88,9 @@ int main(int argc, char** argv) {
   config["expected"] = nlohmann::json::array();
   const fiberfluid::experiment::Experiment ex =
       fiberfluid::experiment::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
-  const fiberfluid::model::Model& model = ex.cases.front().model;
+  fiberfluid::model::Model model = ex.cases.front().model;
+  if (law == "exponential")
+    model.material.law = fiberfluid::model::FiberLaw::exponential(3000.0, 4.0);
   const int n = model.num_vertices();
   const double ordered = static_cast<double>(n) * (n - 1), unordered = ordered / 2.0;
 
@@ -97,7 +102,7 @@ int main(int argc, char** argv) {
   Eigen::VectorXd x = 1e-3 * Eigen::VectorXd::Random(model.num_unknowns());
   const std::vector<double> factors(model.loads.size(), 1.0);
   const Eigen::VectorXd w = Eigen::VectorXd::Random(model.num_unknowns());
-  const fiberfluid::model::TangentOperator stored = equilibrium.linearize(x, factors);
+  fiberfluid::model::TangentOperator stored = equilibrium.linearize(x, factors);
 
   struct Row {
     const char* name;
@@ -111,6 +116,12 @@ int main(int argc, char** argv) {
   std::vector<double> squared_lengths(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i)
     squared_lengths[static_cast<size_t>(i)] = 1.0 + model.surface.V.row(i).squaredNorm();
+  // The law over one pair per fiber, a row of 256 strains at a time (as the
+  // kernels call it), against libm's exp value by value.
+  std::vector<double> strains(256), moduli(256), slopes(256);
+  for (size_t k = 0; k < strains.size(); ++k) strains[k] = -0.3 + 0.6 * k / 255.0;
+  const auto rows_of_pairs = static_cast<long long>(unordered / 256.0);
+  const fiberfluid::model::FiberLaw& the_law = model.material.law;
   const std::vector<Row> rows = {
       {"bulk_product (3 columns)", ordered, 21, unordered, 27,
        [&] { sink = system.bulk_product(V); }},
@@ -124,6 +135,24 @@ int main(int argc, char** argv) {
       {"tangent_product (recomputed)", ordered, 50, unordered, 59,
        [&] { vector_sink = equilibrium.tangent_product(x, factors, w); }},
       {"tangent apply (stored)", ordered, 27, ordered, 27, [&] { vector_sink = stored.apply(w); }},
+      // Newton's two passes over the pairs at a state (the law evaluated in each).
+      {"residual (Newton)", ordered, 0, unordered, 0,  // pairs per second only
+       [&] { vector_sink = equilibrium.residual(x, factors); }},
+      {"linearize (store c1, c2)", ordered, 0, unordered, 0,
+       [&] { equilibrium.linearize(x, factors, stored); }},
+      {"law: block evaluation", unordered, 0, unordered, 0,
+       [&] {
+         for (long long r = 0; r < rows_of_pairs; ++r)
+           the_law.evaluate(strains.data(), strains.size(), moduli.data(), slopes.data());
+         scalar_sink += moduli[7];
+       }},
+      {"law: libm exp per value", unordered, 0, unordered, 0,
+       [&] {
+         for (long long r = 0; r < rows_of_pairs; ++r)
+           for (size_t k = 0; k < strains.size(); ++k)
+             moduli[k] = 3000.0 * std::exp(4.0 * strains[k]);
+         scalar_sink += moduli[7];
+       }},
       {"floor: sqrt + div per pair", unordered, 2, unordered, 2,
        [&] { scalar_sink = sqrt_div_floor(squared_lengths); }},
       {"floor: write a new N x N", ordered, 0, ordered, 0,
@@ -134,7 +163,7 @@ int main(int argc, char** argv) {
          sink.swap(fresh);
        }},
   };
-  std::printf("%d vertices, dgemm peak %.1f GFLOP/s\n", n, peak);
+  std::printf("%d vertices, %s law, dgemm peak %.1f GFLOP/s\n", n, law.c_str(), peak);
   std::printf("%-30s %9s %9s %9s %7s %9s %7s\n", "kernel", "seconds", "Gpairs/s", "nominal",
               "% peak", "executed", "% peak");
   for (const Row& row : rows) {
@@ -146,6 +175,7 @@ int main(int argc, char** argv) {
                 ordered / seconds / 1e9, nominal, 100.0 * nominal / peak, executed,
                 100.0 * executed / peak);
     std::cerr << nlohmann::json{{"vertices", n},
+                                {"law", law},
                                 {"kernel", row.name},
                                 {"seconds", seconds},
                                 {"nominal_gflops", nominal},

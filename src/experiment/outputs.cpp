@@ -76,12 +76,30 @@ json law_json(const model::Material& material, int dim) {
   return out;
 }
 
+// Passes over every fiber pair: computed (lengths and the law) and stored
+// (a stored tangent read).
+json pair_passes_json(const model::PairPasses& p) {
+  return {{"computed", p.computed}, {"stored", p.stored}};
+}
+
+// A Newton run's passes over the pairs in all, and per Newton iteration.
+json run_pair_passes_json(const solve::SteppingSummary& s) {
+  model::PairPasses total;
+  for (const solve::StepRecord& r : s.steps) total += r.pair_passes;
+  json out = pair_passes_json(total);
+  const double iterations = std::max(1, s.newton_iterations);
+  out["computed_per_newton_iteration"] = static_cast<double>(total.computed) / iterations;
+  out["stored_per_newton_iteration"] = static_cast<double>(total.stored) / iterations;
+  return out;
+}
+
 // The Newton and contact records of a step (Newton scheme only).
 void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& step) {
   step["newton"] = {{"iterations", r.newton_iterations},
                     {"residual_norms", r.residual_norms},
                     {"line_search_halvings", r.line_search_halvings},
                     {"krylov_iterations", r.krylov_iterations},
+                    {"pair_passes", pair_passes_json(r.pair_passes)},
                     {"step_cuts", r.step_cuts},
                     {"volume_drift", r.volume_drift}};
   json paddles = json::object();
@@ -147,6 +165,7 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"material", law_json(m.material, m.dim())},
           {"newton_iterations", run.summary.newton_iterations},
           {"krylov_iterations", run.summary.krylov_iterations},
+          {"pair_passes", run_pair_passes_json(run.summary)},
           {"limit_load_factor", std::isnan(run.summary.limit_load_factor)
                                     ? json(nullptr)
                                     : json(run.summary.limit_load_factor)},

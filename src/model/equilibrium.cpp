@@ -194,6 +194,7 @@ void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>&
 }
 
 Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
+  ++pair_passes().stored;
   const Equilibrium& eq = *equilibrium_;
   const Eigen::MatrixXd W = displacements(eq.model(), v);
   Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());

@@ -472,8 +472,14 @@ struct DeformedPairs::ListedRow {
   RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
 };
 
+PairPasses& pair_passes() {
+  thread_local PairPasses count;
+  return count;
+}
+
 template <class Visit>
 void DeformedPairs::for_each_listed_row(Visit&& visit) const {
+  ++pair_passes().computed;
 #pragma omp parallel
   {
     ListedRow row;
@@ -551,6 +557,7 @@ struct DeformedPairs::RowScratch {
 
 template <class Visit>
 void DeformedPairs::for_each_row(Visit&& visit) const {
+  ++pair_passes().computed;
   std::vector<RowScratch> scratch(static_cast<size_t>(omp_get_max_threads()));
   const DeformedRow geometry{s_[0].data(), s_[1].data(), s_[2].data(),
                              x_[0].data(), x_[1].data(), x_[2].data()};

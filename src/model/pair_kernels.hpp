@@ -22,6 +22,23 @@
 
 namespace fiberfluid::model {
 
+// How many times the pair loops of this thread have gone over every fiber
+// pair: what a Newton iteration costs (issue 25). A run counts on its own
+// thread (a sweep runs each variant on a thread of its own).
+struct PairPasses {
+  long long computed = 0;  // lengths and the law at a state (DeformedPairs)
+  long long stored = 0;    // a stored tangent's coefficients read (TangentOperator::apply)
+  PairPasses operator-(const PairPasses& before) const {
+    return {computed - before.computed, stored - before.stored};
+  }
+  PairPasses& operator+=(const PairPasses& more) {
+    computed += more.computed;
+    stored += more.stored;
+    return *this;
+  }
+};
+PairPasses& pair_passes();  // this thread's count
+
 // The bulk weights of a set of vertices (paper Eq. 6, model.md section 5):
 //   w_ij = m_ij (|S_i| + |S_j|) / ((c_i + c_j) |x_i - x_j|),
 // with c_i from PairFactors::vertex_counts (so that h_ij = 1 / (c_i + c_j)),

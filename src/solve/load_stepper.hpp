@@ -11,6 +11,7 @@
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/fiber_system.hpp"
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/solve/linear_solver.hpp"
 
 namespace fiberfluid::solve {
@@ -137,8 +138,9 @@ struct StepRecord {
   std::vector<double> residual_norms;  // relative, at every iteration (before its correction)
   int line_search_halvings = 0;
   int krylov_iterations = 0;
-  int step_cuts = 0;          // halvings of this step
-  double volume_drift = 0.0;  // (V - V0) / V0 after the step
+  model::PairPasses pair_passes;  // over every fiber pair, in the step (its solves, its checks)
+  int step_cuts = 0;              // halvings of this step
+  double volume_drift = 0.0;      // (V - V0) / V0 after the step
   struct PaddleState {
     double plane = 0.0;                               // the plane's coordinate
     double travel = 0.0;                              // how far it has moved

@@ -784,10 +784,13 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   const int n = options.steps;
   Eigen::VectorXd& x = summary.unknowns;
   // A converged point of the path at t: its record, the observer.
+  model::PairPasses passes_before = model::pair_passes();
   const auto keep = [&](StepRecord& record, double t, const Clock::time_point step_start) {
     const std::string stop = finisher.finish(path_point(model, t, n), x, record);
     if (!stop.empty()) return stop;
     record.seconds = seconds_since(step_start);
+    record.pair_passes = model::pair_passes() - passes_before;
+    passes_before = model::pair_passes();
     summary.steps.push_back(record);
     if (observer) observer(record, x);
     return std::string();
