@@ -179,13 +179,35 @@ TangentOperator Equilibrium::linearize(const Eigen::VectorXd& x,
   return op;
 }
 
-void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
+Eigen::VectorXd Equilibrium::residual(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                                      TangentOperator& op) const {
+  if (bulk_.sparse()) {
+    linearize(x, factors, op);
+    return residual(x, factors);
+  }
+  set_state(x, factors, op);
+  op.listed_ = false;
+  const TermState s(context_, x, factors);
+  Eigen::VectorXd R = Eigen::VectorXd::Zero(num_unknowns());
+  bulk_.add_residual_and_coefficients(s, R, &op.weighted_modulus_, &op.weighted_slope_);
+  for (const auto& term : terms_) term->add_residual(s, R);
+  return R;
+}
+
+void Equilibrium::set_state(const Eigen::VectorXd& x, const std::vector<double>& factors,
                             TangentOperator& op) const {
   op.equilibrium_ = this;
   op.x_ = x;
   op.factors_ = factors;
   op.X_ = positions(model_, x);
   op.U_ = displacements(model_, x);
+}
+
+void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                            TangentOperator& op) const {
+  if (op.equilibrium_ == this && op.x_.size() == x.size() && op.x_ == x && op.factors_ == factors)
+    return;  // stored by residual(x, factors, op)
+  set_state(x, factors, op);
   op.listed_ = bulk_.sparse();
   if (op.listed_)
     bulk_.listed_coefficients(op.X_, op.U_, &op.listed_modulus_, &op.listed_slope_);

@@ -74,6 +74,12 @@ class Equilibrium {
   std::vector<std::string> term_names() const;
 
   Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
+  // The same, with the tangent at x stored into `op` on the way, so that
+  // linearize(x, factors, op) then costs nothing: one pass over the pairs
+  // where the fibers are a table (a Newton line search's trial, which
+  // becomes the next iterate), two for neighbour lists.
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                           TangentOperator& op) const;
   // The loads alone, F_i + q_i S_i (follower), full layout with 0 for g.
   Eigen::VectorXd external_forces(const Eigen::VectorXd& x,
                                   const std::vector<double>& factors) const;
@@ -107,7 +113,8 @@ class Equilibrium {
   // The tangent at x as an operator with its pair coefficients stored: for
   // the many products of one Krylov solve.
   TangentOperator linearize(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
-  // The same into an existing operator, reusing its arrays (no new pages to fault in).
+  // The same into an existing operator, reusing its arrays (no new pages to
+  // fault in); nothing to do when it holds the tangent at (x, factors) already.
   void linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
                  TangentOperator& op) const;
 
@@ -135,6 +142,9 @@ class Equilibrium {
   // The residual of the terms with this role alone.
   Eigen::VectorXd residual_of(EquilibriumTerm::Role role, const Eigen::VectorXd& x,
                               const std::vector<double>& factors) const;
+  // The state an operator is linearised at (x, factors, positions, displacements).
+  void set_state(const Eigen::VectorXd& x, const std::vector<double>& factors,
+                 TangentOperator& op) const;
   // out += dR/dx v of every term but the bulk fibers.
   void add_other_products(const TermState& s, const Eigen::VectorXd& v, const Eigen::MatrixXd& W,
                           Eigen::VectorXd& out) const;

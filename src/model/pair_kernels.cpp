@@ -13,8 +13,33 @@
 #include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::model {
+
+namespace detail {
+// One n x cols accumulator per thread, summed in thread order: with
+// for_each_tile_pair's fixed shares, the same bits run after run.
+class ThreadAccumulators {
+ public:
+  ThreadAccumulators(int n, int cols)
+      : partial_(static_cast<size_t>(omp_get_max_threads()), Eigen::MatrixXd::Zero(n, cols)) {}
+  double* column(int thread, int c) { return partial_[static_cast<size_t>(thread)].col(c).data(); }
+  std::array<double*, 3> columns(int thread) {
+    return {column(thread, 0), column(thread, 1), column(thread, 2)};
+  }
+  Eigen::MatrixXd sum() const {
+    Eigen::MatrixXd total = Eigen::MatrixXd::Zero(partial_[0].rows(), partial_[0].cols());
+    for (const Eigen::MatrixXd& p : partial_) total += p;
+    return total;
+  }
+
+ private:
+  std::vector<Eigen::MatrixXd> partial_;
+};
+
+}  // namespace detail
+
 namespace {
 
+using detail::ThreadAccumulators;
 using Tile = BulkPairs::Tile;
 
 // Runs visit(tile, thread) over the tiles covering the pairs i <= j of n
@@ -35,26 +60,6 @@ void for_each_tile_pair(int n, Visit&& visit) {
     for (size_t k = 0; k < tiles.size(); ++k) visit(tiles[k], thread);
   }
 }
-
-// One n x cols accumulator per thread, summed in thread order: with
-// for_each_tile_pair's fixed shares, the same bits run after run.
-class ThreadAccumulators {
- public:
-  ThreadAccumulators(int n, int cols)
-      : partial_(static_cast<size_t>(omp_get_max_threads()), Eigen::MatrixXd::Zero(n, cols)) {}
-  double* column(int thread, int c) { return partial_[static_cast<size_t>(thread)].col(c).data(); }
-  std::array<double*, 3> columns(int thread) {
-    return {column(thread, 0), column(thread, 1), column(thread, 2)};
-  }
-  Eigen::MatrixXd sum() const {
-    Eigen::MatrixXd total = Eigen::MatrixXd::Zero(partial_[0].rows(), partial_[0].cols());
-    for (const Eigen::MatrixXd& p : partial_) total += p;
-    return total;
-  }
-
- private:
-  std::vector<Eigen::MatrixXd> partial_;
-};
 
 // The set's arrays, indexed by position in the set.
 struct SetArrays {
@@ -644,6 +649,22 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
     }
     return;
   }
+  store_coefficients(c1, c2, nullptr);
+}
+
+Eigen::MatrixXd DeformedPairs::forces_and_coefficients(Eigen::MatrixXd* c1,
+                                                       Eigen::MatrixXd* c2) const {
+  if (sparse()) {  // two passes: the lists keep no table to fill on the way
+    coefficients(c1, c2);
+    return forces();
+  }
+  ThreadAccumulators forces(n_, 3);
+  store_coefficients(c1, c2, &forces);
+  return forces.sum();
+}
+
+void DeformedPairs::store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
+                                       ThreadAccumulators* forces) const {
   c1->resize(n_, n_);
   c2->resize(n_, n_);
   advise_huge_pages(c1->data(), 8.0 * static_cast<double>(c1->size()));
@@ -651,9 +672,12 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
   c1->diagonal().setZero();
   c2->diagonal().setZero();
   const double *area = area_.data(), *count = count_.data();
+  const PairColumns p = columns_of(x_, u_);
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
-    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int) {
+    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+      if (forces != nullptr)  // the row's lengths and law, used twice
+        forces_row<K>(p, area, count, i, j0, first, end, row, forces->columns(thread));
       double* k1 = c1->col(i).data();
       double* k2 = c2->col(i).data();
       for (int j = first; j < end; ++j) {

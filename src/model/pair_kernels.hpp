@@ -22,6 +22,10 @@
 
 namespace fiberfluid::model {
 
+namespace detail {
+class ThreadAccumulators;  // pair_kernels.cpp
+}
+
 // How many times the pair loops of this thread have gone over every fiber
 // pair: what a Newton iteration costs (issue 25). A run counts on its own
 // thread (a sweep runs each variant on a thread of its own).
@@ -138,6 +142,9 @@ class DeformedPairs {
   Eigen::MatrixXd tangent_product(const Eigen::MatrixXd& W) const;
   // c1 and c2 of every pair (N x N each, symmetric, zero diagonal).
   void coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
+  // forces() and coefficients() in one pass over the pairs (their lengths
+  // and the law computed once); two passes for a sparse mask.
+  Eigen::MatrixXd forces_and_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
 
   // A mask stored sparse (neighbour lists): the pairs are visited from both
   // ends, row by row, and their coefficients can be kept in list order.
@@ -163,6 +170,9 @@ class DeformedPairs {
   // term(policy, i, j, coefficients, a) (forces, tangent products).
   template <class Term>
   Eigen::MatrixXd listed_sums(Term&& term) const;
+  // The table of c1, c2, and with `forces` the forces summed on the way.
+  void store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
+                          detail::ThreadAccumulators* forces) const;
 
   int n_ = 0;
   std::vector<double> s_[3], x_[3], u_[3], count_;

@@ -507,6 +507,14 @@ void BulkFiberTerm::add_residual(const TermState& s, Eigen::VectorXd& R) const {
   for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) += m[a] * bulk.col(a);
 }
 
+void BulkFiberTerm::add_residual_and_coefficients(const TermState& s, Eigen::VectorXd& R,
+                                                  Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+  const int n = c_.model.num_vertices();
+  const Eigen::Vector3d m = c_.model.material.axis_factors;
+  const Eigen::MatrixXd bulk = deformed_pairs(c_, s.X, s.U).forces_and_coefficients(c1, c2);
+  for (int a = 0; a < c_.model.dim(); ++a) R.segment(a * n, n) += m[a] * bulk.col(a);
+}
+
 void BulkFiberTerm::add_tangent_product(const TermState& s, const Eigen::VectorXd&,
                                         const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
   const int n = c_.model.num_vertices();

@@ -312,7 +312,7 @@ class NewtonSolver {
   std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
                      StepRecord& record, bool* converged) {
     *converged = false;
-    Eigen::VectorXd R = equilibrium_->residual(x, at.factors);
+    Eigen::VectorXd R = tangent_->residual(x, at.factors);  // and the tangent there
     double last_move = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
       if (cancel_requested()) return "interrupted";
@@ -354,7 +354,7 @@ class NewtonSolver {
       Eigen::VectorXd trial, R_trial;
       for (int halving = 0;; ++halving) {
         trial = x + alpha * step;
-        R_trial = equilibrium_->residual(trial, at.factors);
+        R_trial = tangent_->residual(trial, at.factors);  // and the tangent there
         const double trial_norm = measure(at, dofs, trial, R_trial);
         if (!newton_.line_search || trial_norm <= (1.0 - 1e-4 * alpha) * norm ||
             trial_norm <= newton_.residual_tolerance)
@@ -477,7 +477,7 @@ class NewtonSolver {
       dofs.scatter(delta, step);
       *x += step;
       const std::vector<double> factors = factors_at(*t, n);
-      const Eigen::VectorXd R = equilibrium_->residual(*x, factors);
+      const Eigen::VectorXd R = tangent_->residual(*x, factors);  // and the tangent there
       PathPoint at;
       at.factors = factors;
       double scale = 0.0;

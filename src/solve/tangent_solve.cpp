@@ -119,6 +119,14 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
   return {};
 }
 
+Eigen::VectorXd TangentSolve::residual(const Eigen::VectorXd& x,
+                                       const std::vector<double>& factors) {
+  if (kind_ == TangentSolver::Dense || kind_ == TangentSolver::Sparse || !store_)
+    return equilibrium_->residual(x, factors);
+  ready_ = false;  // stored_ now holds the tangent at x
+  return equilibrium_->residual(x, factors, stored_);
+}
+
 Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
   Eigen::VectorXd w = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
   dofs_.scatter(reduced, w);  // held entries stay zero

@@ -51,6 +51,11 @@ class TangentSolve {
   // nullptr: the same set).
   Status prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
                  const model::DofMap& dofs, const model::DofMap* preconditioner_dofs = nullptr);
+  // The residual R(x) (Equilibrium::residual), with the tangent at x stored
+  // on the way where this solve stores its tangent: a prepare() at x then
+  // skips its pass over the fiber pairs (Newton's accepted trial is the next
+  // iterate). The tangent prepared before is gone: prepare() again to solve.
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors);
   // J_ff y = b over the reduced unknowns (DofMap layout); krylov stops at the
   // relative residual `tolerance`. iterations (krylov) is added to.
   Status solve(const Eigen::VectorXd& b, double tolerance, Eigen::VectorXd* y,

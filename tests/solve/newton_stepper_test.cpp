@@ -104,6 +104,35 @@ TEST(Newton, KrylovAgreesWithTheDenseTangent) {
   }
 }
 
+// Issue 25: the line search's residual stores the tangent at its trial, which
+// becomes the next iterate: one pass over the pairs per Newton iteration
+// (and one per Newton solve's start), not two, and the same bits as
+// linearising again.
+TEST(Newton, EachIterationGoesOverThePairsOnce) {
+  const model::Model m = hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+  SteppingOptions o = newton(3, TangentSolver::Krylov);
+  o.solver = SolverKind::BlockCholesky;
+  const SteppingSummary run = solve_load_steps(m, o);
+  ASSERT_TRUE(run.success) << run.message;
+  for (const StepRecord& step : run.steps) {
+    SCOPED_TRACE(step.step);
+    EXPECT_EQ(step.line_search_halvings, 0);
+    EXPECT_EQ(step.pair_passes.computed, step.newton_iterations + 1);
+    EXPECT_GE(step.pair_passes.stored, step.krylov_iterations);
+  }
+  // The operator stored by the residual is the one linearize builds.
+  const model::Equilibrium eq(m);
+  const Eigen::VectorXd x = run.unknowns, v = Eigen::VectorXd::Random(x.size());
+  const std::vector<double> factors = {0.8};
+  model::TangentOperator stored;
+  const Eigen::VectorXd R = eq.residual(x, factors, stored);
+  EXPECT_EQ(R, eq.residual(x, factors));
+  EXPECT_EQ(stored.apply(v), eq.linearize(x, factors).apply(v));
+  const model::PairPasses before = model::pair_passes();
+  eq.linearize(x, factors, stored);  // held already: no pass
+  EXPECT_EQ((model::pair_passes() - before).computed, 0);
+}
+
 // The summary's final tangent gives the sensitivity of the solution to a
 // material parameter, du/dtheta = -K_T^{-1} dR/dtheta: against central
 // differences of whole Newton runs, with the dense and the krylov tangent.
