@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds fiberfluid with its tests (RelWithDebInfo) and runs them all; then
 # builds the suite again with AddressSanitizer and UndefinedBehaviorSanitizer
-# (build-sanitize/) and runs it there too; then runs each fuzz target for 30 s.
+# (build-sanitize/) and runs it there too; then runs each fuzz target for 20 s.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -27,10 +27,16 @@ phase "tests"
 # of 40 dense-Newton runs);
 # the block benchmark's two meshes (benchmark_block_mp1 and _mp2: the 2D FEM
 # and the fiber model the Benchmark.* tests run here on the same scene, two
-# minutes each under ASan); and four long loops over code that shorter tests run here: the progress
+# minutes each under ASan); and long loops over code that shorter tests run here: the progress
 # lines of two runs of 400 load steps (Cli.LongPhasesShowProgressUnlessQuiet), the FEM
 # liver's fit and the exact synthetic liver's fit (fit_synthetic_liver.json
-# runs the same fit), and a fit driven onto its bounds (FitStatus.*Bounds*).
+# runs the same fit), a fit driven onto its bounds (FitStatus.*Bounds*), the
+# pruning against brute force on the shared meshes (100 s under ASan; the same
+# comparison on generated bodies runs here), the finer liver's force-curve fit
+# (fit_liver_force.json; ForceCurveFit.* fits force curves here), the resolved
+# experiment's bit-for-bit round trip (three whole runs; the run above checks
+# the bits) and the fitted benchmark (Benchmark.TheFittedFiberModelIsTheClosest;
+# the other Benchmark.* tests run here).
 # Line tables only (-g1): ASan's reports keep their file and line, and the
 # build is faster than with full debug information.
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFIBERFLUID_SANITIZE=ON \
@@ -42,11 +48,11 @@ phase "sanitized build"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS="print_stacktrace=1:suppressions=$PWD/tests/sanitize/ubsan.supp"
 ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" \
-      -E 'install\.|bunny_gravity\.json|benchmark_rod\.json|bar_bending\.json|cantilever_large\.json|TheCommittedCantileverTargetIsCurrent|TheBarsProfileHoldsAsTheMeshIsRefined|benchmark_block_mp[12]\.json|LongPhasesShowProgressUnlessQuiet|fit_liver_fem\.json|fit_synthetic_liver_exact\.json|ParametersOnTheirBoundsAreNamedWithTheirCorrelation'
+      -E 'install\.|bunny_gravity\.json|benchmark_rod\.json|bar_bending\.json|cantilever_large\.json|TheCommittedCantileverTargetIsCurrent|TheBarsProfileHoldsAsTheMeshIsRefined|benchmark_block_mp[12]\.json|LongPhasesShowProgressUnlessQuiet|fit_liver_fem\.json|fit_synthetic_liver_exact\.json|ParametersOnTheirBoundsAreNamedWithTheirCorrelation|AgreesWithTheBruteForceOnSharedMeshes|fit_liver_force\.json|TheResolvedExperimentRepeatsTheRunBitForBit|TheFittedFiberModelIsTheClosest'
 phase "sanitized tests (ASan + UBSan)"
 
-# The libFuzzer targets (clang, ASan + UBSan, build-fuzz/), each for 30 s from
+# The libFuzzer targets (clang, ASan + UBSan, build-fuzz/), each for 20 s from
 # its seeds: a crash, hang, leak or broken invariant fails the run and leaves
 # its input in tests/fuzz/regressions/ (scripts/fuzz.sh).
-scripts/fuzz.sh 30
+scripts/fuzz.sh 20
 phase "fuzzing"
