@@ -138,7 +138,9 @@ class ExponentialLaw final : public LawModel {
 // cubic 1/2 + 3t/4 - t^3/4 (t = e / w) between; w = 0 is a sharp step.
 double tension_share(double e, double w) {
   if (w <= 0.0) return e >= 0.0 ? 1.0 : 0.0;
-  const double t = std::clamp(e / w, -1.0, 1.0);
+  double t = e / w;  // clamped to [-1, 1] by selects (std::clamp's reference stops the vectoriser)
+  t = t < -1.0 ? -1.0 : t;
+  t = t > 1.0 ? 1.0 : t;
   return 0.5 + 0.75 * t - 0.25 * t * t * t;
 }
 
@@ -146,6 +148,18 @@ double tension_share_slope(double e, double w) {
   if (w <= 0.0 || std::abs(e) >= w) return 0.0;
   const double t = e / w;
   return 0.75 * (1.0 - t * t) / w;
+}
+
+// The bilinear law's Y and dY/de at n strains, vectorised (the share's clamp
+// and its branch become blends).
+FIBERFLUID_VECTOR_CLONES
+void bilinear_moduli(double Y_t, double Y_c, double w, const double* strain, size_t n, double* Y,
+                     double* Yp) {
+#pragma omp simd
+  for (size_t k = 0; k < n; ++k) {
+    Y[k] = Y_c + (Y_t - Y_c) * tension_share(strain[k], w);
+    Yp[k] = (Y_t - Y_c) * tension_share_slope(strain[k], w);
+  }
 }
 
 class BilinearLaw final : public LawModel {
@@ -162,6 +176,10 @@ class BilinearLaw final : public LawModel {
   double modulus_derivative(const double*, int k, double e) const override {
     const double share = tension_share(e, w_);
     return k == 0 ? share : 1.0 - share;
+  }
+  void evaluate(const double* p, const double* strain, size_t n, double* Y,
+                double* Yp) const override {
+    bilinear_moduli(p[0], p[1], w_, strain, n, Y, Yp);
   }
   std::string check(const double* p, double lowest, double highest) const override {
     if (std::string why = finite_parameters(*this, p); !why.empty()) return why;

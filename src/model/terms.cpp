@@ -105,6 +105,16 @@ Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixX
   return out;
 }
 
+// Where each vertex's partners start in a sparse mask's pairs listed row by
+// row (the listed coefficients' layout), N + 1 entries.
+std::vector<size_t> list_offsets(const geom::FiberMask& mask) {
+  std::vector<size_t> offsets(static_cast<size_t>(mask.num_vertices()) + 1, 0);
+  for (int i = 0; i < mask.num_vertices(); ++i)
+    offsets[static_cast<size_t>(i) + 1] =
+        offsets[static_cast<size_t>(i)] + mask.neighbours(i).size();
+  return offsets;
+}
+
 // A fiber's reading from its force coefficients (pair_stencil.hpp): the
 // residual's part on i is m (c1 g), the force the fiber exerts on i its
 // opposite. b = x_i - x_j, d = u_i - u_j, L its reference length.
@@ -558,10 +568,7 @@ std::vector<FiberReading> BulkFiberTerm::readings(
   if (sparse()) {
     listed_coefficients(s.X, s.U, &c1, &c2);
     const geom::FiberMask& mask = *c_.pair_factors.mask();
-    std::vector<size_t> offsets(static_cast<size_t>(c_.model.num_vertices()) + 1, 0);
-    for (int i = 0; i < c_.model.num_vertices(); ++i)
-      offsets[static_cast<size_t>(i) + 1] =
-          offsets[static_cast<size_t>(i)] + mask.neighbours(i).size();
+    const std::vector<size_t> offsets = list_offsets(mask);
     for (size_t p = 0; p < pairs.size(); ++p) {
       const auto [i, j] = pairs[p];
       const std::vector<int>& partners = mask.neighbours(i);
@@ -595,10 +602,7 @@ void BulkFiberTerm::for_each_listed_row(const std::vector<double>& c1,
                                         const std::vector<double>& c2, Body&& body) const {
   const geom::FiberMask& mask = *c_.pair_factors.mask();
   const int n = c_.model.num_vertices();
-  std::vector<size_t> offsets(static_cast<size_t>(n) + 1, 0);
-  for (int i = 0; i < n; ++i)
-    offsets[static_cast<size_t>(i) + 1] =
-        offsets[static_cast<size_t>(i)] + mask.neighbours(i).size();
+  const std::vector<size_t> offsets = list_offsets(mask);
 #pragma omp parallel for schedule(dynamic, 64)
   for (int i = 0; i < n; ++i)
     body(i, mask.neighbours(i), c1.data() + offsets[static_cast<size_t>(i)],
