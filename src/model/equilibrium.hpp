@@ -114,7 +114,8 @@ class Equilibrium {
   // the many products of one Krylov solve.
   TangentOperator linearize(const Eigen::VectorXd& x, const std::vector<double>& factors) const;
   // The same into an existing operator, reusing its arrays (no new pages to
-  // fault in); nothing to do when it holds the tangent at (x, factors) already.
+  // fault in); nothing to do when it holds the tangent at (x, factors) already
+  // (so a model whose material changes in place needs a fresh operator).
   void linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
                  TangentOperator& op) const;
 
