@@ -506,12 +506,8 @@ void OutputWriter::begin() {
                         "these are not the results of a complete run.\n");
   if (experiment_.kind != Experiment::Kind::Simulate) return;
   series_.assign(experiment_.cases.size(), {});
-  // The equations each run's fiber readings come from (surface tension per
-  // face, fibers_final.vtu).
   equilibria_.clear();
-  if (experiment_.output.vtk || experiment_.cases.front().fibers.write != "none")
-    for (const Case& c : experiment_.cases)
-      equilibria_.push_back(std::make_unique<const model::Equilibrium>(c.model));
+  equilibria_.resize(experiment_.cases.size());  // made when a run first writes
   write_fibers();
   for (size_t r = 0; r < experiment_.cases.size(); ++r) {
     fs::create_directories(run_folder(r));
@@ -595,6 +591,14 @@ void OutputWriter::write_fibers() const {
   geom::write_lines_vtu(staging_ / "fibers.vtu", S, lines, content);
 }
 
+// Made on a run's first use, by the thread that runs it (each run's slot is
+// its own): a sweep whose runs write no .vtu builds none.
+const model::Equilibrium& OutputWriter::equilibrium(size_t run) const {
+  std::unique_ptr<const model::Equilibrium>& slot = equilibria_[run];
+  if (!slot) slot = std::make_unique<const model::Equilibrium>(experiment_.cases[run].model);
+  return *slot;
+}
+
 // RUN/fibers_final.vtu: the written fibers at the run's last state, each
 // with its strain, its tension and the size of its force (the equilibrium
 // equations' fiber forces, model.md section 7).
@@ -602,7 +606,7 @@ void OutputWriter::write_final_fibers(size_t run, const Eigen::VectorXd& unknown
   const Case& c = experiment_.cases[run];
   const std::vector<std::pair<int, int>> lines = written_fibers(c);
   const std::vector<model::FiberReading> readings =
-      equilibria_[run]->bulk_fiber_readings(unknowns, lines);
+      equilibrium(run).bulk_fiber_readings(unknowns, lines);
   const auto size = static_cast<Eigen::Index>(lines.size());
   Eigen::VectorXd strain(size), tension(size), force(size);
   for (Eigen::Index k = 0; k < size; ++k) {
@@ -658,7 +662,7 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
   content.cells = {
       {"area_change", now.cwiseQuotient(rest)},
       {"surface_tension_force",
-       face_surface_tension(m.surface, equilibria_[run]->surface_fiber_readings(unknowns))}};
+       face_surface_tension(m.surface, equilibrium(run).surface_fiber_readings(unknowns))}};
   content.field = {{"step", {static_cast<double>(step)}},
                    {"load_factors", load_factors},
                    {"pressure", {unknowns[m.pressure_dof()]}}};

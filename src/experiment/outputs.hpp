@@ -97,6 +97,9 @@ class OutputWriter {
   void write_fem_path(const FemReferenceResult& f);
   void write_fibers() const;  // fibers.vtu: the kept or pruned fibers, if asked
   void write_final_fibers(size_t run, const Eigen::VectorXd& unknowns) const;
+  // The equations of a run's fiber readings (surface tension per face,
+  // fibers_final.vtu), made on the run's first use.
+  const model::Equilibrium& equilibrium(size_t run) const;
   void write_experiment_files() const;  // experiment.json and experiment.resolved.json
   void set_aside(const char* mark, const char* suffix, const std::string& what,
                  const std::string& why);
@@ -104,8 +107,8 @@ class OutputWriter {
 
   const Experiment& experiment_;
   std::filesystem::path target_, staging_, result_folder_;
-  std::vector<std::vector<std::pair<double, std::string>>> series_;    // per run
-  std::vector<std::unique_ptr<const model::Equilibrium>> equilibria_;  // per run, if written
+  std::vector<std::vector<std::pair<double, std::string>>> series_;  // per run
+  mutable std::vector<std::unique_ptr<const model::Equilibrium>> equilibria_;  // per run
   std::vector<std::string> warnings_;
 };
 
