@@ -17,6 +17,7 @@
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/fiber_system.hpp"
 #include "fiberfluid/model/loads.hpp"
+#include "fiberfluid/solve/interactive_stepper.hpp"
 #include "fiberfluid/solve/load_stepper.hpp"
 #include "fiberfluid/solve/stepping_common.hpp"
 #include "fiberfluid/solve/tangent_solve.hpp"
@@ -25,24 +26,12 @@
 #include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
-namespace {
 
-using model::DofMap;
-using model::Model;
-
-// Loads, prescribed displacements and paddle planes at a point t of the load
-// path: t = k after step k, linear in between (for the pieces of a cut step).
-struct PathPoint {
-  std::vector<double> factors;  // per load
-  Eigen::VectorXd held_values;  // dim N: prescribed displacements, zero where free
-  std::vector<double> planes;   // per paddle
-};
-
-PathPoint path_point(const Model& m, double t, int steps) {
+LoadPoint scheduled_point(const model::Model& m, double t, int steps) {
   const int k0 = std::clamp(static_cast<int>(std::floor(t)), 0, steps);
   const int k1 = std::min(k0 + 1, steps);
   const double s = t - k0;
-  PathPoint at;
+  LoadPoint at;
   const std::vector<double> f0 = model::load_factors(m, k0, steps),
                             f1 = model::load_factors(m, k1, steps);
   for (size_t l = 0; l < f0.size(); ++l) at.factors.push_back(f0[l] + s * (f1[l] - f0[l]));
@@ -55,6 +44,13 @@ PathPoint path_point(const Model& m, double t, int steps) {
   }
   return at;
 }
+
+namespace {
+
+using model::DofMap;
+using model::Model;
+
+using PathPoint = LoadPoint;
 
 class NewtonSolver {
  public:
@@ -159,7 +155,7 @@ class NewtonSolver {
       if (why.empty() && t_new >= n) {  // past the final load: land on it by load control
         const double s = (n - t) / (t_new - t);
         Eigen::VectorXd landing = x + s * (x_new - x);
-        why = solve(path_point(model_, n, n), landing, record);
+        why = solve(scheduled_point(model_, n, n), landing, record);
         if (why.empty()) {
           x = landing;
           return keep(record, n, step_start);
@@ -424,10 +420,10 @@ class NewtonSolver {
   // The load factors at a path parameter t, the end segments extended
   // beyond [0, n] (an arc-length corrector may step past the final load).
   std::vector<double> factors_at(double t, int n) const {
-    if (t >= 0.0 && t <= n) return path_point(model_, t, n).factors;
+    if (t >= 0.0 && t <= n) return scheduled_point(model_, t, n).factors;
     const double edge = t > n ? n : 0.0, inner = t > n ? n - 1.0 : 1.0;
-    const std::vector<double> a = path_point(model_, edge, n).factors,
-                              b = path_point(model_, inner, n).factors;
+    const std::vector<double> a = scheduled_point(model_, edge, n).factors,
+                              b = scheduled_point(model_, inner, n).factors;
     std::vector<double> f(a.size());
     for (size_t l = 0; l < a.size(); ++l) f[l] = a[l] + (t - edge) / (inner - edge) * (b[l] - a[l]);
     return f;
@@ -564,6 +560,45 @@ class PathPredictor {
   std::vector<Point> points_;
 };
 
+// Solves one step from the solution x at path parameter `from` to the point
+// at(to), along the points at(t) between: the whole step, or pieces of it
+// halved when Newton fails (newton.max_step_cuts times at most). A piece that
+// fails from the predictor's guess is first tried again from the last
+// solution. Each converged piece joins the predictor. "" or why it failed
+// (x and the contact state are then those of the last converged piece).
+std::string walk_step(NewtonSolver& solver, const std::function<PathPoint(double)>& at, double from,
+                      double to, const NewtonOptions& options, PathPredictor& predictor,
+                      Eigen::VectorXd& x, StepRecord& record) {
+  double reached = from, piece = to - from;
+  bool predict = options.predictor;
+  while (reached < to) {
+    if (cancel_requested()) return "interrupted";
+    const double target = std::min(to, reached + piece);
+    const Eigen::VectorXd saved = x;
+    const auto contact = solver.contact_state();
+    if (predict) x = predictor.predict(target);
+    const std::string why = solver.solve(at(target), x, record);
+    if (why.empty()) {
+      reached = target;
+      predictor.add(reached, x);
+      predict = options.predictor;
+      continue;
+    }
+    x = saved;
+    solver.restore(contact);
+    if (predict && predictor.extrapolates()) {
+      predict = false;
+      continue;
+    }
+    if (record.step_cuts == options.max_step_cuts)
+      return why + "; the step was halved " + std::to_string(record.step_cuts) +
+             " times (newton.max_step_cuts): the load step is too large or the material too soft";
+    ++record.step_cuts;
+    piece *= 0.5;
+  }
+  return {};
+}
+
 bool partition_holds(const model::DofPartition& partition, int dof) {
   return std::binary_search(partition.constrained.begin(), partition.constrained.end(), dof);
 }
@@ -581,31 +616,46 @@ std::string sensitivity_problem(const Model& model) {
 
 namespace {
 
-// Why a paddle setup cannot work, or "".
-std::string paddle_problem(const Model& model, int steps) {
+// Why paddles at these planes cannot work, or "": two on one axis, on
+// opposite sides, that meet or pass each other (`where`: when, for the message).
+std::string planes_problem(const Model& model, const std::vector<double>& planes,
+                           const std::string& where = "") {
+  for (size_t p = 0; p < model.paddles.size(); ++p)
+    for (size_t q = p + 1; q < model.paddles.size(); ++q) {
+      const model::Paddle& a = model.paddles[p];
+      const model::Paddle& b = model.paddles[q];
+      if (b.axis != a.axis || b.above == a.above) continue;
+      const size_t top = a.above ? p : q, bottom = a.above ? q : p;
+      const double gap = planes[top] - planes[bottom];
+      if (!(gap > 0.0))
+        return "paddles " + model.paddles[top].label + " and " + model.paddles[bottom].label +
+               " meet or pass each other" + where + " (gap " + std::to_string(gap) + ")";
+    }
+  return {};
+}
+
+// Why a paddle setup cannot start, or "": an axis out of range, a paddle
+// inside the body at its start.
+std::string paddle_start_problem(const Model& model) {
   const Eigen::MatrixXd& V = model.surface.V;
-  for (size_t p = 0; p < model.paddles.size(); ++p) {
-    const model::Paddle& a = model.paddles[p];
+  for (const model::Paddle& a : model.paddles) {
     if (a.axis < 0 || a.axis >= model.dim()) return "paddle " + a.label + ": axis out of range";
     const double extreme = a.above ? V.col(a.axis).maxCoeff() : V.col(a.axis).minCoeff();
     if (a.penetration(extreme, a.position) > 1e-9 * std::abs(extreme) + 1e-300)
       return "paddle " + a.label + ": it starts inside the body (position " +
              std::to_string(a.position) + ", body extends to " + std::to_string(extreme) + ")";
-    for (size_t q = p + 1; q < model.paddles.size(); ++q) {
-      const model::Paddle& b = model.paddles[q];
-      if (b.axis != a.axis || b.above == a.above) continue;
-      const model::Paddle& top = a.above ? a : b;
-      const model::Paddle& bottom = a.above ? b : a;
-      for (int k = 0; k <= steps; ++k) {
-        const double gap = top.plane(top.schedule.factor(k, steps)) -
-                           bottom.plane(bottom.schedule.factor(k, steps));
-        if (!(gap > 0.0))
-          return "paddles " + top.label + " and " + bottom.label + " meet or pass each other " +
-                 "at step " + std::to_string(k) + " (gap " + std::to_string(gap) + ")";
-      }
-    }
   }
   return {};
+}
+
+// Why a paddle setup cannot work over `steps` steps, or "".
+std::string paddle_problem(const Model& model, int steps) {
+  std::string why = paddle_start_problem(model);
+  for (int k = 0; k <= steps && why.empty(); ++k) {
+    why = planes_problem(model, scheduled_point(model, k, steps).planes,
+                         " at step " + std::to_string(k));
+  }
+  return why;
 }
 
 // What every converged step leaves behind: its record (forces on the body,
@@ -786,7 +836,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   // A converged point of the path at t: its record, the observer.
   model::PairPasses passes_before = model::pair_passes();
   const auto keep = [&](StepRecord& record, double t, const Clock::time_point step_start) {
-    const std::string stop = finisher.finish(path_point(model, t, n), x, record);
+    const std::string stop = finisher.finish(scheduled_point(model, t, n), x, record);
     if (!stop.empty()) return stop;
     record.seconds = seconds_since(step_start);
     record.pair_passes = model::pair_passes() - passes_before;
@@ -804,39 +854,10 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     const Clock::time_point step_start = Clock::now();
     StepRecord record;
     record.step = k;
-    // Pieces of the step: the whole step, halved on failure. A piece that
-    // fails from the predicted guess is first tried again from the last
-    // solution.
-    double reached = k - 1, piece = 1.0;
-    bool predict = options.newton.predictor;
-    while (reached < k) {
-      if (cancel_requested()) return fail("step " + std::to_string(k) + ": interrupted");
-      const double target = std::min<double>(k, reached + piece);
-      const PathPoint at = path_point(model, target, n);
-      const Eigen::VectorXd saved = x;
-      const auto contact = solver->contact_state();
-      if (predict) x = predictor.predict(target);
-      why = solver->solve(at, x, record);
-      if (why.empty()) {
-        reached = target;
-        predictor.add(reached, x);
-        predict = options.newton.predictor;
-        continue;
-      }
-      x = saved;
-      solver->restore(contact);
-      if (predict && predictor.extrapolates()) {
-        predict = false;
-        continue;
-      }
-      if (record.step_cuts == options.newton.max_step_cuts)
-        return fail("step " + std::to_string(k) + ": " + why + "; the step was halved " +
-                    std::to_string(record.step_cuts) +
-                    " times (newton.max_step_cuts): the load step is too large or the "
-                    "material too soft");
-      ++record.step_cuts;
-      piece *= 0.5;
-    }
+    why = walk_step(
+        *solver, [&](double t) { return scheduled_point(model, t, n); }, k - 1.0, k, options.newton,
+        predictor, x, record);
+    if (!why.empty()) return fail("step " + std::to_string(k) + ": " + why);
     if (!(why = keep(record, k, step_start)).empty()) return fail(why);
     report_progress("step", k, n);
   }
@@ -845,10 +866,145 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     if (!why.empty()) return fail(why);
   }
   if (options.keep_final_tangent)
-    summary.final_tangent = solver->final_tangent(path_point(model, n, n), x);
+    summary.final_tangent = solver->final_tangent(scheduled_point(model, n, n), x);
   summary.success = true;
   summary.total_seconds = seconds_since(start);
   return summary;
 }
+
+// ------------------------------------------------------------ interactive
+
+namespace {
+
+// The options an interactive stepper runs with: Newton by load control, one
+// step at a time, nothing kept for calibration. Each step starts from the last
+// equilibrium: a hand's moves are no smooth path, and extrapolating along the
+// steps taken would guess wrong where it stops or turns.
+SteppingOptions interactive_options(SteppingOptions options) {
+  options.scheme = Scheme::Newton;
+  options.newton.predictor = false;
+  options.steps = 1;
+  options.newton.control = NewtonOptions::Control::Load;
+  options.sensitivities = {};
+  options.keep_final_tangent = false;
+  return options;
+}
+
+// The point a share s of the way from `a` to `b` (b itself at s = 1, to the bit).
+LoadPoint between(const LoadPoint& a, const LoadPoint& b, double s) {
+  LoadPoint at = b;
+  if (s == 1.0) return at;
+  for (size_t l = 0; l < at.factors.size(); ++l)
+    at.factors[l] = a.factors[l] + s * (b.factors[l] - a.factors[l]);
+  at.held_values = a.held_values + s * (b.held_values - a.held_values);
+  for (size_t p = 0; p < at.planes.size(); ++p)
+    at.planes[p] = a.planes[p] + s * (b.planes[p] - a.planes[p]);
+  return at;
+}
+
+bool all_finite(const std::vector<double>& values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+class InteractiveStepper::Impl {
+ public:
+  Impl(const Model& model, const SteppingOptions& options)
+      : model_(model),
+        options_(interactive_options(options)),
+        summary_(empty_summary(model, Scheme::Newton)),
+        predictor_(0) {
+    std::string why = setup_problem(model, options_);
+    if (why.empty()) why = paddle_start_problem(model);
+    if (!why.empty()) throw InputError("interactive stepper: " + why);
+    partition_ = model::partition_dofs(model);
+    solver_ = std::make_unique<NewtonSolver>(model, options_, summary_);
+    finisher_ = std::make_unique<StepFinisher>(model, options_, *solver_, partition_, summary_);
+    point_ = scheduled_point(model, 0.0, 1);
+    predictor_.add(0.0, summary_.unknowns);
+  }
+
+  Result step(const LoadPoint& requested) {
+    const LoadPoint to = checked(requested);
+    const Clock::time_point start = Clock::now();
+    const model::PairPasses passes_before = model::pair_passes();
+    Result result;
+    StepRecord& record = result.record;
+    record.step = steps_ + 1;
+    const LoadPoint from = point_;
+    const double t0 = steps_;
+    const auto at = [&](double t) { return between(from, to, t - t0); };
+    Eigen::VectorXd x = summary_.unknowns;
+    const auto contact = solver_->contact_state();
+    const PathPredictor predictor = predictor_;
+    std::string why = walk_step(*solver_, at, t0, t0 + 1.0, options_.newton, predictor_, x, record);
+    if (why.empty()) why = finisher_->finish(to, x, record);
+    record.seconds = seconds_since(start);
+    record.pair_passes = model::pair_passes() - passes_before;
+    if (!why.empty()) {  // the last equilibrium stays
+      solver_->restore(contact);
+      predictor_ = predictor;
+      result.message = "interactive step " + std::to_string(record.step) + ": " + why;
+      return result;
+    }
+    summary_.unknowns = x;
+    point_ = to;
+    ++steps_;
+    result.success = true;
+    return result;
+  }
+
+  const Model& model() const { return model_; }
+  const Eigen::VectorXd& unknowns() const { return summary_.unknowns; }
+  const LoadPoint& point() const { return point_; }
+  int steps_taken() const { return steps_; }
+
+ private:
+  // `requested` with its sizes and values checked, the held values filled in.
+  LoadPoint checked(const LoadPoint& requested) const {
+    const auto size_error = [](const std::string& what, size_t given, size_t expected) {
+      return InputError("interactive step: " + what + ": " + std::to_string(given) +
+                        " given, the model has " + std::to_string(expected));
+    };
+    LoadPoint to = requested;
+    if (to.factors.size() != model_.loads.size())
+      throw size_error("load factors", to.factors.size(), model_.loads.size());
+    if (to.planes.size() != model_.paddles.size())
+      throw size_error("paddle planes", to.planes.size(), model_.paddles.size());
+    const Eigen::Index held = static_cast<Eigen::Index>(model_.dim()) * model_.num_vertices();
+    if (to.held_values.size() == 0) to.held_values = Eigen::VectorXd::Zero(held);
+    if (to.held_values.size() != held)
+      throw size_error("held values (dim times vertices)",
+                       static_cast<size_t>(to.held_values.size()), static_cast<size_t>(held));
+    if (!all_finite(to.factors) || !all_finite(to.planes) || !to.held_values.allFinite())
+      throw InputError("interactive step: a load factor, paddle plane or held value is not finite");
+    const std::string why = planes_problem(model_, to.planes);
+    if (!why.empty()) throw InputError("interactive step: " + why);
+    return to;
+  }
+
+  const Model& model_;
+  SteppingOptions options_;
+  SteppingSummary summary_;  // the last equilibrium in its unknowns
+  model::DofPartition partition_;
+  std::unique_ptr<NewtonSolver> solver_;
+  std::unique_ptr<StepFinisher> finisher_;
+  PathPredictor predictor_;  // of order 0: the last equilibrium
+  LoadPoint point_;
+  int steps_ = 0;
+};
+
+InteractiveStepper::InteractiveStepper(const model::Model& model, const SteppingOptions& options)
+    : impl_(std::make_unique<Impl>(model, options)) {}
+InteractiveStepper::~InteractiveStepper() = default;
+InteractiveStepper::Result InteractiveStepper::step(const LoadPoint& to) { return impl_->step(to); }
+const model::Model& InteractiveStepper::model() const { return impl_->model(); }
+const Eigen::VectorXd& InteractiveStepper::unknowns() const { return impl_->unknowns(); }
+Eigen::MatrixXd InteractiveStepper::positions() const {
+  return model::positions(impl_->model(), impl_->unknowns());
+}
+const LoadPoint& InteractiveStepper::point() const { return impl_->point(); }
+int InteractiveStepper::steps_taken() const { return impl_->steps_taken(); }
 
 }  // namespace fiberfluid::solve
