@@ -22,6 +22,7 @@
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/solve/interactive_stepper.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
@@ -305,6 +306,112 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
   return out;
 }
 
+// An experiment's run advanced one step at a time (solve::InteractiveStepper)
+// on its own copy of the run's case, so that it outlives the Experiment.
+class Interactive {
+ public:
+  Interactive(const ff::experiment::Experiment& ex, const std::string& variant)
+      : case_(std::make_shared<const ff::experiment::Case>(pick(ex, variant))),
+        stepper_(case_->model, case_->stepping) {}
+
+  // Moves the paddles (plane coordinates, m) and sets the loads' factors,
+  // each given as a list in the model's order or a dict by label; what is not
+  // given stays where it is. Then solves equilibrium there.
+  py::dict step(const py::object& paddles, const py::object& loads) {
+    ff::solve::LoadPoint to = stepper_.point();
+    set_values(paddles, labels(case_->model.paddles), "paddles", &to.planes);
+    set_values(loads, labels(case_->model.loads), "loads", &to.factors);
+    ff::solve::InteractiveStepper::Result result;
+    {
+      py::gil_scoped_release release;
+      result = stepper_.step(to);
+    }
+    const ff::solve::StepRecord& r = result.record;
+    py::dict out;
+    out["success"] = result.success;
+    out["message"] = result.message;
+    out["positions"] = positions();
+    out["pressure"] = stepper_.unknowns()[case_->model.pressure_dof()];
+    out["newton_iterations"] = r.newton_iterations;
+    out["krylov_iterations"] = r.krylov_iterations;
+    out["step_cuts"] = r.step_cuts;
+    out["residual"] = r.residual;
+    out["seconds"] = r.seconds;
+    out["pair_passes"] = py::dict(py::arg("computed") = r.pair_passes.computed,
+                                  py::arg("stored") = r.pair_passes.stored);
+    py::dict forces, contacts;
+    const auto& model_paddles = case_->model.paddles;
+    for (size_t p = 0; p < r.paddles.size() && p < model_paddles.size(); ++p) {
+      forces[py::str(model_paddles[p].label)] = Eigen::Vector3d(r.paddles[p].force);
+      contacts[py::str(model_paddles[p].label)] = r.paddles[p].contacts;
+    }
+    out["paddle_forces"] = forces;
+    out["contacts"] = contacts;
+    return out;
+  }
+
+  Eigen::MatrixXd positions() const {
+    return ff::experiment::input_positions(*case_, stepper_.unknowns());
+  }
+  py::dict point() const { return point_dict(stepper_.point()); }
+  py::dict scheduled(double t) const {
+    const int steps = case_->stepping.steps;
+    if (!(t >= 0.0 && t <= steps))
+      throw ff::InputError("scheduled: t must be in [0, " + std::to_string(steps) + "]");
+    return point_dict(ff::solve::scheduled_point(case_->model, t, steps));
+  }
+  py::dict point_dict(const ff::solve::LoadPoint& at) const {
+    py::dict paddles, loads;
+    for (size_t p = 0; p < at.planes.size(); ++p)
+      paddles[py::str(case_->model.paddles[p].label)] = at.planes[p];
+    for (size_t l = 0; l < at.factors.size(); ++l)
+      loads[py::str(case_->model.loads[l].label)] = at.factors[l];
+    return py::dict(py::arg("paddles") = paddles, py::arg("loads") = loads);
+  }
+  int steps_taken() const { return stepper_.steps_taken(); }
+  const Eigen::MatrixXi& faces() const { return case_->input_surface.F; }
+
+ private:
+  static const ff::experiment::Case& pick(const ff::experiment::Experiment& ex,
+                                          const std::string& variant) {
+    if (ex.cases.empty()) throw ff::InputError(ex.name + ": the experiment has no run");
+    if (variant.empty()) return ex.cases.front();
+    for (const ff::experiment::Case& c : ex.cases)
+      if (c.variant == variant) return c;
+    throw ff::InputError(ex.name + ": no variant named \"" + variant + "\"");
+  }
+  template <class Item>
+  static std::vector<std::string> labels(const std::vector<Item>& items) {
+    std::vector<std::string> out;
+    for (const Item& item : items) out.push_back(item.label);
+    return out;
+  }
+  // values[i] from a list (one per label) or a dict {label: value}; None leaves them.
+  static void set_values(const py::object& given, const std::vector<std::string>& names,
+                         const std::string& what, std::vector<double>* values) {
+    if (given.is_none()) return;
+    if (py::isinstance<py::dict>(given)) {
+      for (const auto& [key, value] : given.cast<py::dict>()) {
+        const std::string name = py::str(key);
+        const auto at = std::find(names.begin(), names.end(), name);
+        if (at == names.end())
+          throw ff::InputError("interactive step: " + what + ": no " + what + " labelled \"" +
+                               name + "\"");
+        (*values)[static_cast<size_t>(at - names.begin())] = value.cast<double>();
+      }
+      return;
+    }
+    const std::vector<double> list = given.cast<std::vector<double>>();
+    if (list.size() != names.size())
+      throw ff::InputError("interactive step: " + what + ": " + std::to_string(list.size()) +
+                           " values given, the experiment has " + std::to_string(names.size()));
+    *values = list;
+  }
+
+  std::shared_ptr<const ff::experiment::Case> case_;
+  ff::solve::InteractiveStepper stepper_;
+};
+
 PYBIND11_MODULE(fiberfluid, m) {
   m.doc() =
       "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
@@ -399,6 +506,34 @@ PYBIND11_MODULE(fiberfluid, m) {
            "result folder as `fiberfluid run -o` does. Returns a dict with success, runs (each "
            "with positions, displacements, pressure, steps as numpy arrays, figures), figures "
            "and checks.");
+
+  py::class_<Interactive>(
+      m, "Interactive",
+      "One run of an experiment advanced one Newton step at a time, to paddle planes and load "
+      "factors chosen as it goes (a visual or haptic loop). Each step starts from the last "
+      "equilibrium and keeps the tangent's preconditioner; a failed step keeps the last "
+      "equilibrium.")
+      .def(py::init<const ff::experiment::Experiment&, const std::string&>(), py::arg("experiment"),
+           py::arg("variant") = std::string(),
+           "Starts at the unloaded body of the experiment's run (its first variant, or the one "
+           "named), with its stepping options (Newton).")
+      .def("step", &Interactive::step, py::arg("paddles") = py::none(),
+           py::arg("loads") = py::none(),
+           "Moves the paddles (plane coordinates in m: a list in the experiment's order or a "
+           "dict by label) and sets the loads' factors (0 unloaded, 1 the full load; likewise), "
+           "then solves equilibrium there. What is not given stays. Returns a dict: success, "
+           "message, positions (input order), pressure, newton_iterations, krylov_iterations, "
+           "step_cuts, residual, seconds, pair_passes, paddle_forces and contacts (by label).")
+      .def_property_readonly("positions", &Interactive::positions,
+                             "The last equilibrium's vertices (input order, m).")
+      .def_property_readonly("faces", &Interactive::faces)
+      .def_property_readonly("point", &Interactive::point,
+                             "Where the paddles and loads stand: {paddles: {label: plane}, "
+                             "loads: {label: factor}}.")
+      .def("scheduled", &Interactive::scheduled, py::arg("t"),
+           "The experiment's own load path at t (t = k after its step k, linear in between), "
+           "as `point` gives it.")
+      .def_property_readonly("steps_taken", &Interactive::steps_taken);
 
   m.def(
       "fit", &fit_experiment, py::arg("experiment"), py::arg("targets"), py::arg("parameters"),

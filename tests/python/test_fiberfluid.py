@@ -210,3 +210,36 @@ def test_a_name_never_makes_a_path_outside_the_output_root(tmp_path):
     with pytest.raises(ValueError, match="was not written by fiberfluid"):
         fiberfluid.Experiment.from_dict(document).run(output=str(data))
     assert (data / "summary.json").read_text() == "{}"
+
+
+def test_an_interactive_press_follows_the_schedule_and_returns():
+    """The liver between paddles, pressed one step at a time by hand: on the experiment's
+    own schedule it gives the batch run's paddle force; pressed back it comes to rest."""
+    ex = fiberfluid.Experiment.from_file(os.path.join(EXPERIMENTS, "liver_paddles.json"))
+    live = fiberfluid.Interactive(ex, "constant")
+    start = live.point["paddles"]
+    assert live.steps_taken == 0
+    for k in range(1, 11):
+        result = live.step(paddles=live.scheduled(k)["paddles"])
+        assert result["success"], result["message"]
+        assert result["newton_iterations"] <= 10
+    # experiments/liver_paddles.json's expected figure (the batch Newton run)
+    assert result["paddle_forces"]["upper"][1] == pytest.approx(-74.9966155, rel=1e-6)
+    assert result["contacts"]["upper"] > 0
+    assert live.positions.shape == ex.run()["runs"][0]["reference_positions"].shape
+    used = np.unique(live.faces)  # liver.obj lists 42 vertices no face uses
+    assert np.max(live.positions[used, 1]) <= live.point["paddles"]["upper"] + 1e-12
+    # Back up by the dict of one paddle, in two moves: the liver rests again.
+    middle = (start["upper"] + live.point["paddles"]["upper"]) / 2
+    assert live.step(paddles={"upper": middle})["success"]
+    back = live.step(paddles={"upper": start["upper"]})
+    assert back["success"], back["message"]
+    assert np.linalg.norm(back["paddle_forces"]["upper"]) < 1e-6
+    reference = ex.run()["runs"][0]["reference_positions"]
+    assert np.max(np.abs(live.positions - reference)) < 1e-9
+    with pytest.raises(ValueError, match="no paddles labelled \"side\""):
+        live.step(paddles={"side": 0.0})
+    with pytest.raises(ValueError, match="paddles: 1 values given, the experiment has 2"):
+        live.step(paddles=[0.0])
+    with pytest.raises(ValueError, match="no variant named"):
+        fiberfluid.Interactive(ex, "nonsense")
