@@ -10,6 +10,7 @@
 #include "fiberfluid/geom/horizon.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/geom/remesh.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/solve/load_stepper.hpp"
@@ -35,6 +36,32 @@ geom::Surface load_checked_surface(const std::filesystem::path& path, bool flip,
     for (const auto& w : report.warnings) warnings->push_back(path.string() + ": " + w);
   }
   return read.surface;
+}
+
+// The surface remeshed to about spec.remesh_vertices vertices, checked again
+// (what CGAL made must be as usable as a mesh file); a warning gives the count.
+geom::Surface remeshed(const SurfaceSpec& spec, const geom::Surface& surface,
+                       std::vector<std::string>* warnings) {
+  if (surface.dim != 3)
+    spec.field.fail("remesh_vertices", "only a 3D surface can be remeshed (this one is 2D)");
+  geom::Surface out;
+  try {
+    out = geom::remesh_to_vertices(surface, spec.remesh_vertices);
+  } catch (const InputError& e) {
+    spec.field.fail("remesh_vertices", e.what());
+  }
+  const std::string label = spec.field.file + ": " +
+                            (spec.field.path.empty() ? "" : spec.field.path + ".") +
+                            "remesh_vertices";
+  geom::require_usable(geom::inspect(out), label);
+  std::vector<int> used(surface.F.data(), surface.F.data() + surface.F.size());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  if (warnings)
+    warnings->push_back(label + ": remeshed from " + std::to_string(used.size()) + " to " +
+                        std::to_string(out.num_vertices()) + " vertices (asked " +
+                        std::to_string(spec.remesh_vertices) + ")");
+  return out;
 }
 
 geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* warnings) {
@@ -66,6 +93,7 @@ geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* w
                                        << " m across; expected a size from "
                                           "1e-100 to 1e100 m")
                      .str());
+  if (spec.remesh_vertices > 0) surface = remeshed(spec, surface, warnings);
   return surface;
 }
 

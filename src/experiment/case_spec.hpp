@@ -40,6 +40,7 @@ struct SurfaceSpec {
   std::function<geom::Surface()> generate;  // a generator whose parameters were checked
   std::string generator;                    // its name, for messages
   double scale = 1.0;
+  int remesh_vertices = 0;  // > 0: remeshed isotropically to about this many vertices
   bool empty() const { return file.empty() && !generate; }
 };
 

@@ -95,7 +95,7 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   return [=] { return geom::polygon(P); };
 }
 
-// "file" (with "flip") or "generator", then "scale".
+// "file" (with "flip") or "generator", then "scale" and "remesh_vertices".
 // A file's path as the resolved experiment gives it: absolute, so that it
 // reads the same file from any folder.
 std::string absolute_path(const std::filesystem::path& path) {
@@ -117,6 +117,8 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
     spec.generator = f.string("generator");
   }
   spec.scale = f.positive("scale", 1.0);
+  if (f.has("remesh_vertices"))
+    spec.remesh_vertices = f.integer("remesh_vertices", 0, 20, 1000000);
   return spec;
 }
 

@@ -196,6 +196,29 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   EXPECT_THROW(load_experiment(broken), InputError);
 }
 
+TEST(ExperimentConfig, ASurfaceIsRemeshedToTheCountAsked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"]["subdivisions"] = 3;
+  c["surface"]["remesh_vertices"] = 300;  // from the icosphere's 642
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const int n = ex.cases[0].model.num_vertices();
+  EXPECT_NEAR(n, 300, 6);
+  EXPECT_EQ(ex.cases[0].input_surface.num_vertices(), n);
+  bool told = false;
+  for (const std::string& w : ex.warnings)
+    told = told || w.find("surface.remesh_vertices: remeshed from 642 to " + std::to_string(n) +
+                          " vertices (asked 300)") != std::string::npos;
+  EXPECT_TRUE(told);
+  c["surface"]["remesh_vertices"] = 3;
+  expect_config_error(dir, c, "surface.remesh_vertices");
+  c["surface"] = {
+      {"generator", "rectangle"}, {"min", {0, 0}}, {"max", {1, 1}}, {"remesh_vertices", 100}};
+  c["supports"] = {{{"where", "y <= 0"}}};
+  c["loads"] = nlohmann::json::array();
+  expect_config_error(dir, c, "surface.remesh_vertices: only a 3D surface can be remeshed");
+}
+
 TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   ScratchDir dir;
   nlohmann::json c = base_config();
@@ -539,8 +562,7 @@ TEST(ExperimentConfig, AHorizonsKeptFibersAreWrittenFromItsLists) {
   writer.finish(run_experiment(ex));
   for (const char* name : {"fibers.vtu", "fibers_final.vtu"}) {
     std::ifstream vtu(dir.path() / "out" / name);
-    const std::string text((std::istreambuf_iterator<char>(vtu)),
-                           std::istreambuf_iterator<char>());
+    const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(kept) + "\""), std::string::npos)
         << name << ": " << text.substr(0, 300);
     for (const char* field : {"rest_length", "strain", "tension", "force"})
