@@ -4,7 +4,7 @@
 // last equilibrium (solve::InteractiveStepper). Prints the frames per second
 // the solver sustains and a step's cost in exact residual passes on the same
 // mesh (one pass: lengths, law and forces of every fiber pair).
-//   fiberfluid_interactive [--frames 300] [--depth 0.2] [--vertices 1000]
+//   fiberfluid_interactive [--frames 300] [--depth 0.2] [--vertices 1000] [--trace]
 //
 // The hand: the paddle goes down by `depth` of the organ's height and back
 // up, as 1 - cos over the frames (at 30 frames a second and 300 frames, 10 s
@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
   cli.add_option("--tangent", tangent, "newton.tangent: auto, dense, krylov or sparse")
       ->check(CLI::IsMember({"auto", "dense", "krylov", "sparse"}));
   cli.add_option("--repeat", repeat, "timings of the residual pass (the median is kept)");
+  bool trace = false;
+  cli.add_flag("--trace", trace, "print each frame's residuals, gmres iterations and contacts");
   CLI11_PARSE(cli, argc, argv);
 
   std::ifstream in(FIBERFLUID_INTERACTIVE_EXPERIMENT);
@@ -85,6 +87,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "frame %d: %s\n", k, r.message.c_str());
       continue;
     }
+    if (trace) {
+      std::fprintf(stderr, "frame %d:", k);
+      for (double v : r.record.residual_norms) std::fprintf(stderr, " %.1e", v);
+      std::fprintf(stderr, " gmres %d contacts %d\n", r.record.krylov_iterations,
+                   r.record.paddles[0].contacts);
+    }
     iterations += r.record.newton_iterations;
     most_iterations = std::max(most_iterations, r.record.newton_iterations);
     krylov += r.record.krylov_iterations;
@@ -109,14 +117,14 @@ int main(int argc, char** argv) {
   const double pass = median(pass_seconds), step = run_seconds / frames;
 
   const int n = model.num_vertices();
-  std::printf("interactive step: liver remeshed to %d vertices (%lld fibers kept), %s tangent\n",
-              n, static_cast<long long>(c.fibers.kept),
-              fiberfluid::solve::to_string(fiberfluid::solve::choose_tangent(
-                  c.stepping.newton.tangent, model.num_unknowns(), model.material.kinematics,
-                  false)));
+  std::printf(
+      "interactive step: liver remeshed to %d vertices (%lld fibers kept), %s tangent\n", n,
+      static_cast<long long>(c.fibers.kept),
+      fiberfluid::solve::to_string(fiberfluid::solve::choose_tangent(
+          c.stepping.newton.tangent, model.num_unknowns(), model.material.kinematics, false)));
   std::printf("  set-up (read, remesh, prune): %.3f s\n", build_seconds);
-  std::printf("  %d frames, paddle down %.1f mm and back, deepest push %.2f N, %d failed\n",
-              frames, 1e3 * depth * height, -deepest_force, failed);
+  std::printf("  %d frames, paddle down %.1f mm and back, deepest push %.2f N, %d failed\n", frames,
+              1e3 * depth * height, -deepest_force, failed);
   std::printf("  frames per second: %.1f (mean step %.2f ms, median %.2f ms, slowest %.2f ms)\n",
               frames / run_seconds, 1e3 * step, 1e3 * median(step_seconds),
               1e3 * *std::max_element(step_seconds.begin(), step_seconds.end()));

@@ -119,6 +119,15 @@ class BulkPairs {
   double projection(int vi, int vj) const;
 };
 
+// The bulk tangent times W (#V by dim, #V by 3 out, before the axis factors)
+// from stored pair coefficients C1, C2 (DeformedPairs::coefficients: only
+// the lower triangle is read), at positions X and displacements U: each
+// unordered pair read once, its term added at i and subtracted at j, as
+// DeformedPairs::tangent_product sums it.
+Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::MatrixXd& X,
+                                       const Eigen::MatrixXd& U, const Eigen::MatrixXd& C1,
+                                       const Eigen::MatrixXd& C2, const Eigen::MatrixXd& W);
+
 // The bulk fibers at a deformed state, for Newton's residual and tangent
 // (model.md section 7, pair_stencil.hpp): per pair the reference length
 // L = |s_i - s_j|, the current r = |x_i - x_j|, the strain e = r / L - 1, the
@@ -140,7 +149,9 @@ class DeformedPairs {
   //   c1 (w_i - w_j) + c2 ((x_i - x_j) . (w_i - w_j)) g_ij,
   // summed over j; #V by 3, before the axis factors.
   Eigen::MatrixXd tangent_product(const Eigen::MatrixXd& W) const;
-  // c1 and c2 of every pair (N x N each, symmetric, zero diagonal).
+  // c1 and c2 of every pair (N x N each, zero diagonal), symmetric and kept
+  // once: column i holds the pairs (i, j) with j > i (the lower triangle);
+  // the upper one is left unwritten (a neighbour-list mask fills both).
   void coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
   // forces() and coefficients() in one pass over the pairs (their lengths
   // and the law computed once); two passes for a sparse mask.

@@ -580,8 +580,10 @@ std::vector<FiberReading> BulkFiberTerm::readings(
   } else {
     Eigen::MatrixXd dense_c1, dense_c2;
     coefficients(s.X, s.U, &dense_c1, &dense_c2);
-    for (size_t p = 0; p < pairs.size(); ++p)
-      force_coefficient[p] = dense_c1(pairs[p].first, pairs[p].second);
+    for (size_t p = 0; p < pairs.size(); ++p) {  // stored once: row max(i, j), column min
+      const auto [i, j] = pairs[p];
+      force_coefficient[p] = dense_c1(std::max(i, j), std::min(i, j));
+    }
   }
   std::vector<FiberReading> out(pairs.size());
   const Eigen::MatrixXd& V0 = c_.model.surface.V;
@@ -677,10 +679,14 @@ void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::Matr
                                      Eigen::MatrixXd& J) const {
   const int n = c_.model.num_vertices(), dim = c_.model.dim();
   const Eigen::Vector3d m = c_.model.material.axis_factors;
-  // Column by column (the pair coefficients are symmetric, so column j of
-  // the stored arrays runs over i): for j != i,
-  //   J(a i, b j) = -m_a T_ab(i, j)   (the stencil's pair_tangent_entry),
-  // and each diagonal block is minus the sum of its row's off-diagonal ones.
+  // For j != i: J(a i, b j) = -m_a T_ab(i, j) (the stencil's
+  // pair_tangent_entry), and each diagonal block is minus the sum of its
+  // row's off-diagonal ones. The coefficients are symmetric, stored once
+  // (the lower triangle: column min(i, j), row max(i, j)).
+  const auto pair = [&](int i, int j) -> PairCoefficients {
+    const int low = std::min(i, j), high = std::max(i, j);
+    return {C1(high, low), C2(high, low)};
+  };
   with_kinematics(c_.model.material.kinematics, [&](auto policy) {
     using K = decltype(policy);
     // T_ab of the pair (i, j) with its coefficients c.
@@ -689,80 +695,33 @@ void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::Matr
                                    X(i, b) - X(j, b));
     };
 #pragma omp parallel for schedule(dynamic, 16)
-    for (int j = 0; j < n; ++j) {
-      const double* c1 = C1.col(j).data();
-      const double* c2 = C2.col(j).data();
+    for (int j = 0; j < n; ++j)
       for (int a = 0; a < dim; ++a)
         for (int b = 0; b < dim; ++b) {
           double* column = J.col(b * n + j).data() + a * n;
           for (int i = 0; i < n; ++i)
-            if (i != j) column[i] += -m[a] * block(i, j, {c1[i], c2[i]}, a, b);
+            if (i != j) column[i] += -m[a] * block(i, j, pair(i, j), a, b);
         }
-    }
 #pragma omp parallel for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      const double* c1 = C1.col(i).data();
-      const double* c2 = C2.col(i).data();
+    for (int i = 0; i < n; ++i)
       for (int a = 0; a < dim; ++a)
         for (int b = 0; b < dim; ++b) {
-          double sum = 0.0;  // c1_ii = c2_ii = 0: the pair (i, i) adds nothing
-          for (int j = 0; j < n; ++j) sum += block(i, j, {c1[j], c2[j]}, a, b);
+          double sum = 0.0;
+          for (int j = 0; j < n; ++j)
+            if (j != i) sum += block(i, j, pair(i, j), a, b);
           J(a * n + i, b * n + i) += m[a] * sum;
         }
-    }
   });
 }
-
-namespace {
-
-// Row i of the bulk tangent times w from the stored coefficients c1, c2
-// (column i: the pairs (i, j)): sum_j the stencil's pair_tangent. The
-// row's own values are hoisted so that the loop over j vectorises.
-template <class K>
-void stored_product_row(int i, int n, const double* c1, const double* c2, const double* const x[3],
-                        const double* const d[3], const double* const w[3], double product[3]) {
-  const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *d0 = d[0], *d1 = d[1], *d2 = d[2];
-  const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
-  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], di0 = d0[i], di1 = d1[i], di2 = d2[i];
-  const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
-  double p0 = 0.0, p1 = 0.0, p2 = 0.0;
-#pragma omp simd reduction(+ : p0, p1, p2)
-  for (int j = 0; j < n; ++j) {
-    const PairCoefficients c{c1[j], c2[j]};
-    const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
-    const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
-    const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-    p0 += pair_tangent<K>(c, v0, b_dot_v, b0, di0 - d0[j]);
-    p1 += pair_tangent<K>(c, v1, b_dot_v, b1, di1 - d1[j]);
-    p2 += pair_tangent<K>(c, v2, b_dot_v, b2, di2 - d2[j]);
-  }
-  product[0] = p0, product[1] = p1, product[2] = p2;
-}
-
-}  // namespace
 
 void BulkFiberTerm::add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
                                        const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2,
                                        const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
   const int n = c_.model.num_vertices(), dim = c_.model.dim();
   const Eigen::Vector3d m = c_.model.material.axis_factors;
-  const std::vector<double> zeros(static_cast<size_t>(n), 0.0);
-  const double *x[3], *d[3], *w[3];
-  for (int a = 0; a < 3; ++a) {
-    x[a] = a < dim ? X.col(a).data() : zeros.data();
-    d[a] = a < dim ? U.col(a).data() : zeros.data();
-    w[a] = a < dim ? W.col(a).data() : zeros.data();
-  }
-  double* o = out.data();
-  with_kinematics(c_.model.material.kinematics, [&](auto policy) {
-    using K = decltype(policy);
-#pragma omp parallel for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      double product[3];
-      stored_product_row<K>(i, n, C1.col(i).data(), C2.col(i).data(), x, d, w, product);
-      for (int a = 0; a < dim; ++a) o[a * n + i] += m[a] * product[a];
-    }
-  });
+  const Eigen::MatrixXd product =
+      stored_tangent_product(c_.model.material.kinematics, X, U, C1, C2, W);
+  for (int a = 0; a < dim; ++a) out.segment(a * n, n) += m[a] * product.col(a);
 }
 
 void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialParameter& p,

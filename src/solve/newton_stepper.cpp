@@ -52,6 +52,19 @@ using model::Model;
 
 using PathPoint = LoadPoint;
 
+// Inexact Newton's forcing term: the relative residual a Krylov solve of
+// J dx = -R stops at, for a Newton residual `norm` (relative). As accurate as
+// the residual it corrects (0.1 norm: the convergence stays quadratic), but
+// never sharper than the tolerance asks (0.5 tolerance / norm: the last
+// iteration lands just below the tolerance, not decades below it); Eisenstat
+// and Walker, SIAM J. Sci. Comput. 17 (1996) 16, with the safeguard against
+// oversolving of Kelley, "Iterative Methods for Linear and Nonlinear
+// Equations" (SIAM 1995), eq. 6.20.
+double forcing_term(double norm, const NewtonOptions& options) {
+  const double quadratic = 0.1 * norm, enough = 0.5 * options.residual_tolerance / norm;
+  return std::max(options.krylov_tolerance, std::min(0.1, std::max(quadratic, enough)));
+}
+
 class NewtonSolver {
  public:
   NewtonSolver(const Model& model, const SteppingOptions& options, SteppingSummary& summary)
@@ -338,9 +351,7 @@ class NewtonSolver {
         return out.str();
       }
       Eigen::VectorXd dx;
-      // Inexact Newton: a Krylov solve only as accurate as the residual it
-      // corrects (relative to it), which keeps the convergence quadratic.
-      const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
+      const double forcing = forcing_term(norm, newton_);
       const Status status = prepare_and_solve(x, at.factors, dofs, -r, forcing, record, &dx);
       if (!status.ok) return status.message;
       // Backtracking: halve the step until the residual falls (Armijo).
@@ -489,7 +500,7 @@ class NewtonSolver {
         return "no convergence in " + std::to_string(it) + " iterations (relative residual " +
                std::to_string(norm) + ")";
       Eigen::VectorXd a, b;
-      const double forcing = std::max(newton_.krylov_tolerance, std::min(0.1, 0.1 * norm));
+      const double forcing = forcing_term(norm, newton_);
       why = solve_with_tangent(*x, *t, -dofs.reduce(R), forcing, &a);
       if (why.empty()) {  // du/dt with the same tangent
         const Status status = solve_prepared(-path_derivative(dofs, *x, *t, n, dt >= 0.0),
@@ -877,12 +888,9 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
 namespace {
 
 // The options an interactive stepper runs with: Newton by load control, one
-// step at a time, nothing kept for calibration. Each step starts from the last
-// equilibrium: a hand's moves are no smooth path, and extrapolating along the
-// steps taken would guess wrong where it stops or turns.
+// step at a time, nothing kept for calibration.
 SteppingOptions interactive_options(SteppingOptions options) {
   options.scheme = Scheme::Newton;
-  options.newton.predictor = false;
   options.steps = 1;
   options.newton.control = NewtonOptions::Control::Load;
   options.sensitivities = {};
@@ -902,6 +910,18 @@ LoadPoint between(const LoadPoint& a, const LoadPoint& b, double s) {
   return at;
 }
 
+// A point's values in one vector (load factors, planes, held values), to
+// compare two moves' directions.
+Eigen::VectorXd flattened(const LoadPoint& p) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(p.factors.size() + p.planes.size()) +
+                      p.held_values.size());
+  Eigen::Index k = 0;
+  for (double f : p.factors) out[k++] = f;
+  for (double q : p.planes) out[k++] = q;
+  out.tail(p.held_values.size()) = p.held_values;
+  return out;
+}
+
 bool all_finite(const std::vector<double>& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
@@ -913,8 +933,7 @@ class InteractiveStepper::Impl {
   Impl(const Model& model, const SteppingOptions& options)
       : model_(model),
         options_(interactive_options(options)),
-        summary_(empty_summary(model, Scheme::Newton)),
-        predictor_(0) {
+        summary_(empty_summary(model, Scheme::Newton)) {
     std::string why = setup_problem(model, options_);
     if (why.empty()) why = paddle_start_problem(model);
     if (!why.empty()) throw InputError("interactive stepper: " + why);
@@ -922,7 +941,6 @@ class InteractiveStepper::Impl {
     solver_ = std::make_unique<NewtonSolver>(model, options_, summary_);
     finisher_ = std::make_unique<StepFinisher>(model, options_, *solver_, partition_, summary_);
     point_ = scheduled_point(model, 0.0, 1);
-    predictor_.add(0.0, summary_.unknowns);
   }
 
   Result step(const LoadPoint& requested) {
@@ -937,17 +955,18 @@ class InteractiveStepper::Impl {
     const auto at = [&](double t) { return between(from, to, t - t0); };
     Eigen::VectorXd x = summary_.unknowns;
     const auto contact = solver_->contact_state();
-    const PathPredictor predictor = predictor_;
-    std::string why = walk_step(*solver_, at, t0, t0 + 1.0, options_.newton, predictor_, x, record);
+    NewtonOptions newton = options_.newton;
+    PathPredictor predictor = start_predictor(from, to, &newton.predictor);
+    std::string why = walk_step(*solver_, at, t0, t0 + 1.0, newton, predictor, x, record);
     if (why.empty()) why = finisher_->finish(to, x, record);
     record.seconds = seconds_since(start);
     record.pair_passes = model::pair_passes() - passes_before;
     if (!why.empty()) {  // the last equilibrium stays
       solver_->restore(contact);
-      predictor_ = predictor;
       result.message = "interactive step " + std::to_string(record.step) + ": " + why;
       return result;
     }
+    previous_ = {from, summary_.unknowns};
     summary_.unknowns = x;
     point_ = to;
     ++steps_;
@@ -961,6 +980,29 @@ class InteractiveStepper::Impl {
   int steps_taken() const { return steps_; }
 
  private:
+  // The step's first guess. A move on in the direction of the last one (a
+  // hand pressing on, a load turned further up) extrapolates the last two
+  // equilibria linearly by the moves' lengths; a move that turns, stops or
+  // comes first starts from the last equilibrium alone (*extrapolate false).
+  // With newton.predictor false, always the last equilibrium.
+  PathPredictor start_predictor(const LoadPoint& from, const LoadPoint& to,
+                                bool* extrapolate) const {
+    const double t0 = steps_;
+    PathPredictor predictor(1);
+    *extrapolate = false;
+    if (options_.newton.predictor && previous_) {
+      const Eigen::VectorXd ahead = flattened(to) - flattened(from),
+                            behind = flattened(from) - flattened(previous_->point);
+      const double a = ahead.norm(), b = behind.norm();
+      if (a > 0.0 && b > 0.0 && ahead.dot(behind) >= 0.999 * a * b) {
+        predictor.add(t0 - b / a, previous_->unknowns);  // where the last move started
+        *extrapolate = true;
+      }
+    }
+    predictor.add(t0, summary_.unknowns);
+    return predictor;
+  }
+
   // `requested` with its sizes and values checked, the held values filled in.
   LoadPoint checked(const LoadPoint& requested) const {
     const auto size_error = [](const std::string& what, size_t given, size_t expected) {
@@ -990,7 +1032,11 @@ class InteractiveStepper::Impl {
   model::DofPartition partition_;
   std::unique_ptr<NewtonSolver> solver_;
   std::unique_ptr<StepFinisher> finisher_;
-  PathPredictor predictor_;  // of order 0: the last equilibrium
+  struct Equilibrium {
+    LoadPoint point;
+    Eigen::VectorXd unknowns;
+  };
+  std::optional<Equilibrium> previous_;  // the one before the last, for the predictor
   LoadPoint point_;
   int steps_ = 0;
 };

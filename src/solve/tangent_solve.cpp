@@ -114,6 +114,8 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
       const Status status = factor_preconditioner();
       if (!status.ok) return status;
     }
+    const Status status = update_capacitance();
+    if (!status.ok) return status;
   }
   ready_ = true;
   return {};
@@ -133,8 +135,48 @@ Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
   return dofs_.reduce(store_ ? stored_.apply(w) : equilibrium_->tangent_product(x_, factors_, w));
 }
 
+// The held unknowns of the tangent that the preconditioner leaves free (at
+// most a few hundred: beyond, they stay free in its solve, as GMRES can
+// still cope), with the preconditioner's solve of each one's unit vector
+// and the capacitance matrix C = E^T P^-1 E of their rows.
+Status TangentSolve::update_capacitance() {
+  constexpr size_t kMostHeld = 256;
+  extra_held_.clear();
+  if (preconditioner_dofs_.num_reduced() == dofs_.num_reduced()) return {};
+  std::vector<int> position(static_cast<size_t>(equilibrium_->num_unknowns()), -1);
+  const std::vector<int>& index = preconditioner_dofs_.full_index();
+  for (size_t k = 0; k < index.size(); ++k)
+    position[static_cast<size_t>(index[k])] = static_cast<int>(k);
+  std::vector<int> dofs;
+  for (int d : dofs_.held_dofs())
+    if (!preconditioner_dofs_.held(d)) dofs.push_back(d);
+  if (dofs.empty() || dofs.size() > kMostHeld) return {};
+  const Eigen::Index m = preconditioner_dofs_.num_reduced();
+  extra_columns_.resize(m, static_cast<Eigen::Index>(dofs.size()));
+  for (size_t c = 0; c < dofs.size(); ++c) {
+    auto cached = unit_solves_.find(dofs[c]);
+    if (cached == unit_solves_.end()) {
+      Eigen::VectorXd unit = Eigen::VectorXd::Zero(m), column;
+      unit[position[static_cast<size_t>(dofs[c])]] = 1.0;
+      const Status status = preconditioner_->solve(unit, &column);
+      if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
+      cached = unit_solves_.emplace(dofs[c], std::move(column)).first;
+    }
+    extra_columns_.col(static_cast<Eigen::Index>(c)) = cached->second;
+  }
+  for (int d : dofs) extra_held_.push_back(position[static_cast<size_t>(d)]);
+  Eigen::MatrixXd C(extra_held_.size(), extra_held_.size());
+  for (size_t r = 0; r < extra_held_.size(); ++r)
+    C.row(static_cast<Eigen::Index>(r)) = extra_columns_.row(extra_held_[r]);
+  capacitance_.compute(C);
+  return {};
+}
+
 // The preconditioner's solve, through its own layout when it holds fewer
-// unknowns: the tangent's held unknowns enter as zeros and leave unread.
+// unknowns: the tangent's held unknowns enter as zeros, and the capacitance
+// correction keeps them at zero in the solution, y = P^-1 b - Z C^-1 (P^-1 b)_H
+// with Z = P^-1 E: the solve of the preconditioner's block over the
+// tangent's free unknowns alone.
 Eigen::VectorXd TangentSolve::precondition(const Eigen::VectorXd& reduced) const {
   const bool same_layout = preconditioner_dofs_.num_reduced() == dofs_.num_reduced();
   Eigen::VectorXd in = reduced;
@@ -146,6 +188,12 @@ Eigen::VectorXd TangentSolve::precondition(const Eigen::VectorXd& reduced) const
   Eigen::VectorXd out;
   if (!preconditioner_->solve(in, &out).ok) return Eigen::VectorXd::Constant(reduced.size(), NAN);
   if (same_layout) return out;
+  if (!extra_held_.empty()) {
+    Eigen::VectorXd at_held(static_cast<Eigen::Index>(extra_held_.size()));
+    for (size_t r = 0; r < extra_held_.size(); ++r)
+      at_held[static_cast<Eigen::Index>(r)] = out[extra_held_[r]];
+    out -= extra_columns_ * capacitance_.solve(at_held);
+  }
   Eigen::VectorXd full = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
   preconditioner_dofs_.scatter(out, full);
   return dofs_.reduce(full);
@@ -183,7 +231,8 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   else if (rate > 2.0 * baseline_rate_ + 1.0)
     refactor_ = true;
   if (!result.status.ok && !just_factored_) {
-    const Status status = factor_preconditioner();
+    Status status = factor_preconditioner();
+    if (status.ok) status = update_capacitance();
     if (!status.ok) return status;
     y->resize(0);
     result = gmres(apply_tangent, precondition, b, *y, gmres_options);
@@ -228,6 +277,7 @@ Status TangentSolve::factor_preconditioner() {
   const Status status = preconditioner_->factorize(*secant_);
   if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
   ++factorizations_;
+  unit_solves_.clear();  // solves with the factor replaced
   preconditioned_held_ = preconditioner_dofs_.held_flags();
   baseline_rate_ = -1.0;
   refactor_ = false;

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -26,9 +28,11 @@ namespace fiberfluid::solve {
 // refactored when its own held set changes or GMRES needs clearly more
 // iterations per decade than just after its last factorisation. Its held set
 // may be a subset of the tangent's (the supports without the paddle
-// contacts, which come and go): it then stands in for the tangent's
-// preconditioner, costing GMRES an iteration or so per extra held unknown
-// instead of a factorisation per change.
+// contacts, which come and go): the extra held unknowns are then held in
+// its solve by a capacitance correction (Woodbury; Hager, SIAM Rev. 31
+// (1989) 221), one preconditioner solve per unknown the first time it is
+// held, kept until the next factorisation, instead of a factorisation per
+// change of the contacts.
 //
 // The Newton stepper prepares one per iteration. With
 // SteppingOptions::keep_final_tangent the summary keeps it prepared at the
@@ -67,6 +71,7 @@ class TangentSolve {
 
  private:
   Status factor_preconditioner();
+  Status update_capacitance();
   Eigen::VectorXd apply(const Eigen::VectorXd& reduced) const;
   Eigen::VectorXd precondition(const Eigen::VectorXd& reduced) const;
 
@@ -93,6 +98,14 @@ class TangentSolve {
   std::unique_ptr<LinearSolver> preconditioner_;
   SolverKind preconditioner_kind_ = SolverKind::Auto;
   std::vector<char> preconditioned_held_;
+  // The capacitance correction: the unknowns the tangent holds beyond the
+  // preconditioner's (their index in the preconditioner's layout), the
+  // preconditioner's solve of each one's unit vector (P^-1 e_h, cached by
+  // unknown until the next factorisation), and the LU of their rows.
+  std::vector<int> extra_held_;
+  std::map<int, Eigen::VectorXd> unit_solves_;
+  Eigen::MatrixXd extra_columns_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
   double baseline_rate_ = -1.0;  // gmres iterations per decade after the last factorisation
   bool refactor_ = false, just_factored_ = false;
   int factorizations_ = 0;
