@@ -59,6 +59,27 @@ TEST(InteractiveStepper, StepsAlongTheScheduleGiveTheBatchRunBitForBit) {
   }
 }
 
+TEST(InteractiveStepper, APressThatGoesOnIsExtrapolatedAndReachesTheSameState) {
+  // Equal moves down, then one back up: the predictor extrapolates the moves
+  // that go on in the last one's direction, and not the one that turns.
+  const model::Model m = pressed_sphere();
+  SteppingOptions plain = newton_options(1), predicted = newton_options(1);
+  predicted.newton.predictor = true;
+  InteractiveStepper a(m, plain), b(m, predicted);
+  LoadPoint point = a.point();
+  int plain_iterations = 0, predicted_iterations = 0;
+  for (int k = 1; k <= 9; ++k) {
+    point.planes[0] -= k < 9 ? 0.03 : -0.05;
+    const InteractiveStepper::Result ra = a.step(point), rb = b.step(point);
+    ASSERT_TRUE(ra.success && rb.success) << ra.message << rb.message;
+    plain_iterations += ra.record.newton_iterations;
+    predicted_iterations += rb.record.newton_iterations;
+  }
+  EXPECT_LT(predicted_iterations, plain_iterations);
+  const Eigen::VectorXd &xa = a.unknowns(), &xb = b.unknowns();
+  EXPECT_LT((xa - xb).head(xa.size() - 1).norm(), 1e-8 * xa.head(xa.size() - 1).norm());
+}
+
 TEST(InteractiveStepper, APaddleMovedDownAndBackLeavesTheBodyAtRest) {
   // Frictionless contact on an elastic body: no memory of the path.
   const model::Model m = pressed_sphere();
