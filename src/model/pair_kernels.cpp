@@ -692,37 +692,34 @@ void DeformedPairs::store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
 
 namespace {
 
-// The stored tangent product over one tile: row i's terms summed into out at
-// i, their opposites (the pair seen from j: b, v and g change sign) into out
-// at j. Column i of c1, c2 holds the pairs (i, j > i).
+// The stored tangent product over row i's pairs (i, j > i): their terms
+// summed into out at i, their opposites (the pair seen from j: b, v and g
+// change sign) into out at j. Column i of c1, c2 holds those pairs: one
+// contiguous run of memory per row, which is what bounds this product.
 template <class K>
-FIBERFLUID_VECTOR_CLONES void stored_tangent_tile(
-    const Tile& t, const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2, const double* const x[3],
-    const double* const d[3], const double* const w[3], const std::array<double*, 3>& out) {
+FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const double* k1, const double* k2,
+                                                 const double* const x[3], const double* const d[3],
+                                                 const double* const w[3],
+                                                 const std::array<double*, 3>& out) {
   const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *d0 = d[0], *d1 = d[1], *d2 = d[2];
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
-  for (int r = 0; r < t.ni; ++r) {
-    const int i = t.i0 + r;
-    const double* k1 = C1.col(i).data();
-    const double* k2 = C2.col(i).data();
-    const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], di0 = d0[i], di1 = d1[i], di2 = d2[i];
-    const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], di0 = d0[i], di1 = d1[i], di2 = d2[i];
+  const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0;
 #pragma omp simd reduction(+ : s0, s1, s2)
-    for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
-      const PairCoefficients c{k1[j], k2[j]};
-      const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
-      const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
-      const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-      const double p0 = pair_tangent<K>(c, v0, b_dot_v, b0, di0 - d0[j]);
-      const double p1 = pair_tangent<K>(c, v1, b_dot_v, b1, di1 - d1[j]);
-      const double p2 = pair_tangent<K>(c, v2, b_dot_v, b2, di2 - d2[j]);
-      s0 += p0, s1 += p1, s2 += p2;
-      o0[j] -= p0, o1[j] -= p1, o2[j] -= p2;
-    }
-    o0[i] += s0, o1[i] += s1, o2[i] += s2;
+  for (int j = i + 1; j < n; ++j) {
+    const PairCoefficients c{k1[j], k2[j]};
+    const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
+    const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
+    const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+    const double p0 = pair_tangent<K>(c, v0, b_dot_v, b0, di0 - d0[j]);
+    const double p1 = pair_tangent<K>(c, v1, b_dot_v, b1, di1 - d1[j]);
+    const double p2 = pair_tangent<K>(c, v2, b_dot_v, b2, di2 - d2[j]);
+    s0 += p0, s1 += p1, s2 += p2;
+    o0[j] -= p0, o1[j] -= p1, o2[j] -= p2;
   }
+  o0[i] += s0, o1[i] += s1, o2[i] += s2;
 }
 
 }  // namespace
@@ -738,12 +735,18 @@ Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::
     d[a] = a < dim ? U.col(a).data() : zeros.data();
     w[a] = a < dim ? W.col(a).data() : zeros.data();
   }
+  // Rows dealt out in turn (their lengths fall by one each: the shares
+  // balance), a fixed share per thread: the same bits run after run.
   ThreadAccumulators products(n, 3);
   with_kinematics(kinematics, [&](auto policy) {
     using K = decltype(policy);
-    for_each_tile_pair(n, [&](const Tile& t, int thread) {
-      stored_tangent_tile<K>(t, C1, C2, x, d, w, products.columns(thread));
-    });
+#pragma omp parallel
+    {
+      const std::array<double*, 3> out = products.columns(omp_get_thread_num());
+#pragma omp for schedule(static, 1)
+      for (int i = 0; i < n; ++i)
+        stored_tangent_row<K>(i, n, C1.col(i).data(), C2.col(i).data(), x, d, w, out);
+    }
   });
   return products.sum();
 }
