@@ -9,6 +9,8 @@
 
 extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info, std::size_t);
+void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
+             double* b, const int* ldb, int* info, std::size_t);
 void dtrsv_(const char* uplo, const char* trans, const char* diag, const int* n, const double* a,
             const int* lda, double* x, const int* incx, std::size_t, std::size_t, std::size_t);
 }
@@ -52,22 +54,31 @@ class BlockCholeskySolver final : public SchurSolver {
     return {};
   }
 
-  // L L^T w = f per axis block as two triangular solves with dtrsv, which
-  // reads the factor as it lies; dpotrs's dtrsm first copies it into packed
-  // panels, a second pass over the factor's memory on every solve (a
-  // preconditioner's solves, one per GMRES iteration, spent a third of
-  // their time copying). Equal blocks share one factor.
   Status solve_K(const Eigen::VectorXd& f, Eigen::VectorXd* w) override {
     *w = f;
-    const char lower = 'L', no = 'N', transposed = 'T', non_unit = 'N';
+    const char lower = 'L';
+    if (factors_.size() == 1) {
+      // One factor for equal blocks: the axes are the columns of one
+      // multi-right-hand-side solve, a single pass over the factor.
+      const int n = offsets_[1] - offsets_[0];
+      const int nrhs = static_cast<int>(offsets_.size()) - 1;
+      int info = 0;
+      if (n > 0) dpotrs_(&lower, &n, &nrhs, factors_[0].data(), &n, w->data(), &n, &info, 1);
+      return {};
+    }
+    // One right-hand side per factor: two triangular solves with dtrsv, which
+    // reads the factor as it lies. dpotrs's dtrsm would first copy it into
+    // packed panels, another pass over its memory: measured (OpenBLAS 0.3.21,
+    // 2 cores), 0.16 ms against 0.44 ms at n = 993, 2.7 against 4.9 ms at
+    // n = 2,562. With three right-hand sides dpotrs is as fast or faster.
+    const char no = 'N', transposed = 'T', non_unit = 'N';
     const int one = 1;
     for (size_t a = 0; a + 1 < offsets_.size(); ++a) {
       const int n = offsets_[a + 1] - offsets_[a];
       if (n == 0) continue;
-      const double* factor = factors_[factors_.size() == 1 ? 0 : a].data();
       double* x = w->data() + offsets_[a];
-      dtrsv_(&lower, &no, &non_unit, &n, factor, &n, x, &one, 1, 1, 1);
-      dtrsv_(&lower, &transposed, &non_unit, &n, factor, &n, x, &one, 1, 1, 1);
+      dtrsv_(&lower, &no, &non_unit, &n, factors_[a].data(), &n, x, &one, 1, 1, 1);
+      dtrsv_(&lower, &transposed, &non_unit, &n, factors_[a].data(), &n, x, &one, 1, 1, 1);
     }
     return {};
   }
