@@ -194,6 +194,61 @@ class BilinearLaw final : public LawModel {
   double w_;
 };
 
+// A table's segments for the block evaluation: the interior breakpoints
+// (segment k of e: how many of them e is not below), each segment's
+// sigma = m e + c, and each side's slope through zero for the blend.
+struct TableArrays {
+  const double *breaks, *m, *c;
+  int num_breaks;
+  double tension_slope, compression_slope, transition;
+};
+
+// The tabulated law's Y and dY/de at n strains (before its scale), without
+// a branch or a search: the segment's m and c by one vector pass of selects
+// per breakpoint over a block of strains (the last breakpoint passed wins),
+// the sides and the blend by selects. The same operations as TabulatedLaw::modulus
+// and slope, value by value.
+FIBERFLUID_VECTOR_CLONES
+void tabulated_moduli(const TableArrays& t, double scale, const double* strain, size_t n, double* Y,
+                      double* Yp) {
+  constexpr size_t kBlock = 256;
+  const double w = t.transition;
+  alignas(64) double slope_of[kBlock], offset_of[kBlock];  // the segment's m and c
+  for (size_t k0 = 0; k0 < n; k0 += kBlock) {
+    const size_t len = std::min(kBlock, n - k0);
+    const double* e = strain + k0;
+#pragma omp simd
+    for (size_t k = 0; k < len; ++k) slope_of[k] = t.m[0], offset_of[k] = t.c[0];
+    for (int b = 0; b < t.num_breaks; ++b) {  // past breakpoint b: segment b + 1 or later
+      const double at = t.breaks[b], m = t.m[b + 1], c = t.c[b + 1];
+#pragma omp simd
+      for (size_t k = 0; k < len; ++k) {
+        const bool past = !(e[k] < at);
+        slope_of[k] = past ? m : slope_of[k];
+        offset_of[k] = past ? c : offset_of[k];
+      }
+    }
+#pragma omp simd
+    for (size_t k = 0; k < len; ++k) {
+      const double m = slope_of[k], c = offset_of[k], x = e[k];
+      const double table_modulus = c == 0.0 ? m : m + c / x;
+      const double table_slope = c == 0.0 ? 0.0 : -c / (x * x);
+      const double share = tension_share(x, w);
+      const double tension_modulus = x >= 0.0 ? table_modulus : t.tension_slope;
+      const double compression_modulus = x >= 0.0 ? t.compression_slope : table_modulus;
+      const double tension_side_slope = x >= 0.0 ? table_slope : 0.0;
+      const double compression_side_slope = x >= 0.0 ? 0.0 : table_slope;
+      const double blended_modulus = (1.0 - share) * compression_modulus + share * tension_modulus;
+      const double blended_slope =
+          (1.0 - share) * compression_side_slope + share * tension_side_slope +
+          tension_share_slope(x, w) * (tension_modulus - compression_modulus);
+      const double blends = std::abs(x) < w ? 1.0 : 0.0;  // never when w <= 0
+      Y[k0 + k] = scale * (blends != 0.0 ? blended_modulus : table_modulus);
+      Yp[k0 + k] = scale * (blends != 0.0 ? blended_slope : table_slope);
+    }
+  }
+}
+
 // A piecewise-linear sigma(e) from a table. Its slope may differ on the two
 // sides of e = 0 (a tissue softer in compression), where the secant modulus,
 // and with the vector spring the force, would jump and stall Newton: over
@@ -202,7 +257,28 @@ class BilinearLaw final : public LawModel {
 class TabulatedLaw final : public LawModel {
  public:
   TabulatedLaw(std::vector<double> strain, std::vector<double> stress, double transition)
-      : strain_(std::move(strain)), stress_(std::move(stress)), w_(transition) {}
+      : strain_(std::move(strain)), stress_(std::move(stress)), w_(transition) {
+    // The block evaluation's arrays, for a table check() will accept in shape.
+    if (strain_.size() < 2 || stress_.size() != strain_.size()) return;
+    breaks_.assign(strain_.begin() + 1, strain_.end() - 1);
+    for (size_t k = 0; k + 1 < strain_.size(); ++k) {
+      const Segment s = segment(strain_[k]);  // segment k (it starts at strain_k)
+      m_.push_back(s.m);
+      c_.push_back(s.c);
+    }
+  }
+  void evaluate(const double* p, const double* strain, size_t n, double* Y,
+                double* Yp) const override {
+    if (m_.empty()) return LawModel::evaluate(p, strain, n, Y, Yp);
+    const TableArrays arrays{breaks_.data(),
+                             m_.data(),
+                             c_.data(),
+                             static_cast<int>(breaks_.size()),
+                             zero_segment_slope(true),
+                             zero_segment_slope(false),
+                             w_};
+    tabulated_moduli(arrays, p[0], strain, n, Y, Yp);
+  }
   std::string name() const override { return "tabulated"; }
   std::vector<std::string> parameter_names() const override { return {"scale"}; }
   double modulus(const double* p, double e) const override {
@@ -289,6 +365,7 @@ class TabulatedLaw final : public LawModel {
 
   std::vector<double> strain_, stress_;
   double w_;
+  std::vector<double> breaks_, m_, c_;  // for the block evaluation
 };
 
 }  // namespace
