@@ -9,7 +9,9 @@
 namespace fiberfluid::solve {
 
 std::unique_ptr<LinearSolver> make_dense_lu_solver();
-std::unique_ptr<LinearSolver> make_block_cholesky_solver();
+// single_precision: the factors in float (a preconditioner's: half the
+// memory and time; its solves then hold about 7 digits).
+std::unique_ptr<LinearSolver> make_block_cholesky_solver(bool single_precision = false);
 std::unique_ptr<LinearSolver> make_cholmod_solver();
 std::unique_ptr<LinearSolver> make_pcg_solver(const PcgOptions& options);
 
