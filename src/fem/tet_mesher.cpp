@@ -14,6 +14,7 @@
 #include <map>
 #include <vector>
 
+#include "fiberfluid/geom/cgal_surface_mesh.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
@@ -32,16 +33,7 @@ using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
 Mesh tetrahedralize(const geom::Surface& s, const TetMeshOptions& options) {
   if (s.dim != 3 || s.num_faces() == 0)
     throw InputError("tetrahedralize: expected a closed 3D triangle mesh");
-  SurfaceMesh mesh;
-  std::vector<SurfaceMesh::Vertex_index> vertex;
-  for (int v = 0; v < s.num_vertices(); ++v)
-    vertex.push_back(mesh.add_vertex(Kernel::Point_3(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
-  for (int f = 0; f < s.num_faces(); ++f)
-    if (mesh.add_face(vertex[static_cast<size_t>(s.F(f, 0))],
-                      vertex[static_cast<size_t>(s.F(f, 1))],
-                      vertex[static_cast<size_t>(s.F(f, 2))]) == SurfaceMesh::null_face())
-      throw InputError("tetrahedralize: the surface is not a manifold triangle mesh (face " +
-                       std::to_string(f) + ")");
+  const SurfaceMesh mesh = geom::to_surface_mesh<SurfaceMesh>(s, "tetrahedralize");
   if (!CGAL::is_closed(mesh)) throw InputError("tetrahedralize: the surface is not closed");
 
   const double diagonal = geom::bounding_box_diagonal(s.V);

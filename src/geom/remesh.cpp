@@ -4,7 +4,6 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
-#include <CGAL/Polygon_mesh_processing/repair.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <cmath>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/cgal_surface_mesh.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::geom {
@@ -19,20 +19,6 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
-
-Mesh to_cgal(const Surface& s) {
-  Mesh mesh;
-  std::vector<Mesh::Vertex_index> vertex;
-  for (int v = 0; v < s.num_vertices(); ++v)
-    vertex.push_back(mesh.add_vertex(Kernel::Point_3(s.V(v, 0), s.V(v, 1), s.V(v, 2))));
-  for (int f = 0; f < s.num_faces(); ++f)
-    if (mesh.add_face(vertex[static_cast<size_t>(s.F(f, 0))],
-                      vertex[static_cast<size_t>(s.F(f, 1))],
-                      vertex[static_cast<size_t>(s.F(f, 2))]) == Mesh::null_face())
-      throw InputError("remesh: face " + std::to_string(f) +
-                       " does not fit a closed manifold surface");
-  return mesh;
-}
 
 Surface from_cgal(const Mesh& mesh) {
   Surface s;
@@ -61,7 +47,7 @@ Surface from_cgal(const Mesh& mesh) {
 Surface remesh_to_vertices(const Surface& s, int vertices, int iterations) {
   if (s.dim != 3) throw InputError("remesh: only a 3D triangle surface can be remeshed");
   if (vertices < 4) throw InputError("remesh: at least 4 vertices are needed");
-  const Mesh original = to_cgal(s);
+  const Mesh original = to_surface_mesh<Mesh>(s, "remesh");
   const double area = face_area_vectors(s.V, s.F).rowwise().norm().sum();
   // 2 V equilateral triangles of edge l cover the area: 2 V (sqrt(3) / 4) l^2 = A.
   double edge = std::sqrt(2.0 * area / (std::sqrt(3.0) * vertices));
@@ -79,7 +65,6 @@ Surface remesh_to_vertices(const Surface& s, int vertices, int iterations) {
     PMP::isotropic_remeshing(
         faces(mesh), edge, mesh,
         PMP::parameters::number_of_iterations(static_cast<unsigned>(iterations)));
-    PMP::remove_isolated_vertices(mesh);  // a file's vertices that no face used
     mesh.collect_garbage();
     const long reached = static_cast<long>(mesh.number_of_vertices());
     const long miss = std::abs(reached - vertices);

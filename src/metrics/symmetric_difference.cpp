@@ -18,6 +18,7 @@
 #include <iterator>
 #include <vector>
 
+#include "fiberfluid/geom/cgal_surface_mesh.hpp"
 #include "fiberfluid/metrics/metrics.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -77,46 +78,18 @@ double symmetric_difference_2d(const geom::Surface& a, const geom::Surface& b,
   return CGAL::to_double(p.area()) + CGAL::to_double(q.area()) - 2.0 * common;
 }
 
-// The surface as a CGAL mesh of kernel K; throws unless every face makes a
-// manifold. Only the vertices of some face are added: CGAL's volume
-// predicates (does_bound_a_volume) fail on isolated vertices.
-template <class MeshType>
-MeshType build_mesh(const geom::Surface& s, const std::string& what) {
-  using Point = typename MeshType::Point;
-  MeshType mesh;
-  for (int f = 0; f < s.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k)
-      if (s.F(f, k) < 0 || s.F(f, k) >= s.num_vertices())
-        throw InputError(what + ": face " + std::to_string(f) + " refers to a missing vertex");
-  std::vector<typename MeshType::Vertex_index> vertices(static_cast<size_t>(s.num_vertices()),
-                                                        MeshType::null_vertex());
-  for (int f = 0; f < s.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int v = s.F(f, k);
-      if (vertices[static_cast<size_t>(v)] == MeshType::null_vertex())
-        vertices[static_cast<size_t>(v)] = mesh.add_vertex(Point(s.V(v, 0), s.V(v, 1), s.V(v, 2)));
-    }
-  for (int f = 0; f < s.num_faces(); ++f) {
-    if (mesh.add_face(vertices[static_cast<size_t>(s.F(f, 0))],
-                      vertices[static_cast<size_t>(s.F(f, 1))],
-                      vertices[static_cast<size_t>(s.F(f, 2))]) == MeshType::null_face())
-      throw InputError(what + ": face " + std::to_string(f) + " makes the mesh non-manifold");
-  }
-  return mesh;
-}
-
 // A closed, outward, self-intersection-free triangle mesh (checked with
 // filtered predicates, built again with exact constructions).
 Mesh solid(const geom::Surface& s, const std::string& what) {
   require_representable(s, what);
   if (s.num_faces() == 0)
     throw InputError(what + ": has no faces (a point cloud), so it bounds no solid");
-  CheckMesh check = build_mesh<CheckMesh>(s, what);
+  CheckMesh check = geom::to_surface_mesh<CheckMesh>(s, what);
   if (check.is_empty() || !CGAL::is_closed(check))
     throw InputError(what + ": the mesh is not closed, so it bounds no solid");
   if (PMP::does_self_intersect(check))
     throw InputError(what + ": the mesh intersects itself (an inverted or overlapping part)");
-  Mesh mesh = build_mesh<Mesh>(s, what);
+  Mesh mesh = geom::to_surface_mesh<Mesh>(s, what);
   const bool outward = PMP::is_outward_oriented(check);
   if (!outward) {
     PMP::reverse_face_orientations(check);
