@@ -74,6 +74,19 @@ inline model::Model paper_sphere_model() {
 
 // A 42-vertex sphere with a cap held, gravity, a point load and surface
 // tension, with axis factors that enter every term.
+// The paper's sphere resting on supports at its bottom (z <= -0.9, every
+// axis), no load, pressed by a paddle from above that travels 0.3 down.
+inline model::Model pressed_sphere(bool sticking = false) {
+  model::Model m = paper_sphere_model();
+  m.loads.clear();
+  m.constraints.clear();
+  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
+    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+  m.paddles = {paddle_on_top(m, "top", -0.3)};
+  m.paddles[0].sticking = sticking;
+  return m;
+}
+
 inline model::Model small_sphere(
     const model::FiberLaw& law,
     model::FiberKinematics kinematics = model::FiberKinematics::VectorSpring,

@@ -15,14 +15,10 @@
 namespace fiberfluid::solve {
 namespace {
 
-// The paper's sphere resting on its bottom cap, a paddle pressing from above.
+// The paper's sphere resting on its bottom cap, a paddle pressing from
+// above, the exponential law.
 model::Model pressed_sphere() {
-  model::Model m = testing::paper_sphere_model();
-  m.loads.clear();
-  m.constraints.clear();
-  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.paddles = {testing::paddle_on_top(m, "top", -0.3)};
+  model::Model m = testing::pressed_sphere();
   m.material.law = model::FiberLaw::exponential(3000.0, 3.0);
   return m;
 }

@@ -328,17 +328,7 @@ TEST(Newton, ATablesSlopeJumpAtZeroNoLongerStallsNewton) {
   EXPECT_TRUE(smooth.unknowns.allFinite());
 }
 
-// A sphere resting on supports at its bottom, pressed by a paddle from above.
-model::Model pressed_sphere(bool sticking) {
-  model::Model m = testing::paper_sphere_model();
-  m.loads.clear();
-  m.constraints.clear();
-  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.paddles = {testing::paddle_on_top(m, "top", -0.3)};
-  m.paddles[0].sticking = sticking;
-  return m;
-}
+using testing::pressed_sphere;
 
 TEST(Newton, PaddleContactPushesHoldsAndBalances) {
   for (bool sticking : {false, true}) {
