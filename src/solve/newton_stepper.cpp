@@ -50,8 +50,6 @@ namespace {
 using model::DofMap;
 using model::Model;
 
-using PathPoint = LoadPoint;
-
 // Inexact Newton's forcing term: the relative residual a Krylov solve of
 // J dx = -R stops at, for a Newton residual `norm` (relative). As accurate as
 // the residual it corrects (0.1 norm: the convergence stays quadratic), but
@@ -87,14 +85,14 @@ class NewtonSolver {
 
   const model::Equilibrium& equilibrium() const { return *equilibrium_; }
   // The tangent solve prepared at x (the solution), for the summary.
-  std::shared_ptr<TangentSolve> final_tangent(const PathPoint& at, const Eigen::VectorXd& x) {
+  std::shared_ptr<TangentSolve> final_tangent(const LoadPoint& at, const Eigen::VectorXd& x) {
     if (!tangent_->prepare(x, at.factors, held_map(), &supports_).ok) return nullptr;
     return tangent_;
   }
 
   // Solves R = 0 at `at` from x (updated in place): Newton inside an
   // active-set loop for the paddles. "" or why it failed.
-  std::string solve(const PathPoint& at, Eigen::VectorXd& x, StepRecord& record) {
+  std::string solve(const LoadPoint& at, Eigen::VectorXd& x, StepRecord& record) {
     add_penetrating(at, x);
     for (int round = 0; round < newton_.max_contact_rounds; ++round) {
       const DofMap dofs = held_map();
@@ -115,7 +113,7 @@ class NewtonSolver {
   // `residual_change` receives dR/dtheta along the solution's change,
   // K_T du/dtheta + dR/dtheta: zero at the free rows, and at the held ones
   // the change of the supports' and paddles' forces.
-  std::string sensitivities(const PathPoint& at, const Eigen::VectorXd& x,
+  std::string sensitivities(const LoadPoint& at, const Eigen::VectorXd& x,
                             const std::vector<std::string>& names, Eigen::MatrixXd* out,
                             Eigen::MatrixXd* residual_change) {
     const std::shared_ptr<TangentSolve> tangent = final_tangent(at, x);
@@ -242,7 +240,7 @@ class NewtonSolver {
  private:
   // Held values: supports and prescribed values from the path, contact
   // vertices on their planes (and, sticking, where they first touched).
-  void apply_held_values(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x) const {
+  void apply_held_values(const LoadPoint& at, const DofMap& dofs, Eigen::VectorXd& x) const {
     const int n = model_.num_vertices();
     for (int d = 0; d < model_.dim() * n; ++d)
       if (supports_.held(d)) x[d] = at.held_values[d];
@@ -261,7 +259,7 @@ class NewtonSolver {
 
   // Vertices past a paddle join its contact set; true when any did (with
   // `apply` false, only whether any would).
-  bool add_penetrating(const PathPoint& at, const Eigen::VectorXd& x, bool apply = true) {
+  bool add_penetrating(const LoadPoint& at, const Eigen::VectorXd& x, bool apply = true) {
     const int n = model_.num_vertices();
     bool added = false;
     for (size_t p = 0; p < model_.paddles.size(); ++p) {
@@ -300,14 +298,14 @@ class NewtonSolver {
     return released;
   }
   bool release_pulling() { return release_pulling(residual_); }
-  bool contact_would_change(const PathPoint& at, const Eigen::VectorXd& x,
+  bool contact_would_change(const LoadPoint& at, const Eigen::VectorXd& x,
                             const Eigen::VectorXd& R) {
     return !model_.paddles.empty() && (release_pulling(R, false) || add_penetrating(at, x, false));
   }
 
   // The relative residual of the state x (gauge: the scale of x's loads and
   // reactions, or of the states accepted before, whichever is larger).
-  double measure(const PathPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
+  double measure(const LoadPoint& at, const DofMap& dofs, const Eigen::VectorXd& x,
                  const Eigen::VectorXd& R, double* scale = nullptr) const {
     const double s = gauge_.scale_at(*equilibrium_, dofs, x, at.factors, R);
     if (scale) *scale = s;
@@ -318,7 +316,7 @@ class NewtonSolver {
   // true) or, after an iteration, until the paddles' active set would change:
   // the set is updated as the iterates go (a semi-smooth Newton), rather than
   // after a full solve with each set. "" or why it failed.
-  std::string newton(const PathPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
+  std::string newton(const LoadPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
                      StepRecord& record, bool* converged) {
     *converged = false;
     Eigen::VectorXd R = tangent_->residual(x, at.factors);  // and the tangent there
@@ -485,7 +483,7 @@ class NewtonSolver {
       *x += step;
       const std::vector<double> factors = factors_at(*t, n);
       const Eigen::VectorXd R = tangent_->residual(*x, factors);  // and the tangent there
-      PathPoint at;
+      LoadPoint at;
       at.factors = factors;
       double scale = 0.0;
       const double norm = measure(at, dofs, *x, R, &scale);
@@ -577,7 +575,7 @@ class PathPredictor {
 // fails from the predictor's guess is first tried again from the last
 // solution. Each converged piece joins the predictor. "" or why it failed
 // (x and the contact state are then those of the last converged piece).
-std::string walk_step(NewtonSolver& solver, const std::function<PathPoint(double)>& at, double from,
+std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double)>& at, double from,
                       double to, const NewtonOptions& options, PathPredictor& predictor,
                       Eigen::VectorXd& x, StepRecord& record) {
   double reached = from, piece = to - from;
@@ -685,7 +683,7 @@ class StepFinisher {
         groups_(std::max<size_t>(1, model.constraint_groups.size())) {}
 
   // "" or why the run stops (a runaway, failed sensitivities).
-  std::string finish(const PathPoint& at, const Eigen::VectorXd& x, StepRecord& record) {
+  std::string finish(const LoadPoint& at, const Eigen::VectorXd& x, StepRecord& record) {
     const int nv = model_.num_vertices(), dim = model_.dim(), k = record.step;
     const Eigen::MatrixXd X = model::positions(model_, x);
     const double volume = geom::enclosed_volume(X, model_.surface.F);
