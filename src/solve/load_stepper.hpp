@@ -56,8 +56,9 @@ struct NewtonOptions {
   int max_step_cuts = 6;    // halvings of a failing step before giving up
   bool line_search = true;  // backtracking on the residual norm
   TangentSolver tangent = TangentSolver::Auto;
-  // GMRES stops at a relative residual of max(krylov_tolerance, 0.1 r) for a
-  // Newton residual r (inexact Newton: no sharper than the step needs).
+  // GMRES stops at a relative residual of max(krylov_tolerance, min(0.1,
+  // max(0.1 r, 0.5 residual_tolerance / r))) for a Newton residual r (inexact
+  // Newton: quadratic, and no sharper than the tolerance needs).
   double krylov_tolerance = 1e-10;
   int krylov_restart = 50;
   int krylov_max_iterations = 500;
