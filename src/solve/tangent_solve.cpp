@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/solve/backends.hpp"
@@ -152,6 +153,12 @@ Status TangentSolve::update_capacitance() {
   for (int d : dofs_.held_dofs())
     if (!preconditioner_dofs_.held(d)) dofs.push_back(d);
   if (dofs.empty() || dofs.size() > kMostHeld) return {};
+  // Contacts wander over a long run: the solves of unknowns no longer held
+  // go once the cache holds twice the most that are held at once.
+  if (unit_solves_.size() > 2 * kMostHeld)
+    for (auto it = unit_solves_.begin(); it != unit_solves_.end();)
+      it = std::binary_search(dofs.begin(), dofs.end(), it->first) ? std::next(it)
+                                                                   : unit_solves_.erase(it);
   const Eigen::Index m = preconditioner_dofs_.num_reduced();
   extra_columns_.resize(m, static_cast<Eigen::Index>(dofs.size()));
   for (size_t c = 0; c < dofs.size(); ++c) {

@@ -140,6 +140,31 @@ TEST(Newton, ContactsHeldByCapacitanceGiveTheirOwnFactorisationsPreconditioner) 
     EXPECT_LT((y_corrected - y_factored).norm(), 1e-8 * y_factored.norm());
     EXPECT_EQ(corrected.factorizations(), 1);
   }
+  // Held sets that wander (100 unknowns at a time, 700 in all: the cache of
+  // solves drops those no longer held) keep the correction exact.
+  SteppingOptions o = newton(1, TangentSolver::Krylov);
+  o.solver = SolverKind::BlockCholesky;
+  TangentSolve wandering(equilibrium, o, TangentSolver::Krylov);
+  std::vector<int> free_dofs;
+  for (int d = 0; d < 3 * m.num_vertices(); ++d)
+    if (!supports.held(d)) free_dofs.push_back(d);
+  ASSERT_GE(free_dofs.size(), 400u);
+  for (size_t start = 0; start < 700; start += 100) {
+    std::vector<int> set;
+    for (size_t k = 0; k < 100; ++k) set.push_back(free_dofs[(start + k) % free_dofs.size()]);
+    const model::DofMap moved = supports.with_held(set);
+    const Eigen::VectorXd c = Eigen::VectorXd::Random(moved.num_reduced());
+    ASSERT_TRUE(wandering.prepare(x, factors, moved, &supports).ok);
+    TangentSolve factored(equilibrium, o, TangentSolver::Krylov);
+    ASSERT_TRUE(factored.prepare(x, factors, moved, nullptr).ok);
+    Eigen::VectorXd y_wandering, y_factored;
+    int wandering_iterations = 0, factored_iterations = 0;
+    ASSERT_TRUE(wandering.solve(c, 1e-10, &y_wandering, &wandering_iterations).ok);
+    ASSERT_TRUE(factored.solve(c, 1e-10, &y_factored, &factored_iterations).ok);
+    EXPECT_EQ(wandering_iterations, factored_iterations) << start;
+    EXPECT_LT((y_wandering - y_factored).norm(), 1e-8 * y_factored.norm()) << start;
+  }
+  EXPECT_EQ(wandering.factorizations(), 1);
 }
 
 // Issue 25: the line search's residual stores the tangent at its trial, which
