@@ -4,6 +4,7 @@
 // precision (spotrf) as the Newton-Krylov preconditioner: half the memory and
 // time of its factorisation and solves, while GMRES keeps the tangent exact.
 #include <chrono>
+#include <type_traits>
 #include <vector>
 
 #include "fiberfluid/solve/backends.hpp"
@@ -64,7 +65,12 @@ class BlockCholeskySolver final : public SchurSolver {
     factors_.clear();
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
-      Factor K = system.dense_block(a).cast<Scalar>();
+      // In double the block is factored where it lies (no copy of N^2 entries).
+      Factor K;
+      if constexpr (std::is_same_v<Scalar, double>)
+        K = system.dense_block(a);
+      else
+        K = system.dense_block(a).template cast<Scalar>();
       const int n = static_cast<int>(K.rows());
       int info = 0;
       const auto start = std::chrono::steady_clock::now();
