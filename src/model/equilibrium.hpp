@@ -33,7 +33,7 @@ class TangentOperator {
   Eigen::VectorXd x_;
   std::vector<double> factors_;
   Eigen::MatrixXd X_, U_;
-  Eigen::MatrixXd weighted_modulus_, weighted_slope_;  // column i: the pairs (i, j)
+  Eigen::MatrixXf weighted_modulus_, weighted_slope_;  // column i: the pairs (i, j)
   // Fibers stored as neighbour lists: the kept pairs' coefficients in list order.
   bool listed_ = false;
   std::vector<double> listed_modulus_, listed_slope_;

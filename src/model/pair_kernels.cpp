@@ -634,7 +634,8 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
   return products.sum();
 }
 
-void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+template <class Table>
+void DeformedPairs::table_coefficients(Table* c1, Table* c2) const {
   if (sparse()) {
     std::vector<double> k1, k2;
     listed_coefficients(&k1, &k2);
@@ -643,8 +644,9 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
     for (int i = 0; i < n_; ++i) {
       const std::vector<int>& partners = mask_->neighbours(i);
       for (size_t q = 0; q < partners.size(); ++q) {
-        (*c1)(i, partners[q]) = k1[offsets_[static_cast<size_t>(i)] + q];
-        (*c2)(i, partners[q]) = k2[offsets_[static_cast<size_t>(i)] + q];
+        using Scalar = typename Table::Scalar;
+        (*c1)(i, partners[q]) = static_cast<Scalar>(k1[offsets_[static_cast<size_t>(i)] + q]);
+        (*c2)(i, partners[q]) = static_cast<Scalar>(k2[offsets_[static_cast<size_t>(i)] + q]);
       }
     }
     return;
@@ -652,8 +654,16 @@ void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const
   store_coefficients(c1, c2, nullptr);
 }
 
-Eigen::MatrixXd DeformedPairs::forces_and_coefficients(Eigen::MatrixXd* c1,
-                                                       Eigen::MatrixXd* c2) const {
+void DeformedPairs::coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+  table_coefficients(c1, c2);
+}
+
+void DeformedPairs::coefficients(Eigen::MatrixXf* c1, Eigen::MatrixXf* c2) const {
+  table_coefficients(c1, c2);
+}
+
+Eigen::MatrixXd DeformedPairs::forces_and_coefficients(Eigen::MatrixXf* c1,
+                                                       Eigen::MatrixXf* c2) const {
   if (sparse()) {  // two passes: the lists keep no table to fill on the way
     coefficients(c1, c2);
     return forces();
@@ -663,12 +673,13 @@ Eigen::MatrixXd DeformedPairs::forces_and_coefficients(Eigen::MatrixXd* c1,
   return forces.sum();
 }
 
-void DeformedPairs::store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
-                                       ThreadAccumulators* forces) const {
+template <class Table>
+void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators* forces) const {
+  using Scalar = typename Table::Scalar;
   c1->resize(n_, n_);
   c2->resize(n_, n_);
-  advise_huge_pages(c1->data(), 8.0 * static_cast<double>(c1->size()));
-  advise_huge_pages(c2->data(), 8.0 * static_cast<double>(c2->size()));
+  advise_huge_pages(c1->data(), sizeof(Scalar) * static_cast<double>(c1->size()));
+  advise_huge_pages(c2->data(), sizeof(Scalar) * static_cast<double>(c2->size()));
   c1->diagonal().setZero();
   c2->diagonal().setZero();
   const double *area = area_.data(), *count = count_.data();
@@ -678,13 +689,13 @@ void DeformedPairs::store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
       if (forces != nullptr)  // the row's lengths and law, used twice
         forces_row<K>(p, area, count, i, j0, first, end, row, forces->columns(thread));
-      double* k1 = c1->col(i).data();
-      double* k2 = c2->col(i).data();
+      Scalar* k1 = c1->col(i).data();
+      Scalar* k2 = c2->col(i).data();
       for (int j = first; j < end; ++j) {  // j > i: the lower triangle, written in order
         const PairCoefficients c =
             row_coefficients<K>(row, j - j0, area[i], area[j], count[i], count[j]);
-        k1[j] = c.c1;
-        k2[j] = c.c2;
+        k1[j] = static_cast<Scalar>(c.c1);
+        k2[j] = static_cast<Scalar>(c.c2);
       }
     });
   });
@@ -697,7 +708,7 @@ namespace {
 // change sign) into out at j. Column i of c1, c2 holds those pairs: one
 // contiguous run of memory per row, which is what bounds this product.
 template <class K>
-FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const double* k1, const double* k2,
+FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const float* k1, const float* k2,
                                                  const double* const x[3], const double* const d[3],
                                                  const double* const w[3],
                                                  const std::array<double*, 3>& out) {
@@ -725,8 +736,8 @@ FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const double* k1,
 }  // namespace
 
 Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::MatrixXd& X,
-                                       const Eigen::MatrixXd& U, const Eigen::MatrixXd& C1,
-                                       const Eigen::MatrixXd& C2, const Eigen::MatrixXd& W) {
+                                       const Eigen::MatrixXd& U, const Eigen::MatrixXf& C1,
+                                       const Eigen::MatrixXf& C2, const Eigen::MatrixXd& W) {
   const int n = static_cast<int>(X.rows()), dim = static_cast<int>(X.cols());
   const std::vector<double> zeros(static_cast<size_t>(n), 0.0);
   const double *x[3], *d[3], *w[3];

@@ -123,10 +123,12 @@ class BulkPairs {
 // from stored pair coefficients C1, C2 (DeformedPairs::coefficients: only
 // the lower triangle is read), at positions X and displacements U: each
 // unordered pair read once, its term added at i and subtracted at j, as
-// DeformedPairs::tangent_product sums it.
+// DeformedPairs::tangent_product sums it. The tables are single precision:
+// this product is bound by reading them, and it is Newton-Krylov's tangent,
+// whose direction GMRES needs to a few digits (the residual stays exact).
 Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::MatrixXd& X,
-                                       const Eigen::MatrixXd& U, const Eigen::MatrixXd& C1,
-                                       const Eigen::MatrixXd& C2, const Eigen::MatrixXd& W);
+                                       const Eigen::MatrixXd& U, const Eigen::MatrixXf& C1,
+                                       const Eigen::MatrixXf& C2, const Eigen::MatrixXd& W);
 
 // The bulk fibers at a deformed state, for Newton's residual and tangent
 // (model.md section 7, pair_stencil.hpp): per pair the reference length
@@ -152,10 +154,12 @@ class DeformedPairs {
   // c1 and c2 of every pair (N x N each, zero diagonal), symmetric and kept
   // once: column i holds the pairs (i, j) with j > i (the lower triangle);
   // the upper one is left unwritten (a neighbour-list mask fills both).
+  // In double for the dense tangent, in single for stored_tangent_product.
   void coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
+  void coefficients(Eigen::MatrixXf* c1, Eigen::MatrixXf* c2) const;
   // forces() and coefficients() in one pass over the pairs (their lengths
   // and the law computed once); two passes for a sparse mask.
-  Eigen::MatrixXd forces_and_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const;
+  Eigen::MatrixXd forces_and_coefficients(Eigen::MatrixXf* c1, Eigen::MatrixXf* c2) const;
 
   // A mask stored sparse (neighbour lists): the pairs are visited from both
   // ends, row by row, and their coefficients can be kept in list order.
@@ -182,8 +186,10 @@ class DeformedPairs {
   template <class Term>
   Eigen::MatrixXd listed_sums(Term&& term) const;
   // The table of c1, c2, and with `forces` the forces summed on the way.
-  void store_coefficients(Eigen::MatrixXd* c1, Eigen::MatrixXd* c2,
-                          detail::ThreadAccumulators* forces) const;
+  template <class Table>
+  void store_coefficients(Table* c1, Table* c2, detail::ThreadAccumulators* forces) const;
+  template <class Table>
+  void table_coefficients(Table* c1, Table* c2) const;
 
   int n_ = 0;
   std::vector<double> s_[3], x_[3], u_[3], count_;

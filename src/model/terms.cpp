@@ -506,7 +506,7 @@ void fill_row(const TermContext& c, int i, const Columns& col, RowState& row) {
 }  // namespace
 
 void BulkFiberTerm::coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                                 Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+                                 Eigen::MatrixXf* c1, Eigen::MatrixXf* c2) const {
   deformed_pairs(c_, X, U).coefficients(c1, c2);
 }
 
@@ -518,7 +518,7 @@ void BulkFiberTerm::add_residual(const TermState& s, Eigen::VectorXd& R) const {
 }
 
 void BulkFiberTerm::add_residual_and_coefficients(const TermState& s, Eigen::VectorXd& R,
-                                                  Eigen::MatrixXd* c1, Eigen::MatrixXd* c2) const {
+                                                  Eigen::MatrixXf* c1, Eigen::MatrixXf* c2) const {
   const int n = c_.model.num_vertices();
   const Eigen::Vector3d m = c_.model.material.axis_factors;
   const Eigen::MatrixXd bulk = deformed_pairs(c_, s.X, s.U).forces_and_coefficients(c1, c2);
@@ -539,8 +539,8 @@ void BulkFiberTerm::add_tangent(const TermState& s, TangentSink& J) const {
     listed_coefficients(s.X, s.U, &c1, &c2);
     return add_listed_blocks(s.X, s.U, c1, c2, J);
   }
-  Eigen::MatrixXd c1, c2;
-  coefficients(s.X, s.U, &c1, &c2);
+  Eigen::MatrixXd c1, c2;  // in double: the dense tangent is exact
+  deformed_pairs(c_, s.X, s.U).coefficients(&c1, &c2);
   if (J.dense() != nullptr) return add_dense_blocks(s.X, s.U, c1, c2, *J.dense());
   // Every pair kept (or a dense mask) into a sparse tangent: N^2 entries.
   const int n = c_.model.num_vertices();
@@ -579,7 +579,7 @@ std::vector<FiberReading> BulkFiberTerm::readings(
     }
   } else {
     Eigen::MatrixXd dense_c1, dense_c2;
-    coefficients(s.X, s.U, &dense_c1, &dense_c2);
+    deformed_pairs(c_, s.X, s.U).coefficients(&dense_c1, &dense_c2);  // double: exact readings
     for (size_t p = 0; p < pairs.size(); ++p) {  // stored once: row max(i, j), column min
       const auto [i, j] = pairs[p];
       force_coefficient[p] = dense_c1(std::max(i, j), std::min(i, j));
@@ -715,7 +715,7 @@ void BulkFiberTerm::add_dense_blocks(const Eigen::MatrixXd& X, const Eigen::Matr
 }
 
 void BulkFiberTerm::add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                                       const Eigen::MatrixXd& C1, const Eigen::MatrixXd& C2,
+                                       const Eigen::MatrixXf& C1, const Eigen::MatrixXf& C2,
                                        const Eigen::MatrixXd& W, Eigen::VectorXd& out) const {
   const int n = c_.model.num_vertices(), dim = c_.model.dim();
   const Eigen::Vector3d m = c_.model.material.axis_factors;

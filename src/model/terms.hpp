@@ -120,14 +120,15 @@ class BulkFiberTerm final : public EquilibriumTerm {
                                 Eigen::Ref<Eigen::VectorXd> column) const override;
 
   // c1 and c2 of every pair (N x N, symmetric, zero diagonal).
-  void coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U, Eigen::MatrixXd* c1,
-                    Eigen::MatrixXd* c2) const;
+  // In single precision: the table Newton-Krylov's stored product reads.
+  void coefficients(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U, Eigen::MatrixXf* c1,
+                    Eigen::MatrixXf* c2) const;
   // add_residual and coefficients at the same state in one pass (a table).
-  void add_residual_and_coefficients(const TermState& s, Eigen::VectorXd& R, Eigen::MatrixXd* c1,
-                                     Eigen::MatrixXd* c2) const;
+  void add_residual_and_coefficients(const TermState& s, Eigen::VectorXd& R, Eigen::MatrixXf* c1,
+                                     Eigen::MatrixXf* c2) const;
   // out += the tangent times W from stored coefficients (one pass over memory).
   void add_stored_product(const Eigen::MatrixXd& X, const Eigen::MatrixXd& U,
-                          const Eigen::MatrixXd& c1, const Eigen::MatrixXd& c2,
+                          const Eigen::MatrixXf& c1, const Eigen::MatrixXf& c2,
                           const Eigen::MatrixXd& W, Eigen::VectorXd& out) const;
 
   // The same two for fibers stored as neighbour lists (a sparse mask): the

@@ -3,6 +3,8 @@
 // sphere of the Newton equations' tests and random states of it.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
 #include <string>
@@ -131,6 +133,20 @@ inline Eigen::MatrixXd finite_difference_tangent(const model::Equilibrium& eq,
     J.col(k) = (eq.residual(plus, factors) - eq.residual(minus, factors)) / (2.0 * h);
   }
   return J;
+}
+
+// The stored tangent (Equilibrium::linearize) times v against the exact J v:
+// its pair coefficients are kept in single precision, so each pair's term is
+// within 2^-24 of its own size, and the sum within that of |J| |v| (entry by
+// entry), with a margin of 16 for the other roundings. Cancellation between
+// the terms of a row can make it far larger relative to |J v| itself.
+inline ::testing::AssertionResult stored_product_matches(const Eigen::VectorXd& stored,
+                                                         const Eigen::MatrixXd& J,
+                                                         const Eigen::VectorXd& v) {
+  const double bound = 1e-6 * (J.cwiseAbs() * v.cwiseAbs()).norm();
+  const double error = (stored - J * v).norm();
+  if (error < bound) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "stored product off by " << error << ", bound " << bound;
 }
 
 // The mean z displacement of the vertices at x (a bar's deflection at a station).

@@ -143,7 +143,8 @@ TEST(BulkPairs, SameThreadsSameBitsOneOrTwoThreadsClose) {
 
 // DeformedPairs against the vector spring written out pair by pair here
 // (model.md section 7: c1 = a Y(e), c2 = a Y'(e) / (r L)):
-// forces, the tangent product and the stored coefficients, on a pruned
+// forces, the tangent product and the stored coefficients (in double, and
+// in single for the stored product), on a pruned
 // sphere with a strain-dependent law and a non-affine displacement.
 TEST(DeformedPairs, MatchTheStencilPairByPair) {
   const PairSet s = sphere(true);
@@ -182,11 +183,29 @@ TEST(DeformedPairs, MatchTheStencilPairByPair) {
   };
   EXPECT_LT((lower(c1) - lower(C1)).cwiseAbs().maxCoeff(), 1e-14 * C1.cwiseAbs().maxCoeff());
   EXPECT_LT((lower(c2) - lower(C2)).cwiseAbs().maxCoeff(), 1e-14 * C2.cwiseAbs().maxCoeff());
-  // The product from them, each pair read once, is the product pair by pair.
-  EXPECT_LT((stored_tangent_product(FiberKinematics::VectorSpring, X, U, c1, c2, W) - product)
-                .cwiseAbs()
-                .maxCoeff(),
-            1e-12 * product.cwiseAbs().maxCoeff());
+  // The single-precision table holds the same coefficients rounded.
+  Eigen::MatrixXf f1, f2;
+  pairs.coefficients(&f1, &f2);
+  const auto lower_single = [](const Eigen::MatrixXf& M) {
+    return Eigen::MatrixXf(M.triangularView<Eigen::StrictlyLower>());
+  };
+  EXPECT_TRUE((lower_single(f1).array() == lower(c1).cast<float>().array()).all());
+  EXPECT_TRUE((lower_single(f2).array() == lower(c2).cast<float>().array()).all());
+  // The product from it, each pair read once, is the product pair by pair
+  // of the rounded coefficients, and the exact one to single precision.
+  Eigen::MatrixXd rounded = Eigen::MatrixXd::Zero(n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (i == j) continue;
+      const int low = std::min(i, j), high = std::max(i, j);
+      const Eigen::RowVector3d v = W.row(i) - W.row(j), d = U.row(i) - U.row(j);
+      rounded.row(i) += double(f1(high, low)) * v +
+                        double(f2(high, low)) * (X.row(i) - X.row(j)).dot(v) * d;
+    }
+  const Eigen::MatrixXd stored =
+      stored_tangent_product(FiberKinematics::VectorSpring, X, U, f1, f2, W);
+  EXPECT_LT((stored - rounded).cwiseAbs().maxCoeff(), 1e-12 * product.cwiseAbs().maxCoeff());
+  EXPECT_LT((stored - product).cwiseAbs().maxCoeff(), 1e-6 * product.cwiseAbs().maxCoeff());
 }
 
 }  // namespace
