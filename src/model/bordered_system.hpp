@@ -37,6 +37,11 @@ class BorderedSystem {
   virtual std::string block_name(int block) const { return "block " + std::to_string(block); }
 
   virtual Eigen::MatrixXd dense_block(int block) const = 0;
+  // The same in single precision, for a single-precision factor. A system
+  // that can fill it directly overrides this (no double copy of N^2 first).
+  virtual Eigen::MatrixXf dense_block_single(int block) const {
+    return dense_block(block).cast<float>();
+  }
   virtual Eigen::SparseMatrix<double> sparse_block(int block) const = 0;
   // A sparse, symmetric positive definite approximation of the block that a
   // preconditioner factors.

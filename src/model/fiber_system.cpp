@@ -111,18 +111,29 @@ void FiberSystem::project_on_axes(const Eigen::MatrixXd& positions) {
 }
 
 Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
+  return dense_block_in<Eigen::MatrixXd>(axis);
+}
+
+Eigen::MatrixXf FiberSystem::dense_block_single(int axis) const {
+  return dense_block_in<Eigen::MatrixXf>(axis);
+}
+
+template <class Matrix>
+Matrix FiberSystem::dense_block_in(int axis) const {
+  using Scalar = typename Matrix::Scalar;
   const std::vector<int>& act = active(axis);
   const auto m = static_cast<Eigen::Index>(act.size());
   const double y = young(axis);
-  Eigen::MatrixXd K(m, m);  // every entry is written below (no pass of zeros first)
-  advise_huge_pages(K.data(), 8.0 * static_cast<double>(K.size()));
+  Matrix K(m, m);  // every entry is written below (no pass of zeros first)
+  advise_huge_pages(K.data(), sizeof(Scalar) * static_cast<double>(K.size()));
   if (y == 0.0) {
     K.setZero();
   } else {
     bulk_pairs(act, axis).fill_off_diagonal(y, &K);
     // The diagonal gathers the weights to every vertex, active or not.
     const Eigen::VectorXd& diagonal = bulk_diagonal(axis);
-    for (Eigen::Index r = 0; r < m; ++r) K(r, r) = y * diagonal[act[static_cast<size_t>(r)]];
+    for (Eigen::Index r = 0; r < m; ++r)
+      K(r, r) = static_cast<Scalar>(y * diagonal[act[static_cast<size_t>(r)]]);
   }
   if (gamma_ != 0.0) {
     std::vector<int> position(static_cast<size_t>(n_), -1);
@@ -132,10 +143,10 @@ Eigen::MatrixXd FiberSystem::dense_block(int axis) const {
       for (Eigen::SparseMatrix<double>::InnerIterator it(surface_, col); it; ++it) {
         const int r = position[static_cast<size_t>(it.row())],
                   c = position[static_cast<size_t>(it.col())];
-        if (r >= 0 && c >= 0) K(r, c) += gamma_ * it.value();
+        if (r >= 0 && c >= 0) K(r, c) += static_cast<Scalar>(gamma_ * it.value());
       }
   }
-  for (int k : penalised(axis)) K(k, k) = penalty_;
+  for (int k : penalised(axis)) K(k, k) = static_cast<Scalar>(penalty_);
   return K;
 }
 

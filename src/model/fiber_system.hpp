@@ -73,6 +73,7 @@ class FiberSystem final : public BorderedSystem {
   bool sparse_fibers() const;
   // K_a over the active vertices, dense.
   Eigen::MatrixXd dense_block(int axis) const override;
+  Eigen::MatrixXf dense_block_single(int axis) const override;
   // K_a as a sparse matrix (with the bulk fibers: N^2 entries).
   Eigen::SparseMatrix<double> sparse_block(int axis) const override {
     return sparse_block(axis, true);
@@ -119,6 +120,9 @@ class FiberSystem final : public BorderedSystem {
   Eigen::VectorXd expand(const Eigen::VectorXd& reduced, const Eigen::VectorXd& U_c) const;
 
  private:
+  // dense_block in double or single precision.
+  template <class Matrix>
+  Matrix dense_block_in(int axis) const;
   // The bulk pairs of `vertices` (empty: all), with the secant law if any.
   // Axis a's weights when projected (axis -1: unprojected).
   BulkPairs bulk_pairs(const std::vector<int>& vertices = {}, int axis = -1) const;

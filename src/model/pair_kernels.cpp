@@ -129,26 +129,27 @@ void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult, double* 
 // columns i of the tile written whole (contiguous), then mirrored into the
 // rows i in 32 x 32 blocks, so that the strided side touches 32 pages at a
 // time (the TLB's reach) instead of one per column of the tile.
-FIBERFLUID_VECTOR_CLONES
-void block_tile(const SetArrays& s, const Tile& t, Multipliers mult, double scale, double* K,
-                Eigen::Index ld) {
+template <class Scalar>
+FIBERFLUID_VECTOR_CLONES void block_tile(const SetArrays& s, const Tile& t, Multipliers mult,
+                                         double scale, Scalar* K, Eigen::Index ld) {
   const double *x0 = s.x0, *x1 = s.x1, *x2 = s.x2, *a = s.area, *c = s.count;
   for (int r = 0; r < t.ni; ++r) {
     const int i = t.i0 + r;
     const double xi = x0[i], yi = x1[i], zi = x2[i], ai = a[i], ci = c[i];
     const double* m = mult.m + static_cast<size_t>(r) * mult.stride;  // m[j - j0]
-    double* column = K + static_cast<Eigen::Index>(i) * ld;
+    Scalar* column = K + static_cast<Eigen::Index>(i) * ld;
 #pragma omp simd
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
-      column[j] = -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz);
+      column[j] = static_cast<Scalar>(
+          -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz));
     }
   }
   constexpr int B = 32;
   for (int jb = t.j0; jb < t.j0 + t.nj; jb += B)
     for (int ib = t.i0; ib < t.i0 + t.ni && (!t.diagonal || ib <= jb); ib += B)
       for (int j = jb; j < std::min(jb + B, t.j0 + t.nj); ++j) {
-        double* row_block = K + static_cast<Eigen::Index>(j) * ld;  // K(i, j), i in the block
+        Scalar* row_block = K + static_cast<Eigen::Index>(j) * ld;  // K(i, j), i in the block
         const int end = std::min(ib + B, t.diagonal ? j : t.i0 + t.ni);
         for (int i = ib; i < end; ++i) row_block[i] = K[static_cast<Eigen::Index>(i) * ld + j];
       }
@@ -423,19 +424,29 @@ void BulkPairs::add_off_diagonal(double scale, std::vector<Eigen::Triplet<double
       if (r != c && K(r, c) != 0.0) entries->emplace_back(r, c, K(r, c));
 }
 
-void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
+template <class Matrix>
+void BulkPairs::fill_off_diagonal_of(double scale, Matrix* K) const {
+  using Scalar = typename Matrix::Scalar;
   if (sparse()) {
     for (int c = 0; c < n_; ++c)
       for (int r = 0; r < n_; ++r)
-        if (r != c) (*K)(r, c) = 0.0;
-    for_each_listed([&](int r, int c, double w) { (*K)(r, c) = -scale * w; });
+        if (r != c) (*K)(r, c) = 0;
+    for_each_listed([&](int r, int c, double w) { (*K)(r, c) = static_cast<Scalar>(-scale * w); });
     return;
   }
   const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
-  double* data = K->data();
+  Scalar* data = K->data();
   const Eigen::Index ld = K->rows();
   // Tiles write disjoint parts of K: no accumulators.
   for_each_tile([&](const Tile& t, Multipliers m, int) { block_tile(s, t, m, scale, data, ld); });
+}
+
+void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
+  fill_off_diagonal_of(scale, K);
+}
+
+void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXf* K) const {
+  fill_off_diagonal_of(scale, K);
 }
 
 DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,

@@ -75,8 +75,10 @@ class BulkPairs {
   // (L V)_i = sum_j w_ij (V_i - V_j); V: one row per vertex of the set.
   Eigen::MatrixXd laplacian_product(const Eigen::MatrixXd& V) const;
   // K(r, c) = -scale w_rc for r != c over the set (K: size() x size());
-  // the diagonal is left as it was.
+  // the diagonal is left as it was. In single precision for a
+  // single-precision factor, without a double copy first.
   void fill_off_diagonal(double scale, Eigen::MatrixXd* K) const;
+  void fill_off_diagonal(double scale, Eigen::MatrixXf* K) const;
   // The same as triplets (r, c, -scale w_rc), one per kept pair and order:
   // N times the neighbours for a mask stored sparse, N^2 otherwise.
   void add_off_diagonal(double scale, std::vector<Eigen::Triplet<double>>* entries) const;
@@ -93,6 +95,8 @@ class BulkPairs {
   };
 
  private:
+  template <class Matrix>
+  void fill_off_diagonal_of(double scale, Matrix* K) const;
   // The multipliers m_ij of one tile (row-major, kTile per row), for a
   // pruned body or a strain-dependent law (otherwise every m_ij is 1).
   void multipliers(const Tile& t, double* m) const;

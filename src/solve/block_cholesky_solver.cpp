@@ -34,7 +34,7 @@ class BlockCholeskySolver final : public SchurSolver {
   Status analyze_pattern(const model::BorderedSystem& system) override {
     const double n = system.largest_block();
     const int factors = system.blocks_equal() ? 1 : system.num_blocks();
-    return require_memory(8.0 * n * n + sizeof(Scalar) * n * n * factors,
+    return require_memory(sizeof(Scalar) * n * n * factors,  // each block factored where it lies
                           "block Cholesky with " + std::to_string(factors) + " dense " +
                               std::to_string(system.largest_block()) + "-square factors");
   }
@@ -50,7 +50,7 @@ class BlockCholeskySolver final : public SchurSolver {
       if constexpr (std::is_same_v<Scalar, double>)
         K = system.dense_block(a);
       else
-        K = system.dense_block(a).template cast<Scalar>();
+        K = system.dense_block_single(a);
       const int n = static_cast<int>(K.rows());
       int info = 0;
       const auto start = std::chrono::steady_clock::now();
