@@ -714,13 +714,12 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
 
 namespace {
 
-// The stored tangent product over the pairs (i, j) of row i with j in
-// [first, end), j > i: their terms summed into out at i, their opposites
-// (the pair seen from j: b, v and g change sign) into out at j. Column i of
-// c1, c2 holds row i's pairs, one contiguous run of memory.
+// The stored tangent product over row i's pairs (i, j > i): their terms
+// summed into out at i, their opposites (the pair seen from j: b, v and g
+// change sign) into out at j. Column i of c1, c2 holds those pairs: one
+// contiguous run of memory per row, which is what bounds this product.
 template <class K>
-FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int first, int end, const float* k1,
-                                                 const float* k2,
+FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const float* k1, const float* k2,
                                                  const double* const x[3], const double* const d[3],
                                                  const double* const w[3],
                                                  const std::array<double*, 3>& out) {
@@ -731,7 +730,7 @@ FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int first, int end, cons
   const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
   double s0 = 0.0, s1 = 0.0, s2 = 0.0;
 #pragma omp simd reduction(+ : s0, s1, s2)
-  for (int j = first; j < end; ++j) {
+  for (int j = i + 1; j < n; ++j) {
     const PairCoefficients c{k1[j], k2[j]};
     const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
     const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
@@ -758,13 +757,8 @@ Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::
     d[a] = a < dim ? U.col(a).data() : zeros.data();
     w[a] = a < dim ? W.col(a).data() : zeros.data();
   }
-  // Blocks of kRows rows dealt out in turn (their lengths fall evenly: the
-  // shares balance), a fixed share per thread: the same bits run after run.
-  // A block's rows go over the columns kColumns at a time, so that the
-  // columns' positions, displacements, directions and sums (12 arrays) are
-  // read from L1 once per block, not from L2 once per row.
-  constexpr int kRows = 8, kColumns = 256;
-  const int blocks = (n + kRows - 1) / kRows;
+  // Rows dealt out in turn (their lengths fall by one each: the shares
+  // balance), a fixed share per thread: the same bits run after run.
   ThreadAccumulators products(n, 3);
   with_kinematics(kinematics, [&](auto policy) {
     using K = decltype(policy);
@@ -772,15 +766,8 @@ Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::
     {
       const std::array<double*, 3> out = products.columns(omp_get_thread_num());
 #pragma omp for schedule(static, 1)
-      for (int b = 0; b < blocks; ++b) {
-        const int i0 = b * kRows, i1 = std::min(n, i0 + kRows);
-        for (int i = i0; i < i1; ++i)  // the pairs within the block
-          stored_tangent_row<K>(i, i + 1, i1, C1.col(i).data(), C2.col(i).data(), x, d, w, out);
-        for (int j0 = i1; j0 < n; j0 += kColumns)
-          for (int i = i0; i < i1; ++i)
-            stored_tangent_row<K>(i, j0, std::min(n, j0 + kColumns), C1.col(i).data(),
-                                  C2.col(i).data(), x, d, w, out);
-      }
+      for (int i = 0; i < n; ++i)
+        stored_tangent_row<K>(i, n, C1.col(i).data(), C2.col(i).data(), x, d, w, out);
     }
   });
   return products.sum();
