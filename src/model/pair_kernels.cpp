@@ -714,34 +714,62 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
 
 namespace {
 
-// The stored tangent product over row i's pairs (i, j > i): their terms
-// summed into out at i, their opposites (the pair seen from j: b, v and g
-// change sign) into out at j. Column i of c1, c2 holds those pairs: one
-// contiguous run of memory per row, which is what bounds this product.
+// The stored tangent product over the pairs of rows i and i + 1: the pair
+// (i, i + 1), then (i, j) and (i + 1, j) for j > i + 1 together, which
+// reads column j's positions, displacements and directions once for both and
+// updates its sums once. Each term is summed into out at its row and its
+// opposite (the pair seen from j: b, v and g change sign) into out at j.
+// Column i of c1, c2 holds row i's pairs (j > i): one contiguous run.
 template <class K>
-FIBERFLUID_VECTOR_CLONES void stored_tangent_row(int i, int n, const float* k1, const float* k2,
-                                                 const double* const x[3], const double* const d[3],
-                                                 const double* const w[3],
-                                                 const std::array<double*, 3>& out) {
+FIBERFLUID_VECTOR_CLONES void stored_tangent_rows(int i, int n, const float* k1a, const float* k2a,
+                                                  const float* k1b, const float* k2b,
+                                                  const double* const x[3],
+                                                  const double* const d[3],
+                                                  const double* const w[3],
+                                                  const std::array<double*, 3>& out) {
   const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *d0 = d[0], *d1 = d[1], *d2 = d[2];
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
-  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], di0 = d0[i], di1 = d1[i], di2 = d2[i];
-  const double wi0 = w0[i], wi1 = w1[i], wi2 = w2[i];
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-#pragma omp simd reduction(+ : s0, s1, s2)
-  for (int j = i + 1; j < n; ++j) {
-    const PairCoefficients c{k1[j], k2[j]};
-    const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
-    const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
+  const int h = i + 1;
+  const double xa0 = x0[i], xa1 = x1[i], xa2 = x2[i], da0 = d0[i], da1 = d1[i], da2 = d2[i];
+  const double wa0 = w0[i], wa1 = w1[i], wa2 = w2[i];
+  const double xb0 = x0[h], xb1 = x1[h], xb2 = x2[h], db0 = d0[h], db1 = d1[h], db2 = d2[h];
+  const double wb0 = w0[h], wb1 = w1[h], wb2 = w2[h];
+  // The pair (i, i + 1) itself.
+  double sa0, sa1, sa2;
+  {
+    const PairCoefficients c{k1a[h], k2a[h]};
+    const double b0 = xa0 - xb0, b1 = xa1 - xb1, b2 = xa2 - xb2;
+    const double v0 = wa0 - wb0, v1 = wa1 - wb1, v2 = wa2 - wb2;
     const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-    const double p0 = pair_tangent<K>(c, v0, b_dot_v, b0, di0 - d0[j]);
-    const double p1 = pair_tangent<K>(c, v1, b_dot_v, b1, di1 - d1[j]);
-    const double p2 = pair_tangent<K>(c, v2, b_dot_v, b2, di2 - d2[j]);
-    s0 += p0, s1 += p1, s2 += p2;
-    o0[j] -= p0, o1[j] -= p1, o2[j] -= p2;
+    sa0 = pair_tangent<K>(c, v0, b_dot_v, b0, da0 - db0);
+    sa1 = pair_tangent<K>(c, v1, b_dot_v, b1, da1 - db1);
+    sa2 = pair_tangent<K>(c, v2, b_dot_v, b2, da2 - db2);
   }
-  o0[i] += s0, o1[i] += s1, o2[i] += s2;
+  double sb0 = -sa0, sb1 = -sa1, sb2 = -sa2;
+#pragma omp simd reduction(+ : sa0, sa1, sa2, sb0, sb1, sb2)
+  for (int j = i + 2; j < n; ++j) {
+    const double xj0 = x0[j], xj1 = x1[j], xj2 = x2[j], dj0 = d0[j], dj1 = d1[j], dj2 = d2[j];
+    const double wj0 = w0[j], wj1 = w1[j], wj2 = w2[j];
+    const PairCoefficients ca{k1a[j], k2a[j]}, cb{k1b[j], k2b[j]};
+    const double ba0 = xa0 - xj0, ba1 = xa1 - xj1, ba2 = xa2 - xj2;
+    const double va0 = wa0 - wj0, va1 = wa1 - wj1, va2 = wa2 - wj2;
+    const double a_dot = ba0 * va0 + ba1 * va1 + ba2 * va2;
+    const double pa0 = pair_tangent<K>(ca, va0, a_dot, ba0, da0 - dj0);
+    const double pa1 = pair_tangent<K>(ca, va1, a_dot, ba1, da1 - dj1);
+    const double pa2 = pair_tangent<K>(ca, va2, a_dot, ba2, da2 - dj2);
+    const double bb0 = xb0 - xj0, bb1 = xb1 - xj1, bb2 = xb2 - xj2;
+    const double vb0 = wb0 - wj0, vb1 = wb1 - wj1, vb2 = wb2 - wj2;
+    const double b_dot = bb0 * vb0 + bb1 * vb1 + bb2 * vb2;
+    const double pb0 = pair_tangent<K>(cb, vb0, b_dot, bb0, db0 - dj0);
+    const double pb1 = pair_tangent<K>(cb, vb1, b_dot, bb1, db1 - dj1);
+    const double pb2 = pair_tangent<K>(cb, vb2, b_dot, bb2, db2 - dj2);
+    sa0 += pa0, sa1 += pa1, sa2 += pa2;
+    sb0 += pb0, sb1 += pb1, sb2 += pb2;
+    o0[j] -= pa0 + pb0, o1[j] -= pa1 + pb1, o2[j] -= pa2 + pb2;
+  }
+  o0[i] += sa0, o1[i] += sa1, o2[i] += sa2;
+  o0[h] += sb0, o1[h] += sb1, o2[h] += sb2;
 }
 
 }  // namespace
@@ -757,8 +785,9 @@ Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::
     d[a] = a < dim ? U.col(a).data() : zeros.data();
     w[a] = a < dim ? W.col(a).data() : zeros.data();
   }
-  // Rows dealt out in turn (their lengths fall by one each: the shares
-  // balance), a fixed share per thread: the same bits run after run.
+  // Two rows at a time, dealt out in turn (their lengths fall by two each:
+  // the shares balance), a fixed share per thread: the same bits run after
+  // run. A last row of its own (n odd) has no pairs j > i.
   ThreadAccumulators products(n, 3);
   with_kinematics(kinematics, [&](auto policy) {
     using K = decltype(policy);
@@ -766,8 +795,9 @@ Eigen::MatrixXd stored_tangent_product(FiberKinematics kinematics, const Eigen::
     {
       const std::array<double*, 3> out = products.columns(omp_get_thread_num());
 #pragma omp for schedule(static, 1)
-      for (int i = 0; i < n; ++i)
-        stored_tangent_row<K>(i, n, C1.col(i).data(), C2.col(i).data(), x, d, w, out);
+      for (int i = 0; i < n - 1; i += 2)
+        stored_tangent_rows<K>(i, n, C1.col(i).data(), C2.col(i).data(), C1.col(i + 1).data(),
+                               C2.col(i + 1).data(), x, d, w, out);
     }
   });
   return products.sum();
