@@ -169,7 +169,7 @@ void Equilibrium::add_other_products(const TermState& s, const Eigen::VectorXd& 
 }
 
 double TangentOperator::bytes_for(int num_vertices) {
-  return 2.0 * 8.0 * num_vertices * static_cast<double>(num_vertices);
+  return 2.0 * sizeof(float) * num_vertices * static_cast<double>(num_vertices);
 }
 
 TangentOperator Equilibrium::linearize(const Eigen::VectorXd& x,

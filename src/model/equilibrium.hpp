@@ -19,8 +19,8 @@ namespace fiberfluid::model {
 class Equilibrium;
 
 // The tangent at one state as an operator: the bulk fibers' pair
-// coefficients (the stencil's c1, c2) stored once (two N x N arrays,
-// bytes_for(N)), so that each product is one pass over memory rather than
+// coefficients (the stencil's c1, c2) stored once (two N x N arrays in single
+// precision, bytes_for(N)), so that each product is one pass over memory rather than
 // square roots and law evaluations per pair. Equilibrium::linearize builds it.
 class TangentOperator {
  public:
