@@ -221,6 +221,36 @@ FIBERFLUID_VECTOR_CLONES void forces_row(const PairColumns& p, const double* are
   o0[i] += f0, o1[i] += f1, o2[i] += f2;
 }
 
+// Row i's pair coefficients into k1, k2 (at j, the lower triangle), and
+// with kForces its forces summed into out on the way (as forces_row): one
+// loop over the row arrays for both, each pair's coefficients formed once.
+template <class K, class Scalar, bool kForces>
+FIBERFLUID_VECTOR_CLONES void coefficients_row(const PairColumns& p, const double* area,
+                                               const double* count, int i, int j0, int first,
+                                               int end, const RowArrays& row, Scalar* k1,
+                                               Scalar* k2, const std::array<double*, 3>& out) {
+  const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
+  const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
+  double *o0 = out[0], *o1 = out[1], *o2 = out[2];
+  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], ui0 = u0[i], ui1 = u1[i], ui2 = u2[i];
+  const double ai = area[i], ci = count[i];
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+#pragma omp simd reduction(+ : f0, f1, f2)
+  for (int j = first; j < end; ++j) {
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
+    k1[j] = static_cast<Scalar>(c.c1);
+    k2[j] = static_cast<Scalar>(c.c2);
+    if constexpr (kForces) {
+      const double e0 = pair_force<K>(c, xi0 - x0[j], ui0 - u0[j]),
+                   e1 = pair_force<K>(c, xi1 - x1[j], ui1 - u1[j]),
+                   e2 = pair_force<K>(c, xi2 - x2[j], ui2 - u2[j]);
+      f0 += e0, f1 += e1, f2 += e2;
+      o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
+    }
+  }
+  if constexpr (kForces) o0[i] += f0, o1[i] += f1, o2[i] += f2;
+}
+
 template <class K>
 FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* const w[3],
                                           const double* area, const double* count, int i, int j0,
@@ -698,16 +728,13 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      if (forces != nullptr)  // the row's lengths and law, used twice
-        forces_row<K>(p, area, count, i, j0, first, end, row, forces->columns(thread));
       Scalar* k1 = c1->col(i).data();
       Scalar* k2 = c2->col(i).data();
-      for (int j = first; j < end; ++j) {  // j > i: the lower triangle, written in order
-        const PairCoefficients c =
-            row_coefficients<K>(row, j - j0, area[i], area[j], count[i], count[j]);
-        k1[j] = static_cast<Scalar>(c.c1);
-        k2[j] = static_cast<Scalar>(c.c2);
-      }
+      if (forces != nullptr)
+        coefficients_row<K, Scalar, true>(p, area, count, i, j0, first, end, row, k1, k2,
+                                          forces->columns(thread));
+      else
+        coefficients_row<K, Scalar, false>(p, area, count, i, j0, first, end, row, k1, k2, {});
     });
   });
 }
