@@ -144,6 +144,11 @@ int main(int argc, char** argv) {
          moved[0] = moved[0] == x[0] ? x[0] + 1e-9 : x[0];
          equilibrium.linearize(moved, factors, stored);
        }},
+      {"residual and c1, c2 (one pass)", ordered, 0, unordered, 0,
+       [&] {  // what a Newton iteration computes over the pairs
+         moved[0] = moved[0] == x[0] ? x[0] + 1e-9 : x[0];
+         vector_sink = equilibrium.residual(moved, factors, stored);
+       }},
       {"law: block evaluation", unordered, 0, unordered, 0,
        [&] {
          for (long long r = 0; r < rows_of_pairs; ++r)
