@@ -12,6 +12,8 @@
 //   executed: what the tiled kernels do, each unordered pair once:
 //     bulk product 27, bulk diagonal 16, dense block 15, tangent product 59;
 //     the stored apply is still a row loop (27 per ordered pair).
+// Block Cholesky's solves of the x block (3 columns) by the threaded solve
+// and by LAPACK's potrs, in single and double precision.
 // Two floors say why not more: the square roots and divisions alone (one of
 // each per unordered pair, the divide unit's limit), and writing a fresh
 // matrix of the dense block's size (memory and page faults).
@@ -23,6 +25,7 @@
 #include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -31,8 +34,18 @@
 #include "fiberfluid/model/fiber_system.hpp"
 #include "fiberfluid/model/loads.hpp"
 #include "fiberfluid/model/vector_clones.hpp"
+#include "fiberfluid/solve/cholesky_solve.hpp"
 #include "fiberfluid/util/run_control.hpp"
 #include "gemm_peak.hpp"
+
+extern "C" {
+void spotrf_(const char*, const int*, float*, const int*, int*, std::size_t);
+void spotrs_(const char*, const int*, const int*, const float*, const int*, float*, const int*,
+             int*, std::size_t);
+void dpotrf_(const char*, const int*, double*, const int*, int*, std::size_t);
+void dpotrs_(const char*, const int*, const int*, const double*, const int*, double*, const int*,
+             int*, std::size_t);
+}
 
 namespace {
 
@@ -105,6 +118,21 @@ int main(int argc, char** argv) {
   fiberfluid::model::TangentOperator stored = equilibrium.linearize(x, factors);
   Eigen::VectorXd moved = x;
 
+  // Block Cholesky's solves with the sphere's x block factored, in single
+  // precision (Newton-Krylov's preconditioner) and double (the incremental
+  // scheme), three right-hand sides: the threaded solve against LAPACK's.
+  Eigen::MatrixXf factor_single = system.dense_block_single(0);
+  Eigen::MatrixXd factor_double = system.dense_block(0);
+  const int m = static_cast<int>(factor_double.rows());  // the free vertices
+  int info = 0;
+  spotrf_("L", &m, factor_single.data(), &m, &info, 1);
+  if (info == 0) dpotrf_("L", &m, factor_double.data(), &m, &info, 1);
+  if (info != 0) throw std::runtime_error("the sphere's block is not positive definite");
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(m, 3);
+  Eigen::MatrixXf solved_single;
+  Eigen::MatrixXd solved_double;
+  const int three = 3;
+
   struct Row {
     const char* name;
     double pairs, flops_per_pair;       // nominal: ordered pairs (entries for the block)
@@ -161,6 +189,28 @@ int main(int argc, char** argv) {
            for (size_t k = 0; k < strains.size(); ++k)
              moduli[k] = 3000.0 * std::exp(4.0 * strains[k]);
          scalar_sink += moduli[7];
+       }},
+      {"cholesky solve f32, threaded", 0, 0, 0, 0,
+       [&] {
+         solved_single = rhs.cast<float>();
+         fiberfluid::solve::cholesky_solve_in_place(m, factor_single.data(), solved_single.data(),
+                                                    3, m);
+       }},
+      {"cholesky solve f32, spotrs", 0, 0, 0, 0,
+       [&] {
+         solved_single = rhs.cast<float>();
+         spotrs_("L", &m, &three, factor_single.data(), &m, solved_single.data(), &m, &info, 1);
+       }},
+      {"cholesky solve f64, threaded", 0, 0, 0, 0,
+       [&] {
+         solved_double = rhs;
+         fiberfluid::solve::cholesky_solve_in_place(m, factor_double.data(), solved_double.data(),
+                                                    3, m);
+       }},
+      {"cholesky solve f64, dpotrs", 0, 0, 0, 0,
+       [&] {
+         solved_double = rhs;
+         dpotrs_("L", &m, &three, factor_double.data(), &m, solved_double.data(), &m, &info, 1);
        }},
       {"floor: sqrt + div per pair", unordered, 2, unordered, 2,
        [&] { scalar_sink = sqrt_div_floor(squared_lengths); }},
