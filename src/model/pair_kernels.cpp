@@ -199,10 +199,15 @@ PairColumns columns_of(const std::vector<double> (&x)[3], const std::vector<doub
   return {{x[0].data(), x[1].data(), x[2].data()}, {u[0].data(), u[1].data(), u[2].data()}};
 }
 
-template <class K>
-FIBERFLUID_VECTOR_CLONES void forces_row(const PairColumns& p, const double* area,
-                                         const double* count, int i, int j0, int first, int end,
-                                         const RowArrays& row, const std::array<double*, 3>& out) {
+// One loop over row i's pairs (j in [first, end)), each pair's coefficients
+// formed once: with kForces its forces summed into out (the term at i, its
+// opposite at j); with kTable its coefficients written to k1, k2 at j (the
+// lower triangle of the stored tangent's table).
+template <class K, bool kForces, bool kTable, class Scalar = float>
+FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area, const double* count,
+                                       int i, int j0, int first, int end, const RowArrays& row,
+                                       const std::array<double*, 3>& out, Scalar* k1 = nullptr,
+                                       Scalar* k2 = nullptr) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
   const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
@@ -212,34 +217,10 @@ FIBERFLUID_VECTOR_CLONES void forces_row(const PairColumns& p, const double* are
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (int j = first; j < end; ++j) {
     const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
-    const double e0 = pair_force<K>(c, xi0 - x0[j], ui0 - u0[j]),
-                 e1 = pair_force<K>(c, xi1 - x1[j], ui1 - u1[j]),
-                 e2 = pair_force<K>(c, xi2 - x2[j], ui2 - u2[j]);
-    f0 += e0, f1 += e1, f2 += e2;
-    o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
-  }
-  o0[i] += f0, o1[i] += f1, o2[i] += f2;
-}
-
-// Row i's pair coefficients into k1, k2 (at j, the lower triangle), and
-// with kForces its forces summed into out on the way (as forces_row): one
-// loop over the row arrays for both, each pair's coefficients formed once.
-template <class K, class Scalar, bool kForces>
-FIBERFLUID_VECTOR_CLONES void coefficients_row(const PairColumns& p, const double* area,
-                                               const double* count, int i, int j0, int first,
-                                               int end, const RowArrays& row, Scalar* k1,
-                                               Scalar* k2, const std::array<double*, 3>& out) {
-  const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
-  const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
-  double *o0 = out[0], *o1 = out[1], *o2 = out[2];
-  const double xi0 = x0[i], xi1 = x1[i], xi2 = x2[i], ui0 = u0[i], ui1 = u1[i], ui2 = u2[i];
-  const double ai = area[i], ci = count[i];
-  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
-#pragma omp simd reduction(+ : f0, f1, f2)
-  for (int j = first; j < end; ++j) {
-    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
-    k1[j] = static_cast<Scalar>(c.c1);
-    k2[j] = static_cast<Scalar>(c.c2);
+    if constexpr (kTable) {
+      k1[j] = static_cast<Scalar>(c.c1);
+      k2[j] = static_cast<Scalar>(c.c2);
+    }
     if constexpr (kForces) {
       const double e0 = pair_force<K>(c, xi0 - x0[j], ui0 - u0[j]),
                    e1 = pair_force<K>(c, xi1 - x1[j], ui1 - u1[j]),
@@ -641,7 +622,8 @@ Eigen::MatrixXd DeformedPairs::forces() const {
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      forces_row<K>(p, area_.data(), count_.data(), i, j0, first, end, row, forces.columns(thread));
+      row_pass<K, true, false>(p, area_.data(), count_.data(), i, j0, first, end, row,
+                               forces.columns(thread));
     });
   });
   return forces.sum();
@@ -731,15 +713,36 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
       Scalar* k1 = c1->col(i).data();
       Scalar* k2 = c2->col(i).data();
       if (forces != nullptr)
-        coefficients_row<K, Scalar, true>(p, area, count, i, j0, first, end, row, k1, k2,
-                                          forces->columns(thread));
+        row_pass<K, true, true>(p, area, count, i, j0, first, end, row, forces->columns(thread),
+                                k1, k2);
       else
-        coefficients_row<K, Scalar, false>(p, area, count, i, j0, first, end, row, k1, k2, {});
+        row_pass<K, false, true>(p, area, count, i, j0, first, end, row, {}, k1, k2);
     });
   });
 }
 
 namespace {
+
+// A vertex's three components (position, direction or displacement).
+struct Components {
+  double c0, c1, c2;
+};
+
+Components components_at(const double* const v[3], int i) { return {v[0][i], v[1][i], v[2][i]}; }
+
+// The stored tangent's term of the pair (r, j) at r, from r's and j's
+// positions x, directions w and displacements d (the stencil's b, v, g).
+template <class K>
+inline Components stored_term(const PairCoefficients& c, const Components& xr,
+                              const Components& wr, const Components& dr, const Components& xj,
+                              const Components& wj, const Components& dj) {
+  const double b0 = xr.c0 - xj.c0, b1 = xr.c1 - xj.c1, b2 = xr.c2 - xj.c2;
+  const double v0 = wr.c0 - wj.c0, v1 = wr.c1 - wj.c1, v2 = wr.c2 - wj.c2;
+  const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
+  return {pair_tangent<K>(c, v0, b_dot_v, b0, dr.c0 - dj.c0),
+          pair_tangent<K>(c, v1, b_dot_v, b1, dr.c1 - dj.c1),
+          pair_tangent<K>(c, v2, b_dot_v, b2, dr.c2 - dj.c2)};
+}
 
 // The stored tangent product over the pairs of rows i and i + 1: the pair
 // (i, i + 1), then (i, j) and (i + 1, j) for j > i + 1 together, which
@@ -758,42 +761,19 @@ FIBERFLUID_VECTOR_CLONES void stored_tangent_rows(int i, int n, const float* k1a
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
   const int h = i + 1;
-  const double xa0 = x0[i], xa1 = x1[i], xa2 = x2[i], da0 = d0[i], da1 = d1[i], da2 = d2[i];
-  const double wa0 = w0[i], wa1 = w1[i], wa2 = w2[i];
-  const double xb0 = x0[h], xb1 = x1[h], xb2 = x2[h], db0 = d0[h], db1 = d1[h], db2 = d2[h];
-  const double wb0 = w0[h], wb1 = w1[h], wb2 = w2[h];
-  // The pair (i, i + 1) itself.
-  double sa0, sa1, sa2;
-  {
-    const PairCoefficients c{k1a[h], k2a[h]};
-    const double b0 = xa0 - xb0, b1 = xa1 - xb1, b2 = xa2 - xb2;
-    const double v0 = wa0 - wb0, v1 = wa1 - wb1, v2 = wa2 - wb2;
-    const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-    sa0 = pair_tangent<K>(c, v0, b_dot_v, b0, da0 - db0);
-    sa1 = pair_tangent<K>(c, v1, b_dot_v, b1, da1 - db1);
-    sa2 = pair_tangent<K>(c, v2, b_dot_v, b2, da2 - db2);
-  }
+  const Components xa = components_at(x, i), wa = components_at(w, i), da = components_at(d, i);
+  const Components xb = components_at(x, h), wb = components_at(w, h), db = components_at(d, h);
+  const Components first = stored_term<K>({k1a[h], k2a[h]}, xa, wa, da, xb, wb, db);
+  double sa0 = first.c0, sa1 = first.c1, sa2 = first.c2;
   double sb0 = -sa0, sb1 = -sa1, sb2 = -sa2;
 #pragma omp simd reduction(+ : sa0, sa1, sa2, sb0, sb1, sb2)
   for (int j = i + 2; j < n; ++j) {
-    const double xj0 = x0[j], xj1 = x1[j], xj2 = x2[j], dj0 = d0[j], dj1 = d1[j], dj2 = d2[j];
-    const double wj0 = w0[j], wj1 = w1[j], wj2 = w2[j];
-    const PairCoefficients ca{k1a[j], k2a[j]}, cb{k1b[j], k2b[j]};
-    const double ba0 = xa0 - xj0, ba1 = xa1 - xj1, ba2 = xa2 - xj2;
-    const double va0 = wa0 - wj0, va1 = wa1 - wj1, va2 = wa2 - wj2;
-    const double a_dot = ba0 * va0 + ba1 * va1 + ba2 * va2;
-    const double pa0 = pair_tangent<K>(ca, va0, a_dot, ba0, da0 - dj0);
-    const double pa1 = pair_tangent<K>(ca, va1, a_dot, ba1, da1 - dj1);
-    const double pa2 = pair_tangent<K>(ca, va2, a_dot, ba2, da2 - dj2);
-    const double bb0 = xb0 - xj0, bb1 = xb1 - xj1, bb2 = xb2 - xj2;
-    const double vb0 = wb0 - wj0, vb1 = wb1 - wj1, vb2 = wb2 - wj2;
-    const double b_dot = bb0 * vb0 + bb1 * vb1 + bb2 * vb2;
-    const double pb0 = pair_tangent<K>(cb, vb0, b_dot, bb0, db0 - dj0);
-    const double pb1 = pair_tangent<K>(cb, vb1, b_dot, bb1, db1 - dj1);
-    const double pb2 = pair_tangent<K>(cb, vb2, b_dot, bb2, db2 - dj2);
-    sa0 += pa0, sa1 += pa1, sa2 += pa2;
-    sb0 += pb0, sb1 += pb1, sb2 += pb2;
-    o0[j] -= pa0 + pb0, o1[j] -= pa1 + pb1, o2[j] -= pa2 + pb2;
+    const Components xj{x0[j], x1[j], x2[j]}, wj{w0[j], w1[j], w2[j]}, dj{d0[j], d1[j], d2[j]};
+    const Components pa = stored_term<K>({k1a[j], k2a[j]}, xa, wa, da, xj, wj, dj);
+    const Components pb = stored_term<K>({k1b[j], k2b[j]}, xb, wb, db, xj, wj, dj);
+    sa0 += pa.c0, sa1 += pa.c1, sa2 += pa.c2;
+    sb0 += pb.c0, sb1 += pb.c1, sb2 += pb.c2;
+    o0[j] -= pa.c0 + pb.c0, o1[j] -= pa.c1 + pb.c1, o2[j] -= pa.c2 + pb.c2;
   }
   o0[i] += sa0, o1[i] += sa1, o2[i] += sa2;
   o0[h] += sb0, o1[h] += sb1, o2[h] += sb2;
