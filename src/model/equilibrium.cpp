@@ -201,6 +201,7 @@ void Equilibrium::set_state(const Eigen::VectorXd& x, const std::vector<double>&
   op.factors_ = factors;
   op.X_ = positions(model_, x);
   op.U_ = displacements(model_, x);
+  op.state_.reset();
 }
 
 void Equilibrium::linearize(const Eigen::VectorXd& x, const std::vector<double>& factors,
@@ -224,7 +225,9 @@ Eigen::VectorXd TangentOperator::apply(const Eigen::VectorXd& v) const {
     eq.bulk_.add_listed_product(X_, U_, listed_modulus_, listed_slope_, W, out);
   else
     eq.bulk_.add_stored_product(X_, U_, weighted_modulus_, weighted_slope_, W, out);
-  eq.add_other_products(TermState(eq.context_, x_, factors_), v, W, out);
+  if (state_ == nullptr || &state_->x != &x_)
+    state_ = std::make_shared<const TermState>(eq.context_, x_, factors_);
+  eq.add_other_products(*state_, v, W, out);
   return out;
 }
 

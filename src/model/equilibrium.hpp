@@ -37,6 +37,10 @@ class TangentOperator {
   // Fibers stored as neighbour lists: the kept pairs' coefficients in list order.
   bool listed_ = false;
   std::vector<double> listed_modulus_, listed_slope_;
+  // The other terms' state at x_ (positions, area vectors), built at the first
+  // product and kept for the next ones. It refers to this operator's x_ and
+  // factors_: a copy of the operator builds its own.
+  mutable std::shared_ptr<const TermState> state_;
 };
 
 // The equilibrium equations of the Newton scheme (model.md section 7) at any
