@@ -726,25 +726,17 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
 
 namespace {
 
-// A vertex's three components (position, direction or displacement).
-struct Components {
-  double c0, c1, c2;
-};
-
-Components components_at(const double* const v[3], int i) { return {v[0][i], v[1][i], v[2][i]}; }
-
-// The stored tangent's term of the pair (r, j) at r, from r's and j's
-// positions x, directions w and displacements d (the stencil's b, v, g).
+// The stored tangent's term of the pair (r, j) at r into p: r's position,
+// direction and displacement less j's (the stencil's b, v, g), scalars all,
+// so that the loop that calls it stays a vector loop.
 template <class K>
-inline Components stored_term(const PairCoefficients& c, const Components& xr,
-                              const Components& wr, const Components& dr, const Components& xj,
-                              const Components& wj, const Components& dj) {
-  const double b0 = xr.c0 - xj.c0, b1 = xr.c1 - xj.c1, b2 = xr.c2 - xj.c2;
-  const double v0 = wr.c0 - wj.c0, v1 = wr.c1 - wj.c1, v2 = wr.c2 - wj.c2;
+inline void stored_term(const PairCoefficients& c, double b0, double b1, double b2, double v0,
+                        double v1, double v2, double g0, double g1, double g2, double& p0,
+                        double& p1, double& p2) {
   const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
-  return {pair_tangent<K>(c, v0, b_dot_v, b0, dr.c0 - dj.c0),
-          pair_tangent<K>(c, v1, b_dot_v, b1, dr.c1 - dj.c1),
-          pair_tangent<K>(c, v2, b_dot_v, b2, dr.c2 - dj.c2)};
+  p0 = pair_tangent<K>(c, v0, b_dot_v, b0, g0);
+  p1 = pair_tangent<K>(c, v1, b_dot_v, b1, g1);
+  p2 = pair_tangent<K>(c, v2, b_dot_v, b2, g2);
 }
 
 // The stored tangent product over the pairs of rows i and i + 1: the pair
@@ -764,19 +756,26 @@ FIBERFLUID_VECTOR_CLONES void stored_tangent_rows(int i, int n, const float* k1a
   const double *w0 = w[0], *w1 = w[1], *w2 = w[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
   const int h = i + 1;
-  const Components xa = components_at(x, i), wa = components_at(w, i), da = components_at(d, i);
-  const Components xb = components_at(x, h), wb = components_at(w, h), db = components_at(d, h);
-  const Components first = stored_term<K>({k1a[h], k2a[h]}, xa, wa, da, xb, wb, db);
-  double sa0 = first.c0, sa1 = first.c1, sa2 = first.c2;
+  const double xa0 = x0[i], xa1 = x1[i], xa2 = x2[i], da0 = d0[i], da1 = d1[i], da2 = d2[i];
+  const double wa0 = w0[i], wa1 = w1[i], wa2 = w2[i];
+  const double xb0 = x0[h], xb1 = x1[h], xb2 = x2[h], db0 = d0[h], db1 = d1[h], db2 = d2[h];
+  const double wb0 = w0[h], wb1 = w1[h], wb2 = w2[h];
+  double sa0, sa1, sa2;  // the pair (i, i + 1) itself
+  stored_term<K>({k1a[h], k2a[h]}, xa0 - xb0, xa1 - xb1, xa2 - xb2, wa0 - wb0, wa1 - wb1,
+                 wa2 - wb2, da0 - db0, da1 - db1, da2 - db2, sa0, sa1, sa2);
   double sb0 = -sa0, sb1 = -sa1, sb2 = -sa2;
 #pragma omp simd reduction(+ : sa0, sa1, sa2, sb0, sb1, sb2)
   for (int j = i + 2; j < n; ++j) {
-    const Components xj{x0[j], x1[j], x2[j]}, wj{w0[j], w1[j], w2[j]}, dj{d0[j], d1[j], d2[j]};
-    const Components pa = stored_term<K>({k1a[j], k2a[j]}, xa, wa, da, xj, wj, dj);
-    const Components pb = stored_term<K>({k1b[j], k2b[j]}, xb, wb, db, xj, wj, dj);
-    sa0 += pa.c0, sa1 += pa.c1, sa2 += pa.c2;
-    sb0 += pb.c0, sb1 += pb.c1, sb2 += pb.c2;
-    o0[j] -= pa.c0 + pb.c0, o1[j] -= pa.c1 + pb.c1, o2[j] -= pa.c2 + pb.c2;
+    const double xj0 = x0[j], xj1 = x1[j], xj2 = x2[j], dj0 = d0[j], dj1 = d1[j], dj2 = d2[j];
+    const double wj0 = w0[j], wj1 = w1[j], wj2 = w2[j];
+    double pa0, pa1, pa2, pb0, pb1, pb2;
+    stored_term<K>({k1a[j], k2a[j]}, xa0 - xj0, xa1 - xj1, xa2 - xj2, wa0 - wj0, wa1 - wj1,
+                   wa2 - wj2, da0 - dj0, da1 - dj1, da2 - dj2, pa0, pa1, pa2);
+    stored_term<K>({k1b[j], k2b[j]}, xb0 - xj0, xb1 - xj1, xb2 - xj2, wb0 - wj0, wb1 - wj1,
+                   wb2 - wj2, db0 - dj0, db1 - dj1, db2 - dj2, pb0, pb1, pb2);
+    sa0 += pa0, sa1 += pa1, sa2 += pa2;
+    sb0 += pb0, sb1 += pb1, sb2 += pb2;
+    o0[j] -= pa0 + pb0, o1[j] -= pa1 + pb1, o2[j] -= pa2 + pb2;
   }
   o0[i] += sa0, o1[i] += sa1, o2[i] += sa2;
   o0[h] += sb0, o1[h] += sb1, o2[h] += sb2;
