@@ -703,10 +703,6 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
   c2->resize(n_, n_);
   advise_huge_pages(c1->data(), sizeof(Scalar) * static_cast<double>(c1->size()));
   advise_huge_pages(c2->data(), sizeof(Scalar) * static_cast<double>(c2->size()));
-  // The diagonal is zeroed by each row's own pass, on the thread that writes
-  // the column: a serial pass down the diagonal would be the first touch of
-  // every page of both tables, one thread taking all the page faults.
-  if (n_ > 0) (*c1)(n_ - 1, n_ - 1) = (*c2)(n_ - 1, n_ - 1) = 0;  // a row with no pairs
   const double *area = area_.data(), *count = count_.data();
   const PairColumns p = columns_of(x_, u_);
   with_kinematics(kinematics_, [&](auto policy) {
@@ -714,7 +710,6 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
       Scalar* k1 = c1->col(i).data();
       Scalar* k2 = c2->col(i).data();
-      if (j0 <= i) k1[i] = k2[i] = 0;  // the tile that holds the diagonal
       if (forces != nullptr)
         row_pass<K, true, true>(p, area, count, i, j0, first, end, row, forces->columns(thread),
                                 k1, k2);
@@ -722,6 +717,11 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
         row_pass<K, false, true>(p, area, count, i, j0, first, end, row, {}, k1, k2);
     });
   });
+  // The diagonal after the pass, not before: zeroed first, it would be the
+  // first touch of every page of both new tables, one thread taking all the
+  // page faults that the threaded pass shares out.
+  c1->diagonal().setZero();
+  c2->diagonal().setZero();
 }
 
 namespace {

@@ -191,6 +191,9 @@ TEST(DeformedPairs, MatchTheStencilPairByPair) {
   };
   EXPECT_TRUE((lower_single(f1).array() == lower(c1).cast<float>().array()).all());
   EXPECT_TRUE((lower_single(f2).array() == lower(c2).cast<float>().array()).all());
+  // Both tables have a zero diagonal (a pair of a vertex with itself).
+  EXPECT_TRUE((c1.diagonal().array() == 0.0).all() && (c2.diagonal().array() == 0.0).all());
+  EXPECT_TRUE((f1.diagonal().array() == 0.0f).all() && (f2.diagonal().array() == 0.0f).all());
   // The product from it, each pair read once, is the product pair by pair
   // of the rounded coefficients, and the exact one to single precision.
   Eigen::MatrixXd rounded = Eigen::MatrixXd::Zero(n, 3);
