@@ -45,7 +45,8 @@ class BlockCholeskySolver final : public SchurSolver {
     factors_.clear();
     offsets_ = system.block_offsets();
     for (int a = 0; a < count; ++a) {
-      // In double the block is factored where it lies (no copy of N^2 entries).
+      // The block filled in the factor's precision and factored where it lies
+      // (no copy of N^2 entries).
       Factor K;
       if constexpr (std::is_same_v<Scalar, double>)
         K = system.dense_block(a);
