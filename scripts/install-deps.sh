@@ -12,6 +12,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev libgtest-dev
   libceres-dev libnlopt-dev                  # calibration (src/fit)
   zlib1g-dev                                 # compressed VTK output
+  libopenmpi-dev openmpi-bin                 # mpirun -np N fiberfluid run|fit (optional in the build)
   python3 python3-matplotlib python3-numpy   # plots and the scaling driver
   python3-dev pybind11-dev python3-pytest    # the Python module and its tests
   python3-meshio                             # an independent reader of the .vtu files (tests)

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -27,6 +28,7 @@
 #include "fiberfluid/experiment/schema.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/parallel/ranks.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/progress.hpp"
 #include "fiberfluid/util/run_control.hpp"
@@ -249,18 +251,60 @@ void draw_plot(const std::filesystem::path& folder) {
                "python3-matplotlib)\n";
 }
 
-int run_command(const std::string& path, const RunFlags& flags) {
+// Thrown on a rank whose own part of a step succeeded when another rank's failed.
+struct AnotherRankFailed : fiberfluid::InputError {
+  AnotherRankFailed()
+      : InputError("another MPI rank could not read the experiment or prepare its run (run "
+                   "it without mpirun to see why)") {}
+};
+
+// Runs `step` on every rank and ends in agreement: when it throws on one
+// rank, it throws on all (the others an AnotherRankFailed), so no rank goes on
+// to wait for work that will never be dealt.
+void on_every_rank(const fiberfluid::parallel::Ranks& ranks, const std::function<void()>& step) {
+  try {
+    step();
+  } catch (...) {
+    ranks.all_ok(false);
+    throw;
+  }
+  if (!ranks.all_ok(true)) throw AnotherRankFailed();
+}
+
+int run_command(const std::string& path, const RunFlags& flags,
+                const fiberfluid::parallel::Ranks& ranks) {
   fiberfluid::set_memory_budget(flags.max_memory);
   fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
-  const experiment::Experiment ex = load_showing_progress(path, flags.quiet, printer);
+  // Every rank reads and builds the experiment (the surface and its fibers);
+  // rank 0 alone checks and prepares the output folder.
+  std::optional<experiment::Experiment> loaded;
+  std::optional<experiment::OutputWriter> output;
+  on_every_rank(ranks, [&] {
+    loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
+    if (ranks.root()) output.emplace(*loaded, experiment::output_folder(flags.output, loaded->name));
+  });
+  const experiment::Experiment& ex = *loaded;
+  experiment::RunOptions options;
+  options.jobs = flags.jobs;
+  if (ranks.size() > 1)
+    options.dealer = [&ranks](size_t count, const auto& compute, const auto& deliver) {
+      ranks.deal(count, compute, deliver);
+    };
+  if (!ranks.root()) {
+    experiment::serve_cases(ex, options.dealer);
+    stop_if_interrupted("the run");
+    return kOk;
+  }
   if (ex.fit)
     std::cerr << "note: " << path << " has a \"fit\" section: `run` simulates at the starting "
               << "values; `fiberfluid fit` calibrates\n";
-  experiment::OutputWriter writer(ex, experiment::output_folder(flags.output, ex.name));
+  if (ranks.size() > 1 && flags.jobs > 1)
+    std::cerr << "note: -j is not used under mpirun: each of the " << ranks.size()
+              << " ranks runs one variant at a time with " << ranks.threads()
+              << " threads (OMP_NUM_THREADS)\n";
+  experiment::OutputWriter& writer = *output;
   writer.begin();
-  experiment::RunOptions options;
-  options.jobs = flags.jobs;
   const experiment::ExperimentResult result = experiment::run_experiment(
       ex,
       [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
@@ -540,6 +584,7 @@ std::string version_text() {
   out << "fiberfluid " << fiberfluid::experiment::program_version() << "\n";
   for (const auto& [name, value] : fiberfluid::experiment::build_info())
     if (name != "version") out << "  " << name << ": " << value << "\n";
+  out << "  mpi: " << fiberfluid::parallel::mpi_description() << "\n";
   std::string text = out.str();
   text.pop_back();  // CLI11 ends the line
   return text;
@@ -580,7 +625,21 @@ void report_unexpected_arguments(const CLI::App& cli, const CLI::ExtrasError& e,
             << " --help describes them)\n";
 }
 
+// Discards what is written to it: the output of ranks other than rank 0,
+// which would repeat rank 0's.
+struct DiscardingBuffer : std::streambuf {
+  int overflow(int c) override { return c; }
+};
+
 int main(int argc, char** argv) {
+  // Under mpirun or srun (and built with MPI): this process is one of the
+  // ranks; else the only one.
+  const fiberfluid::parallel::Ranks ranks(&argc, &argv);
+  DiscardingBuffer discard;
+  if (!ranks.root()) {
+    std::cout.rdbuf(&discard);
+    std::cerr.rdbuf(&discard);
+  }
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);
   cli.set_version_flag("--version", version_text());
@@ -654,7 +713,8 @@ int main(int argc, char** argv) {
   }
   stop_on_interrupt();
   try {
-    if (run->parsed()) return run_command(experiment, flags);
+    if (run->parsed()) return run_command(experiment, flags, ranks);
+    if (!ranks.root()) return kOk;  // the other commands run on rank 0 alone
     if (fit->parsed()) return fit_command(experiment, fit_flags);
     if (schema->parsed()) {
       std::cout << fiberfluid::experiment::experiment_schema().dump(2) << "\n";

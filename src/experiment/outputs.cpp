@@ -439,6 +439,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
     t.header("paddle_" + p.label + "_contacts");
   }
   t.header("seconds");
+  t.header("rank");  // the MPI rank that ran it (0 in a one-process run)
   t.header("message");
   t.header("patch");
   t.end_row();
@@ -472,6 +473,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
           t.text("");
       }
     t.number(s.total_seconds);
+    t.number(run.rank);
     t.text(s.message);
     t.text(ex.cases[r].patch.is_null() ? "" : ex.cases[r].patch.dump());
     t.end_row();

@@ -8,9 +8,11 @@
 #include <exception>
 #include <functional>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "fiberfluid/experiment/figures.hpp"
+#include "fiberfluid/experiment/run_archive.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
@@ -70,9 +72,8 @@ FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
   if (expected.matrix.size() > 0) {
     if (r < 0 || figure != "system_matrix") return check;
     // The matrix the run's backend factored for its last step, not a second assembly.
-    const auto& system = result.runs[static_cast<size_t>(r)].summary.system;
-    if (!system) return check;
-    const Eigen::MatrixXd A = system->dense_matrix();
+    const Eigen::MatrixXd& A = result.runs[static_cast<size_t>(r)].system_matrix;
+    if (A.size() == 0) return check;
     check.found = A.rows() == expected.matrix.rows() && A.cols() == expected.matrix.cols();
     if (!check.found) return check;
     check.actual = (A - expected.matrix).cwiseAbs().maxCoeff();
@@ -233,6 +234,98 @@ static void for_each_case(size_t count, int jobs, const std::function<void(size_
     if (error) std::rethrow_exception(error);
 }
 
+namespace {
+
+// True when an expected figure compares a run's system matrix.
+bool checks_system_matrix(const Experiment& ex) {
+  for (const ExpectedFigure& e : ex.expected)
+    if (e.matrix.size() > 0) return true;
+  return false;
+}
+
+// Runs case r here, reporting its steps to `observer`.
+RunResult run_case(const Experiment& ex, size_t r, const solve::StepObserver& observer) {
+  const ProgressLabel label(ex.cases[r].variant);
+  RunResult run;
+  run.variant = ex.cases[r].variant;
+  run.summary = solve::solve_load_steps(ex.cases[r].model, ex.cases[r].stepping, observer);
+  if (run.summary.system && checks_system_matrix(ex))
+    run.system_matrix = run.summary.system->dense_matrix();
+  return run;
+}
+
+void report_variants(const Experiment& ex, size_t finished) {
+  if (ex.cases.size() > 1)
+    report_progress("variants", static_cast<double>(finished),
+                    static_cast<double>(ex.cases.size()));
+}
+
+// The cases in this process, `options.jobs` at a time.
+void run_local_cases(const Experiment& ex, const RunObserver& observer, const RunOptions& options,
+                     ExperimentResult& result) {
+  std::atomic<size_t> finished{0};
+  report_variants(ex, 0);
+  for_each_case(ex.cases.size(), effective_jobs(options, ex.cases.size()), [&](size_t r) {
+    solve::StepObserver step_observer;
+    if (observer)
+      step_observer = [&observer, r](const solve::StepRecord& record, const Eigen::VectorXd& x) {
+        observer(r, record, x);
+      };
+    result.runs[r] = run_case(ex, r, step_observer);
+    report_variants(ex, ++finished);
+  });
+}
+
+// Case r wherever it is dealt, packed with its unknowns after each step. A
+// failure that is not the solver's (an exception) becomes the run's message,
+// so the rank goes on with the next case.
+std::string run_case_packed(const Experiment& ex, size_t r) {
+  RunOutcome outcome;
+  try {
+    outcome.run = run_case(ex, r, [&](const solve::StepRecord&, const Eigen::VectorXd& x) {
+      outcome.step_unknowns.push_back(x);
+    });
+  } catch (const std::exception& e) {
+    outcome = RunOutcome{};
+    outcome.run.variant = ex.cases[r].variant;
+    outcome.run.summary.message = e.what();
+  }
+  return pack_run_outcome(outcome);
+}
+
+// The cases dealt out (over MPI ranks); each outcome replayed into the
+// observer where it arrives, as if it had run here.
+void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const CaseDealer& dealer,
+                     ExperimentResult& result) {
+  std::atomic<size_t> finished{0};
+  report_variants(ex, 0);
+  dealer(
+      ex.cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
+      [&](size_t r, int rank, std::string&& bytes) {
+        RunOutcome outcome = unpack_run_outcome(bytes);
+        const std::vector<solve::StepRecord>& steps = outcome.run.summary.steps;
+        if (outcome.step_unknowns.size() != steps.size())
+          throw std::runtime_error("rank " + std::to_string(rank) + " sent " +
+                                   std::to_string(outcome.step_unknowns.size()) +
+                                   " states for " + std::to_string(steps.size()) + " steps");
+        if (observer)
+          for (size_t k = 0; k < steps.size(); ++k) observer(r, steps[k], outcome.step_unknowns[k]);
+        outcome.run.rank = rank;
+        result.runs[r] = std::move(outcome.run);
+        report_variants(ex, ++finished);
+      });
+}
+
+}  // namespace
+
+void serve_cases(const Experiment& ex, const CaseDealer& dealer) {
+  require_built(ex);
+  if (ex.kind != Experiment::Kind::Simulate) return;
+  dealer(
+      ex.cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
+      [](size_t, int, std::string&&) {});
+}
+
 ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
                                 const RunOptions& options) {
   require_built(ex);
@@ -249,23 +342,10 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
     result.benchmark = benchmark;
   } else {
     result.runs.resize(ex.cases.size());
-    std::atomic<size_t> finished{0};
-    const auto run_case = [&](size_t r) {
-      const ProgressLabel label(ex.cases[r].variant);
-      RunResult& run = result.runs[r];
-      run.variant = ex.cases[r].variant;
-      solve::StepObserver step_observer;
-      if (observer)
-        step_observer = [&observer, r](const solve::StepRecord& record, const Eigen::VectorXd& x) {
-          observer(r, record, x);
-        };
-      run.summary = solve::solve_load_steps(ex.cases[r].model, ex.cases[r].stepping, step_observer);
-      if (ex.cases.size() > 1)
-        report_progress("variants", static_cast<double>(++finished),
-                        static_cast<double>(ex.cases.size()));
-    };
-    if (ex.cases.size() > 1) report_progress("variants", 0.0, static_cast<double>(ex.cases.size()));
-    for_each_case(ex.cases.size(), effective_jobs(options, ex.cases.size()), run_case);
+    if (options.dealer)
+      run_dealt_cases(ex, observer, options.dealer, result);
+    else
+      run_local_cases(ex, observer, options, result);
     if (ex.fem_reference && !ex.cases.empty()) {
       report_progress("FEM reference", 0.0, 1.0);
       auto reference = std::make_shared<FemReferenceResult>(

@@ -709,7 +709,9 @@ bool on_bound(double phi, double lower, double upper) {
 
 }  // namespace
 
-FitResult Calibration::run() const {
+FitResult Calibration::run() const { return run_from(impl_->map.initial_phi()); }
+
+FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
   const Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
   const int P = m.map.size();
@@ -718,7 +720,7 @@ FitResult Calibration::run() const {
   result.method = m.options.method;
   result.analytic_jacobian = m.analytic;
   result.names = m.map.names();
-  result.initial = m.map.values(m.map.initial_phi());
+  result.initial = m.map.values(start_phi);
   // Sized from the start, whatever the ending: a report never reads past them.
   result.values = result.initial;
   result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
@@ -741,7 +743,7 @@ FitResult Calibration::run() const {
   // The start, as Levenberg-Marquardt will ask for it (with analytic
   // sensitivities): a failure here is the user's to fix, not a rejected step.
   const bool levenberg_marquardt = m.options.method == Method::LevenbergMarquardt;
-  const Evaluation& first = evaluations.at(m.map.initial_phi(), levenberg_marquardt && m.analytic);
+  const Evaluation& first = evaluations.at(start_phi, levenberg_marquardt && m.analytic);
   if (!first.ok) {
     if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
     return finish(FitStatus::StartFailed,
@@ -752,8 +754,8 @@ FitResult Calibration::run() const {
     return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
   const OptimizerOutcome outcome = levenberg_marquardt
-                                       ? fit_levenberg_marquardt(evaluations, m.options)
-                                       : fit_nlopt(evaluations, m.options);
+                                       ? fit_levenberg_marquardt(evaluations, m.options, start_phi)
+                                       : fit_nlopt(evaluations, m.options, start_phi);
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.values = m.map.values(outcome.phi);

@@ -208,7 +208,11 @@ class Calibration {
   // 1/2 sum rho(r^2) under the chosen loss.
   double cost(const Eigen::VectorXd& residuals) const;
 
+  // The fit from the parameters' starts.
   FitResult run() const;
+  // The fit from the fitted variables `start_phi` (ParameterMap: log or
+  // linear), within the bounds: one start of a multi-start search.
+  FitResult run_from(const Eigen::VectorXd& start_phi) const;
 
  private:
   struct Impl;

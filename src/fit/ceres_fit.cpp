@@ -137,10 +137,11 @@ class Recorder final : public ceres::IterationCallback {
 
 }  // namespace
 
-OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options) {
+OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
+                                         const Eigen::VectorXd& start) {
   const Calibration& calibration = evaluations.calibration();
   OptimizerOutcome outcome;
-  Eigen::VectorXd phi = calibration.parameters().initial_phi();
+  Eigen::VectorXd phi = start;
   CeresProblem p(evaluations, options, phi);
   Recorder recorder(calibration, options, phi, p.shared, outcome);
   ceres::Solver::Options solver;

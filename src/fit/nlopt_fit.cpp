@@ -128,11 +128,12 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
 
 }  // namespace
 
-OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options) {
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
+                           const Eigen::VectorXd& start) {
   const Calibration& calibration = evaluations.calibration();
   OptimizerOutcome outcome;
   const ParameterMap& map = calibration.parameters();
-  Eigen::VectorXd phi = map.initial_phi();
+  Eigen::VectorXd phi = start;
   Objective objective(evaluations, options, outcome);
   nlopt_result result;
   if (options.method == Method::Bobyqa) {

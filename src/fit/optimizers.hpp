@@ -56,8 +56,11 @@ struct OptimizerOutcome {
   std::vector<IterationRecord> iterations;
 };
 
-OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options);
-OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options);
+// Each from the fitted variables `start`.
+OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
+                                         const Eigen::VectorXd& start);
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
+                           const Eigen::VectorXd& start);
 
 // The covariance of the fitted variables phi at the optimum (Ceres
 // Covariance, unscaled: (J^T J)^-1 of the robustified residuals), or false

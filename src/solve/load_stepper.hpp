@@ -108,6 +108,9 @@ struct SteppingOptions {
   bool IsValid(std::string* why) const;
 };
 
+// A field added to StepRecord or SteppingSummary (other than a live object)
+// goes into experiment/run_archive.cpp's list too: it is how a run made on
+// another MPI rank comes back.
 struct StepRecord {
   int step = 0;                      // 1..n
   std::vector<double> load_factors;  // one per load, after this step
