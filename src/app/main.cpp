@@ -372,6 +372,38 @@ void print_iteration(const fiberfluid::fit::IterationRecord& r,
   std::cerr << "; " << r.forward_runs << " runs, " << r.seconds << " s\n";
 }
 
+// One line per finished start of a multi-start search.
+void print_start(size_t s, const fiberfluid::fit::StartOutcome& o,
+                 const std::vector<std::string>& names) {
+  std::cerr << "fit: start " << s << " (rank " << o.rank << "): "
+            << fiberfluid::fit::to_string(o.fit.status) << ", cost " << o.fit.final_cost
+            << " m^2;";
+  for (size_t k = 0; k < names.size(); ++k)
+    std::cerr << (k ? ", " : " ") << names[k] << " " << o.start[static_cast<Eigen::Index>(k)]
+              << " -> " << o.fit.values[static_cast<Eigen::Index>(k)];
+  std::cerr << "; " << o.fit.iterations.size() << " iterations, " << o.fit.seconds << " s\n";
+}
+
+// The distinct optima of a multi-start search, and a warning when the best
+// was reached from one start only.
+void print_optima(const fiberfluid::fit::MultistartResult& search,
+                  const std::vector<std::string>& names) {
+  std::cout << "  " << search.optima.size() << " distinct optima from " << search.starts.size()
+            << " starts (" << search.seconds << " s):\n";
+  for (size_t o = 0; o < search.optima.size(); ++o) {
+    const fiberfluid::fit::Optimum& optimum = search.optima[o];
+    std::cout << "    " << (o == 0 ? "best" : "    ") << " cost " << optimum.cost << " m^2, "
+              << optimum.starts.size() << " start(s):";
+    for (size_t k = 0; k < names.size(); ++k)
+      std::cout << (k ? ", " : " ") << names[k] << " = "
+                << optimum.values[static_cast<Eigen::Index>(k)];
+    std::cout << "\n";
+  }
+  if (search.best_found_once)
+    std::cerr << "warning: the best optimum was reached from one start only: a cheaper one may "
+                 "lie where no start came near (more \"starts\" or narrower bounds tell)\n";
+}
+
 void print_fit(const fiberfluid::fit::FitResult& fitted) {
   namespace fit = fiberfluid::fit;
   for (size_t k = 0; k < fitted.names.size(); ++k) {
@@ -419,21 +451,44 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
 // Every fit file is in the folder before it moves into place: DIR for a fit
 // that converged, DIR.failed for one that did not, DIR.interrupted (the best
 // point so far, for fit.start_from) for one stopped by SIGINT or SIGTERM.
-int fit_command(const std::string& path, const RunFlags& flags) {
+int fit_command(const std::string& path, const RunFlags& flags,
+                const fiberfluid::parallel::Ranks& ranks) {
   namespace fit = fiberfluid::fit;
   fiberfluid::set_memory_budget(flags.max_memory);
   fiberfluid::set_time_budget(flags.max_time);
   ProgressPrinter printer;
-  const experiment::Experiment ex = load_showing_progress(path, flags.quiet, printer);
-  fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
-  const std::filesystem::path folder =
-      experiment::output_folder(flags.output, ex.name);  // refused now, not after the fit
+  // Every rank reads the experiment and its targets; rank 0 alone checks the
+  // output folder (refused now, not after the fit).
+  std::optional<experiment::Experiment> loaded;
+  std::filesystem::path folder;
+  experiment::FitSetup setup;
   std::vector<std::string> names;
-  if (ex.fit)
-    for (const auto& p : ex.fit->parameters) names.push_back(p.request.name);
-  const experiment::FitSetup setup = experiment::setup_fit(ex, [&](const fit::IterationRecord& r) {
-    if (!flags.quiet) print_iteration(r, names);
+  bool multistart = false;
+  on_every_rank(ranks, [&] {
+    loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
+    fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
+    if (ranks.root()) folder = experiment::output_folder(flags.output, loaded->name);
+    if (loaded->fit)
+      for (const auto& p : loaded->fit->parameters) names.push_back(p.request.name);
+    multistart = loaded->fit && loaded->fit->multistart;
+    // A multi-start search prints a line per start instead of per iteration.
+    setup = experiment::setup_fit(*loaded, [&](const fit::IterationRecord& r) {
+      if (!flags.quiet && !multistart) print_iteration(r, names);
+    });
   });
+  const experiment::Experiment& ex = *loaded;
+  const fit::StartDealer dealer = [&ranks](size_t count, const auto& compute,
+                                           const auto& deliver) {
+    ranks.deal(count, compute, deliver);
+  };
+  if (!ranks.root()) {  // the ranks' share of the starts; a single fit is rank 0's alone
+    if (multistart) fit::serve_multistart(*setup.calibration, *ex.fit->multistart, dealer);
+    stop_if_interrupted("the fit");
+    return kOk;
+  }
+  if (ranks.size() > 1 && !multistart)
+    std::cerr << "note: a single fit runs on rank 0 alone; \"method\": \"multistart\" deals "
+                 "its starts out over the ranks\n";
   for (const auto& t : setup.targets)
     std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
               << "\n";
@@ -459,9 +514,25 @@ int fit_command(const std::string& path, const RunFlags& flags) {
   }
   if (force_rows > 0) std::cout << force_rows << " force misfits";
   std::cout << " (" << fit::to_string(ex.fit->options.method) << ", "
-            << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences")
-            << ")\n";
-  const fit::FitResult fitted = setup.calibration->run();
+            << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences");
+  if (multistart)
+    std::cout << ", from each of " << ex.fit->multistart->starts << " starts over "
+              << ranks.size() << " rank(s)";
+  std::cout << ")\n";
+  std::optional<fit::MultistartResult> search;
+  fit::FitResult fitted;
+  if (multistart) {
+    search = fit::run_multistart(calibration, *ex.fit->multistart, dealer,
+                                 [&](size_t s, const fit::StartOutcome& o) {
+                                   if (!flags.quiet) print_start(s, o, names);
+                                 });
+    fitted = search->best();
+    // Stopped early: the best start so far, kept as an interrupted fit's.
+    if (fiberfluid::cancel_requested()) fitted.status = fit::FitStatus::Interrupted;
+  } else {
+    fitted = calibration.run();
+  }
+  const fit::MultistartResult* searched = search ? &*search : nullptr;
 
   const experiment::Experiment at_fit =
       experiment::with_fitted_material(ex, *setup.calibration, fitted);
@@ -474,7 +545,7 @@ int fit_command(const std::string& path, const RunFlags& flags) {
                                 " iterations; fit.json holds the best point so far (continue "
                                 "with \"start_from\" in the fit section)",
                             [&](const std::filesystem::path& dir) {
-                              experiment::write_fit_files(dir, at_fit, setup, fitted, none);
+                              experiment::write_fit_files(dir, at_fit, setup, fitted, none, searched);
                             });
     std::cerr
         << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
@@ -490,6 +561,9 @@ int fit_command(const std::string& path, const RunFlags& flags) {
         });
     stop_if_interrupted("the run at the fitted values");
     for (const auto& [name, value] : experiment::fit_figures(fitted)) result.figures[name] = value;
+    if (search)
+      for (const auto& [name, value] : experiment::multistart_figures(*search))
+        result.figures[name] = value;
     result.checks = experiment::check_expected(at_fit, result);
   }
   if (!experiment::fit_result_kept(fitted.status))
@@ -497,13 +571,14 @@ int fit_command(const std::string& path, const RunFlags& flags) {
                      fitted.message +
                      (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
   writer.finish(result, [&](const std::filesystem::path& dir) {
-    experiment::write_fit_files(dir, at_fit, setup, fitted, result);
+    experiment::write_fit_files(dir, at_fit, setup, fitted, result, searched);
   });
   for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
   std::cout << ex.name << ": " << fit::to_string(fitted.status) << ": " << fitted.message
             << "; results in " << writer.folder().string() << "\n";
   if (!fitted.status_detail.empty()) std::cout << "  " << fitted.status_detail << "\n";
+  if (search) print_optima(*search, names);
   print_fit(fitted);
   for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
   if (!result.runs_succeeded()) {
@@ -625,21 +700,38 @@ void report_unexpected_arguments(const CLI::App& cli, const CLI::ExtrasError& e,
             << " --help describes them)\n";
 }
 
-// Discards what is written to it: the output of ranks other than rank 0,
-// which would repeat rank 0's.
-struct DiscardingBuffer : std::streambuf {
-  int overflow(int c) override { return c; }
+// Discards what this process writes to std::cout and std::cerr while it
+// lives: the output of ranks other than rank 0, which would repeat rank 0's.
+// (FIBERFLUID_ALL_RANKS_SPEAK=1 keeps it, to see a rank's own failure.)
+class SilencedOutput {
+ public:
+  explicit SilencedOutput(bool silent) {
+    if (!silent || std::getenv("FIBERFLUID_ALL_RANKS_SPEAK") != nullptr) return;
+    cout_ = std::cout.rdbuf(&discard_);
+    cerr_ = std::cerr.rdbuf(&discard_);
+  }
+  // The streams get their own buffers back before this one goes: they are
+  // flushed once more at exit.
+  ~SilencedOutput() {
+    if (cout_ != nullptr) std::cout.rdbuf(cout_);
+    if (cerr_ != nullptr) std::cerr.rdbuf(cerr_);
+  }
+  SilencedOutput(const SilencedOutput&) = delete;
+  SilencedOutput& operator=(const SilencedOutput&) = delete;
+
+ private:
+  struct Discard : std::streambuf {
+    int overflow(int c) override { return c; }
+  } discard_;
+  std::streambuf* cout_ = nullptr;
+  std::streambuf* cerr_ = nullptr;
 };
 
 int main(int argc, char** argv) {
   // Under mpirun or srun (and built with MPI): this process is one of the
   // ranks; else the only one.
   const fiberfluid::parallel::Ranks ranks(&argc, &argv);
-  DiscardingBuffer discard;
-  if (!ranks.root()) {
-    std::cout.rdbuf(&discard);
-    std::cerr.rdbuf(&discard);
-  }
+  const SilencedOutput silenced(!ranks.root());
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);
   cli.set_version_flag("--version", version_text());
@@ -714,8 +806,8 @@ int main(int argc, char** argv) {
   stop_on_interrupt();
   try {
     if (run->parsed()) return run_command(experiment, flags, ranks);
+    if (fit->parsed()) return fit_command(experiment, fit_flags, ranks);
     if (!ranks.root()) return kOk;  // the other commands run on rank 0 alone
-    if (fit->parsed()) return fit_command(experiment, fit_flags);
     if (schema->parsed()) {
       std::cout << fiberfluid::experiment::experiment_schema().dump(2) << "\n";
       return 0;

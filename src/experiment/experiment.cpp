@@ -646,10 +646,26 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     f.fail(key, colon == std::string::npos ? what : what.substr(colon + 2));
   };
   fit::FitOptions& o = spec.options;
-  try {
-    o.method = fit::method_from_string(f.string("method", "levenberg-marquardt"));
-  } catch (const InputError& e) {
-    named("method", e);
+  const std::string method = f.string("method", "levenberg-marquardt");
+  if (method == "multistart") {  // Levenberg-Marquardt from many starts
+    fit::MultistartOptions multistart;
+    multistart.starts = f.integer("starts", multistart.starts, 2, 100000);
+    multistart.same_optimum = f.number("same_optimum", multistart.same_optimum);
+    try {
+      fit::check_options(multistart);
+    } catch (const InputError& e) {
+      named("same_optimum", e);
+    }
+    spec.multistart = multistart;
+  } else {
+    try {
+      o.method = fit::method_from_string(method);
+    } catch (const InputError&) {
+      f.fail("method", "expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart, got \"" +
+                           method.substr(0, 40) + "\"");
+    }
+    for (const char* key : {"starts", "same_optimum"})
+      if (f.has(key)) f.fail(key, "only with \"method\": \"multistart\"");
   }
   o.finite_differences =
       f.choice("jacobian", "analytic", {"analytic", "finite-differences"}) == "finite-differences";

@@ -127,6 +127,7 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
         for (const FitParameterSpec& p : ex.fit->parameters) fitted.push_back(p.request.name);
         if (!ex.fit->force_curves.empty())
           fitted.insert(fitted.end(), {"force_rms", "force_largest", "force_rms_share"});
+        if (ex.fit->multistart) fitted.insert(fitted.end(), {"optima", "best_optimum_starts"});
         for (const std::string& f : fitted) {
           if (figure == "fit." + f) return {};
           valid.push_back("fit." + f);

@@ -8,6 +8,7 @@
 
 #include "fiberfluid/experiment/case_spec.hpp"
 #include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/multistart.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -44,6 +45,9 @@ struct FitSpec {
   // earlier fit, continued).
   std::optional<std::filesystem::path> start_from;
   fit::FitOptions options;               // all but counted_vertices and progress
+  // "method": "multistart": Levenberg-Marquardt (options.method) from each of
+  // several starts spread over the bounds.
+  std::optional<fit::MultistartOptions> multistart;
   std::optional<SelectionSpec> exclude;  // vertices whose distances do not count
 };
 

@@ -241,8 +241,62 @@ Experiment with_fitted_material(const Experiment& experiment, const fit::Calibra
   return fitted;
 }
 
+std::map<std::string, double> multistart_figures(const fit::MultistartResult& search) {
+  return {{"fit.optima", static_cast<double>(search.optima.size())},
+          {"fit.best_optimum_starts",
+           search.optima.empty() ? 0.0 : static_cast<double>(search.optima.front().starts.size())}};
+}
+
+namespace {
+
+// The optimum (index into search.optima) start s reached, or -1.
+int optimum_of(const fit::MultistartResult& search, int s) {
+  for (size_t o = 0; o < search.optima.size(); ++o)
+    for (int t : search.optima[o].starts)
+      if (t == s) return static_cast<int>(o);
+  return -1;
+}
+
+json multistart_json(const fit::MultistartResult& search, const std::vector<std::string>& names) {
+  const auto values_json = [&](const Eigen::VectorXd& values) {
+    json out = json::object();
+    for (size_t k = 0; k < names.size(); ++k) out[names[k]] = values[static_cast<Eigen::Index>(k)];
+    return out;
+  };
+  json starts = json::array();
+  for (size_t s = 0; s < search.starts.size(); ++s) {
+    const fit::StartOutcome& o = search.starts[s];
+    starts.push_back({{"start", values_json(o.start)},
+                      {"end", values_json(o.fit.values)},
+                      {"status", fit::to_string(o.fit.status)},
+                      {"message", o.fit.message},
+                      {"cost", number(o.fit.final_cost)},
+                      {"optimum", optimum_of(search, static_cast<int>(s))},
+                      {"iterations", o.fit.iterations.size()},
+                      {"forward_runs", o.fit.forward_runs},
+                      {"seconds", o.fit.seconds},
+                      {"rank", o.rank}});
+  }
+  json optima = json::array();
+  for (const fit::Optimum& o : search.optima)
+    optima.push_back({{"values", values_json(o.values)},
+                      {"cost", number(o.cost)},
+                      {"starts_reached", o.starts.size()},
+                      {"starts", o.starts}});
+  return {{"starts", starts},
+          {"optima", optima},
+          {"optima_are", "the converged starts' ends, clustered: one optimum where every fitted "
+                         "variable (log of a log-scaled parameter) agrees to same_optimum of its "
+                         "range; cheapest first"},
+          {"best_start", search.best_start},
+          {"best_found_once", search.best_found_once},
+          {"seconds", search.seconds}};
+}
+
+}  // namespace
+
 json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult& r,
-              const ExperimentResult& run) {
+              const ExperimentResult& run, const fit::MultistartResult* search) {
   const fit::Calibration& c = *setup.calibration;
   json parameters = json::array();
   for (size_t k = 0; k < r.names.size(); ++k) {
@@ -371,12 +425,35 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
       {"force_curves", curves},
       {"checks", checks}};
   if (!r.statistics.empty()) doc["distance"] = statistics_json(r.overall);
+  if (search != nullptr) {
+    doc["method"] = "multistart";
+    doc["multistart"] = multistart_json(*search, r.names);
+  }
   return doc;
 }
 
 void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
-                     const FitSetup& setup, const fit::FitResult& r, const ExperimentResult& run) {
-  geom::write_text_file(folder / "fit.json", fit_json(ex, setup, r, run).dump(2) + "\n");
+                     const FitSetup& setup, const fit::FitResult& r, const ExperimentResult& run,
+                     const fit::MultistartResult* search) {
+  geom::write_text_file(folder / "fit.json", fit_json(ex, setup, r, run, search).dump(2) + "\n");
+  if (search != nullptr) {
+    std::ostringstream starts;
+    starts.precision(12);
+    starts << "start,rank,status,cost_m2,optimum,iterations,forward_runs,seconds";
+    for (const std::string& name : r.names) starts << ",start_" << name;
+    for (const std::string& name : r.names) starts << ",end_" << name;
+    starts << "\n";
+    for (size_t s = 0; s < search->starts.size(); ++s) {
+      const fit::StartOutcome& o = search->starts[s];
+      starts << s << "," << o.rank << "," << fit::to_string(o.fit.status) << ","
+             << o.fit.final_cost << "," << optimum_of(*search, static_cast<int>(s)) << ","
+             << o.fit.iterations.size() << "," << o.fit.forward_runs << "," << o.fit.seconds;
+      for (Eigen::Index k = 0; k < o.start.size(); ++k) starts << "," << o.start[k];
+      for (Eigen::Index k = 0; k < o.fit.values.size(); ++k) starts << "," << o.fit.values[k];
+      starts << "\n";
+    }
+    geom::write_text_file(folder / "fit_starts.csv", starts.str());
+  }
   std::ostringstream iterations;
   iterations << "iteration,cost_m2,accepted,trial_cost_m2,forward_runs,seconds";
   for (const std::string& name : r.names) iterations << "," << name;

@@ -9,6 +9,7 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/runner.hpp"
 #include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/multistart.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -37,10 +38,16 @@ bool fit_result_kept(fit::FitStatus status);
 // distance statistics (fit.distance_sd_share is the method paper's figure).
 std::map<std::string, double> fit_figures(const fit::FitResult& result);
 
+// A multi-start search's figures: fit.optima (distinct optima found),
+// fit.best_optimum_starts (how many starts reached the best one).
+std::map<std::string, double> multistart_figures(const fit::MultistartResult& search);
+
 // fit.json: fitted values, errors and intervals, correlation, iterations,
-// distance statistics per target and overall; with the checks.
+// distance statistics per target and overall; with the checks; and for a
+// multi-start search, its starts and the optima they reached.
 nlohmann::json fit_json(const Experiment& experiment, const FitSetup& setup,
-                        const fit::FitResult& result, const ExperimentResult& run);
+                        const fit::FitResult& result, const ExperimentResult& run,
+                        const fit::MultistartResult* search = nullptr);
 
 // The experiment with the fitted material (to run and write as usual).
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
@@ -48,9 +55,11 @@ Experiment with_fitted_material(const Experiment& experiment, const fit::Calibra
 
 // Writes, into `folder`: fit.json, fit_iterations.csv, fit_distances.csv and
 // fit_target_K.vtu (the simulated surface at the target's step, with the
-// distance to the target as point data).
+// distance to the target as point data); for a multi-start search also
+// fit_starts.csv (one row per start: where it began and ended, its cost, the
+// optimum it reached, the rank that ran it).
 void write_fit_files(const std::filesystem::path& folder, const Experiment& experiment,
                      const FitSetup& setup, const fit::FitResult& result,
-                     const ExperimentResult& run);
+                     const ExperimentResult& run, const fit::MultistartResult* search = nullptr);
 
 }  // namespace fiberfluid::experiment

@@ -109,7 +109,7 @@ struct SteppingOptions {
 };
 
 // A field added to StepRecord or SteppingSummary (other than a live object)
-// goes into experiment/run_archive.cpp's list too: it is how a run made on
+// goes into solve/summary_fields.hpp's lists too: it is how a run made on
 // another MPI rank comes back.
 struct StepRecord {
   int step = 0;                      // 1..n

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -49,6 +50,11 @@ class ByteWriter {
   void put(const std::vector<T>& values) {
     put(static_cast<std::uint64_t>(values.size()));
     for (const T& v : values) put(v);
+  }
+  template <class K, class V>
+  void put(const std::map<K, V>& values) {
+    put(static_cast<std::uint64_t>(values.size()));
+    for (const auto& [key, value] : values) put(key), put(value);
   }
 
   std::string bytes_;
@@ -98,6 +104,16 @@ class ByteReader {
   void get(std::vector<T>& values) {
     values.resize(count());
     for (T& v : values) get(v);
+  }
+  template <class K, class V>
+  void get(std::map<K, V>& values) {
+    values.clear();
+    for (size_t n = count(); n > 0; --n) {
+      K key;
+      V value;
+      get(key), get(value);
+      values.emplace(std::move(key), std::move(value));
+    }
   }
   // A container's length, never more than the bytes left could hold.
   size_t count() {

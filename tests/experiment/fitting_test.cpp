@@ -130,7 +130,20 @@ TEST(FitConfig, BadFitSectionsAreNamed) {
   expect_fit_error(d, "fit.targets[0].step: load step 11 is beyond the run's 10 steps");
   d = sphere_fit_document();
   d["fit"]["method"] = "newton";
-  expect_fit_error(d, "fit.method: expected levenberg-marquardt, bobyqa, direct-l or crs2");
+  expect_fit_error(d,
+                   "fit.method: expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart");
+  // A multi-start search's own fields: only with it, and in range.
+  d = sphere_fit_document();
+  d["fit"]["starts"] = 4;
+  expect_fit_error(d, "fit.starts: only with \"method\": \"multistart\"");
+  d = sphere_fit_document();
+  d["fit"]["method"] = "multistart";
+  d["fit"]["starts"] = 1;
+  expect_fit_error(d, "fit.starts");
+  d = sphere_fit_document();
+  d["fit"]["method"] = "multistart";
+  d["fit"]["same_optimum"] = 2;
+  expect_fit_error(d, "fit.same_optimum: expected a share of each parameter's range");
   d = sphere_fit_document();
   d["fit"]["objective"] = {{"exclude", {{"where", "z >= -2"}}}};
   expect_fit_error(d, "excludes every vertex");

@@ -15,7 +15,7 @@ import sys
 # What differs between two runs of the same model: CSV columns and JSON keys.
 RUN_COLUMNS = {"seconds", "rank"}
 # (openmp_threads: the threads of the process, which the ranks share out.)
-RUN_KEYS = {"seconds", "pruning_seconds", "peak_resident_bytes", "openmp_threads"}
+RUN_KEYS = {"seconds", "pruning_seconds", "peak_resident_bytes", "openmp_threads", "rank"}
 
 
 def without_run_keys(value):
@@ -36,7 +36,7 @@ def csv_rows(path):
 def same_file(a, b):
     if a.suffix == ".csv":
         return csv_rows(a) == csv_rows(b)
-    if a.name == "summary.json":
+    if a.suffix == ".json":
         # Floats as written (nlohmann's shortest round trip): equal text, equal bits.
         load = lambda p: json.loads(p.read_text(), parse_float=str)
         return without_run_keys(load(a)) == without_run_keys(load(b))

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Sweeps over MPI ranks against the same sweeps in one process (ctest runs
-# each case; tests/CMakeLists.txt). Usage:
-#   sweep_test.sh CASE MPIEXEC FIBERFLUID SOURCE_DIR
-# CASE: same-bits | failed-variant | interrupted
+# Runs over MPI ranks against the same runs in one process (ctest runs each
+# case; tests/CMakeLists.txt). Usage:
+#   mpi_test.sh CASE MPIEXEC FIBERFLUID SOURCE_DIR
+# CASE: same-bits | failed-variant | interrupted (sweeps) | multistart (a fit)
 set -uo pipefail
 case_name="$1" mpiexec="$2" fiberfluid="$3" source="$4"
 here="$source/tests/mpi"
@@ -85,6 +85,36 @@ interrupted)
   [ $took -le 20 ] || fail "the ranks took $took s to stop"
   grep -q "interrupted" "$work/err" || fail "rank 0 did not say it was interrupted: $(cat "$work/err")"
   [ "$(ls -A "$work" | tr '\n' ' ')" = "err " ] || fail "left behind: $(ls -A "$work")"
+  ;;
+multistart)
+  # fit_synthetic_liver from 8 starts, dealt over two ranks: the single
+  # fit's optimum (its start is the first), reached from other starts too;
+  # the same bits as under one rank.
+  "$fiberfluid" fit "$source/experiments/fit_synthetic_liver.json" -q -o "$work/single" \
+    >/dev/null 2>&1 || fail "the single fit"
+  search="$source/experiments/fit_synthetic_liver_multistart.json"
+  mkdir "$work/one" "$work/two"
+  "${mpirun[@]}" -np 1 "$fiberfluid" fit "$search" -q -o "$work/one/out" >/dev/null 2>&1 ||
+    fail "one rank"
+  "${mpirun[@]}" -np 2 "$fiberfluid" fit "$search" -q -o "$work/two/out" --check >/dev/null \
+    2>"$work/err" || fail "two ranks: $(cat "$work/err")"
+  python3 "$here/same_outputs.py" "$work/one/out" "$work/two/out" || fail "two ranks differ"
+  python3 - "$work/single/fit.json" "$work/two/out/fit.json" <<'EOF' || fail "the optimum"
+import json, sys
+single, search = (json.load(open(p)) for p in sys.argv[1:])
+found = search["multistart"]
+best = found["optima"][0]
+fitted = {p["name"]: p["value"] for p in search["parameters"]}
+for p in single["parameters"]:
+    value, sigma = best["values"][p["name"]], p["standard_error"]
+    # The single fit's optimum, to well within its standard error.
+    assert abs(value - p["value"]) <= 0.05 * sigma, (p["name"], value, p["value"], sigma)
+    assert fitted[p["name"]] == value, "the search's result is not its best optimum"
+assert best["starts_reached"] >= 4 and not found["best_found_once"], best
+assert sorted({s["rank"] for s in found["starts"]}) == [0, 1], "a rank ran no start"
+assert all(s["status"] == "converged" for s in found["starts"]), found["starts"]
+print("optimum", best["values"], "from", best["starts_reached"], "of", len(found["starts"]), "starts")
+EOF
   ;;
 *)
   fail "unknown case $case_name"
