@@ -287,10 +287,7 @@ int run_command(const std::string& path, const RunFlags& flags,
   const experiment::Experiment& ex = *loaded;
   experiment::RunOptions options;
   options.jobs = flags.jobs;
-  if (ranks.size() > 1)
-    options.dealer = [&ranks](size_t count, const auto& compute, const auto& deliver) {
-      ranks.deal(count, compute, deliver);
-    };
+  if (ranks.size() > 1) options.dealer = ranks.dealer();
   if (!ranks.root()) {
     experiment::serve_cases(ex, options.dealer);
     stop_if_interrupted("the run");
@@ -477,10 +474,7 @@ int fit_command(const std::string& path, const RunFlags& flags,
     });
   });
   const experiment::Experiment& ex = *loaded;
-  const fit::StartDealer dealer = [&ranks](size_t count, const auto& compute,
-                                           const auto& deliver) {
-    ranks.deal(count, compute, deliver);
-  };
+  const fiberfluid::WorkDealer dealer = ranks.dealer();
   if (!ranks.root()) {  // the ranks' share of the starts; a single fit is rank 0's alone
     if (multistart) fit::serve_multistart(*setup.calibration, *ex.fit->multistart, dealer);
     stop_if_interrupted("the fit");

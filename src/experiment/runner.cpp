@@ -295,7 +295,7 @@ std::string run_case_packed(const Experiment& ex, size_t r) {
 
 // The cases dealt out (over MPI ranks); each outcome replayed into the
 // observer where it arrives, as if it had run here.
-void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const CaseDealer& dealer,
+void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const WorkDealer& dealer,
                      ExperimentResult& result) {
   std::atomic<size_t> finished{0};
   report_variants(ex, 0);
@@ -318,7 +318,7 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Ca
 
 }  // namespace
 
-void serve_cases(const Experiment& ex, const CaseDealer& dealer) {
+void serve_cases(const Experiment& ex, const WorkDealer& dealer) {
   require_built(ex);
   if (ex.kind != Experiment::Kind::Simulate) return;
   dealer(

@@ -10,6 +10,7 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/util/work_dealer.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -52,24 +53,17 @@ using RunObserver =
 std::vector<FigureCheck> check_expected(const Experiment& experiment,
                                         const ExperimentResult& result);
 
-// Runs `count` cases somewhere, one at a time per worker (over MPI ranks:
-// parallel::Ranks::deal): compute(r) runs case r wherever it is dealt and
-// packs its outcome; deliver(r, rank, bytes) receives it where the results
-// are gathered, for different cases possibly from two threads at once.
-using CaseDealer = std::function<void(
-    size_t count, const std::function<std::string(size_t)>& compute,
-    const std::function<void(size_t, int, std::string&&)>& deliver)>;
-
 struct RunOptions {
   // Cases run at once. Each job's OpenMP loops get cores / jobs threads, so a
   // sweep of small models runs its variants side by side and a single large
   // model keeps every core for its pair loops. 0: as many as there are cores
   // (at most one per case).
   int jobs = 0;
-  // When set, the cases are dealt out through it instead (jobs is not used):
+  // When set, the cases are dealt out through it instead (over MPI ranks:
+  // parallel::Ranks::dealer; jobs is not used):
   // each outcome comes back as bytes and is replayed into the observer, step
   // by step, where it is delivered. The other ranks call serve_cases.
-  CaseDealer dealer;
+  WorkDealer dealer;
 };
 
 // Runs every case of a simulation (or measures the surfaces of an areas
@@ -80,7 +74,7 @@ ExperimentResult run_experiment(const Experiment& experiment, const RunObserver&
 // A rank other than rank 0 of a dealt run: runs the cases dealt to it and
 // sends their outcomes back, through the same dealer rank 0 passed to
 // run_experiment (RunOptions::dealer). Only a simulation has cases to deal.
-void serve_cases(const Experiment& experiment, const CaseDealer& dealer);
+void serve_cases(const Experiment& experiment, const WorkDealer& dealer);
 
 // Positions of every input vertex (input order and count; vertices that are
 // in no face stay where they are) for a model unknown vector.

@@ -110,17 +110,10 @@ std::string run_start(const Calibration& calibration, const Eigen::MatrixXd& sta
   return pack_fit_result(calibration.run_from(starts.row(static_cast<Eigen::Index>(s)).transpose()));
 }
 
-StartDealer in_order() {
-  return [](size_t count, const auto& compute, const auto& deliver) {
-    for (size_t item = 0; item < count && !cancel_requested(); ++item)
-      deliver(item, 0, compute(item));
-  };
-}
-
 }  // namespace
 
 MultistartResult run_multistart(const Calibration& calibration, const MultistartOptions& options,
-                                const StartDealer& dealer,
+                                const WorkDealer& dealer,
                                 const std::function<void(size_t, const StartOutcome&)>& progress) {
   check_options(options);
   const auto began = std::chrono::steady_clock::now();
@@ -137,7 +130,7 @@ MultistartResult run_multistart(const Calibration& calibration, const Multistart
     outcome.fit.initial = outcome.fit.values = outcome.start;
     outcome.fit.initial_cost = outcome.fit.final_cost = std::numeric_limits<double>::quiet_NaN();
   }
-  (dealer ? dealer : in_order())(
+  (dealer ? dealer : WorkDealer(deal_in_order))(
       result.starts.size(), [&](size_t s) { return run_start(calibration, starts, s); },
       [&](size_t s, int rank, std::string&& bytes) {
         StartOutcome& outcome = result.starts[s];
@@ -155,7 +148,7 @@ MultistartResult run_multistart(const Calibration& calibration, const Multistart
 }
 
 void serve_multistart(const Calibration& calibration, const MultistartOptions& options,
-                      const StartDealer& dealer) {
+                      const WorkDealer& dealer) {
   check_options(options);
   const Eigen::MatrixXd starts = spread_starts(calibration.parameters(), options.starts);
   dealer(

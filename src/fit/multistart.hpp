@@ -10,7 +10,7 @@
 // decade. The local optima are clustered: two are one when every fitted
 // variable agrees to `same_optimum` of its range.
 //
-// The starts are independent: they are dealt out through a StartDealer (one
+// The starts are independent: they are dealt out through a WorkDealer (one
 // process: in order; under MPI: over the ranks, parallel::Ranks::deal), and
 // the result is the same whichever rank ran which start.
 
@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/util/work_dealer.hpp"
 
 namespace fiberfluid::fit {
 
@@ -66,20 +67,14 @@ struct MultistartResult {
   const FitResult& best() const;
 };
 
-// Runs `count` items somewhere and delivers each one's bytes where the
-// results are gathered (the shape of parallel::Ranks::deal).
-using StartDealer = std::function<void(
-    size_t count, const std::function<std::string(size_t)>& compute,
-    const std::function<void(size_t, int, std::string&&)>& deliver)>;
-
 // The search. `progress` is called on the gathering process after each start
 // (its index, outcome); `dealer` empty: the starts in order, here. On other
 // MPI ranks, serve_multistart with the same dealer runs their share.
 MultistartResult run_multistart(const Calibration& calibration, const MultistartOptions& options,
-                                const StartDealer& dealer = {},
+                                const WorkDealer& dealer = {},
                                 const std::function<void(size_t, const StartOutcome&)>& progress = {});
 void serve_multistart(const Calibration& calibration, const MultistartOptions& options,
-                      const StartDealer& dealer);
+                      const WorkDealer& dealer);
 
 // Clusters the converged fits of `starts` (see the file's comment).
 std::vector<Optimum> cluster_optima(const std::vector<StartOutcome>& starts,

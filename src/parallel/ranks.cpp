@@ -32,12 +32,11 @@ bool launched_by_mpi() {
 
 int Ranks::threads() const { return omp_get_max_threads(); }
 
-namespace {
-// One rank: the items in order, here.
-void deal_in_order(size_t count, const Ranks::Compute& compute, const Ranks::Deliver& deliver) {
-  for (size_t item = 0; item < count && !cancel_requested(); ++item) deliver(item, 0, compute(item));
+WorkDealer Ranks::dealer() const {
+  return [this](size_t count, const WorkCompute& compute, const WorkDeliver& deliver) {
+    deal(count, compute, deliver);
+  };
 }
-}  // namespace
 
 #ifndef FIBERFLUID_HAVE_MPI
 
@@ -49,7 +48,7 @@ bool Ranks::all_ok(bool ok) const { return ok; }
 void Ranks::sum(std::vector<double>&) const {}
 void Ranks::broadcast(std::string&) const {}
 
-void Ranks::deal(size_t count, const Compute& compute, const Deliver& deliver) const {
+void Ranks::deal(size_t count, const WorkCompute& compute, const WorkDeliver& deliver) const {
   deal_in_order(count, compute, deliver);
 }
 
@@ -84,7 +83,7 @@ std::int64_t receive_item() {
 }
 
 // A worker rank: asks, computes, sends the result with the next request.
-void work(const Ranks::Compute& compute) {
+void work(const WorkCompute& compute) {
   MPI_Send(nullptr, 0, MPI_BYTE, 0, kAsk, MPI_COMM_WORLD);
   for (std::int64_t item = receive_item(); item >= 0; item = receive_item()) {
     std::string message(sizeof item, '\0');
@@ -102,7 +101,7 @@ void work(const Ranks::Compute& compute) {
 // the requests.
 class Dealer {
  public:
-  Dealer(size_t count, int workers, const Ranks::Deliver& deliver)
+  Dealer(size_t count, int workers, const WorkDeliver& deliver)
       : count_(count), workers_(workers), deliver_(deliver) {}
 
   // The next item for anyone, or -1.
@@ -155,7 +154,7 @@ class Dealer {
  private:
   const size_t count_;
   const int workers_;
-  const Ranks::Deliver& deliver_;
+  const WorkDeliver& deliver_;
   std::atomic<size_t> next_{0};
   std::atomic<bool> stopped_{false};
   std::mutex mutex_;
@@ -231,7 +230,7 @@ void Ranks::broadcast(std::string& bytes) const {
   wait_quietly(&request);
 }
 
-void Ranks::deal(size_t count, const Compute& compute, const Deliver& deliver) const {
+void Ranks::deal(size_t count, const WorkCompute& compute, const WorkDeliver& deliver) const {
   if (size_ == 1) return deal_in_order(count, compute, deliver);
   if (!root()) {
     work(compute);

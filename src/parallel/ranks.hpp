@@ -10,9 +10,10 @@
 // (the master-worker pattern; Gropp, Lusk and Skjellum, "Using MPI", 3rd ed.,
 // MIT Press 2014, section 3.6).
 
-#include <functional>
 #include <string>
 #include <vector>
+
+#include "fiberfluid/util/work_dealer.hpp"
 
 namespace fiberfluid::parallel {
 
@@ -48,18 +49,15 @@ class Ranks {
   // in agreement, so no rank waits for work that will never be dealt.
   bool all_ok(bool ok) const;
 
-  // The work item's result, as bytes, computed on whichever rank it was dealt to.
-  using Compute = std::function<std::string(size_t item)>;
-  // Receives item's result on rank 0 (from the rank that computed it); calls
-  // for different items may come from two threads at once.
-  using Deliver = std::function<void(size_t item, int rank, std::string&& bytes)>;
-
-  // Every rank calls it with the same count. Items 0..count-1 are dealt out
+  // Deals work items out (util/work_dealer.hpp's WorkDealer, over the
+  // ranks). Every rank calls it with the same count. Items 0..count-1 are dealt out
   // one at a time: rank 0 computes items too (when MPI lets a second thread
   // answer the others), the others ask for the next when done. Stops dealing
   // after Ctrl-C (util/run_control.hpp) or when `deliver` throws; the first
   // exception is rethrown on rank 0 once every rank has stopped.
-  void deal(size_t count, const Compute& compute, const Deliver& deliver) const;
+  void deal(size_t count, const WorkCompute& compute, const WorkDeliver& deliver) const;
+  // This object's deal as a WorkDealer (it must outlive the dealer).
+  WorkDealer dealer() const;
 
   // Element-wise sum of `values` over the ranks, on every rank.
   void sum(std::vector<double>& values) const;
