@@ -443,6 +443,81 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
   }
 }
 
+// A calibration over several specimens ("kind": "calibration"): rank 0 runs
+// Levenberg-Marquardt, every rank evaluates the specimens dealt to it at each
+// point. The folder holds calibration.json and each specimen's fit files.
+int calibrate_specimens(const experiment::Experiment& ex, const experiment::JointSetup& setup,
+                        const std::filesystem::path& folder, const RunFlags& flags,
+                        const fiberfluid::parallel::Ranks& ranks) {
+  namespace fit = fiberfluid::fit;
+  const fit::JointCalibration& joint = *setup.joint;
+  const fit::Broadcast broadcast = [&ranks](std::string& bytes) { ranks.broadcast(bytes); };
+  if (!ranks.root()) {
+    joint.serve(ranks.dealer(), broadcast);
+    stop_if_interrupted("the calibration");
+    return kOk;
+  }
+  std::cout << "calibrating " << joint.names().size() << " parameters (" << ex.calibration->shared.size()
+            << " shared) to " << joint.num_residuals() << " residuals of "
+            << joint.specimen_names().size() << " specimens over " << ranks.size()
+            << " rank(s)\n";
+  for (size_t s = 0; s < setup.specimens.size(); ++s)
+    std::cout << "  specimen " << joint.specimen_names()[s] << ": " << ex.specimens[s].source.string()
+              << ", " << setup.specimens[s].targets.size() << " target(s), "
+              << setup.specimens[s].calibration->num_residuals() << " residuals\n";
+  const fit::JointFitResult fitted = joint.run(ranks.dealer(), broadcast);
+  experiment::OutputWriter writer(ex, folder);
+  writer.begin();
+  experiment::ExperimentResult result;
+  result.figures = experiment::joint_figures(ex, fitted);
+  result.checks = experiment::check_expected(ex, result);
+  const auto files = [&](const std::filesystem::path& dir) {
+    experiment::write_joint_files(dir, ex, setup, fitted, result);
+  };
+  if (fitted.status == fit::FitStatus::Interrupted) {
+    writer.keep_interrupted("the calibration was interrupted after " +
+                                std::to_string(fitted.iterations.size()) + " iterations",
+                            files);
+    std::cerr << "\nerror: the calibration was interrupted (SIGINT or SIGTERM); its best point "
+                 "so far is in " << (writer.folder() / "calibration.json").string() << "\n";
+    return experiment::fit_exit_status(fitted.status);
+  }
+  if (!experiment::fit_result_kept(fitted.status))
+    result.failure = std::string("the calibration ended ") + fit::to_string(fitted.status) + ": " +
+                     fitted.message +
+                     (fitted.status_detail.empty() ? "" : "; " + fitted.status_detail);
+  writer.finish(result, files);
+  for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
+  std::cout << ex.name << ": " << fit::to_string(fitted.status) << ": " << fitted.message
+            << "; results in " << writer.folder().string() << "\n";
+  if (!fitted.status_detail.empty()) std::cout << "  " << fitted.status_detail << "\n";
+  for (size_t k = 0; k < fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    std::cout << "  " << fitted.names[k] << (static_cast<int>(k) < fitted.shared ? " (shared)" : "")
+              << " = " << fitted.values[i];
+    if (std::isfinite(fitted.standard_errors[i]))
+      std::cout << " +- " << fitted.standard_errors[i] << " (95%: " << fitted.lower_95[i] << " .. "
+                << fitted.upper_95[i] << ")";
+    std::cout << "; start " << fitted.initial[i] << "\n";
+  }
+  for (size_t s = 0; s < fitted.specimens.size(); ++s) {
+    const fit::DistanceStatistics& d = fitted.specimens[s].overall;
+    std::cout << "  specimen " << joint.specimen_names()[s] << ": distance sd "
+              << d.standard_deviation << " m (" << 100.0 * d.share(d.standard_deviation)
+              << "% of its length " << d.length << " m), rms " << d.rms << ", largest "
+              << d.largest << " m\n";
+  }
+  std::cout << "  " << fitted.evaluations << " evaluations, " << fitted.seconds << " s\n";
+  for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
+  if (!experiment::fit_result_kept(fitted.status)) std::cerr << "error: " << result.failure << "\n";
+  if (const int status = experiment::fit_exit_status(fitted.status); status != kOk) return status;
+  if (flags.check_expected && !result.checks_passed()) {
+    std::cerr << "error: some expected figures were not met (see above)\n";
+    return kChecksFailed;
+  }
+  return kOk;
+}
+
 // Calibrates the material of an experiment to its "fit" targets, then runs
 // it at the fitted values and writes the usual outputs with the fit's files.
 // Every fit file is in the folder before it moves into place: DIR for a fit
@@ -459,12 +534,19 @@ int fit_command(const std::string& path, const RunFlags& flags,
   std::optional<experiment::Experiment> loaded;
   std::filesystem::path folder;
   experiment::FitSetup setup;
+  experiment::JointSetup joint;
   std::vector<std::string> names;
   bool multistart = false;
   on_every_rank(ranks, [&] {
     loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
     fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
     if (ranks.root()) folder = experiment::output_folder(flags.output, loaded->name);
+    if (loaded->kind == experiment::Experiment::Kind::Calibration) {
+      joint = experiment::setup_joint(*loaded, [&](const fit::IterationRecord& r) {
+        if (!flags.quiet) print_iteration(r, joint.joint->names());
+      });
+      return;
+    }
     if (loaded->fit)
       for (const auto& p : loaded->fit->parameters) names.push_back(p.request.name);
     multistart = loaded->fit && loaded->fit->multistart;
@@ -474,6 +556,8 @@ int fit_command(const std::string& path, const RunFlags& flags,
     });
   });
   const experiment::Experiment& ex = *loaded;
+  if (ex.kind == experiment::Experiment::Kind::Calibration)
+    return calibrate_specimens(ex, joint, folder, flags, ranks);
   const fiberfluid::WorkDealer dealer = ranks.dealer();
   if (!ranks.root()) {  // the ranks' share of the starts; a single fit is rank 0's alone
     if (multistart) fit::serve_multistart(*setup.calibration, *ex.fit->multistart, dealer);

@@ -762,6 +762,31 @@ void read_simulation(Fields& root, const nlohmann::json& document,
   output.finish();
 }
 
+// A calibration over several specimens: their experiment files (read when
+// the experiment is built) and the parameters they share.
+CalibrationSpec read_calibration(Fields& root, const std::filesystem::path& folder) {
+  CalibrationSpec spec;
+  for (Fields f : root.objects("specimens")) {
+    SpecimenSpec specimen;
+    specimen.field = f.field();
+    specimen.name = f.string("name");
+    if (const std::string problem = folder_name_problem(specimen.name); !problem.empty())
+      f.fail("name", "expected " + problem);
+    for (const SpecimenSpec& other : spec.specimens)
+      if (other.name == specimen.name) f.fail("name", "\"" + specimen.name + "\" names another specimen");
+    specimen.file = f.string("experiment");
+    if (specimen.file.is_relative()) specimen.file = folder / specimen.file;
+    f.resolve("experiment", absolute_path(specimen.file));
+    f.finish();
+    spec.specimens.push_back(specimen);
+  }
+  if (spec.specimens.size() < 2)
+    root.fail("specimens", "expected two or more specimens (each {\"name\", \"experiment\"})");
+  spec.shared = root.names("shared");
+  spec.max_iterations = root.integer("max_iterations", spec.max_iterations, 1, 10000);
+  return spec;
+}
+
 void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
   for (Fields f : root.objects("surfaces")) {
     NamedSurfaceSpec named;
@@ -793,10 +818,12 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
     root.fail("name", "expected " + problem);
   ex.description = root.string("description", "");
-  const std::string kind = root.choice("kind", "simulate", {"simulate", "areas", "benchmark"});
-  ex.kind = kind == "areas"       ? Experiment::Kind::Areas
-            : kind == "benchmark" ? Experiment::Kind::Benchmark
-                                  : Experiment::Kind::Simulate;
+  const std::string kind =
+      root.choice("kind", "simulate", {"simulate", "areas", "benchmark", "calibration"});
+  ex.kind = kind == "areas"         ? Experiment::Kind::Areas
+            : kind == "benchmark"   ? Experiment::Kind::Benchmark
+            : kind == "calibration" ? Experiment::Kind::Calibration
+                                    : Experiment::Kind::Simulate;
   ex.expected = read_expected(root);
   if (root.has("fit")) {
     if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
@@ -818,6 +845,9 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
     read_simulation(root, document, folder, ex);  // each case checks its own fields
   } else if (ex.kind == Experiment::Kind::Benchmark) {
     ex.benchmark = read_benchmark(root);
+    root.finish();
+  } else if (ex.kind == Experiment::Kind::Calibration) {
+    ex.calibration = read_calibration(root, folder);
     root.finish();
   } else {
     read_areas(root, folder, ex);
@@ -843,6 +873,29 @@ void require_built(const Experiment& experiment) {
 void build_experiment(Experiment& ex, const geom::Surface* surface) {
   ex.cases.clear();
   ex.area_surfaces.clear();
+  ex.specimens.clear();
+  if (ex.calibration)  // each specimen's file, read and built; its errors name it
+    for (const SpecimenSpec& s : ex.calibration->specimens) {
+      // A specimen is a simulation, never a calibration (which could list itself).
+      static thread_local bool inside_calibration = false;
+      if (inside_calibration)
+        throw InputError(s.file.string() + ": a specimen of a calibration is a simulation with "
+                                           "a \"fit\" section, not a calibration");
+      inside_calibration = true;
+      Experiment specimen;
+      try {
+        specimen = load_experiment(s.file);
+      } catch (...) {
+        inside_calibration = false;
+        throw;
+      }
+      inside_calibration = false;
+      if (!specimen.fit)
+        s.field.fail("experiment", s.file.string() + " has no \"fit\" section: a specimen "
+                                   "brings its targets and parameters");
+      for (const std::string& w : specimen.warnings) ex.warnings.push_back(s.name + ": " + w);
+      ex.specimens.push_back(std::move(specimen));
+    }
   for (const NamedSurfaceSpec& named : ex.area_specs)
     ex.area_surfaces.push_back({named.name, build_surface(named.surface, &ex.warnings)});
   for (const CaseSpec& spec : ex.specs) {

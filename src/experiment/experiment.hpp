@@ -48,9 +48,24 @@ struct NamedSurfaceSpec {
   SurfaceSpec surface;
 };
 
+// One specimen of a calibration over several: an experiment file with a
+// "fit" section (its surface, loads, targets and parameters).
+struct SpecimenSpec {
+  FieldName field;
+  std::string name;
+  std::filesystem::path file;
+};
+
+// "kind": "calibration": one material fitted to several specimens at once.
+struct CalibrationSpec {
+  std::vector<SpecimenSpec> specimens;
+  std::vector<std::string> shared;  // the parameters every specimen shares
+  int max_iterations = 50;
+};
+
 // A parsed and validated experiment file.
 struct Experiment {
-  enum class Kind { Simulate, Areas, Benchmark };
+  enum class Kind { Simulate, Areas, Benchmark, Calibration };
   Kind kind = Kind::Simulate;
   std::string name;
   std::string description;
@@ -72,6 +87,11 @@ struct Experiment {
 
   std::optional<BenchmarkSpec> benchmark;  // Benchmark: the scene, solvers and comparisons
 
+  // Calibration: the specimens and what they share, as parsed; and the
+  // specimens' experiments, as loaded (build_experiment).
+  std::optional<CalibrationSpec> calibration;
+  std::vector<Experiment> specimens;
+
   std::optional<FitSpec> fit;
   // "fem_reference": also solve the simulation by linear FEM on tetrahedra
   // and write its deformed boundary (fem_reference.obj) as a target.
@@ -84,6 +104,7 @@ struct Experiment {
   bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
   // Whether build_experiment has made what running needs (read_experiment leaves it unbuilt).
   bool built() const {
+    if (kind == Kind::Calibration) return calibration && specimens.size() == calibration->specimens.size();
     return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
   }
 };

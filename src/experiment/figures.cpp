@@ -99,10 +99,34 @@ std::vector<std::string> run_figure_names(const model::Model& model) {
   return names;
 }
 
+std::vector<std::string> calibration_figures(const Experiment& ex) {
+  std::vector<std::string> names = {"fit.cost"};
+  if (!ex.calibration) return names;
+  for (const std::string& shared : ex.calibration->shared) names.push_back("fit." + shared);
+  for (size_t s = 0; s < ex.specimens.size(); ++s) {
+    const std::string prefix = "fit." + ex.calibration->specimens[s].name + ".";
+    for (const FitParameterSpec& p : ex.specimens[s].fit->parameters)
+      if (std::find(ex.calibration->shared.begin(), ex.calibration->shared.end(),
+                    p.request.name) == ex.calibration->shared.end())
+        names.push_back(prefix + p.request.name);
+    for (const char* f : {"distance_mean", "distance_rms", "distance_sd", "distance_largest",
+                          "distance_sd_share"})
+      names.push_back(prefix + f);
+  }
+  return names;
+}
+
 std::string figure_problem(const Experiment& ex, const std::string& figure, bool fit_figures) {
-  if (!fit_figures && ex.fit && figure.rfind("fit.", 0) == 0) return {};
+  const bool fitted = ex.fit || ex.kind == Experiment::Kind::Calibration;
+  if (!fit_figures && fitted && figure.rfind("fit.", 0) == 0) return {};
   std::vector<std::string> valid;
   switch (ex.kind) {
+    case Experiment::Kind::Calibration:
+      for (const std::string& f : calibration_figures(ex)) {
+        if (figure == f) return {};
+        valid.push_back(f);
+      }
+      break;
     case Experiment::Kind::Benchmark:
       return {};
     case Experiment::Kind::Areas:

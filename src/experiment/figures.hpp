@@ -20,6 +20,11 @@ const std::vector<std::string>& run_figure_names();
 // Those and, for a model with paddles, each paddle's final force and contacts.
 std::vector<std::string> run_figure_names(const model::Model& model);
 
+// A calibration over specimens' figures (once built): fit.cost, fit.SHARED,
+// and per specimen fit.SPECIMEN.PARAMETER (its own) and
+// fit.SPECIMEN.distance_sd_share (and the other distance statistics).
+std::vector<std::string> calibration_figures(const Experiment& experiment);
+
 // "" when `figure` names a figure this experiment will have; else why not,
 // with the valid names. Benchmarks name their figures after their solvers and
 // metrics: those are checked after the run only. Without `fit_figures` a

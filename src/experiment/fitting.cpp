@@ -509,3 +509,141 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
 }
 
 }  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+
+JointSetup setup_joint(const Experiment& ex,
+                       std::function<void(const fit::IterationRecord&)> progress) {
+  if (ex.kind != Experiment::Kind::Calibration || !ex.calibration)
+    throw InputError(ex.source.string() + ": not a calibration over specimens");
+  require_built(ex);
+  const CalibrationSpec& spec = *ex.calibration;
+  JointSetup setup;
+  std::vector<const fit::Calibration*> calibrations;
+  std::vector<std::string> names;
+  for (size_t s = 0; s < ex.specimens.size(); ++s) {
+    setup.specimens.push_back(setup_fit(ex.specimens[s]));
+    calibrations.push_back(setup.specimens.back().calibration.get());
+    names.push_back(spec.specimens[s].name);
+  }
+  fit::JointOptions options;
+  options.max_iterations = spec.max_iterations;
+  options.progress = std::move(progress);
+  const FieldName root{ex.source.string(), ""};
+  try {
+    setup.joint = std::make_unique<fit::JointCalibration>(names, calibrations, spec.shared,
+                                                          std::move(options));
+  } catch (const InputError& e) {
+    root.fail("shared", e.what());
+  }
+  for (size_t k = 0; k < ex.expected.size(); ++k)
+    if (const std::string problem = figure_problem(ex, ex.expected[k].figure); !problem.empty())
+      root.fail("expected[" + std::to_string(k) + "].figure", problem);
+  return setup;
+}
+
+std::map<std::string, double> joint_figures(const Experiment& ex,
+                                            const fit::JointFitResult& r) {
+  std::map<std::string, double> figures = {{"fit.cost", r.final_cost}};
+  for (size_t k = 0; k < r.names.size(); ++k)
+    figures["fit." + r.names[k]] = r.values[static_cast<Eigen::Index>(k)];
+  for (size_t s = 0; s < r.specimens.size() && s < ex.calibration->specimens.size(); ++s) {
+    const std::string prefix = "fit." + ex.calibration->specimens[s].name + ".";
+    const fit::DistanceStatistics& d = r.specimens[s].overall;
+    figures[prefix + "distance_mean"] = d.mean;
+    figures[prefix + "distance_rms"] = d.rms;
+    figures[prefix + "distance_sd"] = d.standard_deviation;
+    figures[prefix + "distance_largest"] = d.largest;
+    figures[prefix + "distance_sd_share"] = d.share(d.standard_deviation);
+  }
+  return figures;
+}
+
+void write_joint_files(const std::filesystem::path& folder, const Experiment& ex,
+                       const JointSetup& setup, const fit::JointFitResult& r,
+                       const ExperimentResult& checked) {
+  json parameters = json::array();
+  for (size_t k = 0; k < r.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    parameters.push_back({{"name", r.names[k]},
+                          {"shared", static_cast<int>(k) < r.shared},
+                          {"initial", r.initial[i]},
+                          {"value", number(r.values[i])},
+                          {"standard_error", number(r.standard_errors[i])},
+                          {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}}});
+  }
+  json correlation = json::array();
+  for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
+    json row = json::array();
+    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b) row.push_back(number(r.correlation(a, b)));
+    correlation.push_back(row);
+  }
+  json specimens = json::array();
+  for (size_t s = 0; s < setup.specimens.size(); ++s) {
+    json specimen = {{"name", ex.calibration->specimens[s].name},
+                     {"experiment", ex.specimens[s].source.string()},
+                     {"body_length", setup.specimens[s].calibration->body_length()},
+                     {"residuals", setup.specimens[s].calibration->num_residuals()}};
+    if (s < r.specimens.size() && !r.specimens[s].statistics.empty()) {
+      const fit::FitResult& f = r.specimens[s];
+      specimen["distance"] = statistics_json(f.overall);
+      json values = json::object();
+      for (size_t k = 0; k < f.names.size(); ++k)
+        values[f.names[k]] = f.values[static_cast<Eigen::Index>(k)];
+      specimen["values"] = values;
+      specimen["cost"] = number(f.final_cost);
+    }
+    specimens.push_back(specimen);
+  }
+  json iterations = json::array();
+  for (const fit::IterationRecord& it : r.iterations) iterations.push_back(iteration_json(it, r.names));
+  json checks = json::array();
+  for (const FigureCheck& check : checked.checks)
+    checks.push_back({{"figure", check.expected.figure},
+                      {"passed", check.passed},
+                      {"actual", number(check.actual)},
+                      {"text", check.Describe()}});
+  const json doc = {
+      {"experiment", ex.name},
+      {"status", fit::to_string(r.status)},
+      {"status_detail", r.status_detail},
+      {"success", r.success},
+      {"message", r.message},
+      {"method", "levenberg-marquardt over every specimen's distances (analytic Jacobian blocks)"},
+      {"shared", ex.calibration->shared},
+      {"parameters", parameters},
+      {"intervals_are", "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
+                        "cost / (residuals - parameters); in log scale for log-scaled parameters"},
+      {"correlation", correlation},
+      {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
+      {"residuals", r.residuals},
+      {"evaluations", r.evaluations},
+      {"seconds", r.seconds},
+      {"specimens", specimens},
+      {"iterations", iterations},
+      {"checks", checks}};
+  geom::write_text_file(folder / "calibration.json", doc.dump(2) + "\n");
+  std::ostringstream rows;
+  rows.precision(12);
+  rows << "iteration,cost_m2,accepted,forward_runs,seconds";
+  for (const std::string& name : r.names) rows << "," << name;
+  rows << "\n";
+  for (const fit::IterationRecord& it : r.iterations) {
+    rows << it.iteration << "," << it.cost << "," << (it.accepted ? 1 : 0) << ","
+         << it.forward_runs << "," << it.seconds;
+    for (Eigen::Index k = 0; k < it.values.size(); ++k) rows << "," << it.values[k];
+    rows << "\n";
+  }
+  geom::write_text_file(folder / "calibration_iterations.csv", rows.str());
+  // Each specimen's fit files at the joint optimum, in a folder of its own.
+  for (size_t s = 0; s < r.specimens.size() && s < setup.specimens.size(); ++s) {
+    if (r.specimens[s].statistics.empty()) continue;  // no run there
+    const std::filesystem::path own = folder / ex.calibration->specimens[s].name;
+    std::filesystem::create_directories(own);
+    const Experiment at_fit =
+        with_fitted_material(ex.specimens[s], *setup.specimens[s].calibration, r.specimens[s]);
+    write_fit_files(own, at_fit, setup.specimens[s], r.specimens[s], ExperimentResult{});
+  }
+}
+
+}  // namespace fiberfluid::experiment

@@ -9,6 +9,7 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/runner.hpp"
 #include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/joint_calibration.hpp"
 #include "fiberfluid/fit/multistart.hpp"
 
 namespace fiberfluid::experiment {
@@ -61,5 +62,30 @@ Experiment with_fitted_material(const Experiment& experiment, const fit::Calibra
 void write_fit_files(const std::filesystem::path& folder, const Experiment& experiment,
                      const FitSetup& setup, const fit::FitResult& result,
                      const ExperimentResult& run, const fit::MultistartResult* search = nullptr);
+
+// A calibration over specimens ("kind": "calibration") set up: each
+// specimen's fit (its targets read, its calibration) and the joint one over
+// them. Throws InputError naming the specimen and field.
+struct JointSetup {
+  std::vector<FitSetup> specimens;
+  std::unique_ptr<fit::JointCalibration> joint;
+};
+JointSetup setup_joint(const Experiment& experiment,
+                       std::function<void(const fit::IterationRecord&)> progress = {});
+
+// Its figures: fit.cost, fit.SHARED, fit.SPECIMEN.PARAMETER and each
+// specimen's distance statistics (fit.SPECIMEN.distance_sd_share: the sd as
+// a share of its body's length).
+std::map<std::string, double> joint_figures(const Experiment& experiment,
+                                            const fit::JointFitResult& result);
+
+// Writes calibration.json (the shared parameters with their intervals, each
+// specimen's own and its distance statistics, the iterations, the checks),
+// calibration_iterations.csv, and per specimen a folder SPECIMEN/ with its
+// fit files at the joint optimum (write_fit_files: fit.json,
+// fit_distances.csv, fit_target_K.vtu, ...).
+void write_joint_files(const std::filesystem::path& folder, const Experiment& experiment,
+                       const JointSetup& setup, const fit::JointFitResult& result,
+                       const ExperimentResult& checked);
 
 }  // namespace fiberfluid::experiment

@@ -202,6 +202,26 @@ class Fields {
     }
     return out;
   }
+  // A non-empty list of distinct names.
+  std::vector<std::string> names(const std::string& key) {
+    note(key, [] {
+      return nlohmann::json{{"type", "array"},
+                            {"items", {{"type", "string"}, {"minLength", 1}}},
+                            {"minItems", 1},
+                            {"uniqueItems", true}};
+    });
+    const nlohmann::json& v = value_of(key);
+    if (!v.is_array() || v.empty()) fail(key, "expected a non-empty list of names");
+    std::vector<std::string> out;
+    for (const nlohmann::json& item : v) {
+      if (!item.is_string() || item.get<std::string>().empty())
+        fail(key, "expected names (strings), got " + excerpt(item));
+      if (std::find(out.begin(), out.end(), item.get<std::string>()) != out.end())
+        fail(key, "\"" + item.get<std::string>() + "\" is named twice");
+      out.push_back(item.get<std::string>());
+    }
+    return out;
+  }
   std::vector<Fields> objects(const std::string& key) {
     note(key, [] { return nlohmann::json{{"type", "array"}, {"items", {{"type", "object"}}}}; });
     std::vector<Fields> out;

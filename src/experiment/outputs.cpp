@@ -253,9 +253,10 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   json build = json::object();
   for (const auto& [name, value] : build_info()) build[name] = value;
   doc["build"] = build;
-  doc["kind"] = ex.kind == Experiment::Kind::Areas       ? "areas"
-                : ex.kind == Experiment::Kind::Benchmark ? "benchmark"
-                                                         : "simulate";
+  doc["kind"] = ex.kind == Experiment::Kind::Areas         ? "areas"
+                : ex.kind == Experiment::Kind::Benchmark   ? "benchmark"
+                : ex.kind == Experiment::Kind::Calibration ? "calibration"
+                                                           : "simulate";
   if (!result.failure.empty()) doc["failure"] = result.failure;
   doc["units"] = {{"length", "m"},
                   {"displacement", "m"},

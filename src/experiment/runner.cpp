@@ -16,6 +16,7 @@
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/progress.hpp"
 
 namespace fiberfluid::experiment {
@@ -320,7 +321,7 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Wo
 
 void serve_cases(const Experiment& ex, const WorkDealer& dealer) {
   require_built(ex);
-  if (ex.kind != Experiment::Kind::Simulate) return;
+  if (ex.kind != Experiment::Kind::Simulate) return;  // rank 0 says why, or runs it alone
   dealer(
       ex.cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
       [](size_t, int, std::string&&) {});
@@ -329,6 +330,9 @@ void serve_cases(const Experiment& ex, const WorkDealer& dealer) {
 ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
                                 const RunOptions& options) {
   require_built(ex);
+  if (ex.kind == Experiment::Kind::Calibration)
+    throw InputError(ex.source.string() + ": a calibration over specimens runs with `fiberfluid "
+                                          "fit` (its specimens run with `fiberfluid run`)");
   ExperimentResult result;
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);

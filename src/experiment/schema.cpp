@@ -203,6 +203,8 @@ const char* const kSeeds[] = {
         "variants": [{"name": "a", "stepping": {"steps": 1}}]})",
     R"({"name": "c", "surface": {"generator": "icosphere"}, "material": {"Y": 1, "gamma": 0},
         "supports": [{"where": "z > 0"}]})",
+    R"({"name": "j", "kind": "calibration", "shared": ["Y0"], "max_iterations": 10,
+        "specimens": [{"name": "a", "experiment": "a.json"}, {"name": "b", "experiment": "b.json"}]})",
     R"({"name": "a", "kind": "areas", "surfaces": [{"name": "o", "generator": "octahedron"},
         {"name": "f", "file": "x.obj", "flip": false}]})",
     R"({"name": "b", "kind": "benchmark", "scene": "block-needle", "material": "MP1",

@@ -345,6 +345,7 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
 Calibration::~Calibration() = default;
 
 const ParameterMap& Calibration::parameters() const { return impl_->map; }
+const FitOptions& Calibration::options() const { return impl_->options; }
 const model::Model& Calibration::model() const { return impl_->model; }
 bool Calibration::analytic_jacobian() const { return impl_->analytic; }
 int Calibration::num_residuals() const { return impl_->residuals; }
@@ -699,15 +700,73 @@ std::string unidentifiable_because(const Eigen::MatrixXd& J,
          "one of them, or add targets that separate them";
 }
 
-// Where phi lies on a bound, to a millionth of the parameter's range.
-bool on_bound(double phi, double lower, double upper) {
-  const double range = std::isfinite(upper - lower) ? upper - lower : std::max(1.0, std::abs(phi));
-  const double tolerance = 1e-6 * range;
-  return (std::isfinite(lower) && phi - lower <= tolerance) ||
-         (std::isfinite(upper) && upper - phi <= tolerance);
+}  // namespace
+
+void Calibration::describe_at(const Evaluation& best, FitResult& result) const {
+  const Impl& m = *impl_;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  result.final_cost = cost(best.residuals);
+  result.summary = best.summary;
+  result.positions = best.positions;
+  const int nv = m.model.num_vertices();
+  Eigen::Index row = 0;
+  std::vector<double> all;
+  for (size_t t = 0; t < m.targets.size(); ++t) {
+    Eigen::VectorXd per_vertex = Eigen::VectorXd::Constant(nv, nan);
+    Eigen::VectorXd counted(static_cast<Eigen::Index>(m.counted.size()));
+    for (size_t c = 0; c < m.counted.size(); ++c, ++row) {
+      per_vertex[m.counted[c]] = best.residuals[row];
+      counted[static_cast<Eigen::Index>(c)] = best.residuals[row];
+      all.push_back(best.residuals[row]);
+    }
+    if (m.options.symmetric) row += m.targets[t].target.points.rows();
+    result.vertex_distances.push_back(per_vertex);
+    result.statistics.push_back(distance_statistics(counted, m.length));
+  }
+  result.overall = distance_statistics(
+      Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())),
+      m.length);
+  for (size_t c = 0; c < m.curves.size(); ++c) {
+    ForceMisfit misfit;
+    misfit.simulated = best.forces[c];
+    misfit.weight = m.curve_weights[c];
+    double squares = 0.0;
+    for (size_t r = 0; r < misfit.simulated.size(); ++r) {
+      const double miss = misfit.simulated[r] - m.curves[c].force[r];
+      squares += miss * miss;
+      misfit.largest = std::max(misfit.largest, std::abs(miss));
+      misfit.scale = std::max(misfit.scale, std::abs(m.curves[c].force[r]));
+    }
+    misfit.rms = std::sqrt(squares / static_cast<double>(misfit.simulated.size()));
+    result.force_misfits.push_back(misfit);
+  }
 }
 
-}  // namespace
+FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
+  const Impl& m = *impl_;
+  const int P = m.map.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  FitResult result;
+  result.method = m.options.method;
+  result.analytic_jacobian = m.analytic;
+  result.names = m.map.names();
+  result.initial = result.values = m.map.values(phi);
+  result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
+  result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
+  result.initial_cost = result.final_cost = nan;
+  const Evaluation at = evaluate(phi, false);
+  result.forward_runs = at.forward_runs;
+  if (!at.ok) {
+    result.status = cancel_requested() ? FitStatus::Interrupted : FitStatus::ForwardRunsFailed;
+    result.message = "the forward run failed: " + at.message;
+    return result;
+  }
+  describe_at(at, result);
+  result.initial_cost = result.final_cost;
+  result.status = FitStatus::Converged;
+  result.success = true;
+  return result;
+}
 
 FitResult Calibration::run() const { return run_from(impl_->map.initial_phi()); }
 
@@ -773,41 +832,7 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
     return finish(FitStatus::ForwardRunsFailed,
                   "the forward run at the fitted parameters failed: " + best.message);
   }
-  result.final_cost = cost(best.residuals);
-  result.summary = best.summary;
-  result.positions = best.positions;
-  const int nv = m.model.num_vertices();
-  Eigen::Index row = 0;
-  std::vector<double> all;
-  for (size_t t = 0; t < m.targets.size(); ++t) {
-    Eigen::VectorXd per_vertex = Eigen::VectorXd::Constant(nv, nan);
-    Eigen::VectorXd counted(static_cast<Eigen::Index>(m.counted.size()));
-    for (size_t c = 0; c < m.counted.size(); ++c, ++row) {
-      per_vertex[m.counted[c]] = best.residuals[row];
-      counted[static_cast<Eigen::Index>(c)] = best.residuals[row];
-      all.push_back(best.residuals[row]);
-    }
-    if (m.options.symmetric) row += m.targets[t].target.points.rows();
-    result.vertex_distances.push_back(per_vertex);
-    result.statistics.push_back(distance_statistics(counted, m.length));
-  }
-  result.overall = distance_statistics(
-      Eigen::Map<const Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size())),
-      m.length);
-  for (size_t c = 0; c < m.curves.size(); ++c) {
-    ForceMisfit misfit;
-    misfit.simulated = best.forces[c];
-    misfit.weight = m.curve_weights[c];
-    double squares = 0.0;
-    for (size_t r = 0; r < misfit.simulated.size(); ++r) {
-      const double miss = misfit.simulated[r] - m.curves[c].force[r];
-      squares += miss * miss;
-      misfit.largest = std::max(misfit.largest, std::abs(miss));
-      misfit.scale = std::max(misfit.scale, std::abs(m.curves[c].force[r]));
-    }
-    misfit.rms = std::sqrt(squares / static_cast<double>(misfit.simulated.size()));
-    result.force_misfits.push_back(misfit);
-  }
+  describe_at(best, result);
   // The parameters on a bound, said whatever the ending (a fit that ran out
   // of iterations against a bound is the usual sign of a wrong model).
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();

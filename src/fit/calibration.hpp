@@ -192,6 +192,7 @@ class Calibration {
   ~Calibration();
 
   const ParameterMap& parameters() const;
+  const FitOptions& options() const;
   const model::Model& model() const;
   bool analytic_jacobian() const;
   int num_residuals() const;
@@ -213,8 +214,16 @@ class Calibration {
   // The fit from the fitted variables `start_phi` (ParameterMap: log or
   // linear), within the bounds: one start of a multi-start search.
   FitResult run_from(const Eigen::VectorXd& start_phi) const;
+  // No fit: the run and the distances at the fitted variables phi (as a
+  // fit's result; status Converged when the run succeeded, with no standard
+  // errors): one specimen's share of a calibration over several.
+  FitResult result_at(const Eigen::VectorXd& phi) const;
 
  private:
+  // The distances, their statistics, the run and the force misfits of an
+  // evaluation, into result.
+  void describe_at(const Evaluation& at, FitResult& result) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

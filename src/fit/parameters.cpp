@@ -162,4 +162,11 @@ void ParameterMap::alignment(const Eigen::VectorXd& values, Eigen::Vector3d* rot
   *scale = alignment_index_[6] >= 0 ? values[alignment_index_[6]] : 1.0;
 }
 
+bool on_bound(double phi, double lower, double upper) {
+  const double range = std::isfinite(upper - lower) ? upper - lower : std::max(1.0, std::abs(phi));
+  const double tolerance = 1e-6 * range;
+  return (std::isfinite(lower) && phi - lower <= tolerance) ||
+         (std::isfinite(upper) && upper - phi <= tolerance);
+}
+
 }  // namespace fiberfluid::fit

@@ -44,6 +44,10 @@ Parameter make_parameter(const ParameterRequest& request, const model::Material&
 // linear for an exponent (beta) and the alignment's rotation and translation.
 bool log_scale_by_default(const std::string& name, const model::Material& material);
 
+// Whether a fitted variable phi lies on one of its bounds (in phi), to a
+// millionth of its range (of max(1, |phi|) when a bound is infinite).
+bool on_bound(double phi, double lower, double upper);
+
 // The parameters in the optimiser's variables phi (log or linear) and back.
 class ParameterMap {
  public:

@@ -407,3 +407,58 @@ TEST(FitConfig, BadForceTargetsAreNamed) {
 
 }  // namespace
 }  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+namespace {
+
+// A calibration over specimens that cannot be set up is named: too few
+// specimens, one without a fit, a calibration as a specimen, a shared
+// parameter a specimen does not fit, a figure it will not have; and `run`
+// is told to use `fit`.
+TEST(CalibrationConfig, BadCalibrationsAreNamed) {
+  const auto document = [](const char* second) {
+    return nlohmann::json{{"name", "two"},
+                          {"kind", "calibration"},
+                          {"specimens",
+                           {{{"name", "synthetic"}, {"experiment", "fit_synthetic_liver.json"}},
+                            {{"name", "second"}, {"experiment", second}}}},
+                          {"shared", {"Y0", "beta"}}};
+  };
+  const auto expect_error = [](const nlohmann::json& d, const std::string& part) {
+    try {
+      const Experiment ex =
+          parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+      setup_joint(ex);
+      ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::json d = document("fit_fine_liver.json");
+  d["specimens"].erase(1);
+  expect_error(d, "doc: specimens: expected two or more specimens");
+  expect_error(document("liver_gravity.json"), "has no \"fit\" section");
+  expect_error(document("calibrate_two_livers.json"), "not a calibration");
+  expect_error(document("no_such_file.json"), "no_such_file.json");
+  d = document("fit_fine_liver.json");
+  d["shared"] = {"Y0", "rotation_x"};
+  expect_error(d, "specimen \"synthetic\" does not fit \"rotation_x\"");
+  d = document("fit_fine_liver.json");
+  d["shared"] = {"Y0", "Y0"};
+  expect_error(d, "doc: shared: \"Y0\" is named twice");
+  d = document("fit_fine_liver.json");
+  d["expected"] = {{{"figure", "fit.second.gamm"}, {"value", 1}}};
+  expect_error(d, "no figure \"fit.second.gamm\" in this experiment (expected one of fit.cost, "
+                  "fit.Y0, fit.beta, fit.synthetic.gamma");
+
+  const Experiment ex = parse_experiment(document("fit_fine_liver.json"),
+                                         testing::experiment_file("").parent_path(), "doc");
+  ASSERT_EQ(ex.specimens.size(), 2u);
+  EXPECT_THROW(run_experiment(ex), InputError);
+  const JointSetup setup = setup_joint(ex);
+  EXPECT_EQ(setup.joint->names(),
+            (std::vector<std::string>{"Y0", "beta", "synthetic.gamma", "second.gamma"}));
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment

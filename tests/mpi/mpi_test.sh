@@ -4,6 +4,7 @@
 # case; tests/CMakeLists.txt). Usage:
 #   mpi_test.sh CASE MPIEXEC FIBERFLUID SOURCE_DIR
 # CASE: same-bits | failed-variant | interrupted (sweeps) | multistart (a fit)
+#       | specimens (a calibration over two specimens)
 set -uo pipefail
 case_name="$1" mpiexec="$2" fiberfluid="$3" source="$4"
 here="$source/tests/mpi"
@@ -115,6 +116,35 @@ assert sorted({s["rank"] for s in found["starts"]}) == [0, 1], "a rank ran no st
 assert all(s["status"] == "converged" for s in found["starts"]), found["starts"]
 print("optimum", best["values"], "from", best["starts_reached"], "of", len(found["starts"]), "starts")
 EOF
+  ;;
+specimens)
+  # Two livers, one tissue: the shared Y0 and beta of the truth (20 kPa, 3)
+  # within the calibration's 95% intervals, each specimen's gamma (200 N/m)
+  # within its own; each rank evaluated a specimen; the same bits as one rank.
+  calibration="$source/experiments/calibrate_two_livers.json"
+  mkdir "$work/one" "$work/two"
+  "${mpirun[@]}" -np 1 "$fiberfluid" fit "$calibration" -q -o "$work/one/out" >/dev/null 2>&1 ||
+    fail "one rank"
+  "${mpirun[@]}" -np 2 "$fiberfluid" fit "$calibration" -q --check -o "$work/two/out" \
+    >/dev/null 2>"$work/err" || fail "two ranks: $(cat "$work/err")"
+  python3 "$here/same_outputs.py" "$work/one/out" "$work/two/out" || fail "two ranks differ"
+  python3 - "$work/two/out/calibration.json" <<'EOF' || fail "the calibration"
+import json, sys
+c = json.load(open(sys.argv[1]))
+assert c["status"] == "converged", c["status"]
+truth = {"Y0": 20000.0, "beta": 3.0, "synthetic.gamma": 200.0, "fine.gamma": 200.0}
+for p in c["parameters"]:
+    low, high = p["interval_95"]
+    assert low <= truth[p["name"]] <= high, (p["name"], low, high)
+    assert p["shared"] == (p["name"] in ("Y0", "beta")), p
+for s in c["specimens"]:
+    share = s["distance"]["standard_deviation"] / s["body_length"]
+    assert share < 0.002, (s["name"], share)  # the scans' noise at most
+print({p["name"]: p["value"] for p in c["parameters"]})
+EOF
+  for specimen in synthetic fine; do
+    [ -f "$work/two/out/$specimen/fit_target_2.vtu" ] || fail "no fit files for $specimen"
+  done
   ;;
 *)
   fail "unknown case $case_name"
