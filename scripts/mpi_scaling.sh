@@ -29,14 +29,18 @@ workloads=(
 )
 
 # Wall time of one run (s), best of $repeats; its output kept in $work/$3.
+# One item at a time per rank (-j 1: one rank runs one variant at a time,
+# as every rank does under mpirun), with $threads OpenMP threads each.
 timed() {
   local ranks="$1" threads="$2" out="$3" command="$4" file="$5" best=""
+  local jobs=()
+  [ "$command" = run ] && jobs=(-j 1)
   for _ in $(seq 1 "$repeats"); do
     rm -rf "$work/$out"
     local start end
     start=$(date +%s.%N)
     OMP_NUM_THREADS="$threads" OMP_WAIT_POLICY=passive mpirun --allow-run-as-root \
-      --oversubscribe --bind-to none -np "$ranks" "$fiberfluid" "$command" "$file" -q \
+      --oversubscribe --bind-to none -np "$ranks" "$fiberfluid" "$command" "$file" "${jobs[@]}" -q \
       -o "$work/$out" >/dev/null 2>&1 || { echo "failed: $ranks ranks, $threads threads: $file" >&2; exit 1; }
     end=$(date +%s.%N)
     best=$(python3 -c "t=$end-$start; b='$best'; print(t if not b else min(t, float(b)))")
