@@ -36,6 +36,16 @@ json statistics_json(const fit::DistanceStatistics& s) {
             {"largest", number(s.share(s.largest))}}}};
 }
 
+json checks_json(const std::vector<FigureCheck>& checks) {
+  json out = json::array();
+  for (const FigureCheck& check : checks)
+    out.push_back({{"figure", check.expected.figure},
+                   {"passed", check.passed},
+                   {"actual", number(check.actual)},
+                   {"text", check.Describe()}});
+  return out;
+}
+
 json iteration_json(const fit::IterationRecord& it, const std::vector<std::string>& names) {
   json values = json::object();
   for (size_t k = 0; k < names.size(); ++k)
@@ -360,12 +370,6 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     }
     curves.push_back(curve);
   }
-  json checks = json::array();
-  for (const FigureCheck& check : run.checks)
-    checks.push_back({{"figure", check.expected.figure},
-                      {"passed", check.passed},
-                      {"actual", number(check.actual)},
-                      {"text", check.Describe()}});
   json failures = json::object();
   for (const auto& [cause, count] : r.failures_by_cause) failures[cause] = count;
   json examples = json::array();
@@ -423,7 +427,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
          "surface), when asked, enter the cost and the residuals, not these statistics"}}},
       {"targets", targets},
       {"force_curves", curves},
-      {"checks", checks}};
+      {"checks", checks_json(run.checks)}};
   if (!r.statistics.empty()) doc["distance"] = statistics_json(r.overall);
   if (search != nullptr) {
     doc["method"] = "multistart";
@@ -597,12 +601,6 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   }
   json iterations = json::array();
   for (const fit::IterationRecord& it : r.iterations) iterations.push_back(iteration_json(it, r.names));
-  json checks = json::array();
-  for (const FigureCheck& check : checked.checks)
-    checks.push_back({{"figure", check.expected.figure},
-                      {"passed", check.passed},
-                      {"actual", number(check.actual)},
-                      {"text", check.Describe()}});
   const json doc = {
       {"experiment", ex.name},
       {"status", fit::to_string(r.status)},
@@ -621,7 +619,7 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
       {"seconds", r.seconds},
       {"specimens", specimens},
       {"iterations", iterations},
-      {"checks", checks}};
+      {"checks", checks_json(checked.checks)}};
   geom::write_text_file(folder / "calibration.json", doc.dump(2) + "\n");
   std::ostringstream rows;
   rows.precision(12);

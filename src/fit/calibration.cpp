@@ -742,7 +742,7 @@ void Calibration::describe_at(const Evaluation& best, FitResult& result) const {
   }
 }
 
-FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
+FitResult Calibration::result_from(const Eigen::VectorXd& phi) const {
   const Impl& m = *impl_;
   const int P = m.map.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -754,6 +754,11 @@ FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
   result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
   result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
   result.initial_cost = result.final_cost = nan;
+  return result;
+}
+
+FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
+  FitResult result = result_from(phi);
   const Evaluation at = evaluate(phi, false);
   result.forward_runs = at.forward_runs;
   if (!at.ok) {
@@ -774,17 +779,8 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
   const Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
   const int P = m.map.size();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  FitResult result;
-  result.method = m.options.method;
-  result.analytic_jacobian = m.analytic;
-  result.names = m.map.names();
-  result.initial = m.map.values(start_phi);
   // Sized from the start, whatever the ending: a report never reads past them.
-  result.values = result.initial;
-  result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
-  result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
-  result.initial_cost = result.final_cost = nan;
+  FitResult result = result_from(start_phi);
   EvaluationCache evaluations(*this);
   auto finish = [&](FitStatus status, std::string message) {
     result.status = status;

@@ -220,6 +220,9 @@ class Calibration {
   FitResult result_at(const Eigen::VectorXd& phi) const;
 
  private:
+  // A result at phi with nothing known yet: the values there, NaN errors,
+  // intervals and costs, sized for the parameters.
+  FitResult result_from(const Eigen::VectorXd& phi) const;
   // The distances, their statistics, the run and the force misfits of an
   // evaluation, into result.
   void describe_at(const Evaluation& at, FitResult& result) const;

@@ -104,19 +104,13 @@ class Recorder final : public ceres::IterationCallback {
         outcome_(outcome),
         start_(std::chrono::steady_clock::now()) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    IterationRecord r;
-    r.iteration = s.iteration;
-    // Ceres reports a rejected step's cost as the iteration's cost; the
-    // current point's is the last accepted one.
-    r.accepted = s.iteration == 0 || s.step_is_successful;
-    r.trial_cost = s.cost;
+    IterationRecord r = lm_iteration(s.iteration, s.step_is_successful, s.cost, outcome_.iterations);
     // A trial point whose forward run failed since the last report: say why,
     // not its stand-in cost. (Ceres reports no iteration for a trial point
     // it could not evaluate: it shrinks the region and tries again.)
     const int failed = shared_.cache().failed_runs;
     if (failed > failures_seen_) r.trial_failure = shared_.cache().last_failure;
     failures_seen_ = failed;
-    r.cost = r.accepted || outcome_.iterations.empty() ? s.cost : outcome_.iterations.back().cost;
     r.values = calibration_.parameters().values(phi_);  // update_state_every_iteration
     r.forward_runs = shared_.cache().forward_runs;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -136,6 +130,18 @@ class Recorder final : public ceres::IterationCallback {
 };
 
 }  // namespace
+
+IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
+                             const std::vector<IterationRecord>& earlier) {
+  IterationRecord r;
+  r.iteration = iteration;
+  // Ceres reports a rejected step's cost as the iteration's cost; the
+  // current point's is the last accepted one.
+  r.accepted = iteration == 0 || step_taken;
+  r.trial_cost = cost;
+  r.cost = r.accepted || earlier.empty() ? cost : earlier.back().cost;
+  return r;
+}
 
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start) {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "fiberfluid/fit/fit_archive.hpp"
+#include "fiberfluid/fit/optimizers.hpp"
 #include "fiberfluid/util/byte_archive.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -220,11 +221,7 @@ class JointRecorder final : public ceres::IterationCallback {
         iterations_(iterations),
         start_(std::chrono::steady_clock::now()) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    IterationRecord r;
-    r.iteration = s.iteration;
-    r.accepted = s.iteration == 0 || s.step_is_successful;
-    r.trial_cost = s.cost;
-    r.cost = r.accepted || iterations_.empty() ? s.cost : iterations_.back().cost;
+    IterationRecord r = lm_iteration(s.iteration, s.step_is_successful, s.cost, iterations_);
     r.values.resize(phi_.size());
     for (Eigen::Index k = 0; k < phi_.size(); ++k)
       r.values[k] = value_of(parameters_[static_cast<size_t>(k)], phi_[k]);

@@ -56,6 +56,12 @@ struct OptimizerOutcome {
   std::vector<IterationRecord> iterations;
 };
 
+// A Levenberg-Marquardt iteration's record from Ceres' summary (its number,
+// whether its step was taken, the cost there), after the `earlier` ones: a
+// rejected step's record keeps the current (last accepted) cost.
+IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
+                             const std::vector<IterationRecord>& earlier);
+
 // Each from the fitted variables `start`.
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start);

@@ -18,20 +18,9 @@
 namespace fiberfluid::fit {
 namespace {
 
+using testing::hanging_sphere;
 using testing::newton;
 using testing::parameter;
-
-// A small hanging sphere (42 vertices, cap held) with a stiffening law.
-model::Model hanging_sphere() {
-  model::Model m;
-  m.surface = geom::icosphere(1, 1.0);
-  m.material.law = model::FiberLaw::exponential(3000.0, 5.0);
-  m.material.surface_tension = 300.0;
-  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.5", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.loads = {testing::hydrostatic_load({0.0, 0.0, -10.0}, 300.0)};
-  return m;
-}
 
 // The deformed surfaces of a run at every step, as targets on the same mesh.
 std::vector<MeasuredStep> synthetic_targets(const model::Model& m, const solve::SteppingOptions& o,

@@ -17,23 +17,9 @@
 namespace fiberfluid::fit {
 namespace {
 
+using testing::hanging_sphere;
 using testing::newton;
 using testing::parameter;
-
-// A hanging sphere of radius r (cap held) under gravity g, with the truth's
-// law (Y0 3000, beta 5) and its own surface tension.
-model::Model specimen(double radius, double gravity, double gamma) {
-  model::Model m;
-  m.surface = geom::icosphere(1, radius);
-  m.material.law = model::FiberLaw::exponential(3000.0, 5.0);
-  m.material.surface_tension = gamma;
-  for (int v : model::select_half_space(m.surface.V,
-                                        model::parse_half_space(
-                                            "z >= " + std::to_string(0.5 * radius), 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.loads = {testing::hydrostatic_load({0.0, 0.0, -gravity}, 300.0)};
-  return m;
-}
 
 // Its deformed surface after the last of `steps` steps, as its target.
 std::vector<MeasuredStep> own_surface(const model::Model& m, int steps) {
@@ -48,7 +34,7 @@ std::vector<Parameter> started(double gamma) {
 }
 
 TEST(JointCalibration, RecoversTheSharedLawAndEachSpecimensOwnGamma) {
-  const model::Model a = specimen(1.0, 10.0, 300.0), b = specimen(1.2, 6.0, 150.0);
+  const model::Model a = hanging_sphere(1.0, 10.0, 300.0), b = hanging_sphere(1.2, 6.0, 150.0);
   model::Model a_start = a, b_start = b;
   const Calibration ca(a_start, newton(2), own_surface(a, 2), started(400.0));
   const Calibration cb(b_start, newton(2), own_surface(b, 2), started(100.0));
@@ -81,7 +67,7 @@ TEST(JointCalibration, RecoversTheSharedLawAndEachSpecimensOwnGamma) {
 // Every set-up it cannot fit is named: a shared parameter a specimen does not
 // fit, a shared one with other bounds, a robust loss, one specimen alone.
 TEST(JointCalibration, RefusesWhatItCannotFit) {
-  const model::Model a = specimen(1.0, 10.0, 300.0);
+  const model::Model a = hanging_sphere(1.0, 10.0, 300.0);
   const std::vector<MeasuredStep> targets = own_surface(a, 2);
   const Calibration with_gamma(a, newton(2), targets, started(400.0));
   const Calibration without_beta(a, newton(2), targets,

@@ -130,13 +130,7 @@ TEST(Multistart, ConvergedEndsAreClusteredCheapestFirst) {
 // over the bounds ends at the truth; the result is the best start's fit,
 // and a result survives being packed.
 TEST(Multistart, ASmallSearchFindsTheTruthFromEveryStart) {
-  model::Model m;
-  m.surface = geom::icosphere(1, 1.0);
-  m.material.law = model::FiberLaw::exponential(3000.0, 5.0);
-  m.material.surface_tension = 300.0;
-  for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z >= 0.5", 3)))
-    for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
-  m.loads = {testing::hydrostatic_load({0.0, 0.0, -10.0}, 300.0)};
+  const model::Model m = testing::hanging_sphere();
   const solve::SteppingOptions stepping = testing::newton(2);
   const solve::SteppingSummary truth = solve::solve_load_steps(m, stepping);
   ASSERT_TRUE(truth.success) << truth.message;
