@@ -6,6 +6,7 @@
 #include <chrono>
 #include <memory>
 
+#include "fiberfluid/fit/lm_solver.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
@@ -150,18 +151,9 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   Eigen::VectorXd phi = start;
   CeresProblem p(evaluations, options, phi);
   Recorder recorder(calibration, options, phi, p.shared, outcome);
-  ceres::Solver::Options solver;
-  solver.minimizer_type = ceres::TRUST_REGION;
-  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.initial_trust_region_radius = options.initial_trust_region_radius;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = options.function_tolerance;
-  solver.parameter_tolerance = options.parameter_tolerance;
-  solver.gradient_tolerance = 1e-16;
-  solver.num_threads = 1;  // the forward run is threaded itself; the blocks share it
-  solver.logging_type = ceres::SILENT;
-  solver.update_state_every_iteration = true;
+  ceres::Solver::Options solver =
+      lm_solver(options.max_iterations, options.function_tolerance, options.parameter_tolerance,
+                options.initial_trust_region_radius);
   solver.callbacks.push_back(&recorder);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &p.problem, &summary);

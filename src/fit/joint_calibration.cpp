@@ -9,6 +9,7 @@
 #include <set>
 
 #include "fiberfluid/fit/fit_archive.hpp"
+#include "fiberfluid/fit/lm_solver.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
 #include "fiberfluid/util/byte_archive.hpp"
 #include "fiberfluid/util/error.hpp"
@@ -309,17 +310,9 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
     if (std::isfinite(upper[k])) problem.SetParameterUpperBound(phi.data(), k, upper[k]);
   }
   JointRecorder recorder(parameters_, phi, evaluator, options_, result.iterations);
-  ceres::Solver::Options solver;
-  solver.minimizer_type = ceres::TRUST_REGION;
-  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options_.max_iterations;
-  solver.function_tolerance = options_.function_tolerance;
-  solver.parameter_tolerance = options_.parameter_tolerance;
-  solver.gradient_tolerance = 1e-16;
-  solver.num_threads = 1;  // the forward runs are threaded themselves
-  solver.logging_type = ceres::SILENT;
-  solver.update_state_every_iteration = true;
+  ceres::Solver::Options solver =
+      lm_solver(options_.max_iterations, options_.function_tolerance,
+                options_.parameter_tolerance, FitOptions{}.initial_trust_region_radius);
   solver.callbacks.push_back(&recorder);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
