@@ -10,10 +10,10 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <mutex>
-#include <functional>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -254,8 +254,9 @@ void draw_plot(const std::filesystem::path& folder) {
 // Thrown on a rank whose own part of a step succeeded when another rank's failed.
 struct AnotherRankFailed : fiberfluid::InputError {
   AnotherRankFailed()
-      : InputError("another MPI rank could not read the experiment or prepare its run (run "
-                   "it without mpirun to see why)") {}
+      : InputError(
+            "another MPI rank could not read the experiment or prepare its run (run "
+            "it without mpirun to see why)") {}
 };
 
 // Runs `step` on every rank and ends in agreement: when it throws on one
@@ -282,7 +283,8 @@ int run_command(const std::string& path, const RunFlags& flags,
   std::optional<experiment::OutputWriter> output;
   on_every_rank(ranks, [&] {
     loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
-    if (ranks.root()) output.emplace(*loaded, experiment::output_folder(flags.output, loaded->name));
+    if (ranks.root())
+      output.emplace(*loaded, experiment::output_folder(flags.output, loaded->name));
   });
   const experiment::Experiment& ex = *loaded;
   experiment::RunOptions options;
@@ -372,8 +374,8 @@ void print_iteration(const fiberfluid::fit::IterationRecord& r,
 // One line per finished start of a multi-start search.
 void print_start(size_t s, const fiberfluid::fit::StartOutcome& o,
                  const std::vector<std::string>& names) {
-  std::cerr << "fit: start " << s << " (rank " << o.rank << "): "
-            << fiberfluid::fit::to_string(o.fit.status) << ", cost " << o.fit.final_cost
+  std::cerr << "fit: start " << s << " (rank " << o.rank
+            << "): " << fiberfluid::fit::to_string(o.fit.status) << ", cost " << o.fit.final_cost
             << " m^2;";
   for (size_t k = 0; k < names.size(); ++k)
     std::cerr << (k ? ", " : " ") << names[k] << " " << o.start[static_cast<Eigen::Index>(k)]
@@ -457,14 +459,15 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
     stop_if_interrupted("the calibration");
     return kOk;
   }
-  std::cout << "calibrating " << joint.names().size() << " parameters (" << ex.calibration->shared.size()
-            << " shared) to " << joint.num_residuals() << " residuals of "
-            << joint.specimen_names().size() << " specimens over " << ranks.size()
-            << " rank(s)\n";
+  std::cout << "calibrating " << joint.names().size() << " parameters ("
+            << ex.calibration->shared.size() << " shared) to " << joint.num_residuals()
+            << " residuals of " << joint.specimen_names().size() << " specimens over "
+            << ranks.size() << " rank(s)\n";
   for (size_t s = 0; s < setup.specimens.size(); ++s)
-    std::cout << "  specimen " << joint.specimen_names()[s] << ": " << ex.specimens[s].source.string()
-              << ", " << setup.specimens[s].targets.size() << " target(s), "
-              << setup.specimens[s].calibration->num_residuals() << " residuals\n";
+    std::cout << "  specimen " << joint.specimen_names()[s] << ": "
+              << ex.specimens[s].source.string() << ", " << setup.specimens[s].targets.size()
+              << " target(s), " << setup.specimens[s].calibration->num_residuals()
+              << " residuals\n";
   const fit::JointFitResult fitted = joint.run(ranks.dealer(), broadcast);
   experiment::OutputWriter writer(ex, folder);
   writer.begin();
@@ -479,7 +482,8 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
                                 std::to_string(fitted.iterations.size()) + " iterations",
                             files);
     std::cerr << "\nerror: the calibration was interrupted (SIGINT or SIGTERM); its best point "
-                 "so far is in " << (writer.folder() / "calibration.json").string() << "\n";
+                 "so far is in "
+              << (writer.folder() / "calibration.json").string() << "\n";
     return experiment::fit_exit_status(fitted.status);
   }
   if (!experiment::fit_result_kept(fitted.status))
@@ -504,8 +508,8 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
     const fit::DistanceStatistics& d = fitted.specimens[s].overall;
     std::cout << "  specimen " << joint.specimen_names()[s] << ": distance sd "
               << d.standard_deviation << " m (" << 100.0 * d.share(d.standard_deviation)
-              << "% of its length " << d.length << " m), rms " << d.rms << ", largest "
-              << d.largest << " m\n";
+              << "% of its length " << d.length << " m), rms " << d.rms << ", largest " << d.largest
+              << " m\n";
   }
   std::cout << "  " << fitted.evaluations << " evaluations, " << fitted.seconds << " s\n";
   for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
@@ -592,10 +596,11 @@ int fit_command(const std::string& path, const RunFlags& flags,
   }
   if (force_rows > 0) std::cout << force_rows << " force misfits";
   std::cout << " (" << fit::to_string(ex.fit->options.method) << ", "
-            << (setup.calibration->analytic_jacobian() ? "analytic Jacobian" : "finite differences");
+            << (setup.calibration->analytic_jacobian() ? "analytic Jacobian"
+                                                       : "finite differences");
   if (multistart)
-    std::cout << ", from each of " << ex.fit->multistart->starts << " starts over "
-              << ranks.size() << " rank(s)";
+    std::cout << ", from each of " << ex.fit->multistart->starts << " starts over " << ranks.size()
+              << " rank(s)";
   std::cout << ")\n";
   std::optional<fit::MultistartResult> search;
   fit::FitResult fitted;
@@ -618,13 +623,13 @@ int fit_command(const std::string& path, const RunFlags& flags,
   writer.begin();
   if (fitted.status == fit::FitStatus::Interrupted) {
     const experiment::ExperimentResult none;
-    writer.keep_interrupted("the fit was interrupted after " +
-                                std::to_string(fitted.iterations.size()) +
-                                " iterations; fit.json holds the best point so far (continue "
-                                "with \"start_from\" in the fit section)",
-                            [&](const std::filesystem::path& dir) {
-                              experiment::write_fit_files(dir, at_fit, setup, fitted, none, searched);
-                            });
+    writer.keep_interrupted(
+        "the fit was interrupted after " + std::to_string(fitted.iterations.size()) +
+            " iterations; fit.json holds the best point so far (continue "
+            "with \"start_from\" in the fit section)",
+        [&](const std::filesystem::path& dir) {
+          experiment::write_fit_files(dir, at_fit, setup, fitted, none, searched);
+        });
     std::cerr
         << "\nerror: the fit was interrupted (SIGINT or SIGTERM); its best point so far is in "
         << (writer.folder() / "fit.json").string() << " (continue with \"start_from\": \""

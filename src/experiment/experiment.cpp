@@ -117,8 +117,7 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
     spec.generator = f.string("generator");
   }
   spec.scale = f.positive("scale", 1.0);
-  if (f.has("remesh_vertices"))
-    spec.remesh_vertices = f.integer("remesh_vertices", 0, 20, 1000000);
+  if (f.has("remesh_vertices")) spec.remesh_vertices = f.integer("remesh_vertices", 0, 20, 1000000);
   return spec;
 }
 
@@ -661,8 +660,9 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     try {
       o.method = fit::method_from_string(method);
     } catch (const InputError&) {
-      f.fail("method", "expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart, got \"" +
-                           method.substr(0, 40) + "\"");
+      f.fail("method",
+             "expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart, got \"" +
+                 method.substr(0, 40) + "\"");
     }
     for (const char* key : {"starts", "same_optimum"})
       if (f.has(key)) f.fail(key, "only with \"method\": \"multistart\"");
@@ -773,7 +773,8 @@ CalibrationSpec read_calibration(Fields& root, const std::filesystem::path& fold
     if (const std::string problem = folder_name_problem(specimen.name); !problem.empty())
       f.fail("name", "expected " + problem);
     for (const SpecimenSpec& other : spec.specimens)
-      if (other.name == specimen.name) f.fail("name", "\"" + specimen.name + "\" names another specimen");
+      if (other.name == specimen.name)
+        f.fail("name", "\"" + specimen.name + "\" names another specimen");
     specimen.file = f.string("experiment");
     if (specimen.file.is_relative()) specimen.file = folder / specimen.file;
     f.resolve("experiment", absolute_path(specimen.file));
@@ -879,8 +880,9 @@ void build_experiment(Experiment& ex, const geom::Surface* surface) {
       // A specimen is a simulation, never a calibration (which could list itself).
       static thread_local bool inside_calibration = false;
       if (inside_calibration)
-        throw InputError(s.file.string() + ": a specimen of a calibration is a simulation with "
-                                           "a \"fit\" section, not a calibration");
+        throw InputError(s.file.string() +
+                         ": a specimen of a calibration is a simulation with "
+                         "a \"fit\" section, not a calibration");
       inside_calibration = true;
       Experiment specimen;
       try {
@@ -891,8 +893,9 @@ void build_experiment(Experiment& ex, const geom::Surface* surface) {
       }
       inside_calibration = false;
       if (!specimen.fit)
-        s.field.fail("experiment", s.file.string() + " has no \"fit\" section: a specimen "
-                                   "brings its targets and parameters");
+        s.field.fail("experiment", s.file.string() +
+                                       " has no \"fit\" section: a specimen "
+                                       "brings its targets and parameters");
       for (const std::string& w : specimen.warnings) ex.warnings.push_back(s.name + ": " + w);
       ex.specimens.push_back(std::move(specimen));
     }

@@ -104,7 +104,8 @@ struct Experiment {
   bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
   // Whether build_experiment has made what running needs (read_experiment leaves it unbuilt).
   bool built() const {
-    if (kind == Kind::Calibration) return calibration && specimens.size() == calibration->specimens.size();
+    if (kind == Kind::Calibration)
+      return calibration && specimens.size() == calibration->specimens.size();
     return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
   }
 };

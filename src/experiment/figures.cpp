@@ -106,11 +106,11 @@ std::vector<std::string> calibration_figures(const Experiment& ex) {
   for (size_t s = 0; s < ex.specimens.size(); ++s) {
     const std::string prefix = "fit." + ex.calibration->specimens[s].name + ".";
     for (const FitParameterSpec& p : ex.specimens[s].fit->parameters)
-      if (std::find(ex.calibration->shared.begin(), ex.calibration->shared.end(),
-                    p.request.name) == ex.calibration->shared.end())
+      if (std::find(ex.calibration->shared.begin(), ex.calibration->shared.end(), p.request.name) ==
+          ex.calibration->shared.end())
         names.push_back(prefix + p.request.name);
-    for (const char* f : {"distance_mean", "distance_rms", "distance_sd", "distance_largest",
-                          "distance_sd_share"})
+    for (const char* f :
+         {"distance_mean", "distance_rms", "distance_sd", "distance_largest", "distance_sd_share"})
       names.push_back(prefix + f);
   }
   return names;

@@ -44,7 +44,7 @@ struct FitSpec {
   // A fit.json whose parameters' values are the starts (an interrupted or
   // earlier fit, continued).
   std::optional<std::filesystem::path> start_from;
-  fit::FitOptions options;               // all but counted_vertices and progress
+  fit::FitOptions options;  // all but counted_vertices and progress
   // "method": "multistart": Levenberg-Marquardt (options.method) from each of
   // several starts spread over the bounds.
   std::optional<fit::MultistartOptions> multistart;

@@ -295,9 +295,10 @@ json multistart_json(const fit::MultistartResult& search, const std::vector<std:
                       {"starts", o.starts}});
   return {{"starts", starts},
           {"optima", optima},
-          {"optima_are", "the converged starts' ends, clustered: one optimum where every fitted "
-                         "variable (log of a log-scaled parameter) agrees to same_optimum of its "
-                         "range; cheapest first"},
+          {"optima_are",
+           "the converged starts' ends, clustered: one optimum where every fitted "
+           "variable (log of a log-scaled parameter) agrees to same_optimum of its "
+           "range; cheapest first"},
           {"best_start", search.best_start},
           {"best_found_once", search.best_found_once},
           {"seconds", search.seconds}};
@@ -449,9 +450,9 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
     starts << "\n";
     for (size_t s = 0; s < search->starts.size(); ++s) {
       const fit::StartOutcome& o = search->starts[s];
-      starts << s << "," << o.rank << "," << fit::to_string(o.fit.status) << ","
-             << o.fit.final_cost << "," << optimum_of(*search, static_cast<int>(s)) << ","
-             << o.fit.iterations.size() << "," << o.fit.forward_runs << "," << o.fit.seconds;
+      starts << s << "," << o.rank << "," << fit::to_string(o.fit.status) << "," << o.fit.final_cost
+             << "," << optimum_of(*search, static_cast<int>(s)) << "," << o.fit.iterations.size()
+             << "," << o.fit.forward_runs << "," << o.fit.seconds;
       for (Eigen::Index k = 0; k < o.start.size(); ++k) starts << "," << o.start[k];
       for (Eigen::Index k = 0; k < o.fit.values.size(); ++k) starts << "," << o.fit.values[k];
       starts << "\n";
@@ -546,8 +547,7 @@ JointSetup setup_joint(const Experiment& ex,
   return setup;
 }
 
-std::map<std::string, double> joint_figures(const Experiment& ex,
-                                            const fit::JointFitResult& r) {
+std::map<std::string, double> joint_figures(const Experiment& ex, const fit::JointFitResult& r) {
   std::map<std::string, double> figures = {{"fit.cost", r.final_cost}};
   for (size_t k = 0; k < r.names.size(); ++k)
     figures["fit." + r.names[k]] = r.values[static_cast<Eigen::Index>(k)];
@@ -579,7 +579,8 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   json correlation = json::array();
   for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
     json row = json::array();
-    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b) row.push_back(number(r.correlation(a, b)));
+    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b)
+      row.push_back(number(r.correlation(a, b)));
     correlation.push_back(row);
   }
   json specimens = json::array();
@@ -600,7 +601,8 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
     specimens.push_back(specimen);
   }
   json iterations = json::array();
-  for (const fit::IterationRecord& it : r.iterations) iterations.push_back(iteration_json(it, r.names));
+  for (const fit::IterationRecord& it : r.iterations)
+    iterations.push_back(iteration_json(it, r.names));
   const json doc = {
       {"experiment", ex.name},
       {"status", fit::to_string(r.status)},
@@ -610,8 +612,9 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
       {"method", "levenberg-marquardt over every specimen's distances (analytic Jacobian blocks)"},
       {"shared", ex.calibration->shared},
       {"parameters", parameters},
-      {"intervals_are", "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
-                        "cost / (residuals - parameters); in log scale for log-scaled parameters"},
+      {"intervals_are",
+       "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
+       "cost / (residuals - parameters); in log scale for log-scaled parameters"},
       {"correlation", correlation},
       {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
       {"residuals", r.residuals},
@@ -627,8 +630,8 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   for (const std::string& name : r.names) rows << "," << name;
   rows << "\n";
   for (const fit::IterationRecord& it : r.iterations) {
-    rows << it.iteration << "," << it.cost << "," << (it.accepted ? 1 : 0) << ","
-         << it.forward_runs << "," << it.seconds;
+    rows << it.iteration << "," << it.cost << "," << (it.accepted ? 1 : 0) << "," << it.forward_runs
+         << "," << it.seconds;
     for (Eigen::Index k = 0; k < it.values.size(); ++k) rows << "," << it.values[k];
     rows << "\n";
   }

@@ -307,8 +307,8 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Wo
         const std::vector<solve::StepRecord>& steps = outcome.run.summary.steps;
         if (outcome.step_unknowns.size() != steps.size())
           throw std::runtime_error("rank " + std::to_string(rank) + " sent " +
-                                   std::to_string(outcome.step_unknowns.size()) +
-                                   " states for " + std::to_string(steps.size()) + " steps");
+                                   std::to_string(outcome.step_unknowns.size()) + " states for " +
+                                   std::to_string(steps.size()) + " steps");
         if (observer)
           for (size_t k = 0; k < steps.size(); ++k) observer(r, steps[k], outcome.step_unknowns[k]);
         outcome.run.rank = rank;
@@ -331,8 +331,9 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
                                 const RunOptions& options) {
   require_built(ex);
   if (ex.kind == Experiment::Kind::Calibration)
-    throw InputError(ex.source.string() + ": a calibration over specimens runs with `fiberfluid "
-                                          "fit` (its specimens run with `fiberfluid run`)");
+    throw InputError(ex.source.string() +
+                     ": a calibration over specimens runs with `fiberfluid "
+                     "fit` (its specimens run with `fiberfluid run`)");
   ExperimentResult result;
   if (ex.kind == Experiment::Kind::Areas) {
     add_area_figures(ex, result);

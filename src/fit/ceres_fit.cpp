@@ -105,7 +105,8 @@ class Recorder final : public ceres::IterationCallback {
         outcome_(outcome),
         start_(std::chrono::steady_clock::now()) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    IterationRecord r = lm_iteration(s.iteration, s.step_is_successful, s.cost, outcome_.iterations);
+    IterationRecord r =
+        lm_iteration(s.iteration, s.step_is_successful, s.cost, outcome_.iterations);
     // A trial point whose forward run failed since the last report: say why,
     // not its stand-in cost. (Ceres reports no iteration for a trial point
     // it could not evaluate: it shrinks the region and tries again.)

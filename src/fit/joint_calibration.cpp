@@ -61,7 +61,8 @@ JointCalibration::JointCalibration(std::vector<std::string> specimen_names,
     if (specimens_[s]->options().loss != Loss::Squared)
       throw InputError("specimen \"" + specimen +
                        "\": a calibration over specimens fits squared distances; its "
-                       "objective.loss is " + to_string(specimens_[s]->options().loss));
+                       "objective.loss is " +
+                       to_string(specimens_[s]->options().loss));
     joint_of_[s].assign(static_cast<size_t>(specimens_[s]->parameters().size()), -1);
   }
   for (const std::string& name : shared) {
@@ -293,7 +294,8 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
     result.success = converged(status);
     if (!message.empty()) result.message = std::move(message);
     result.evaluations = evaluator.evaluations;
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
     return result;
   };
   if (!evaluator.at(phi, true)) {
@@ -311,8 +313,8 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   }
   JointRecorder recorder(parameters_, phi, evaluator, options_, result.iterations);
   ceres::Solver::Options solver =
-      lm_solver(options_.max_iterations, options_.function_tolerance,
-                options_.parameter_tolerance, FitOptions{}.initial_trust_region_radius);
+      lm_solver(options_.max_iterations, options_.function_tolerance, options_.parameter_tolerance,
+                FitOptions{}.initial_trust_region_radius);
   solver.callbacks.push_back(&recorder);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
@@ -322,9 +324,9 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   if (summary.termination_type == ceres::NO_CONVERGENCE)
     return finish(FitStatus::IterationLimit, "");
   if (summary.termination_type != ceres::CONVERGENCE)
-    return finish(evaluator.message().empty() ? FitStatus::OptimizerFailed
-                                              : FitStatus::ForwardRunsFailed,
-                  "");
+    return finish(
+        evaluator.message().empty() ? FitStatus::OptimizerFailed : FitStatus::ForwardRunsFailed,
+        "");
 
   // At the optimum: the covariance of phi from the Jacobian, (J^T J)^-1.
   if (!evaluator.at(phi, true))
@@ -348,12 +350,12 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   broadcast(describe);
   result.specimens.resize(specimens_.size());
   deal(
-      specimens_.size(),
-      [&](size_t s) { return specimen_result(s, phi); },
+      specimens_.size(), [&](size_t s) { return specimen_result(s, phi); },
       [&](size_t s, int, std::string&& bytes) { result.specimens[s] = unpack_fit_result(bytes); });
   if (!result.covariance_ok) {
-    result.status_detail = "J^T J at the optimum is singular: the specimens' distances cannot "
-                           "tell the parameters apart";
+    result.status_detail =
+        "J^T J at the optimum is singular: the specimens' distances cannot "
+        "tell the parameters apart";
     return finish(FitStatus::NotIdentifiable, "");
   }
   const Eigen::MatrixXd covariance = eigen.eigenvectors() *

@@ -91,7 +91,7 @@ class JointCalibration {
  private:
   std::vector<std::string> specimen_names_, names_;
   std::vector<const Calibration*> specimens_;
-  std::vector<Parameter> parameters_;  // joint, with their bounds and scales
+  std::vector<Parameter> parameters_;       // joint, with their bounds and scales
   std::vector<std::vector<int>> joint_of_;  // per specimen: its k-th variable's joint index
   int shared_ = 0, residuals_ = 0;
   JointOptions options_;

@@ -17,8 +17,10 @@ void check_options(const MultistartOptions& options) {
     throw InputError("starts: expected a whole number from 2 to 100000 (got " +
                      std::to_string(options.starts) + ")");
   if (!(options.same_optimum > 0.0 && options.same_optimum < 1.0))
-    throw InputError("same_optimum: expected a share of each parameter's range, above 0 and "
-                     "below 1 (got " + std::to_string(options.same_optimum) + ")");
+    throw InputError(
+        "same_optimum: expected a share of each parameter's range, above 0 and "
+        "below 1 (got " +
+        std::to_string(options.same_optimum) + ")");
 }
 
 namespace {
@@ -107,7 +109,8 @@ namespace {
 
 // The local fit from start s, packed.
 std::string run_start(const Calibration& calibration, const Eigen::MatrixXd& starts, size_t s) {
-  return pack_fit_result(calibration.run_from(starts.row(static_cast<Eigen::Index>(s)).transpose()));
+  return pack_fit_result(
+      calibration.run_from(starts.row(static_cast<Eigen::Index>(s)).transpose()));
 }
 
 }  // namespace

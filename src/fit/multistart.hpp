@@ -43,8 +43,8 @@ Eigen::MatrixXd spread_starts(const ParameterMap& map, int count);
 
 // Local optima found by more than one start.
 struct Optimum {
-  Eigen::VectorXd values;  // the parameters' values at its cheapest start's end
-  double cost = 0.0;       // the least cost among its starts
+  Eigen::VectorXd values;   // the parameters' values at its cheapest start's end
+  double cost = 0.0;        // the least cost among its starts
   std::vector<int> starts;  // which starts reached it (0-based), cheapest first
 };
 
@@ -70,9 +70,9 @@ struct MultistartResult {
 // The search. `progress` is called on the gathering process after each start
 // (its index, outcome); `dealer` empty: the starts in order, here. On other
 // MPI ranks, serve_multistart with the same dealer runs their share.
-MultistartResult run_multistart(const Calibration& calibration, const MultistartOptions& options,
-                                const WorkDealer& dealer = {},
-                                const std::function<void(size_t, const StartOutcome&)>& progress = {});
+MultistartResult run_multistart(
+    const Calibration& calibration, const MultistartOptions& options, const WorkDealer& dealer = {},
+    const std::function<void(size_t, const StartOutcome&)>& progress = {});
 void serve_multistart(const Calibration& calibration, const MultistartOptions& options,
                       const WorkDealer& dealer);
 

@@ -215,8 +215,8 @@ bool Ranks::all_ok(bool ok) const {
 void Ranks::sum(std::vector<double>& values) const {
   if (size_ == 1) return;
   MPI_Request request;
-  MPI_Iallreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
-                 MPI_SUM, MPI_COMM_WORLD, &request);
+  MPI_Iallreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM,
+                 MPI_COMM_WORLD, &request);
   wait_quietly(&request);
 }
 

@@ -130,8 +130,8 @@ TEST(FitConfig, BadFitSectionsAreNamed) {
   expect_fit_error(d, "fit.targets[0].step: load step 11 is beyond the run's 10 steps");
   d = sphere_fit_document();
   d["fit"]["method"] = "newton";
-  expect_fit_error(d,
-                   "fit.method: expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart");
+  expect_fit_error(
+      d, "fit.method: expected levenberg-marquardt, bobyqa, direct-l, crs2 or multistart");
   // A multi-start search's own fields: only with it, and in range.
   d = sphere_fit_document();
   d["fit"]["starts"] = 4;
@@ -426,8 +426,7 @@ TEST(CalibrationConfig, BadCalibrationsAreNamed) {
   };
   const auto expect_error = [](const nlohmann::json& d, const std::string& part) {
     try {
-      const Experiment ex =
-          parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+      const Experiment ex = parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
       setup_joint(ex);
       ADD_FAILURE() << "no error, expected one mentioning '" << part << "'";
     } catch (const InputError& e) {
@@ -448,8 +447,9 @@ TEST(CalibrationConfig, BadCalibrationsAreNamed) {
   expect_error(d, "doc: shared: \"Y0\" is named twice");
   d = document("fit_fine_liver.json");
   d["expected"] = {{{"figure", "fit.second.gamm"}, {"value", 1}}};
-  expect_error(d, "no figure \"fit.second.gamm\" in this experiment (expected one of fit.cost, "
-                  "fit.Y0, fit.beta, fit.synthetic.gamma");
+  expect_error(d,
+               "no figure \"fit.second.gamm\" in this experiment (expected one of fit.cost, "
+               "fit.Y0, fit.beta, fit.synthetic.gamma");
 
   const Experiment ex = parse_experiment(document("fit_fine_liver.json"),
                                          testing::experiment_file("").parent_path(), "doc");

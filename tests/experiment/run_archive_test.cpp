@@ -33,11 +33,11 @@ RunOutcome paddle_run() {
   RunOutcome outcome;
   outcome.run.variant = "pressed";
   outcome.run.rank = 3;
-  outcome.run.summary = solve::solve_load_steps(
-      ex.cases.front().model, ex.cases.front().stepping,
-      [&](const solve::StepRecord&, const Eigen::VectorXd& x) {
-        outcome.step_unknowns.push_back(x);
-      });
+  outcome.run.summary =
+      solve::solve_load_steps(ex.cases.front().model, ex.cases.front().stepping,
+                              [&](const solve::StepRecord&, const Eigen::VectorXd& x) {
+                                outcome.step_unknowns.push_back(x);
+                              });
   solve::StepRecord& last = outcome.run.summary.steps.back();
   last.sensitivities = Eigen::MatrixXd::Random(outcome.run.summary.unknowns.size(), 2);
   last.reaction_sensitivities = {Eigen::MatrixXd::Random(3, 2)};
@@ -136,8 +136,8 @@ TEST(Ranks, OneProcessIsRankZeroOfOne) {
     EXPECT_EQ(rank, 0);
     delivered.emplace_back(item, bytes);
   });
-  EXPECT_EQ(delivered, (std::vector<std::pair<size_t, std::string>>{
-                           {0, "0"}, {1, "1"}, {2, "4"}, {3, "9"}}));
+  EXPECT_EQ(delivered,
+            (std::vector<std::pair<size_t, std::string>>{{0, "0"}, {1, "1"}, {2, "4"}, {3, "9"}}));
 
   delivered.clear();
   ranks.deal(4, compute, [&](size_t item, int, std::string&& bytes) {

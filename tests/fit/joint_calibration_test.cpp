@@ -86,15 +86,27 @@ TEST(JointCalibration, RefusesWhatItCannotFit) {
       EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
     }
   };
-  expect_refused([&] { JointCalibration({"a", "b"}, {&with_gamma, &without_beta}, {"beta"}); },
-                 "specimen \"b\" does not fit \"beta\"");
-  expect_refused([&] { JointCalibration({"a", "b"}, {&with_gamma, &other_bounds}, {"Y0"}); },
-                 "the shared \"Y0\" has other bounds");
-  expect_refused([&] { JointCalibration({"a", "b"}, {&with_gamma, &robust}, {"Y0"}); },
-                 "specimen \"b\": a calibration over specimens fits squared distances");
+  expect_refused(
+      [&] {
+        JointCalibration({"a", "b"}, {&with_gamma, &without_beta}, {"beta"});
+      },
+      "specimen \"b\" does not fit \"beta\"");
+  expect_refused(
+      [&] {
+        JointCalibration({"a", "b"}, {&with_gamma, &other_bounds}, {"Y0"});
+      },
+      "the shared \"Y0\" has other bounds");
+  expect_refused(
+      [&] {
+        JointCalibration({"a", "b"}, {&with_gamma, &robust}, {"Y0"});
+      },
+      "specimen \"b\": a calibration over specimens fits squared distances");
   expect_refused([&] { JointCalibration({"a"}, {&with_gamma}, {"Y0"}); }, "two or more");
-  expect_refused([&] { JointCalibration({"a", "a"}, {&with_gamma, &with_gamma}, {"Y0"}); },
-                 "the same name");
+  expect_refused(
+      [&] {
+        JointCalibration({"a", "a"}, {&with_gamma, &with_gamma}, {"Y0"});
+      },
+      "the same name");
 }
 
 }  // namespace

@@ -55,7 +55,8 @@ TEST(Multistart, HaltonPointsAreTheRadicalInverses) {
 // evenly in log for a log-scaled parameter (a decade each: the median of
 // 1..1000 is near 31.6, not 500).
 TEST(Multistart, StartsSpreadOverTheBoundsInTheFittedVariables) {
-  const ParameterMap map = map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0, 4.0, false}});
+  const ParameterMap map =
+      map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0, 4.0, false}});
   const Eigen::MatrixXd starts = spread_starts(map, 101);
   ASSERT_EQ(starts.rows(), 101);
   EXPECT_EQ(starts.row(0).transpose(), map.initial_phi());
@@ -73,8 +74,8 @@ TEST(Multistart, StartsSpreadOverTheBoundsInTheFittedVariables) {
 }
 
 TEST(Multistart, AParameterWithoutBothBoundsIsNamed) {
-  const ParameterMap map = map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0,
-                                                                     INFINITY, false}});
+  const ParameterMap map =
+      map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0, INFINITY, false}});
   try {
     spread_starts(map, 4);
     FAIL() << "no error";
@@ -105,14 +106,15 @@ StartOutcome ended(FitStatus status, double Y0, double beta, double cost) {
 // first, listing its starts cheapest first; fits that did not converge are
 // no optima.
 TEST(Multistart, ConvergedEndsAreClusteredCheapestFirst) {
-  const ParameterMap map = map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0, 4.0, false}});
+  const ParameterMap map =
+      map_of({{"Y0", 10.0, 1.0, 1000.0, true}, {"beta", 1.0, 0.0, 4.0, false}});
   const std::vector<StartOutcome> starts = {
-      ended(FitStatus::Converged, 100.0, 2.0, 0.5),        // A
-      ended(FitStatus::Converged, 50.0, 1.0, 0.2),         // B, the best
-      ended(FitStatus::Converged, 100.5, 2.003, 0.49),     // A again, its cheapest
-      ended(FitStatus::IterationLimit, 50.0, 1.0, 0.1),    // not converged: not counted
+      ended(FitStatus::Converged, 100.0, 2.0, 0.5),           // A
+      ended(FitStatus::Converged, 50.0, 1.0, 0.2),            // B, the best
+      ended(FitStatus::Converged, 100.5, 2.003, 0.49),        // A again, its cheapest
+      ended(FitStatus::IterationLimit, 50.0, 1.0, 0.1),       // not converged: not counted
       ended(FitStatus::ConvergedAtBounds, 1000.0, 4.0, 0.9),  // C, on its bounds
-      ended(FitStatus::Converged, 108.0, 2.0, 0.5),        // 8% from A in Y0: apart
+      ended(FitStatus::Converged, 108.0, 2.0, 0.5),           // 8% from A in Y0: apart
   };
   const std::vector<Optimum> optima = cluster_optima(starts, map, 1e-3);
   ASSERT_EQ(optima.size(), 4u);
