@@ -814,6 +814,10 @@ int main(int argc, char** argv) {
   // Under mpirun or srun (and built with MPI): this process is one of the
   // ranks; else the only one.
   const fiberfluid::parallel::Ranks ranks(&argc, &argv);
+  if (!ranks.problem().empty()) {
+    std::cerr << "error: " << ranks.problem() << "\n";
+    return kUsage;
+  }
   const SilencedOutput silenced(!ranks.root());
   CLI::App cli{"fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016)"};
   cli.require_subcommand(1);

@@ -42,7 +42,14 @@ WorkDealer Ranks::dealer() const {
 
 std::string mpi_description() { return "none (built without MPI)"; }
 
-Ranks::Ranks(int*, char***) {}
+Ranks::Ranks(int*, char***) {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"})
+    if (const char* size = std::getenv(name); size != nullptr && std::atoi(size) > 1)
+      problem_ = std::string("started as one of ") + size +
+                 " MPI ranks, but this fiberfluid was built without MPI (--version says "
+                 "\"mpi: none\"): install Open MPI (scripts/install-deps.sh) and build again, "
+                 "or run it without mpirun";
+}
 Ranks::~Ranks() = default;
 bool Ranks::all_ok(bool ok) const { return ok; }
 void Ranks::sum(std::vector<double>&) const {}

@@ -38,6 +38,10 @@ class Ranks {
   int rank() const { return rank_; }
   int size() const { return size_; }
   bool root() const { return rank_ == 0; }
+  // "" unless a launcher started this process as one of several ranks and
+  // the build has no MPI: then why it cannot take part (each process would
+  // run the whole experiment alone).
+  const std::string& problem() const { return problem_; }
   // Ranks on this machine (they share its cores).
   int local_size() const { return local_size_; }
   // OpenMP threads of this rank: OMP_NUM_THREADS when set, else this
@@ -68,6 +72,7 @@ class Ranks {
   int rank_ = 0, size_ = 1, local_size_ = 1;
   bool initialised_ = false;
   bool second_thread_ = false;  // MPI may be called from a thread other than main's
+  std::string problem_;
 };
 
 }  // namespace fiberfluid::parallel
