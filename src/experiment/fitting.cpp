@@ -36,6 +36,17 @@ json statistics_json(const fit::DistanceStatistics& s) {
             {"largest", number(s.share(s.largest))}}}};
 }
 
+// Row by row; a NaN entry (no estimate) as null.
+json matrix_json(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index a = 0; a < m.rows(); ++a) {
+    json row = json::array();
+    for (Eigen::Index b = 0; b < m.cols(); ++b) row.push_back(number(m(a, b)));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 json checks_json(const std::vector<FigureCheck>& checks) {
   json out = json::array();
   for (const FigureCheck& check : checks)
@@ -324,13 +335,6 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
                           {"bounds", {number(p.lower), number(p.upper)}},
                           {"log_scale", p.log_scale}});
   }
-  json correlation = json::array();
-  for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
-    json row = json::array();
-    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b)
-      row.push_back(number(r.correlation(a, b)));
-    correlation.push_back(row);
-  }
   json iterations = json::array();
   for (const fit::IterationRecord& it : r.iterations)
     iterations.push_back(iteration_json(it, r.names));
@@ -402,7 +406,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
       {"covariance", r.covariance_ok ? "ceres covariance at the optimum, scaled by the "
                                        "residual variance"
                                      : "not available (see status)"},
-      {"correlation", correlation},
+      {"correlation", matrix_json(r.correlation)},
       {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
       {"iterations", iterations},
       {"forward_runs", r.forward_runs},
@@ -576,13 +580,6 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
                           {"standard_error", number(r.standard_errors[i])},
                           {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}}});
   }
-  json correlation = json::array();
-  for (Eigen::Index a = 0; a < r.correlation.rows(); ++a) {
-    json row = json::array();
-    for (Eigen::Index b = 0; b < r.correlation.cols(); ++b)
-      row.push_back(number(r.correlation(a, b)));
-    correlation.push_back(row);
-  }
   json specimens = json::array();
   for (size_t s = 0; s < setup.specimens.size(); ++s) {
     json specimen = {{"name", ex.calibration->specimens[s].name},
@@ -615,7 +612,7 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
       {"intervals_are",
        "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
        "cost / (residuals - parameters); in log scale for log-scaled parameters"},
-      {"correlation", correlation},
+      {"correlation", matrix_json(r.correlation)},
       {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
       {"residuals", r.residuals},
       {"evaluations", r.evaluations},
