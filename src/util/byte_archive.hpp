@@ -40,8 +40,9 @@ class ByteWriter {
     } else if constexpr (std::is_base_of_v<Eigen::PlainObjectBase<T>, T>) {
       put(static_cast<std::int64_t>(value.rows()));
       put(static_cast<std::int64_t>(value.cols()));
-      bytes_.append(reinterpret_cast<const char*>(value.data()),
-                    sizeof(typename T::Scalar) * static_cast<size_t>(value.size()));
+      if (value.size() > 0)  // an empty matrix's data() may be null
+        bytes_.append(reinterpret_cast<const char*>(value.data()),
+                      sizeof(typename T::Scalar) * static_cast<size_t>(value.size()));
     } else {
       fields(*this, const_cast<T&>(value));  // a struct: its own field list
     }
@@ -73,6 +74,7 @@ class ByteReader {
 
  private:
   void take(void* to, size_t size) {
+    if (size == 0) return;  // `to` may be null (an empty matrix, an empty string)
     if (size > bytes_.size() - at_)
       throw std::runtime_error("byte archive: the message ends early (" +
                                std::to_string(bytes_.size()) + " bytes)");

@@ -50,7 +50,8 @@ RunOutcome paddle_run() {
 // Bit for bit, NaN included.
 bool same_bits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+         (a.size() == 0 ||  // an empty matrix's data() may be null
+          std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0);
 }
 
 TEST(RunArchive, AnOutcomeArrivesBitForBit) {
