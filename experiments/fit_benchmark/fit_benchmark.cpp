@@ -16,10 +16,12 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/fit/calibration.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/util/omp_wait_policy.hpp"
 
 namespace ff = fiberfluid;
 
 int main(int argc, char** argv) {
+  fiberfluid::util::wait_passively_unless_chosen(argv);  // as the fiberfluid program runs
   CLI::App cli{"fiberfluid calibration benchmark"};
   std::string experiment = FIBERFLUID_BENCHMARK_EXPERIMENT;
   bool skip_differences = false;

@@ -22,6 +22,7 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/solve/interactive_stepper.hpp"
+#include "fiberfluid/util/omp_wait_policy.hpp"
 
 namespace {
 
@@ -38,6 +39,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fiberfluid::util::wait_passively_unless_chosen(argv);  // as the fiberfluid program runs
   CLI::App cli{"fiberfluid interactive step: frames per second of a paddle moved by hand"};
   int frames = 300, vertices = 1000, repeat = 20;
   double depth = 0.2;

@@ -18,6 +18,7 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/util/omp_wait_policy.hpp"
 #include "gemm_peak.hpp"
 
 namespace {
@@ -31,6 +32,7 @@ double peak_memory_mib() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fiberfluid::util::wait_passively_unless_chosen(argv);  // as the fiberfluid program runs
   CLI::App cli{"fiberfluid scaling benchmark: one case"};
   int subdivisions = 2;
   std::string solver = "dense-lu", save;

@@ -30,6 +30,7 @@
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/parallel/ranks.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/omp_wait_policy.hpp"
 #include "fiberfluid/util/progress.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
@@ -811,6 +812,8 @@ class SilencedOutput {
 };
 
 int main(int argc, char** argv) {
+  // Threads that sleep rather than spin while they wait, unless the user chose.
+  fiberfluid::util::wait_passively_unless_chosen(argv);
   // Under mpirun or srun (and built with MPI): this process is one of the
   // ranks; else the only one.
   const fiberfluid::parallel::Ranks ranks(&argc, &argv);

@@ -10,6 +10,8 @@
 #include <ceres/version.h>
 #include <Eigen/Core>
 
+#include "fiberfluid/util/omp_wait_policy.hpp"
+
 namespace fiberfluid::experiment {
 
 namespace {
@@ -45,6 +47,7 @@ std::vector<std::pair<std::string, std::string>> build_info() {
       {"build_type", FIBERFLUID_BUILD_TYPE},
       {"sanitizers", FIBERFLUID_SANITIZERS},
       {"openmp_threads", std::to_string(omp_get_max_threads())},
+      {"openmp_wait_policy", util::omp_wait_policy()},
       {"lapack", FIBERFLUID_LAPACK},
       {"blas", blas_in_use()},
       {"blas_threading_at_build", FIBERFLUID_BLAS_THREADING},
