@@ -12,6 +12,7 @@
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/geom/remesh.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/free_motions.hpp"
 #include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/solve/load_stepper.hpp"
 #include "fiberfluid/util/error.hpp"
@@ -246,6 +247,8 @@ class ModelBuilder {
     c_.model.paddles.clear();
     for (const PaddleSpec& p : spec_.paddles) c_.model.paddles.push_back(paddle(p));
     check_paddles_leave_room();
+    c_.notes.clear();
+    hold_free_rotations();
   }
 
  private:
@@ -378,6 +381,58 @@ class ModelBuilder {
     p.travel = spec.travel ? *spec.travel
                            : (p.above ? -1.0 : 1.0) * spec.compression.value_or(0.0) * extent;
     return p;
+  }
+
+  // Central fibers resist no rigid rotation (a vector spring does): one that
+  // the supports, mirror layers and paddles leave free makes Newton's tangent
+  // singular (a body between frictionless paddles held at one point spins
+  // freely about the paddles' axis). Where the loads do not turn the body
+  // about it, the answer does not depend on it: one unknown that the
+  // rotation moves most is held at zero (a gauge, in its own group "gauge",
+  // whose reaction is zero at equilibrium) and a note says so. Where the
+  // loads turn the body, no equilibrium exists: refused, naming the rotation.
+  // Free translations are singular_setup_reason's (solve/stepping_common).
+  void hold_free_rotations() {
+    model::Model& m = c_.model;
+    if (spec_.stepping.scheme != solve::Scheme::Newton ||
+        m.material.kinematics != model::FiberKinematics::Central || m.constraints.empty())
+      return;
+    for (int held = 0; held < 3; ++held) {  // at most three rotations
+      const std::vector<model::FreeMotion> free = model::free_rigid_motions(m);
+      const auto rotation = std::find_if(free.begin(), free.end(), [](const model::FreeMotion& f) {
+        return !f.rotation.isZero();
+      });
+      if (rotation == free.end()) return;
+      const std::string motion = rotation->describe();
+      const auto [vertex, axis] = model::gauge_unknown(m, *rotation);
+      if (rotation->driven > 1e-9 || vertex < 0)
+        spec_.constraints.empty()
+            ? spec_.paddles_field.fail("", "nothing holds the " + motion + free_motion_advice())
+            : spec_.constraints.front().field.fail(
+                  "", "the supports leave the " + motion +
+                          " free, and the loads turn the body about it: no equilibrium "
+                          "exists" + free_motion_advice());
+      if (std::find(m.constraint_groups.begin(), m.constraint_groups.end(), "gauge") ==
+          m.constraint_groups.end())
+        m.constraint_groups.push_back("gauge");
+      const int group = static_cast<int>(std::find(m.constraint_groups.begin(),
+                                                   m.constraint_groups.end(), "gauge") -
+                                         m.constraint_groups.begin());
+      m.constraints.push_back({vertex, axis, 0.0, {}, group});
+      const int input = c_.model_to_input.empty()
+                            ? vertex
+                            : c_.model_to_input[static_cast<size_t>(vertex)];
+      c_.notes.push_back("the supports and paddles leave the " + motion +
+                         " free and the loads do not turn the body about it: vertex " +
+                         std::to_string(input) + " is held along " +
+                         std::string(1, static_cast<char>('x' + axis)) +
+                         " as a gauge (group \"gauge\", its reaction zero at equilibrium); "
+                         "a support that holds the rotation replaces it");
+    }
+  }
+  static std::string free_motion_advice() {
+    return ": hold a vertex away from the axis (a support with \"axes\" across it), make "
+           "the paddles \"sticking\", or clamp a face";
   }
 
   // Two paddles on one axis may not meet (checked at every step by the solver too).

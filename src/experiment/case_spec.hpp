@@ -153,6 +153,9 @@ struct Case {
   solve::SteppingOptions stepping;
   FiberReport fibers;
   ResourceEstimate estimate;  // memory and time, estimated before pruning
+  // What the builder decided that the file did not say (a gauge that holds a
+  // free rotation), for the run's warnings.
+  std::vector<std::string> notes;
 };
 
 // Loads or generates the spec's surface and checks it (closed, manifold,

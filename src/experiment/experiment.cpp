@@ -365,10 +365,11 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
   o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
   o.line_search = f.boolean("line_search", o.line_search);
-  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse"});
+  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse", "reused"});
   o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
               : tangent == "krylov" ? solve::TangentSolver::Krylov
               : tangent == "sparse" ? solve::TangentSolver::Sparse
+              : tangent == "reused" ? solve::TangentSolver::Reused
                                     : solve::TangentSolver::Auto;
   o.krylov_tolerance = f.positive("krylov_tolerance", o.krylov_tolerance);
   o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
@@ -912,6 +913,8 @@ void build_experiment(Experiment& ex, const geom::Surface* surface) {
       ex.cases.push_back(build_case(spec, *surface, &ex.warnings));
     else
       ex.cases.push_back(build_case(spec, &ex.warnings));
+    for (const std::string& note : ex.cases.back().notes)
+      ex.warnings.push_back(spec.variant.empty() ? note : spec.variant + ": " + note);
   }
 }
 

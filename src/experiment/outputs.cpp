@@ -108,7 +108,12 @@ void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& st
                                    {"travel", r.paddles[p].travel},
                                    {"force", vector_json(r.paddles[p].force, m.dim())},
                                    {"contacts", r.paddles[p].contacts}};
-  if (!m.paddles.empty()) step["paddles"] = paddles;
+  if (!m.paddles.empty()) {
+    step["paddles"] = paddles;
+    step["newton"]["contact"] = {{"rounds", r.contact_rounds},
+                                 {"added", r.contacts_added},
+                                 {"released", r.contacts_released}};
+  }
 }
 
 std::string group_name(const model::Model& m, size_t g) {

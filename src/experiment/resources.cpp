@@ -126,8 +126,11 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
       o.newton.tangent, blocks.newton_unknowns, model.material.kinematics, sparse_fibers);
   const bool dense_tangent = newton && tangent_kind == solve::TangentSolver::Dense;
   const bool sparse_tangent = newton && tangent_kind == solve::TangentSolver::Sparse;
-  const solve::SolverKind kind =
-      dense_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
+  // The reused tangent LU costs what the dense one does a factorisation; it
+  // is then counted as Krylov's preconditioner (one factorisation a step).
+  const bool reused_tangent = newton && tangent_kind == solve::TangentSolver::Reused;
+  const solve::SolverKind kind = dense_tangent || reused_tangent ? solve::SolverKind::DenseLU
+                                                                 : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)

@@ -30,17 +30,21 @@ const char* to_string(Scheme scheme);
 // How each Newton step's linear system with the tangent is solved.
 enum class TangentSolver {
   Auto,    // dense up to 600 unknowns (about 200 vertices; 4,000 for central fibers), then
-           // sparse for central fibers within a horizon up to 50,000, else krylov
-  Dense,   // LU of the dense tangent (LAPACK)
+           // for central fibers sparse within a horizon up to 50,000, reused for every
+           // pair (or a horizon that keeps more than an eighth of them), else krylov
+  Dense,   // LU of the dense tangent (LAPACK) at every iteration
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
   Sparse,  // LU of the sparse tangent (UMFPACK): N times the neighbours entries
+  Reused,  // GMRES on the exact tangent, preconditioned by the dense LU of an earlier
+           // one, reused across iterations and steps while GMRES needs few iterations
 };
 const char* to_string(TangentSolver solver);
 // What `requested` means for a Newton run with `reduced_unknowns` (the
 // unknowns left after the supports): Auto is dense up to 600 (4,000 for
 // central fibers, whose tangent the secant preconditioner fits poorly);
-// above, the sparse LU for central fibers stored as neighbour lists
-// (`sparse_fibers`, a horizon) up to 50,000 unknowns, else Krylov.
+// above, for central fibers the sparse LU when they are stored as neighbour
+// lists (`sparse_fibers`, a horizon) up to 50,000 unknowns, else the reused
+// dense LU up to 50,000 (its 20 GB); else Krylov.
 TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
                              model::FiberKinematics kinematics, bool sparse_fibers);
 
@@ -145,6 +149,9 @@ struct StepRecord {
   model::PairPasses pair_passes;  // over every fiber pair, in the step (its solves, its checks)
   int step_cuts = 0;              // halvings of this step
   double volume_drift = 0.0;      // (V - V0) / V0 after the step
+  // Paddles: the active-set rounds of the step (over its pieces), and the
+  // vertices that joined and left the contact set in them.
+  int contact_rounds = 0, contacts_added = 0, contacts_released = 0;
   struct PaddleState {
     double plane = 0.0;                               // the plane's coordinate
     double travel = 0.0;                              // how far it has moved

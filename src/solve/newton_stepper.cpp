@@ -92,17 +92,30 @@ class NewtonSolver {
 
   // Solves R = 0 at `at` from x (updated in place): Newton inside an
   // active-set loop for the paddles. "" or why it failed.
+  //
+  // A vertex that passes a paddle joins its set as soon as an iterate shows
+  // it (feasibility first); a vertex leaves only at an equilibrium of the
+  // current set, where its contact force is that of a solution and not of an
+  // iterate on the way to one. Releasing on iterates made the set chatter at
+  // first touch: a body held at one point rocked from one paddle to the other
+  // and back, every iteration, for ever (issue 42). Holding the set fixed
+  // within each solve and updating it between solves is the usual active-set
+  // strategy of implicit contact (Wriggers, Computational Contact Mechanics,
+  // 2nd ed. 2006, section 6.3; Sierra/SolidMechanics' "control contact").
   std::string solve(const LoadPoint& at, Eigen::VectorXd& x, StepRecord& record) {
-    add_penetrating(at, x);
+    record.contacts_added += add_penetrating(at, x);
     for (int round = 0; round < newton_.max_contact_rounds; ++round) {
+      if (!model_.paddles.empty()) ++record.contact_rounds;
       const DofMap dofs = held_map();
       apply_held_values(at, dofs, x);
       bool converged = false;
       const std::string why = newton(at, dofs, x, record, &converged);
       if (!why.empty()) return why;
-      const bool released = release_pulling();
-      const bool added = add_penetrating(at, x);
-      if (converged && !released && !added) return {};
+      const int released = converged ? release_pulling() : 0;
+      const int added = add_penetrating(at, x);
+      record.contacts_released += released;
+      record.contacts_added += added;
+      if (converged && released == 0 && added == 0) return {};
     }
     return "the paddle contact did not settle in " + std::to_string(newton_.max_contact_rounds) +
            " active-set rounds (newton.max_contact_rounds)";
@@ -257,11 +270,11 @@ class NewtonSolver {
     }
   }
 
-  // Vertices past a paddle join its contact set; true when any did (with
-  // `apply` false, only whether any would).
-  bool add_penetrating(const LoadPoint& at, const Eigen::VectorXd& x, bool apply = true) {
+  // Vertices past a paddle join its contact set; how many did (with `apply`
+  // false, 1 when any would).
+  int add_penetrating(const LoadPoint& at, const Eigen::VectorXd& x, bool apply = true) {
     const int n = model_.num_vertices();
-    bool added = false;
+    int added = 0;
     for (size_t p = 0; p < model_.paddles.size(); ++p) {
       const model::Paddle& paddle = model_.paddles[p];
       for (int v = 0; v < n; ++v) {
@@ -269,10 +282,10 @@ class NewtonSolver {
           continue;
         const double coordinate = model_.surface.V(v, paddle.axis) + x[paddle.axis * n + v];
         if (paddle.penetration(coordinate, at.planes[p]) > 1e-12 * diagonal_) {
-          if (!apply) return true;
+          if (!apply) return 1;
           contact_paddle_[static_cast<size_t>(v)] = static_cast<int>(p);
           for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
-          added = true;
+          ++added;
         }
       }
     }
@@ -280,28 +293,23 @@ class NewtonSolver {
   }
 
   // Contact vertices whose paddle would have to pull them (the force on the
-  // body in `R` at their held unknown) leave the set; true when any did.
-  bool release_pulling(const Eigen::VectorXd& R, bool apply = true) {
+  // body in `R` at their held unknown) leave the set; how many did.
+  int release_pulling(const Eigen::VectorXd& R) {
     const int n = model_.num_vertices();
-    bool released = false;
+    int released = 0;
     for (int v = 0; v < n; ++v) {
       const int p = contact_paddle_[static_cast<size_t>(v)];
       if (p < 0) continue;
       const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
       const double force = R[paddle.axis * n + v];  // on the body, along the axis
       if (paddle.above ? force > 0.0 : force < 0.0) {
-        if (!apply) return true;
         contact_paddle_[static_cast<size_t>(v)] = -1;
-        released = true;
+        ++released;
       }
     }
     return released;
   }
-  bool release_pulling() { return release_pulling(residual_); }
-  bool contact_would_change(const LoadPoint& at, const Eigen::VectorXd& x,
-                            const Eigen::VectorXd& R) {
-    return !model_.paddles.empty() && (release_pulling(R, false) || add_penetrating(at, x, false));
-  }
+  int release_pulling() { return release_pulling(residual_); }
 
   // The relative residual of the state x (gauge: the scale of x's loads and
   // reactions, or of the states accepted before, whichever is larger).
@@ -313,9 +321,9 @@ class NewtonSolver {
   }
 
   // Newton iterations with the held set `dofs`, until converged (*converged
-  // true) or, after an iteration, until the paddles' active set would change:
-  // the set is updated as the iterates go (a semi-smooth Newton), rather than
-  // after a full solve with each set. "" or why it failed.
+  // true) or, after an iteration, until a vertex passes a paddle: the set
+  // grows as the iterates go, rather than after a full solve with each set
+  // (solve() says why it shrinks only at a solution). "" or why it failed.
   std::string newton(const LoadPoint& at, const DofMap& dofs, Eigen::VectorXd& x,
                      StepRecord& record, bool* converged) {
     *converged = false;
@@ -338,7 +346,7 @@ class NewtonSolver {
         *converged = true;
         return {};
       }
-      if (it > 0 && contact_would_change(at, x, R)) {
+      if (it > 0 && !model_.paddles.empty() && add_penetrating(at, x, false) > 0) {
         residual_ = R;
         return {};
       }

@@ -136,6 +136,8 @@ const char* to_string(TangentSolver solver) {
       return "krylov";
     case TangentSolver::Sparse:
       return "sparse";
+    case TangentSolver::Reused:
+      return "reused";
   }
   return "?";
 }
@@ -148,13 +150,17 @@ TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
   // fibers keep the dense LU up to sizes whose LU still takes seconds.
   const int dense_up_to = kinematics == model::FiberKinematics::VectorSpring ? 600 : 4000;
   if (reduced_unknowns <= dense_up_to) return TangentSolver::Dense;
+  // The vector spring's own secant preconditioner fits its tangent at any size.
+  const bool central = kinematics != model::FiberKinematics::VectorSpring;
+  if (!central || reduced_unknowns > 50000) return TangentSolver::Krylov;
   // A horizon's central tangent has N times the neighbours entries: its
   // exact LU beats GMRES with a vector-spring preconditioner up to sizes
-  // whose LU takes seconds (about 4 s at 30,000 unknowns); the vector
-  // spring's own secant preconditioner fits its tangent at any size.
-  const bool central = kinematics != model::FiberKinematics::VectorSpring;
-  return sparse_fibers && central && reduced_unknowns <= 50000 ? TangentSolver::Sparse
-                                                               : TangentSolver::Krylov;
+  // whose LU takes seconds (about 4 s at 30,000 unknowns). Where the fibers
+  // are many (every pair, or a horizon that keeps more than an eighth of
+  // them) the dense LU of the tangent is as small, and one of them
+  // preconditions GMRES over many iterations and steps: the secant system
+  // stalls GMRES once contact and large rotations couple the axes (issue 42).
+  return sparse_fibers ? TangentSolver::Sparse : TangentSolver::Reused;
 }
 
 std::string SteppingSummary::BriefReport() const {
@@ -164,9 +170,10 @@ std::string SteppingSummary::BriefReport() const {
     out << "newton (" << to_string(tangent);
     if (tangent == TangentSolver::Krylov) out << ", preconditioner " << to_string(solver);
     out << "), " << steps.size() << " steps, " << newton_iterations << " newton iterations";
-    if (tangent == TangentSolver::Krylov)
+    if (tangent == TangentSolver::Krylov || tangent == TangentSolver::Reused)
       out << ", " << krylov_iterations << " gmres iterations, " << factorizations
-          << " preconditioner factorizations";
+          << (tangent == TangentSolver::Reused ? " tangent LU" : " preconditioner")
+          << " factorizations";
     if (tangent == TangentSolver::Sparse)
       out << ", " << factorizations << " sparse LU factorizations";
   } else {

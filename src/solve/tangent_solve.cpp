@@ -14,6 +14,10 @@
 namespace fiberfluid::solve {
 namespace {
 
+// The most unknowns held beyond the preconditioner's that the capacitance
+// correction takes (each costs one preconditioner solve when first held).
+constexpr size_t kMostCapacitanceHeld = 256;
+
 // The power of two that brings `largest` nearest 1 (1 for zero or non-finite).
 double power_of_two(double largest) {
   return largest > 0.0 && std::isfinite(largest) ? std::exp2(-std::round(std::log2(largest))) : 1.0;
@@ -85,7 +89,9 @@ TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium
   // The pair coefficients are stored when they fit in a quarter of the
   // memory budget; else each product recomputes them.
   store_ = equilibrium_->stored_tangent_bytes() < 0.25 * memory_budget_bytes();
-  preconditioner_kind_ = kind_ == TangentSolver::Dense ? SolverKind::DenseLU : options.solver;
+  preconditioner_kind_ = kind_ == TangentSolver::Dense || kind_ == TangentSolver::Reused
+                             ? SolverKind::DenseLU
+                             : options.solver;
 }
 
 Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
@@ -108,6 +114,17 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
     const Status status = sparse_lu_->factorize(J);
     ++factorizations_;
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+  } else if (kind_ == TangentSolver::Reused) {
+    if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
+    if (reused_factor_still_serves()) {
+      preconditioner_dofs_ = model::DofMap(dofs_.dim(), dofs_.num_vertices(), preconditioned_held_);
+    } else {
+      preconditioner_dofs_ = dofs_;
+      const Status status = factor_tangent_preconditioner();
+      if (!status.ok) return status;
+    }
+    const Status status = update_capacitance();
+    if (!status.ok) return status;
   } else {
     if (store_) equilibrium_->linearize(x_, factors_, stored_);  // reuses the arrays
     const bool same_set =
@@ -121,6 +138,23 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
   }
   ready_ = true;
   return {};
+}
+
+// The reused factor serves while GMRES converges quickly with it and every
+// unknown it holds is still held: the unknowns held since (new contacts, up
+// to update_capacitance's limit) are held in its solve by the capacitance
+// correction. An unknown released since (a contact let go) would be missing
+// from its solve: refactor.
+bool TangentSolve::reused_factor_still_serves() const {
+  if (!lu_ || refactor_) return false;
+  const std::vector<char>& now = dofs_.held_flags();
+  if (now.size() != preconditioned_held_.size()) return false;
+  size_t added = 0;
+  for (size_t d = 0; d < now.size(); ++d) {
+    if (preconditioned_held_[d] && !now[d]) return false;
+    added += now[d] && !preconditioned_held_[d];
+  }
+  return added <= kMostCapacitanceHeld;
 }
 
 Eigen::VectorXd TangentSolve::residual(const Eigen::VectorXd& x,
@@ -142,7 +176,7 @@ Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
 // still cope), with the preconditioner's solve of each one's unit vector
 // and the capacitance matrix C = E^T P^-1 E of their rows.
 Status TangentSolve::update_capacitance() {
-  constexpr size_t kMostHeld = 256;
+  constexpr size_t kMostHeld = kMostCapacitanceHeld;
   extra_held_.clear();
   if (preconditioner_dofs_.num_reduced() == dofs_.num_reduced()) return {};
   std::vector<int> position(static_cast<size_t>(equilibrium_->num_unknowns()), -1);
@@ -166,7 +200,7 @@ Status TangentSolve::update_capacitance() {
     if (cached == unit_solves_.end()) {
       Eigen::VectorXd unit = Eigen::VectorXd::Zero(m), column;
       unit[position[static_cast<size_t>(dofs[c])]] = 1.0;
-      const Status status = preconditioner_->solve(unit, &column);
+      const Status status = preconditioner_solve(unit, &column);
       if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
       cached = unit_solves_.emplace(dofs[c], std::move(column)).first;
     }
@@ -194,7 +228,7 @@ Eigen::VectorXd TangentSolve::precondition(const Eigen::VectorXd& reduced) const
     in = preconditioner_dofs_.reduce(full);
   }
   Eigen::VectorXd out;
-  if (!preconditioner_->solve(in, &out).ok) return Eigen::VectorXd::Constant(reduced.size(), NAN);
+  if (!preconditioner_solve(in, &out).ok) return Eigen::VectorXd::Constant(reduced.size(), NAN);
   if (same_layout) return out;
   if (!extra_held_.empty()) {
     Eigen::VectorXd at_held(static_cast<Eigen::Index>(extra_held_.size()));
@@ -230,16 +264,21 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   y->resize(0);
   GmresResult result = gmres(apply_tangent, precondition, b, *y, gmres_options);
   if (iterations != nullptr) *iterations += result.iterations;
-  // The secant factor ages as the strains move: refactor when gmres needs
-  // clearly more iterations per decade of residual reduction than it did
-  // just after the last factorisation.
+  // The factor ages as the strains move: refactor when gmres needs clearly
+  // more iterations per decade of residual reduction than it did just after
+  // the last factorisation. A reused tangent LU costs about n / 3 of its own
+  // solves (n unknowns; LU 2n^3/3 flops, a solve 2n^2): it is kept while
+  // gmres needs at most 10 iterations per decade.
   const double rate = result.iterations / std::max(1.0, -std::log10(tolerance));
+  const double floor = kind_ == TangentSolver::Reused ? 10.0 : 0.0;
   if (baseline_rate_ < 0.0)
     baseline_rate_ = rate;
-  else if (rate > 2.0 * baseline_rate_ + 1.0)
+  else if (rate > std::max(2.0 * baseline_rate_ + 1.0, floor))
     refactor_ = true;
   if (!result.status.ok && !just_factored_) {
-    Status status = factor_preconditioner();
+    if (kind_ == TangentSolver::Reused) preconditioner_dofs_ = dofs_;
+    Status status = kind_ == TangentSolver::Reused ? factor_tangent_preconditioner()
+                                                   : factor_preconditioner();
     if (status.ok) status = update_capacitance();
     if (!status.ok) return status;
     y->resize(0);
@@ -256,6 +295,29 @@ Status TangentSolve::solve_full(const Eigen::VectorXd& b, Eigen::VectorXd* y, do
   if (!status.ok) return status;
   *y = Eigen::VectorXd::Zero(b.size());
   dofs_.scatter(reduced, *y);
+  return {};
+}
+
+Status TangentSolve::preconditioner_solve(const Eigen::VectorXd& in, Eigen::VectorXd* out) const {
+  if (kind_ != TangentSolver::Reused) return preconditioner_->solve(in, out);
+  *out = column_scale_.cwiseProduct(lu_->solve(row_scale_.cwiseProduct(in)));
+  return out->allFinite() ? Status{} : Status::failure("the tangent's LU solve is not finite");
+}
+
+// The reused preconditioner: the equilibrated dense LU of the exact tangent
+// at the current state over the current held set.
+Status TangentSolve::factor_tangent_preconditioner() {
+  Eigen::MatrixXd J = preconditioner_dofs_.reduce(equilibrium_->tangent(x_, factors_));
+  equilibrate(J, &row_scale_, &column_scale_);
+  lu_ = std::make_unique<DenseLU>();
+  const Status status = lu_->factorize(J);
+  if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+  ++factorizations_;
+  unit_solves_.clear();
+  preconditioned_held_ = preconditioner_dofs_.held_flags();
+  baseline_rate_ = -1.0;
+  refactor_ = false;
+  just_factored_ = true;
   return {};
 }
 

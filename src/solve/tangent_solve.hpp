@@ -22,7 +22,9 @@ namespace fiberfluid::solve {
 // DofMap leaves free: the dense LU of the reduced tangent, the sparse LU of
 // it (fibers within a horizon: N times the neighbours entries), or GMRES on the
 // tangent as an operator (its pair coefficients stored), right-preconditioned
-// by the structured secant solve (the reference bordered system with each
+// by the dense LU of the tangent at an earlier state (`reused`: a modified
+// Newton's factor, whose GMRES restores the exact Newton step) or by the
+// structured secant solve (the reference bordered system with each
 // bulk weight times Y(e_ij); for central fibers each axis block's weights
 // also times that axis's share of the fiber's direction). The preconditioner is kept between states and
 // refactored when its own held set changes or GMRES needs clearly more
@@ -71,6 +73,9 @@ class TangentSolve {
 
  private:
   Status factor_preconditioner();
+  Status factor_tangent_preconditioner();
+  bool reused_factor_still_serves() const;
+  Status preconditioner_solve(const Eigen::VectorXd& in, Eigen::VectorXd* out) const;
   Status update_capacitance();
   Eigen::VectorXd apply(const Eigen::VectorXd& reduced) const;
   Eigen::VectorXd precondition(const Eigen::VectorXd& reduced) const;
@@ -83,7 +88,7 @@ class TangentSolve {
   model::DofMap dofs_;
   model::DofMap preconditioner_dofs_;
   bool ready_ = false;
-  // Dense.
+  // Dense (and reused: the LU of the tangent at an earlier state).
   std::unique_ptr<DenseLU> lu_;
   // Sparse (its scaling in row_scale_, column_scale_ as the dense one's).
   std::unique_ptr<SparseLU> sparse_lu_;

@@ -364,17 +364,17 @@ TEST(Cli, VersionSaysWhatTheBuildIs) {
 // spin (its default 300,000 times; passive 0).
 TEST(Cli, ThreadsWaitPassivelyUnlessTheUserChose) {
   const std::string cli = std::string(" OMP_DISPLAY_ENV=VERBOSE ") + FIBERFLUID_CLI + " --version";
-  Outcome o = run_cli_command("env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT" + cli);
+  Outcome o = testing::run_cli_command("env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT" + cli);
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("GOMP_SPINCOUNT = '0'"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("openmp_wait_policy: passive (fiberfluid's default)"), std::string::npos)
       << o.output;
-  o = run_cli_command("env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active" + cli);
+  o = testing::run_cli_command("env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active" + cli);
   EXPECT_NE(o.output.find("OMP_WAIT_POLICY = 'ACTIVE'"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("openmp_wait_policy: OMP_WAIT_POLICY=active (the user's)"),
             std::string::npos)
       << o.output;
-  o = run_cli_command("env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=1000" + cli);
+  o = testing::run_cli_command("env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=1000" + cli);
   EXPECT_NE(o.output.find("GOMP_SPINCOUNT = '1000'"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("openmp_wait_policy: GOMP_SPINCOUNT=1000 (the user's)"),
             std::string::npos)
