@@ -145,22 +145,22 @@ const char* to_string(TangentSolver solver) {
 TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
                              model::FiberKinematics kinematics, bool sparse_fibers) {
   if (requested != TangentSolver::Auto) return requested;
-  // Krylov's preconditioner is the vector spring's secant system: close to a
-  // vector-spring tangent, far from a central one (GMRES stalls), so central
-  // fibers keep the dense LU up to sizes whose LU still takes seconds.
-  const int dense_up_to = kinematics == model::FiberKinematics::VectorSpring ? 600 : 4000;
-  if (reduced_unknowns <= dense_up_to) return TangentSolver::Dense;
   // The vector spring's own secant preconditioner fits its tangent at any size.
-  const bool central = kinematics != model::FiberKinematics::VectorSpring;
-  if (!central || reduced_unknowns > 50000) return TangentSolver::Krylov;
-  // A horizon's central tangent has N times the neighbours entries: its
-  // exact LU beats GMRES with a vector-spring preconditioner up to sizes
-  // whose LU takes seconds (about 4 s at 30,000 unknowns). Where the fibers
-  // are many (every pair, or a horizon that keeps more than an eighth of
-  // them) the dense LU of the tangent is as small, and one of them
-  // preconditions GMRES over many iterations and steps: the secant system
-  // stalls GMRES once contact and large rotations couple the axes (issue 42).
-  return sparse_fibers ? TangentSolver::Sparse : TangentSolver::Reused;
+  if (kinematics == model::FiberKinematics::VectorSpring)
+    return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
+  // Krylov's secant preconditioner is far from a central tangent (GMRES
+  // stalls once contact and large rotations couple the axes). A horizon's
+  // central tangent has N times the neighbours entries: its exact LU beats
+  // the dense one above 4,000 unknowns and takes seconds up to 50,000 (about
+  // 4 s at 30,000). Where the fibers are many (every pair, or a horizon that
+  // keeps more than an eighth of them), one dense LU of the tangent
+  // preconditions GMRES on the exact tangent over many iterations and steps:
+  // above 600 unknowns that beats an LU per iteration (issue 42: a bending
+  // phantom of 1,418 vertices in 10 s with one LU, against 70 s with 34).
+  if (reduced_unknowns > 50000) return TangentSolver::Krylov;
+  if (sparse_fibers)
+    return reduced_unknowns <= 4000 ? TangentSolver::Dense : TangentSolver::Sparse;
+  return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Reused;
 }
 
 std::string SteppingSummary::BriefReport() const {

@@ -484,6 +484,56 @@ TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
 
 // A prescribed group may turn rigidly: "rotation" (axis, angle in degrees,
 // centre) with an optional translation, along its schedule.
+// A cylinder of central fibers pressed between two frictionless paddles and
+// held only at the centre of its base (the compression of issue 42, small):
+// nothing holds the spin about the paddles' axis, which the loads do not
+// drive, so a gauge holds it, says so, and carries no force; the contact set
+// settles at first touch in a few rounds instead of rocking the body from
+// one paddle to the other. With a load that turns the body about that axis
+// there is no equilibrium: refused, naming the rotation.
+TEST(ExperimentConfig, AFreeRotationIsHeldByAGaugeOrRefused) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"generator", "cylinder"},
+                  {"radius", 0.025},
+                  {"length", 0.03},
+                  {"segments", {4, 16}}};
+  c["material"] = {{"Y", 100000}, {"gamma", 0.001}};
+  c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.03}};
+  c["loads"] = nlohmann::json::array();
+  c["supports"] = {{{"label", "centre"}, {"box", {{"min", {-1e-7, -1e-7, -1e-7}},
+                                                  {"max", {1e-7, 1e-7, 1e-7}}}}}};
+  c["paddles"] = {{{"label", "lower"}, {"axis", "x"}, {"side", "below"}, {"travel", 0}},
+                  {{"label", "upper"}, {"axis", "x"}, {"side", "above"}, {"travel", -0.006}}};
+  c["stepping"] = {{"scheme", "newton"}, {"steps", 3}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  ASSERT_EQ(ex.warnings.size(), 1u);
+  EXPECT_NE(ex.warnings[0].find("rotation about the axis x through (0.015, 0, 0) free"),
+            std::string::npos)
+      << ex.warnings[0];
+  EXPECT_NE(ex.warnings[0].find("as a gauge"), std::string::npos) << ex.warnings[0];
+  const model::Model& m = ex.cases[0].model;
+  ASSERT_EQ(m.constraint_groups.back(), "gauge");
+  const ExperimentResult r = run_experiment(ex);
+  ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+  const solve::SteppingSummary& s = r.runs[0].summary;
+  EXPECT_LE(s.steps[0].contact_rounds, 4);
+  EXPECT_GT(s.steps[0].contacts_added, 0);
+  const solve::StepRecord& last = s.steps.back();
+  const double pressing = std::abs(last.paddles[1].force.x());
+  EXPECT_GT(pressing, 0.1);
+  EXPECT_LT(last.reactions.back().norm(), 1e-9 * pressing);  // the gauge carries nothing
+  Eigen::Vector3d total = last.paddles[0].force + last.paddles[1].force;
+  for (const Eigen::Vector3d& reaction : last.reactions) total += reaction;
+  EXPECT_LT(total.norm(), 1e-8 * pressing);  // paddles and supports balance
+
+  nlohmann::json turned = c;  // a push across the axis at the rim turns the body
+  turned["loads"] = {{{"type", "point"}, {"vertex", 1}, {"force", {0, 0.01, 0.01}}}};
+  expect_config_error(dir, turned,
+                      "supports[0]: the supports leave the rotation about the axis x through "
+                      "(0.015, 0, 0) free, and the loads turn the body about it");
+}
+
 TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
   ScratchDir dir;
   nlohmann::json c = base_config();

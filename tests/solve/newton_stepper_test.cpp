@@ -570,11 +570,40 @@ TEST(Newton, TheSparseTangentAgreesWithTheDenseOne) {
   EXPECT_LT((du_sparse - du_dense).norm(), 1e-8 * du_dense.norm());
   const auto central = model::FiberKinematics::Central;
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, true), TangentSolver::Sparse);
-  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, false), TangentSolver::Krylov);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, false), TangentSolver::Reused);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 1000, central, false), TangentSolver::Reused);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 600, central, false), TangentSolver::Dense);
+  EXPECT_EQ(choose_tangent(TangentSolver::Auto, 60000, central, false), TangentSolver::Krylov);
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 60000, central, true), TangentSolver::Krylov);
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, model::FiberKinematics::VectorSpring, true),
             TangentSolver::Krylov);
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 3000, central, true), TangentSolver::Dense);
+}
+
+// Central fibers over every pair: GMRES on the exact tangent preconditioned
+// by the LU of an earlier one gives the dense LU's path and sensitivities
+// to rounding, with fewer factorisations than Newton iterations.
+TEST(Newton, TheReusedTangentAgreesWithTheDenseOne) {
+  model::Model m = hanging_sphere(model::FiberLaw::exponential(20000.0, 5.0), 100.0);
+  m.material.kinematics = model::FiberKinematics::Central;
+  SteppingOptions o = newton(3, TangentSolver::Dense);
+  o.keep_final_tangent = true;
+  const SteppingSummary dense = solve_load_steps(m, o);
+  o.newton.tangent = TangentSolver::Reused;
+  const SteppingSummary reused = solve_load_steps(m, o);
+  ASSERT_TRUE(dense.success && reused.success) << dense.message << reused.message;
+  EXPECT_EQ(reused.tangent, TangentSolver::Reused);
+  EXPECT_GT(reused.factorizations, 0);
+  EXPECT_LT(reused.factorizations, reused.newton_iterations);
+  EXPECT_GT(reused.krylov_iterations, 0);
+  EXPECT_LT(displacement_norm(m, reused.unknowns - dense.unknowns),
+            1e-9 * displacement_norm(m, dense.unknowns));
+  const Eigen::VectorXd dR =
+      model::Equilibrium(m).parameter_derivatives(reused.unknowns, {"beta"});
+  Eigen::VectorXd du_reused, du_dense;
+  ASSERT_TRUE(reused.final_tangent->solve_full(-dR, &du_reused).ok);
+  ASSERT_TRUE(dense.final_tangent->solve_full(-dR, &du_dense).ok);
+  EXPECT_LT((du_reused - du_dense).norm(), 1e-8 * du_dense.norm());
 }
 
 }  // namespace
