@@ -23,11 +23,11 @@ HERE = Path(__file__).resolve().parent
 EXPERIMENTS = ["compression_cylinder.json", "bending_phantom.json"]
 
 
-def runs(summary):
+def runs(summary, name):
     for run in summary["runs"]:
         steps = run["steps"]
         yield {
-            "run": run["variant"] or summary.get("experiment", {}).get("name", ""),
+            "run": run["variant"] or name,
             "steps": len(steps),
             "seconds": run["seconds"]["total"],
             "slowest": max((s["seconds"] for s in steps), default=float("nan")),
@@ -54,10 +54,11 @@ def main():
                 with tempfile.TemporaryDirectory() as folder:
                     out = Path(folder) / "out"
                     subprocess.run([args.fiberfluid, "run", str(HERE / name), "-o", str(out),
-                                    "-q", "-j", "1"], stdout=subprocess.DEVNULL)
+                                    "-q", "-j", "1"], stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
                     result = out if out.exists() else Path(str(out) + ".failed")
                     summary = json.loads((result / "summary.json").read_text())
-                for r in runs(summary):
+                for r in runs(summary, Path(name).stem):
                     print(f"| {name} | {r['run']} | {beside} | {r['steps']} | {r['seconds']:.1f} | "
                           f"{r['slowest']:.1f} | {r['newton']} | {r['factorisations']} | "
                           f"{r['estimate']:.1f} | {r['seconds'] / r['estimate']:.2f} |"
