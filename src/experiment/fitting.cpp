@@ -396,6 +396,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
       {"status_detail", r.status_detail},
       {"success", r.success},
       {"message", r.message},
+      {"start_note", r.start_note},
       {"method", fit::to_string(r.method)},
       {"jacobian", r.analytic_jacobian ? "analytic: Newton sensitivities, one tangent solve per "
                                          "material parameter"

@@ -775,6 +775,53 @@ FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
 
 FitResult Calibration::run() const { return run_from(impl_->map.initial_phi()); }
 
+namespace {
+
+// The fitted parameters that scale the body's stiffness: the law's moduli
+// (Y, Y0, Y_t, Y_c), gamma and the axis factors.
+bool scales_stiffness(const std::string& name) {
+  return (!name.empty() && name[0] == 'Y') || name == "gamma" || name.rfind("factor_", 0) == 0;
+}
+
+}  // namespace
+
+// A forward run that fails at the start is most often a material too soft
+// for its load: a face turns over, or the run runs away. With every modulus
+// and gamma times s the small-load response is 1/s of the start's (the same
+// body at 1/s of the load), so the start is stiffened by 2, 4, ... 1024,
+// within the bounds, until its run succeeds. The softest start that runs is
+// returned (nullopt when none does, or nothing scales the stiffness).
+std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd& start_phi,
+                                                          EvaluationCache& evaluations,
+                                                          bool with_sensitivities,
+                                                          double* factor) const {
+  const Impl& m = *impl_;
+  const std::vector<Parameter>& parameters = m.map.parameters();
+  const Eigen::VectorXd upper = m.map.upper_phi();
+  std::vector<int> stiffness;
+  for (int k = 0; k < m.map.size(); ++k)
+    if (scales_stiffness(parameters[static_cast<size_t>(k)].name)) stiffness.push_back(k);
+  if (stiffness.empty()) return std::nullopt;
+  const Eigen::VectorXd start = m.map.values(start_phi);
+  for (double s = 2.0; s <= 1024.0 && !cancel_requested(); s *= 2.0) {
+    Eigen::VectorXd phi = start_phi;
+    bool moved = false;
+    for (int k : stiffness) {
+      const Parameter& p = parameters[static_cast<size_t>(k)];
+      const double value = s * start[k];
+      const double wanted = p.log_scale ? std::log(value) : value;
+      phi[k] = std::min(wanted, upper[k]);
+      moved |= phi[k] > start_phi[k];
+    }
+    if (!moved) return std::nullopt;  // every stiffness on its upper bound
+    if (evaluations.at(phi, with_sensitivities).ok) {
+      *factor = s;
+      return phi;
+    }
+  }
+  return std::nullopt;
+}
+
 FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
   const Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
@@ -798,19 +845,36 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
   // The start, as Levenberg-Marquardt will ask for it (with analytic
   // sensitivities): a failure here is the user's to fix, not a rejected step.
   const bool levenberg_marquardt = m.options.method == Method::LevenbergMarquardt;
-  const Evaluation& first = evaluations.at(start_phi, levenberg_marquardt && m.analytic);
-  if (!first.ok) {
+  Eigen::VectorXd phi0 = start_phi;
+  const bool with_sensitivities = levenberg_marquardt && m.analytic;
+  if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities); !given.ok) {
     if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-    return finish(FitStatus::StartFailed,
-                  "the forward run at the starting parameters failed: " + first.message);
+    const std::string why = given.message;  // `given` moves as the cache grows
+    double factor = 1.0;
+    const std::optional<Eigen::VectorXd> stiffer =
+        stiffer_start(start_phi, evaluations, with_sensitivities, &factor);
+    if (!stiffer) {
+      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+      return finish(FitStatus::StartFailed,
+                    "the forward run at the starting parameters failed: " + why +
+                        " (and with the moduli and gamma up to 1024 times the start's, within "
+                        "their bounds)");
+    }
+    phi0 = *stiffer;
+    std::ostringstream note;
+    note << "the forward run at the starting parameters failed (" << why
+         << "); the fit started from the moduli and gamma times " << factor
+         << ", the softest such start whose run succeeds";
+    result.start_note = note.str();
   }
+  const Evaluation& first = evaluations.at(phi0, with_sensitivities);
   result.initial_cost = cost(first.residuals);
   if (!std::isfinite(result.initial_cost))
     return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
   const OptimizerOutcome outcome = levenberg_marquardt
-                                       ? fit_levenberg_marquardt(evaluations, m.options, start_phi)
-                                       : fit_nlopt(evaluations, m.options, start_phi);
+                                       ? fit_levenberg_marquardt(evaluations, m.options, phi0)
+                                       : fit_nlopt(evaluations, m.options, phi0);
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.values = m.map.values(outcome.phi);

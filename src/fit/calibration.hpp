@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,8 @@
 namespace fiberfluid::fit {
 
 // A measured surface tied to the load step it was measured at.
+class EvaluationCache;
+
 struct MeasuredStep {
   Target target;
   int step = 0;  // 1..stepping.steps
@@ -145,6 +148,10 @@ struct FitResult {
   // bounds and their strongest correlation, the parameter no distance
   // depends on, ... (empty for Converged).
   std::string status_detail;
+  // Where the forward run at the given start failed and the fit went on from
+  // a stiffer start that runs: what failed and where it started ("" when the
+  // given start ran).
+  std::string start_note;
   std::vector<std::string> at_bounds;  // the parameters on a bound (ConvergedAtBounds)
   Method method = Method::LevenbergMarquardt;
   bool analytic_jacobian = true;
@@ -226,6 +233,12 @@ class Calibration {
   // The distances, their statistics, the run and the force misfits of an
   // evaluation, into result.
   void describe_at(const Evaluation& at, FitResult& result) const;
+  // Where the start's forward run fails: the softest start with every
+  // modulus and gamma 2, 4, ... 1024 times the start's (within the bounds)
+  // whose run succeeds, and that factor; nullopt when none runs.
+  std::optional<Eigen::VectorXd> stiffer_start(const Eigen::VectorXd& start_phi,
+                                               EvaluationCache& evaluations,
+                                               bool with_sensitivities, double* factor) const;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

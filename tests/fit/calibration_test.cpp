@@ -80,6 +80,28 @@ TEST(Calibration, JacobianMatchesFiniteDifferencesForEveryParameterKind) {
   EXPECT_LT((d.jacobian - e.jacobian).norm(), 1e-6 * e.jacobian.norm());
 }
 
+// A start so soft that its forward run fails (issue 42: a phantom fitted
+// from a fifth of its modulus failed its first run, so the fit could not
+// start): the fit goes on from the softest stiffer start that runs (the
+// moduli and gamma times 2, 4, ...), says so, and finds the truth.
+TEST(Calibration, AStartWhoseRunFailsIsStiffenedUntilItRuns) {
+  const model::Model m = hanging_sphere();
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {2});
+  const std::vector<Parameter> parameters = {parameter("Y0", 150.0), parameter("gamma", 15.0)};
+  const Calibration c(m, newton(2), targets, parameters);
+  ASSERT_FALSE(c.evaluate(c.parameters().initial_phi(), false).ok)
+      << "the start must fail for this test to mean something";
+  const FitResult r = c.run();
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_NE(r.start_note.find("the forward run at the starting parameters failed"),
+            std::string::npos)
+      << r.start_note;
+  EXPECT_NE(r.start_note.find("the moduli and gamma times"), std::string::npos) << r.start_note;
+  EXPECT_NEAR(r.values[0] / 3000.0, 1.0, 1e-6);
+  EXPECT_NEAR(r.values[1] / 300.0, 1.0, 1e-6);
+  EXPECT_NEAR(r.initial[0], 150.0, 1e-9);  // the start reported is the one given
+}
+
 TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   const model::Model m = hanging_sphere();
   const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {1, 2});
