@@ -406,6 +406,7 @@ void print_optima(const fiberfluid::fit::MultistartResult& search,
 
 void print_fit(const fiberfluid::fit::FitResult& fitted) {
   namespace fit = fiberfluid::fit;
+  if (!fitted.start_note.empty()) std::cout << "  start: " << fitted.start_note << "\n";
   for (size_t k = 0; k < fitted.names.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     std::cout << "  " << fitted.names[k] << " = " << fitted.values[i];
