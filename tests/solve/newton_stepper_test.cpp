@@ -544,6 +544,29 @@ TEST(ArcLength, DisplacementDrivenRunsAreLeftToLoadControl) {
   EXPECT_NE(pressed.message.find("arc_length: paddles"), std::string::npos) << pressed.message;
 }
 
+// Runs `m` with the dense tangent and with `kind` (steps, final tangents
+// kept), checks that they give the same path and the same sensitivities
+// du/dbeta from their final tangents, and returns the run with `kind`.
+SteppingSummary expect_the_dense_path(const model::Model& m, int steps, TangentSolver kind) {
+  SteppingOptions o = newton(steps, TangentSolver::Dense);
+  o.keep_final_tangent = true;
+  const SteppingSummary dense = solve_load_steps(m, o);
+  o.newton.tangent = kind;
+  SteppingSummary other = solve_load_steps(m, o);
+  EXPECT_TRUE(dense.success && other.success) << dense.message << other.message;
+  if (!dense.success || !other.success) return other;
+  EXPECT_EQ(other.tangent, kind);
+  EXPECT_GT(other.factorizations, 0);
+  EXPECT_LT(displacement_norm(m, other.unknowns - dense.unknowns),
+            1e-9 * displacement_norm(m, dense.unknowns));
+  const Eigen::VectorXd dR = model::Equilibrium(m).parameter_derivatives(other.unknowns, {"beta"});
+  Eigen::VectorXd du_other, du_dense;
+  EXPECT_TRUE(other.final_tangent->solve_full(-dR, &du_other).ok);
+  EXPECT_TRUE(dense.final_tangent->solve_full(-dR, &du_dense).ok);
+  EXPECT_LT((du_other - du_dense).norm(), 1e-8 * du_dense.norm());
+  return other;
+}
+
 // Fibers within a horizon stored as neighbour lists: the sparse LU of the
 // tangent (UMFPACK) gives the dense LU's path, and its final tangent the
 // same sensitivities; Auto takes it above the dense sizes.
@@ -553,21 +576,7 @@ TEST(Newton, TheSparseTangentAgreesWithTheDenseOne) {
   const double radius = 0.5 * (m.surface.V.col(0).maxCoeff() - m.surface.V.col(0).minCoeff());
   m.fibers = std::make_shared<const geom::FiberMask>(
       geom::horizon_fibers(m.surface, 0.6 * radius, geom::MaskStorage::Sparse));
-  SteppingOptions o = newton(2, TangentSolver::Dense);
-  o.keep_final_tangent = true;
-  const SteppingSummary dense = solve_load_steps(m, o);
-  o.newton.tangent = TangentSolver::Sparse;
-  const SteppingSummary sparse = solve_load_steps(m, o);
-  ASSERT_TRUE(dense.success && sparse.success) << dense.message << sparse.message;
-  EXPECT_EQ(sparse.tangent, TangentSolver::Sparse);
-  EXPECT_GT(sparse.factorizations, 0);
-  EXPECT_LT(displacement_norm(m, sparse.unknowns - dense.unknowns),
-            1e-9 * displacement_norm(m, dense.unknowns));
-  const Eigen::VectorXd dR = model::Equilibrium(m).parameter_derivatives(sparse.unknowns, {"beta"});
-  Eigen::VectorXd du_sparse, du_dense;
-  ASSERT_TRUE(sparse.final_tangent->solve_full(-dR, &du_sparse).ok);
-  ASSERT_TRUE(dense.final_tangent->solve_full(-dR, &du_dense).ok);
-  EXPECT_LT((du_sparse - du_dense).norm(), 1e-8 * du_dense.norm());
+  expect_the_dense_path(m, 2, TangentSolver::Sparse);
   const auto central = model::FiberKinematics::Central;
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, true), TangentSolver::Sparse);
   EXPECT_EQ(choose_tangent(TangentSolver::Auto, 5000, central, false), TangentSolver::Reused);
@@ -586,24 +595,9 @@ TEST(Newton, TheSparseTangentAgreesWithTheDenseOne) {
 TEST(Newton, TheReusedTangentAgreesWithTheDenseOne) {
   model::Model m = hanging_sphere(model::FiberLaw::exponential(20000.0, 5.0), 100.0);
   m.material.kinematics = model::FiberKinematics::Central;
-  SteppingOptions o = newton(3, TangentSolver::Dense);
-  o.keep_final_tangent = true;
-  const SteppingSummary dense = solve_load_steps(m, o);
-  o.newton.tangent = TangentSolver::Reused;
-  const SteppingSummary reused = solve_load_steps(m, o);
-  ASSERT_TRUE(dense.success && reused.success) << dense.message << reused.message;
-  EXPECT_EQ(reused.tangent, TangentSolver::Reused);
-  EXPECT_GT(reused.factorizations, 0);
+  const SteppingSummary reused = expect_the_dense_path(m, 3, TangentSolver::Reused);
   EXPECT_LT(reused.factorizations, reused.newton_iterations);
   EXPECT_GT(reused.krylov_iterations, 0);
-  EXPECT_LT(displacement_norm(m, reused.unknowns - dense.unknowns),
-            1e-9 * displacement_norm(m, dense.unknowns));
-  const Eigen::VectorXd dR =
-      model::Equilibrium(m).parameter_derivatives(reused.unknowns, {"beta"});
-  Eigen::VectorXd du_reused, du_dense;
-  ASSERT_TRUE(reused.final_tangent->solve_full(-dR, &du_reused).ok);
-  ASSERT_TRUE(dense.final_tangent->solve_full(-dR, &du_dense).ok);
-  EXPECT_LT((du_reused - du_dense).norm(), 1e-8 * du_dense.norm());
 }
 
 }  // namespace
