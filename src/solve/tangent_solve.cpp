@@ -176,7 +176,6 @@ Eigen::VectorXd TangentSolve::apply(const Eigen::VectorXd& reduced) const {
 // still cope), with the preconditioner's solve of each one's unit vector
 // and the capacitance matrix C = E^T P^-1 E of their rows.
 Status TangentSolve::update_capacitance() {
-  constexpr size_t kMostHeld = kMostCapacitanceHeld;
   extra_held_.clear();
   if (preconditioner_dofs_.num_reduced() == dofs_.num_reduced()) return {};
   std::vector<int> position(static_cast<size_t>(equilibrium_->num_unknowns()), -1);
@@ -186,10 +185,10 @@ Status TangentSolve::update_capacitance() {
   std::vector<int> dofs;
   for (int d : dofs_.held_dofs())
     if (!preconditioner_dofs_.held(d)) dofs.push_back(d);
-  if (dofs.empty() || dofs.size() > kMostHeld) return {};
+  if (dofs.empty() || dofs.size() > kMostCapacitanceHeld) return {};
   // Contacts wander over a long run: the solves of unknowns no longer held
   // go once the cache holds twice the most that are held at once.
-  if (unit_solves_.size() > 2 * kMostHeld)
+  if (unit_solves_.size() > 2 * kMostCapacitanceHeld)
     for (auto it = unit_solves_.begin(); it != unit_solves_.end();)
       it = std::binary_search(dofs.begin(), dofs.end(), it->first) ? std::next(it)
                                                                    : unit_solves_.erase(it);
@@ -312,12 +311,7 @@ Status TangentSolve::factor_tangent_preconditioner() {
   lu_ = std::make_unique<DenseLU>();
   const Status status = lu_->factorize(J);
   if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
-  ++factorizations_;
-  unit_solves_.clear();
-  preconditioned_held_ = preconditioner_dofs_.held_flags();
-  baseline_rate_ = -1.0;
-  refactor_ = false;
-  just_factored_ = true;
+  note_new_factor();
   return {};
 }
 
@@ -357,13 +351,17 @@ Status TangentSolve::factor_preconditioner() {
     if (status.ok) status = preconditioner_->factorize(*secant_);
   }
   if (!status.ok) return Status::failure("newton: the preconditioner: " + status.message);
+  note_new_factor();
+  return {};
+}
+
+void TangentSolve::note_new_factor() {
   ++factorizations_;
   unit_solves_.clear();  // solves with the factor replaced
   preconditioned_held_ = preconditioner_dofs_.held_flags();
   baseline_rate_ = -1.0;
   refactor_ = false;
   just_factored_ = true;
-  return {};
 }
 
 }  // namespace fiberfluid::solve

@@ -74,6 +74,7 @@ class TangentSolve {
  private:
   Status factor_preconditioner();
   Status factor_tangent_preconditioner();
+  void note_new_factor();  // a preconditioner factored: counts, caches and the refresh rule reset
   bool reused_factor_still_serves() const;
   Status preconditioner_solve(const Eigen::VectorXd& in, Eigen::VectorXd* out) const;
   Status update_capacitance();
