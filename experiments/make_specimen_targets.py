@@ -8,6 +8,10 @@ a test machine would log it, with Gaussian noise of 0.2 N:
   compression_force.csv             all 40 rows (travel in mm, downwards; push in N)
   compression_force_first_half.csv  the rows up to 10 mm: what experiments/fit_compression_half.json
                                     fits, the rest being what its prediction is checked against
+and runs experiments/bending_phantom.json (Y = 100 kPa, gamma = 0.001 N/m) for a scan of its
+final surface, as make_synthetic_targets.py makes its scans (every triangle split in four,
+vertices shuffled, Gaussian noise of 0.5 mm per coordinate):
+  phantom_step10_scan.obj           what experiments/fit_bending_phantom.json fits
 Usage: /usr/bin/python3 experiments/make_specimen_targets.py [build-release/src/app/fiberfluid]
 """
 import os
@@ -16,6 +20,9 @@ import sys
 import tempfile
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_synthetic_targets import read_vtu, resampled_scan, write_obj  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 FORCE_NOISE = 0.2  # N
@@ -46,6 +53,14 @@ def main():
     with open(os.path.join(out_dir, "compression_force_first_half.csv"), "w") as f:
         f.write(comment + ", the first 20 steps (to 10 mm)\nstep,travel,force\n" +
                 "".join(lines[:len(lines) // 2]))
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([binary, "run", os.path.join(ROOT, "experiments/bending_phantom.json"),
+                        "-o", os.path.join(tmp, "p"), "-q"], check=True, stdout=subprocess.DEVNULL)
+        points, triangles = read_vtu(os.path.join(tmp, "p", "vtk", "step_0010.vtu"))
+    scan, faces = resampled_scan(points, triangles, np.random.default_rng(SEED + 1))
+    write_obj(os.path.join(out_dir, "phantom_step10_scan.obj"), scan, faces,
+              "experiments/bending_phantom.json at load step 10: resampled (midpoint subdivision, "
+              "shuffled), Gaussian noise 0.5 mm per coordinate")
     print("targets in", out_dir)
 
 
