@@ -101,6 +101,7 @@ void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& st
                     {"krylov_iterations", r.krylov_iterations},
                     {"pair_passes", pair_passes_json(r.pair_passes)},
                     {"step_cuts", r.step_cuts},
+                    {"pieces", r.pieces},
                     {"volume_drift", r.volume_drift}};
   json paddles = json::object();
   for (size_t p = 0; p < r.paddles.size() && p < m.paddles.size(); ++p)

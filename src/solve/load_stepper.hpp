@@ -149,6 +149,7 @@ struct StepRecord {
   int krylov_iterations = 0;
   model::PairPasses pair_passes;  // over every fiber pair, in the step (its solves, its checks)
   int step_cuts = 0;              // halvings of this step
+  int pieces = 0;                 // the converged pieces it was walked in (1: uncut)
   double volume_drift = 0.0;      // (V - V0) / V0 after the step
   // Paddles: the active-set rounds of the step (over its pieces), and the
   // vertices that joined and left the contact set in them.

@@ -579,14 +579,20 @@ class PathPredictor {
 
 // Solves one step from the solution x at path parameter `from` to the point
 // at(to), along the points at(t) between: the whole step, or pieces of it
-// halved when Newton fails (newton.max_step_cuts times at most). A piece that
-// fails from the predictor's guess is first tried again from the last
-// solution. Each converged piece joins the predictor. "" or why it failed
-// (x and the contact state are then those of the last converged piece).
+// halved when Newton fails (at most newton.max_step_cuts halvings deep). A
+// piece that converged easily (in at most 3 Newton iterations) doubles the
+// next one again, up to the whole step: one hard moment (first touch, a
+// contact front passing) costs a few short pieces, not the rest of the step
+// in them. A piece that fails from the predictor's guess is first tried
+// again from the last solution. Each converged piece joins the predictor.
+// "" or why it failed (x and the contact state are then those of the last
+// converged piece).
 std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double)>& at, double from,
                       double to, const NewtonOptions& options, PathPredictor& predictor,
                       Eigen::VectorXd& x, StepRecord& record) {
+  constexpr int kEasyIterations = 3;
   double reached = from, piece = to - from;
+  int depth = 0;  // halvings of the piece now taken
   bool predict = options.predictor;
   while (reached < to) {
     if (cancel_requested()) return "interrupted";
@@ -594,11 +600,17 @@ std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double
     const Eigen::VectorXd saved = x;
     const auto contact = solver.contact_state();
     if (predict) x = predictor.predict(target);
+    const int iterations_before = record.newton_iterations;
     const std::string why = solver.solve(at(target), x, record);
     if (why.empty()) {
       reached = target;
+      ++record.pieces;
       predictor.add(reached, x);
       predict = options.predictor;
+      if (depth > 0 && record.newton_iterations - iterations_before <= kEasyIterations) {
+        --depth;
+        piece *= 2.0;
+      }
       continue;
     }
     x = saved;
@@ -607,10 +619,11 @@ std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double
       predict = false;
       continue;
     }
-    if (record.step_cuts == options.max_step_cuts)
-      return why + "; the step was halved " + std::to_string(record.step_cuts) +
+    if (depth == options.max_step_cuts)
+      return why + "; the step was halved " + std::to_string(depth) +
              " times (newton.max_step_cuts): the load step is too large or the material too soft";
     ++record.step_cuts;
+    ++depth;
     piece *= 0.5;
   }
   return {};

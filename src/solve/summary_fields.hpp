@@ -28,7 +28,7 @@ template <class A>
 void fields(A& a, StepRecord& r) {
   a(r.step, r.load_factors, r.pressure, r.volume, r.max_displacement, r.residual, r.seconds,
     r.reactions, r.applied_force, r.held_forces, r.newton_iterations, r.residual_norms,
-    r.line_search_halvings, r.krylov_iterations, r.pair_passes, r.step_cuts, r.volume_drift,
+    r.line_search_halvings, r.krylov_iterations, r.pair_passes, r.step_cuts, r.pieces, r.volume_drift,
     r.contact_rounds, r.contacts_added, r.contacts_released, r.paddles, r.sensitivities, r.reaction_sensitivities);
 }
 template <class A>
