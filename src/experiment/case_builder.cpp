@@ -405,19 +405,14 @@ class ModelBuilder {
       if (rotation == free.end()) return;
       const std::string motion = rotation->describe();
       const auto [vertex, axis] = model::gauge_unknown(m, *rotation);
-      if (rotation->driven > 1e-9 || vertex < 0)
-        spec_.constraints.empty()
-            ? spec_.paddles_field.fail("", "nothing holds the " + motion + free_motion_advice())
-            : spec_.constraints.front().field.fail(
-                  "", "the supports leave the " + motion +
-                          " free, and the loads turn the body about it: no equilibrium "
-                          "exists" + free_motion_advice());
-      if (std::find(m.constraint_groups.begin(), m.constraint_groups.end(), "gauge") ==
-          m.constraint_groups.end())
-        m.constraint_groups.push_back("gauge");
-      const int group = static_cast<int>(std::find(m.constraint_groups.begin(),
-                                                   m.constraint_groups.end(), "gauge") -
-                                         m.constraint_groups.begin());
+      if (rotation->driven > 1e-9 || vertex < 0)  // m.constraints come from the file's groups
+        spec_.constraints.front().field.fail(
+            "", "the supports leave the " + motion +
+                    " free, and the loads turn the body about it: no equilibrium exists: hold "
+                    "a vertex away from the axis (a support with \"axes\" across it), make the "
+                    "paddles \"sticking\", or clamp a face");
+      if (m.constraint_groups.back() != "gauge") m.constraint_groups.push_back("gauge");
+      const int group = static_cast<int>(m.constraint_groups.size()) - 1;
       m.constraints.push_back({vertex, axis, 0.0, {}, group});
       const int input = c_.model_to_input.empty()
                             ? vertex
@@ -430,11 +425,6 @@ class ModelBuilder {
                          "a support that holds the rotation replaces it");
     }
   }
-  static std::string free_motion_advice() {
-    return ": hold a vertex away from the axis (a support with \"axes\" across it), make "
-           "the paddles \"sticking\", or clamp a face";
-  }
-
   // Two paddles on one axis may not meet (checked at every step by the solver too).
   void check_paddles_leave_room() const {
     for (const model::Paddle& a : c_.model.paddles)

@@ -20,14 +20,12 @@ struct RigidModes {
   Eigen::MatrixXd modes;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double size = 1.0;
-  int translations = 0;
 };
 
 RigidModes rigid_modes(const Model& model) {
   const Eigen::MatrixXd& V = model.surface.V;
   const int n = model.num_vertices(), dim = model.dim();
   RigidModes r;
-  r.translations = dim;
   r.centre.head(dim) = V.colwise().mean().transpose();
   r.size = std::max((V.colwise().maxCoeff() - V.colwise().minCoeff()).norm(), 1e-300);
   const int rotations = dim == 3 ? 3 : 1;
