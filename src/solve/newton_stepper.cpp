@@ -346,7 +346,7 @@ class NewtonSolver {
         *converged = true;
         return {};
       }
-      if (it > 0 && !model_.paddles.empty() && add_penetrating(at, x, false) > 0) {
+      if (it > 0 && add_penetrating(at, x, false) > 0) {
         residual_ = R;
         return {};
       }
