@@ -694,6 +694,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   o.parameter_tolerance = f.number("parameter_tolerance", o.parameter_tolerance);
   o.initial_trust_region_radius =
       f.number("initial_trust_region_radius", o.initial_trust_region_radius);
+  o.max_step_factor = f.number("max_step_factor", o.max_step_factor);
   try {
     fit::check_options(o);
   } catch (const InputError& e) {

@@ -158,6 +158,9 @@ void check_options(const FitOptions& o) {
   positive("parameter_tolerance", o.parameter_tolerance, 1.0, "a relative change in (0, 1]");
   positive("initial_trust_region_radius", o.initial_trust_region_radius,
            std::numeric_limits<double>::max(), "a positive finite number");
+  if (!(o.max_step_factor > 1.0 && o.max_step_factor <= std::numeric_limits<double>::max()))
+    throw InputError("max_step_factor: expected a finite factor above 1, got " +
+                     std::to_string(o.max_step_factor));
   if (o.max_iterations < 1 || o.max_iterations > 100000)
     throw InputError("max_iterations: expected 1 to 100000, got " +
                      std::to_string(o.max_iterations));
@@ -618,7 +621,8 @@ std::deque<EvaluationCache::Entry>::const_iterator EvaluationCache::find(const E
                                                                          bool with_jacobian) const {
   return std::find_if(kept_.begin(), kept_.end(), [&](const Entry& entry) {
     if (entry.phi.size() != phi.size() || entry.phi != phi) return false;
-    if (with_jacobian) return entry.has_jacobian;
+    // A point whose forward run failed fails with a Jacobian too: one run.
+    if (with_jacobian) return entry.has_jacobian || !entry.evaluation.ok;
     // A point whose finite-difference runs failed still has valid residuals
     // in its Jacobian-free entry: a failed Jacobian must not hide them.
     return !entry.has_jacobian || entry.evaluation.ok;

@@ -109,6 +109,11 @@ struct FitOptions {
   // when a far start makes the full steps overshoot (each rejected step
   // costs a forward run and only halves the region).
   double initial_trust_region_radius = 1e4;
+  // Levenberg-Marquardt: a trial point may change a log-scaled parameter by
+  // at most this factor from the current point (a larger step is refused
+  // without a forward run, and the region shrinks): a far start takes a few
+  // more steps instead of trial runs at the bounds that fail slowly.
+  double max_step_factor = 4.0;
   // Called after every iteration (LM) or every improvement (NLopt).
   std::function<void(const IterationRecord&)> progress;
 };

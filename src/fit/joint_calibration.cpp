@@ -4,7 +4,9 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <set>
 
@@ -121,8 +123,9 @@ std::string JointCalibration::specimen_result(size_t s, const Eigen::VectorXd& p
 namespace {
 
 // The joint residuals (each specimen's in turn) and Jacobian at one point,
-// the specimens dealt out; the last point is kept (Ceres asks for a point's
-// Jacobian after its residuals).
+// the specimens dealt out. The last few points are kept: Ceres asks for a
+// point's Jacobian after its residuals, and for the current point again
+// after a rejected trial one.
 class JointEvaluator {
  public:
   JointEvaluator(const JointCalibration& joint, const std::vector<const Calibration*>& specimens,
@@ -131,7 +134,33 @@ class JointEvaluator {
 
   // False when a specimen's forward run failed (why in message()).
   bool at(const Eigen::VectorXd& phi, bool with_jacobian) {
-    if (has_ && phi == phi_ && (has_jacobian_ || !with_jacobian)) return ok_;
+    for (auto it = kept_.begin(); it != kept_.end(); ++it)
+      if (it->phi == phi && (it->has_jacobian || !with_jacobian)) {
+        std::rotate(kept_.begin(), it, std::next(it));
+        return kept_.front().ok;
+      }
+    kept_.push_front(evaluate(phi, with_jacobian));
+    if (kept_.size() > kKept) kept_.pop_back();
+    if (!kept_.front().ok) last_failure_ = kept_.front().message;
+    return kept_.front().ok;
+  }
+  const Eigen::VectorXd& residuals() const { return kept_.front().residuals; }
+  const Eigen::MatrixXd& jacobian() const { return kept_.front().jacobian; }
+  const std::string& message() const { return kept_.front().message; }
+  // Why the last point whose run failed failed ("" if none did).
+  const std::string& last_failure() const { return last_failure_; }
+  int evaluations = 0, forward_runs = 0;
+
+ private:
+  struct Point {
+    Eigen::VectorXd phi, residuals;
+    Eigen::MatrixXd jacobian;
+    bool has_jacobian = false, ok = true;
+    std::string message;
+  };
+  static constexpr size_t kKept = 3;
+
+  Point evaluate(const Eigen::VectorXd& phi, bool with_jacobian) {
     std::string command = command_bytes(Command::Evaluate, with_jacobian, phi);
     broadcast_(command);
     std::vector<Evaluation> parts(specimens_.size());
@@ -144,48 +173,39 @@ class JointEvaluator {
           arrived[s] = 1;
         });
     ++evaluations;
-    has_ = true;
-    phi_ = phi;
-    has_jacobian_ = with_jacobian;
-    ok_ = true;
-    message_.clear();
-    residuals_.resize(joint_.num_residuals());
-    jacobian_.setZero(joint_.num_residuals(), phi.size());
+    Point point;
+    point.phi = phi;
+    point.has_jacobian = with_jacobian;
+    point.residuals.resize(joint_.num_residuals());
+    point.jacobian.setZero(joint_.num_residuals(), phi.size());
     Eigen::Index row = 0;
     for (size_t s = 0; s < parts.size(); ++s) {
       const Evaluation& e = parts[s];
       forward_runs += e.forward_runs;
       if (!arrived[s] || !e.ok) {
-        ok_ = false;
-        if (message_.empty())
-          message_ = "specimen \"" + joint_.specimen_names()[s] +
-                     "\": " + (arrived[s] ? e.message : std::string("interrupted"));
+        point.ok = false;
+        if (point.message.empty())
+          point.message = "specimen \"" + joint_.specimen_names()[s] +
+                          "\": " + (arrived[s] ? e.message : std::string("interrupted"));
         continue;
       }
       const Eigen::Index rows = e.residuals.size();
-      residuals_.segment(row, rows) = e.residuals;
+      point.residuals.segment(row, rows) = e.residuals;
       if (with_jacobian)
         for (Eigen::Index k = 0; k < e.jacobian.cols(); ++k)
-          jacobian_.block(row, joint_.joint_index(s, static_cast<int>(k)), rows, 1) =
+          point.jacobian.block(row, joint_.joint_index(s, static_cast<int>(k)), rows, 1) =
               e.jacobian.col(k);
       row += rows;
     }
-    return ok_;
+    return point;
   }
-  const Eigen::VectorXd& residuals() const { return residuals_; }
-  const Eigen::MatrixXd& jacobian() const { return jacobian_; }
-  const std::string& message() const { return message_; }
-  int evaluations = 0, forward_runs = 0;
 
- private:
   const JointCalibration& joint_;
   const std::vector<const Calibration*>& specimens_;
   const WorkDealer& deal_;
   const Broadcast& broadcast_;
-  bool has_ = false, has_jacobian_ = false, ok_ = false;
-  Eigen::VectorXd phi_, residuals_;
-  Eigen::MatrixXd jacobian_;
-  std::string message_;
+  std::deque<Point> kept_;
+  std::string last_failure_;
 };
 
 // The whole joint residual as one Ceres block over all the variables.
@@ -305,19 +325,18 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   }
   result.initial_cost = 0.5 * evaluator.residuals().squaredNorm();
 
+  std::vector<bool> log_scaled;
+  for (const Parameter& p : parameters_) log_scaled.push_back(p.log_scale);
   ceres::Problem problem;
   problem.AddResidualBlock(new JointCost(evaluator, residuals_, P), nullptr, phi.data());
-  for (int k = 0; k < P; ++k) {
-    if (std::isfinite(lower[k])) problem.SetParameterLowerBound(phi.data(), k, lower[k]);
-    if (std::isfinite(upper[k])) problem.SetParameterUpperBound(phi.data(), k, upper[k]);
-  }
   JointRecorder recorder(parameters_, phi, evaluator, options_, result.iterations);
-  ceres::Solver::Options solver =
-      lm_solver(options_.max_iterations, options_.function_tolerance, options_.parameter_tolerance,
-                FitOptions{}.initial_trust_region_radius);
-  solver.callbacks.push_back(&recorder);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
+  LmSteps steps;
+  steps.max_iterations = options_.max_iterations;
+  steps.function_tolerance = options_.function_tolerance;
+  steps.parameter_tolerance = options_.parameter_tolerance;
+  steps.max_step_factor = options_.max_step_factor;
+  const ceres::Solver::Summary summary =
+      solve_in_moving_box(problem, phi.data(), log_scaled, lower, upper, steps, &recorder);
   result.message = "levenberg-marquardt: " + summary.message;
   result.values = values(phi);
   if (cancel_requested()) return finish(FitStatus::Interrupted, "");
@@ -325,7 +344,7 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
     return finish(FitStatus::IterationLimit, "");
   if (summary.termination_type != ceres::CONVERGENCE)
     return finish(
-        evaluator.message().empty() ? FitStatus::OptimizerFailed : FitStatus::ForwardRunsFailed,
+        evaluator.last_failure().empty() ? FitStatus::OptimizerFailed : FitStatus::ForwardRunsFailed,
         "");
 
   // At the optimum: the covariance of phi from the Jacobian, (J^T J)^-1.

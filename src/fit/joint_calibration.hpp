@@ -31,6 +31,7 @@ struct JointOptions {
   int max_iterations = 50;
   double function_tolerance = 1e-12;
   double parameter_tolerance = 1e-8;
+  double max_step_factor = 4.0;  // as FitOptions::max_step_factor
   // Called on the gathering process after every iteration.
   std::function<void(const IterationRecord&)> progress;
 };

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/self_intersection.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/dof_map.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
@@ -84,6 +85,7 @@ class NewtonSolver {
   }
 
   const model::Equilibrium& equilibrium() const { return *equilibrium_; }
+  const Model& model() const { return model_; }
   // The tangent solve prepared at x (the solution), for the summary.
   std::shared_ptr<TangentSolve> final_tangent(const LoadPoint& at, const Eigen::VectorXd& x) {
     if (!tangent_->prepare(x, at.factors, held_map(), &supports_).ok) return nullptr;
@@ -577,23 +579,49 @@ class PathPredictor {
   std::vector<Point> points_;
 };
 
+// Why no equilibrium continues the path, in the body's terms where it can
+// be told: the surface of the last Newton iterate passes through itself (a
+// self-contact ahead, which the model does not treat). "" when nothing is
+// seen.
+std::string physical_reason(const Model& model, const Eigen::VectorXd& iterate) {
+  geom::Surface at = model.surface;
+  at.V = model::positions(model, iterate);
+  if (!at.V.allFinite()) return {};
+  if (const auto crossing = geom::find_self_intersection(at))
+    return "; the last iterate passes through itself (faces " + std::to_string(crossing->first) +
+           " and " + std::to_string(crossing->second) +
+           " cross): the path may run into a self-contact, which the model does not treat";
+  return {};
+}
+
 // Solves one step from the solution x at path parameter `from` to the point
-// at(to), along the points at(t) between: the whole step, or pieces of it
-// halved when Newton fails (at most newton.max_step_cuts halvings deep). A
-// piece that converged easily (in at most 3 Newton iterations) doubles the
-// next one again, up to the whole step: one hard moment (first touch, a
-// contact front passing) costs a few short pieces, not the rest of the step
-// in them. A piece that fails from the predictor's guess is first tried
-// again from the last solution. Each converged piece joins the predictor.
+// at(to), along the points at(t) between: pieces of 2^-depth of a step,
+// `depth` carried from step to step (the pieces the last step ended with).
+// A failing piece is halved (at most newton.max_step_cuts deep); a piece that
+// converged easily (in at most 3 Newton iterations) doubles the next one
+// again, up to the whole step: one hard moment (first touch, a contact front
+// passing) costs a few short pieces, and a hard stretch of the path is
+// walked in short pieces without failing at each step's start first. A piece
+// that fails from the predictor's guess is first tried again from the last
+// solution. Each converged piece joins the predictor.
+//
+// When the line search stalls at about the same residual three cuts in a
+// row, shorter pieces will not help (a step too long stalls lower as it is
+// cut): the path has no equilibrium to go on to, and the walk stops there,
+// saying so, rather than halving on to the limit (a fit's trial point that
+// is too soft for its load failed in minutes that way).
+//
 // "" or why it failed (x and the contact state are then those of the last
 // converged piece).
 std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double)>& at, double from,
                       double to, const NewtonOptions& options, PathPredictor& predictor,
-                      Eigen::VectorXd& x, StepRecord& record) {
+                      Eigen::VectorXd& x, StepRecord& record, int& depth) {
   constexpr int kEasyIterations = 3;
-  double reached = from, piece = to - from;
-  int depth = 0;  // halvings of the piece now taken
+  constexpr int kStalledCuts = 3;  // failures in a row at one residual level
+  depth = std::min(depth, options.max_step_cuts);
+  double reached = from, piece = (to - from) * std::ldexp(1.0, -depth);
   bool predict = options.predictor;
+  std::vector<double> stalls;  // the residual of each line-search failure since the last success
   while (reached < to) {
     if (cancel_requested()) return "interrupted";
     const double target = std::min(to, reached + piece);
@@ -601,27 +629,51 @@ std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double
     const auto contact = solver.contact_state();
     if (predict) x = predictor.predict(target);
     const int iterations_before = record.newton_iterations;
+    const size_t norms_before = record.residual_norms.size();
     const std::string why = solver.solve(at(target), x, record);
     if (why.empty()) {
       reached = target;
       ++record.pieces;
       predictor.add(reached, x);
       predict = options.predictor;
+      stalls.clear();
       if (depth > 0 && record.newton_iterations - iterations_before <= kEasyIterations) {
         --depth;
         piece *= 2.0;
       }
       continue;
     }
+    const Eigen::VectorXd iterate = x;
     x = saved;
     solver.restore(contact);
     if (predict && predictor.extrapolates()) {
       predict = false;
       continue;
     }
+    const bool stalled = why.rfind("newton: the line search found no decrease", 0) == 0 &&
+                         record.residual_norms.size() > norms_before;
+    if (stalled) {
+      stalls.push_back(record.residual_norms.back());
+    } else {
+      stalls.clear();
+    }
+    if (stalls.size() >= static_cast<size_t>(kStalledCuts)) {
+      const auto last = stalls.end() - kStalledCuts;
+      const auto [low, high] = std::minmax_element(last, stalls.end());
+      if (*high <= 2.0 * *low) {
+        std::ostringstream out;
+        out << why << ", " << kStalledCuts << " cuts in a row (down to " << std::ldexp(1.0, -depth)
+            << " of a step): shorter pieces will not help; no equilibrium continues the path "
+               "here (a limit or bifurcation point, or a material too soft for the load)"
+            << physical_reason(solver.model(), iterate);
+        return out.str();
+      }
+    }
     if (depth == options.max_step_cuts)
       return why + "; the step was halved " + std::to_string(depth) +
-             " times (newton.max_step_cuts): the load step is too large or the material too soft";
+             " times (newton.max_step_cuts): the load step is too large or the material too "
+             "soft" +
+             physical_reason(solver.model(), iterate);
     ++record.step_cuts;
     ++depth;
     piece *= 0.5;
@@ -879,6 +931,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   PathPredictor predictor(options.newton.predictor ? 2 : 0);
   predictor.add(0.0, x);
   report_progress("step", 0, n);
+  int depth = 0;  // the pieces' halvings, carried from step to step
   // Load control: each step to t = k (t = 1 only, the arc's first step, by arc length).
   for (int k = 1; k <= (by_arc ? 1 : n); ++k) {
     const Clock::time_point step_start = Clock::now();
@@ -886,7 +939,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     record.step = k;
     why = walk_step(
         *solver, [&](double t) { return scheduled_point(model, t, n); }, k - 1.0, k, options.newton,
-        predictor, x, record);
+        predictor, x, record, depth);
     if (!why.empty()) return fail("step " + std::to_string(k) + ": " + why);
     if (!(why = keep(record, k, step_start)).empty()) return fail(why);
     report_progress("step", k, n);
@@ -976,7 +1029,8 @@ class InteractiveStepper::Impl {
     const auto contact = solver_->contact_state();
     NewtonOptions newton = options_.newton;
     PathPredictor predictor = start_predictor(from, to, &newton.predictor);
-    std::string why = walk_step(*solver_, at, t0, t0 + 1.0, newton, predictor, x, record);
+    int depth = 0;  // each move starts whole
+    std::string why = walk_step(*solver_, at, t0, t0 + 1.0, newton, predictor, x, record, depth);
     if (why.empty()) why = finisher_->finish(to, x, record);
     record.seconds = seconds_since(start);
     record.pair_passes = model::pair_passes() - passes_before;

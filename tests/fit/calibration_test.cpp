@@ -102,6 +102,37 @@ TEST(Calibration, AStartWhoseRunFailsIsStiffenedUntilItRuns) {
   EXPECT_NEAR(r.initial[0], 150.0, 1e-9);  // the start reported is the one given
 }
 
+// Levenberg-Marquardt moves a log-scaled parameter by at most
+// max_step_factor per step (a box around the current point), and still
+// reaches the truth from 30 times it.
+TEST(Calibration, LevenbergMarquardtStepsStayWithinTheStepFactor) {
+  const model::Model m = hanging_sphere();
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {2});
+  const std::vector<Parameter> parameters = {parameter("Y0", 90000.0), parameter("gamma", 300.0)};
+  for (const double factor : {4.0, 1.5}) {
+    FitOptions options;
+    options.max_step_factor = factor;
+    const FitResult r = Calibration(m, newton(2), targets, parameters, options).run();
+    ASSERT_TRUE(r.success) << r.message;
+    EXPECT_NEAR(r.values[0] / 3000.0, 1.0, 1e-6) << factor;
+    EXPECT_NEAR(r.values[1] / 300.0, 1.0, 1e-6) << factor;
+    Eigen::VectorXd from = r.initial;
+    int accepted = 0;
+    for (const IterationRecord& it : r.iterations) {
+      for (Eigen::Index k = 0; k < from.size(); ++k)
+        EXPECT_LE(std::abs(std::log(it.values[k] / from[k])), std::log(factor) * (1 + 1e-12))
+            << "iteration " << it.iteration << ", " << r.names[static_cast<size_t>(k)];
+      if (it.accepted && it.iteration > 0) ++accepted;
+      from = it.values;
+    }
+    // 30 times the truth is more than two steps of 4 (ten of 1.5) away.
+    EXPECT_GE(accepted, static_cast<int>(std::ceil(std::log(30.0) / std::log(factor)))) << factor;
+  }
+  FitOptions bad;
+  bad.max_step_factor = 1.0;
+  EXPECT_THROW(check_options(bad), InputError);
+}
+
 TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   const model::Model m = hanging_sphere();
   const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(2), {1, 2});
