@@ -11,7 +11,7 @@ a test machine would log it, with Gaussian noise of 0.2 N:
 and runs experiments/bending_phantom.json (Y = 100 kPa, gamma = 0.001 N/m) for a scan of its
 final surface, as make_synthetic_targets.py makes its scans (every triangle split in four,
 vertices shuffled, Gaussian noise of 0.5 mm per coordinate):
-  phantom_step10_scan.obj           for the phantom's fit from far away (issue 42)
+  phantom_step10_scan.obj           what experiments/fit_bending_phantom.json fits
 Usage: /usr/bin/python3 experiments/make_specimen_targets.py [build-release/src/app/fiberfluid]
 """
 import os
