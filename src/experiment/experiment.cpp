@@ -12,8 +12,11 @@
 #include <istream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
@@ -931,10 +934,33 @@ namespace {
 template <class Input>
 json parse_json_from(Input&& input, const std::string& label) {
   struct TooDeep {};
-  const json::parser_callback_t guard = [](int depth, json::parse_event_t event, json&) {
+  struct Duplicate {
+    std::string path;
+  };
+  // A key given twice in one object: nlohmann keeps the last one without a
+  // word, so the file would mean what its last line says (issue 43, "a file
+  // means one thing"). Each open object's keys, and the key it sits under.
+  struct Open {
+    std::set<std::string> keys;
+    std::string under;
+  };
+  std::vector<Open> open;
+  std::string last_key;
+  const json::parser_callback_t guard = [&](int depth, json::parse_event_t event, json& parsed) {
     if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
         depth >= kDeepestJson)
       throw TooDeep{};
+    if (event == json::parse_event_t::object_start) open.push_back({{}, last_key});
+    if (event == json::parse_event_t::object_end && !open.empty()) open.pop_back();
+    if (event == json::parse_event_t::key && !open.empty()) {
+      last_key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+      if (!open.back().keys.insert(last_key).second) {
+        std::string path = last_key;
+        for (auto it = open.rbegin(); it != open.rend(); ++it)
+          if (!it->under.empty()) path = it->under + "." + path;
+        throw Duplicate{path};
+      }
+    }
     return true;
   };
   try {
@@ -942,6 +968,10 @@ json parse_json_from(Input&& input, const std::string& label) {
   } catch (const TooDeep&) {
     throw InputError(label + ": nested more than " + std::to_string(kDeepestJson) +
                      " levels deep (an experiment needs a few)");
+  } catch (const Duplicate& d) {
+    throw InputError(label + ": \"" + d.path.substr(0, 80) +
+                     "\" is given twice in one object (expected each key once: which one "
+                     "would count?)");
   } catch (const json::exception& e) {  // a syntax error, or a number a double cannot hold (1e999)
     // The parser quotes the token it last read, which may be a whole line: cut it short.
     std::string what = e.what();

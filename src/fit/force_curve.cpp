@@ -49,6 +49,13 @@ ForceCurve read_force_curve(const std::filesystem::path& path, double travel_sca
       int travel_column = -1, step_column = -1;
       for (size_t c = 0; c < row.size(); ++c) {
         const int column = static_cast<int>(c);
+        // A column named twice: which one is the force? (issue 43: a file means one thing)
+        for (size_t earlier = 0; earlier < c; ++earlier)
+          if (!row[c].empty() && row[earlier] == row[c])
+            throw InputError(file + ": line " + std::to_string(number) + ": the header names \"" +
+                             row[c].substr(0, 40) + "\" twice (columns " +
+                             std::to_string(earlier + 1) + " and " + std::to_string(c + 1) +
+                             "): expected each column once");
         if (row[c] == "force") force_column = column;
         if (row[c] == "travel") travel_column = column;
         if (row[c] == "step") step_column = column;

@@ -197,6 +197,29 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   EXPECT_THROW(load_experiment(broken), InputError);
 }
 
+TEST(AFileMeansOneThing, AnExperimentKeyGivenTwiceIsRefused) {
+  testing::ScratchDir dir;
+  // Issue 43, "a file means one thing": a key given twice in one object
+  // (JSON leaves it open; the parser kept the last) is refused, naming it.
+  for (const auto& [text, path] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"name": "x", "material": {"Y": 1000, "gamma": 1, "Y": 2000}})", "material.Y"},
+           {R"({"name": "x", "name": "y"})", "name"},
+           {R"({"name": "x", "supports": [{"where": "z < 0", "where": "z > 0"}]})",
+            "supports.where"}}) {
+    const auto twice = dir.write("twice.json", text);
+    try {
+      load_experiment(twice);
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("twice.json: \"" + path + "\" is given twice"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // The same key in two objects is two keys.
+  EXPECT_NO_THROW(parse_json(std::string(R"({"a": {"Y": 1}, "b": {"Y": 2}, "c": [{"Y": 3}, {"Y": 4}]})"), "ok"));
+}
+
 TEST(ExperimentConfig, ASurfaceIsRemeshedToTheCountAsked) {
   ScratchDir dir;
   nlohmann::json c = base_config();

@@ -120,6 +120,21 @@ ForceCurve paddle_curve(const std::vector<double>& travel, const std::vector<dou
 // Rows between steps read the force interpolated by travel; the Jacobian of
 // the force rows (Newton sensitivities of the held rows) matches central
 // differences of whole runs, and the finite-difference mode agrees.
+// Issue 43, "a file means one thing": a header that names a column twice
+// was read from its last such column without a word (step,travel,force,force
+// fitted the second force column).
+TEST(AFileMeansOneThing, AForceCurveHeaderNamingAColumnTwiceIsRefused) {
+  testing::ScratchDir dir;
+  for (const char* header : {"step,travel,force,force", "travel,travel,force", "force,step,step",
+                             "time,force,time,travel"}) {
+    const auto file = dir.write("twice.csv", std::string(header) + "\n1,2,3,4\n");
+    expect_input_error([&] { read_force_curve(file); }, "line 1: the header names");
+    expect_input_error([&] { read_force_curve(file); }, "twice (columns");
+  }
+  // Empty cells are not names: "travel,,force" is one travel, one force.
+  EXPECT_EQ(read_force_curve(dir.write("gap.csv", "travel,,force\n1,,2\n")).force[0], 2.0);
+}
+
 TEST(ForceCurve, ItsResidualsAndJacobianMatchTheRunAndFiniteDifferences) {
   const model::Model m = pressed_sphere(true, model::FiberLaw::exponential(3000.0, 5.0));
   const Measured truth = measure(m, 4, {4});
