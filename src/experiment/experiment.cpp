@@ -368,7 +368,8 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
   o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
   o.line_search = f.boolean("line_search", o.line_search);
-  const std::string tangent = f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse", "reused"});
+  const std::string tangent =
+      f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse", "reused"});
   o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
               : tangent == "krylov" ? solve::TangentSolver::Krylov
               : tangent == "sparse" ? solve::TangentSolver::Sparse
@@ -670,6 +671,12 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     }
     for (const char* key : {"starts", "same_optimum"})
       if (f.has(key)) f.fail(key, "only with \"method\": \"multistart\"");
+    // Every option is honoured by the method it is given with, or refused.
+    if (o.method != fit::Method::LevenbergMarquardt)
+      for (const char* key : {"max_iterations", "initial_trust_region_radius", "max_step_factor"})
+        if (f.has(key))
+          f.fail(key, "only with levenberg-marquardt or multistart (" + method +
+                          " takes no trust-region steps: max_evaluations bounds its runs)");
   }
   o.finite_differences =
       f.choice("jacobian", "analytic", {"analytic", "finite-differences"}) == "finite-differences";

@@ -4,6 +4,7 @@
 #include <glog/logging.h>
 
 #include <chrono>
+#include <limits>
 #include <memory>
 
 #include "fiberfluid/fit/lm_solver.hpp"
@@ -18,7 +19,8 @@ namespace {
 // distance), and the cache keeps the run.
 class SharedEvaluation {
  public:
-  explicit SharedEvaluation(EvaluationCache& cache) : cache_(cache) {}
+  explicit SharedEvaluation(EvaluationCache& cache, int max_runs = std::numeric_limits<int>::max())
+      : cache_(cache), max_runs_(max_runs) {}
 
   const Evaluation& at(const double* phi, bool with_jacobian) {
     // Analytic sensitivities cost a few tangent solves next to a whole
@@ -28,10 +30,20 @@ class SharedEvaluation {
     const int P = cache_.calibration().parameters().size();
     return cache_.at(Eigen::Map<const Eigen::VectorXd>(phi, P), with_jacobian);
   }
+  // False when the point would need forward runs beyond max_evaluations
+  // (a kept point needs none).
+  bool affordable(const double* phi, bool with_jacobian) const {
+    const Calibration& calibration = cache_.calibration();
+    if (cache_.forward_runs < max_runs_) return true;
+    with_jacobian = with_jacobian || calibration.analytic_jacobian();
+    return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, calibration.parameters().size()),
+                       with_jacobian) != nullptr;
+  }
   const EvaluationCache& cache() const { return cache_; }
 
  private:
   EvaluationCache& cache_;
+  int max_runs_;
 };
 
 class DistanceResidual final : public ceres::CostFunction {
@@ -43,6 +55,7 @@ class DistanceResidual final : public ceres::CostFunction {
   }
   bool Evaluate(double const* const* phi, double* residuals, double** jacobians) const override {
     const bool with_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
+    if (!shared_->affordable(phi[0], with_jacobian)) return false;  // the recorder stops the fit
     const Evaluation& e = shared_->at(phi[0], with_jacobian);
     if (!e.ok) return false;  // a failed forward run: Ceres rejects the step
     residuals[0] = e.residuals[index_];
@@ -74,8 +87,9 @@ struct CeresProblem {
   std::unique_ptr<ceres::LossFunction> loss;
   ceres::Problem problem;
 
-  CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi)
-      : shared(cache), loss(make_loss(options)), problem(problem_options()) {
+  CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi,
+               int max_runs = std::numeric_limits<int>::max())
+      : shared(cache, max_runs), loss(make_loss(options)), problem(problem_options()) {
     const Calibration& calibration = cache.calibration();
     const ParameterMap& map = calibration.parameters();
     for (int i = 0; i < calibration.num_residuals(); ++i)
@@ -118,8 +132,12 @@ class Recorder final : public ceres::IterationCallback {
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     outcome_.iterations.push_back(r);
     if (options_.progress) options_.progress(r);
-    return cancel_requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    // max_evaluations bounds the forward runs (as for NLopt's methods); the
+    // point reached is kept.
+    evaluations_spent = r.forward_runs >= options_.max_evaluations;
+    return cancel_requested() || evaluations_spent ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
   }
+  bool evaluations_spent = false;
 
  private:
   const Calibration& calibration_;
@@ -153,7 +171,7 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   std::vector<bool> log_scaled;
   for (const Parameter& parameter : calibration.parameters().parameters())
     log_scaled.push_back(parameter.log_scale);
-  CeresProblem p(evaluations, options, phi);
+  CeresProblem p(evaluations, options, phi, options.max_evaluations);
   Recorder recorder(calibration, options, phi, p.shared, outcome);
   LmSteps steps;
   steps.max_iterations = options.max_iterations;
@@ -177,6 +195,12 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
     case ceres::USER_SUCCESS:
     case ceres::USER_FAILURE:
       outcome.status = cancel_requested() ? FitStatus::Interrupted : FitStatus::OptimizerFailed;
+      if (recorder.evaluations_spent && !cancel_requested()) {
+        outcome.status = FitStatus::IterationLimit;
+        outcome.message =
+            "levenberg-marquardt: stopped at " + std::to_string(evaluations.forward_runs) +
+            " forward runs (max_evaluations " + std::to_string(options.max_evaluations) + ")";
+      }
       break;
     case ceres::FAILURE:
       // Ceres fails when a point it must have (the Jacobian at an accepted

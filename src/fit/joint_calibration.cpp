@@ -6,8 +6,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
-#include <deque>
 #include <cmath>
+#include <deque>
 #include <set>
 
 #include "fiberfluid/fit/fit_archive.hpp"
@@ -343,9 +343,9 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   if (summary.termination_type == ceres::NO_CONVERGENCE)
     return finish(FitStatus::IterationLimit, "");
   if (summary.termination_type != ceres::CONVERGENCE)
-    return finish(
-        evaluator.last_failure().empty() ? FitStatus::OptimizerFailed : FitStatus::ForwardRunsFailed,
-        "");
+    return finish(evaluator.last_failure().empty() ? FitStatus::OptimizerFailed
+                                                   : FitStatus::ForwardRunsFailed,
+                  "");
 
   // At the optimum: the covariance of phi from the Jacobian, (J^T J)^-1.
   if (!evaluator.at(phi, true))

@@ -32,16 +32,14 @@ TEST_P(ExperimentFile, RunsAndMeetsItsExpectedFigures) {
   for (const FigureCheck& c : result.checks) EXPECT_TRUE(c.passed) << c.Describe();
 }
 
-INSTANTIATE_TEST_SUITE_P(Experiments, ExperimentFile,
-                         ::testing::Values("rectangle.json", "areas.json", "sphere.json",
-                                           "round_trip.json", "liver_gravity.json",
-                                           "bunny_gravity.json", "liver_sweep.json",
-                                           "nonlinear_round_trip.json", "liver_paddles.json",
-                                           "stress_strain.json", "benchmark_block_mp1.json",
-                                           "benchmark_block_mp2.json", "benchmark_rod.json",
-                                           "liver_fem_reference.json", "bar_bending.json",
-                                           "cantilever_large.json", "compression_large.json",
-                                           "liver_interactive.json"));
+INSTANTIATE_TEST_SUITE_P(
+    Experiments, ExperimentFile,
+    ::testing::Values("rectangle.json", "areas.json", "sphere.json", "round_trip.json",
+                      "liver_gravity.json", "bunny_gravity.json", "liver_sweep.json",
+                      "nonlinear_round_trip.json", "liver_paddles.json", "stress_strain.json",
+                      "benchmark_block_mp1.json", "benchmark_block_mp2.json", "benchmark_rod.json",
+                      "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
+                      "compression_large.json", "liver_interactive.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
@@ -217,7 +215,8 @@ TEST(AFileMeansOneThing, AnExperimentKeyGivenTwiceIsRefused) {
     }
   }
   // The same key in two objects is two keys.
-  EXPECT_NO_THROW(parse_json(std::string(R"({"a": {"Y": 1}, "b": {"Y": 2}, "c": [{"Y": 3}, {"Y": 4}]})"), "ok"));
+  EXPECT_NO_THROW(parse_json(
+      std::string(R"({"a": {"Y": 1}, "b": {"Y": 2}, "c": [{"Y": 3}, {"Y": 4}]})"), "ok"));
 }
 
 TEST(ExperimentConfig, ASurfaceIsRemeshedToTheCountAsked) {
@@ -517,15 +516,13 @@ TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
 TEST(ExperimentConfig, AFreeRotationIsHeldByAGaugeOrRefused) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  c["surface"] = {{"generator", "cylinder"},
-                  {"radius", 0.025},
-                  {"length", 0.03},
-                  {"segments", {4, 16}}};
+  c["surface"] = {
+      {"generator", "cylinder"}, {"radius", 0.025}, {"length", 0.03}, {"segments", {4, 16}}};
   c["material"] = {{"Y", 100000}, {"gamma", 0.001}};
   c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.03}};
   c["loads"] = nlohmann::json::array();
-  c["supports"] = {{{"label", "centre"}, {"box", {{"min", {-1e-7, -1e-7, -1e-7}},
-                                                  {"max", {1e-7, 1e-7, 1e-7}}}}}};
+  c["supports"] = {{{"label", "centre"},
+                    {"box", {{"min", {-1e-7, -1e-7, -1e-7}}, {"max", {1e-7, 1e-7, 1e-7}}}}}};
   c["paddles"] = {{{"label", "lower"}, {"axis", "x"}, {"side", "below"}, {"travel", 0}},
                   {{"label", "upper"}, {"axis", "x"}, {"side", "above"}, {"travel", -0.006}}};
   c["stepping"] = {{"scheme", "newton"}, {"steps", 3}};

@@ -111,6 +111,94 @@ void expect_fit_error(const nlohmann::json& document, const std::string& part) {
   }
 }
 
+// Issue 43, "every documented option is honoured": each option of the fit
+// section, with each method, is either taken by that method or refused,
+// naming the option and the method that would take it.
+TEST(EveryDocumentedOptionIsHonoured, EachOptionWithEachMethodIsTakenOrRefused) {
+  const std::vector<std::string> methods = {"levenberg-marquardt", "multistart", "bobyqa",
+                                            "direct-l", "crs2"};
+  struct Option {
+    const char* key;
+    nlohmann::json value;
+    std::vector<std::string> taken_by;  // the others refuse it
+  };
+  const std::vector<std::string> all = methods;
+  const std::vector<std::string> trust_region = {"levenberg-marquardt", "multistart"};
+  const std::vector<Option> options = {
+      {"max_iterations", 7, trust_region},
+      {"max_evaluations", 9, all},
+      {"function_tolerance", 1e-6, all},
+      {"parameter_tolerance", 1e-6, all},
+      {"initial_trust_region_radius", 10.0, trust_region},
+      {"max_step_factor", 2.0, trust_region},
+      {"difference_step", 1e-4, all},  // the Jacobian's, for every method's covariance
+      {"starts", 3, {"multistart"}},
+      {"same_optimum", 0.01, {"multistart"}}};
+  for (const std::string& method : methods)
+    for (const Option& option : options) {
+      nlohmann::json d = sphere_fit_document();
+      d["fit"]["method"] = method;
+      d["fit"]["jacobian"] = "finite-differences";
+      d["fit"][option.key] = option.value;
+      const bool taken = std::find(option.taken_by.begin(), option.taken_by.end(), method) !=
+                         option.taken_by.end();
+      if (taken) {
+        const Experiment ex =
+            parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
+        const fit::FitOptions& o = ex.fit->options;
+        const std::string key = option.key;
+        if (key == "max_iterations") {
+          EXPECT_EQ(o.max_iterations, 7);
+        }
+        if (key == "max_evaluations") {
+          EXPECT_EQ(o.max_evaluations, 9);
+        }
+        if (key == "initial_trust_region_radius") {
+          EXPECT_EQ(o.initial_trust_region_radius, 10.0);
+        }
+        if (key == "max_step_factor") {
+          EXPECT_EQ(o.max_step_factor, 2.0);
+        }
+        if (key == "difference_step") {
+          EXPECT_EQ(o.difference_step, 1e-4);
+        }
+        if (key == "starts") {
+          EXPECT_EQ(ex.fit->multistart->starts, 3);
+        }
+      } else {
+        expect_fit_error(d, std::string("fit.") + option.key + ": only with");
+      }
+    }
+
+  // Taken means honoured. Levenberg-Marquardt stops at max_evaluations (it
+  // ran 82 forward runs with a limit of 5 and said "converged"): a point that
+  // would need more runs is not run, and the fit ends iteration_limit.
+  for (const int limit : {5, 12}) {
+    nlohmann::json d = sphere_fit_document();
+    d["fit"]["max_evaluations"] = limit;
+    const fit::FitResult r =
+        setup_fit(parse_experiment(d, testing::experiment_file("").parent_path(), "doc"))
+            .calibration->run();
+    EXPECT_EQ(r.status, fit::FitStatus::IterationLimit) << r.message;
+    EXPECT_NE(r.message.find("(max_evaluations " + std::to_string(limit) + ")"), std::string::npos)
+        << r.message;
+    // A point's Jacobian here is 5 runs (central differences in 2 parameters):
+    // at most the runs of the point under way when the limit came.
+    EXPECT_GE(r.forward_runs, limit);
+    EXPECT_LE(r.forward_runs, limit + 4) << limit;
+    EXPECT_TRUE(r.values.allFinite());
+  }
+  // BOBYQA stops at it too.
+  nlohmann::json d = sphere_fit_document();
+  d["fit"]["method"] = "bobyqa";
+  d["fit"]["max_evaluations"] = 6;
+  const fit::FitResult b =
+      setup_fit(parse_experiment(d, testing::experiment_file("").parent_path(), "doc"))
+          .calibration->run();
+  EXPECT_EQ(b.status, fit::FitStatus::IterationLimit) << b.message;
+  EXPECT_NE(b.message.find("max_evaluations"), std::string::npos) << b.message;
+}
+
 TEST(FitConfig, BadFitSectionsAreNamed) {
   nlohmann::json d = sphere_fit_document();
   d["fit"]["parameters"][0]["name"] = "stiffness";
