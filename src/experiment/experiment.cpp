@@ -724,6 +724,8 @@ void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
   if (const std::string problem = folder_name_problem(name); !problem.empty())
     f.fail("name", "expected " + problem);
+  if (const std::string problem = reserved_name_problem(name); !problem.empty())
+    f.fail("name", "expected " + problem);
   for (const CaseSpec& c : earlier)
     if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
 }
@@ -783,6 +785,8 @@ CalibrationSpec read_calibration(Fields& root, const std::filesystem::path& fold
     specimen.field = f.field();
     specimen.name = f.string("name");
     if (const std::string problem = folder_name_problem(specimen.name); !problem.empty())
+      f.fail("name", "expected " + problem);
+    if (const std::string problem = reserved_name_problem(specimen.name); !problem.empty())
       f.fail("name", "expected " + problem);
     for (const SpecimenSpec& other : spec.specimens)
       if (other.name == specimen.name)

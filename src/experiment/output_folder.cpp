@@ -136,6 +136,57 @@ std::string folder_name_problem(const std::string& name) {
   return "";
 }
 
+const std::vector<std::string>& reserved_result_names() {
+  static const std::vector<std::string> names = {kOutputMarker,
+                                                 "FAILED",
+                                                 "INCOMPLETE",
+                                                 "summary.json",
+                                                 "comparison.csv",
+                                                 "metrics.csv",
+                                                 "experiment.json",
+                                                 "experiment.resolved.json",
+                                                 "steps.csv",
+                                                 "load_displacement.csv",
+                                                 "vertices.csv",
+                                                 "series.pvd",
+                                                 "vtk",
+                                                 "fibers.vtu",
+                                                 "fibers_final.vtu",
+                                                 "final.obj",
+                                                 "input_surface.obj",
+                                                 "reference_final.obj",
+                                                 "fiber_model_final.obj",
+                                                 "fem_reference.obj",
+                                                 "fem_reference.vtu",
+                                                 "fem_reference_series.pvd",
+                                                 "fem_reference_vtk",
+                                                 "fit.json",
+                                                 "fit_distances.csv",
+                                                 "fit_iterations.csv",
+                                                 "fit_starts.csv",
+                                                 "calibration.json",
+                                                 "calibration_iterations.csv",
+                                                 "benchmark.json",
+                                                 "plot.png"};
+  return names;
+}
+
+std::string reserved_name_problem(const std::string& name) {
+  const std::vector<std::string>& names = reserved_result_names();
+  // Numbered ones: fit_force_K.csv, fit_target_K.vtu, fit_target_K_scan.obj.
+  const auto numbered = [&](const std::string& prefix, const std::string& suffix) {
+    return name.size() > prefix.size() + suffix.size() && name.rfind(prefix, 0) == 0 &&
+           name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  const bool reserved = std::find(names.begin(), names.end(), name) != names.end() ||
+                        numbered("fit_force_", ".csv") || numbered("fit_target_", ".vtu") ||
+                        numbered("fit_target_", ".obj");
+  if (!reserved) return "";
+  return "a name that is not one of the result's own files (\"" + name +
+         "\" is written at the top of the result folder, beside the folder this name would "
+         "make)";
+}
+
 std::string folder_name_from(const std::string& stem) {
   std::string name = stem.substr(0, std::min(stem.size(), kLongestName));
   for (char& ch : name)

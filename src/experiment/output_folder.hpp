@@ -33,6 +33,16 @@ constexpr size_t kLongestName = 100;
 // wrong with it, to follow "expected ...".
 std::string folder_name_problem(const std::string& name);
 
+// The names fiberfluid writes at the top of a result folder (summary.json,
+// comparison.csv, FAILED, vtk, ...): a variant or a specimen, whose folder
+// sits beside them, may not take one (issue 43: refused when the file is
+// read, not after the run). Also fit_force_K.csv, fit_target_K.vtu and
+// fit_target_K_scan.obj for any K.
+const std::vector<std::string>& reserved_result_names();
+// Empty when `name` is no reserved result name; else what is wrong, to
+// follow "expected ...".
+std::string reserved_name_problem(const std::string& name);
+
 // A usable stand-in for a file's stem as a default experiment name: every
 // other character becomes '_', cut to kLongestName.
 std::string folder_name_from(const std::string& stem);

@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
@@ -145,8 +146,13 @@ json SchemaRecorder::schema() const {
   };
   json root = object("");
   // A variant is a patch of the experiment's simulation fields, with its name.
+  // Its name makes a folder beside the result's own files: not one of them.
+  json not_reserved = {
+      {"type", "string"},
+      {"not",
+       {{"anyOf", {{{"enum", reserved_result_names()}}, {{"pattern", "^fit_(force_.+[.]csv|target_.+[.](vtu|obj))$"}}}}}}};
   json variant = {{"type", "object"},
-                  {"properties", {{"name", {{"type", "string"}}}}},
+                  {"properties", {{"name", not_reserved}}},
                   {"required", {"name"}},
                   {"additionalProperties", false}};
   for (const auto& [key, value] : root["properties"].items()) {
@@ -155,6 +161,9 @@ json SchemaRecorder::schema() const {
       variant["properties"][key] = nullable(value);
   }
   root["properties"]["variants"] = {{"type", "array"}, {"minItems", 1}, {"items", variant}};
+  json& specimen = root["properties"]["specimens"]["items"];
+  if (specimen.is_object() && specimen.contains("properties"))
+    specimen["properties"]["name"] = not_reserved;
   return root;
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_support.hpp"
+#include "fiberfluid/experiment/output_folder.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {
@@ -42,6 +43,65 @@ json fit_sphere() {
   d["fit"]["targets"][0]["file"] = testing::data_target("sphere_final.obj").string();
   d["expected"] = json::array();
   return d;
+}
+
+// Issue 43, "names are refused when the file is read": a variant or a
+// specimen named like a file of the result (its folder would sit beside it)
+// ran the whole sweep and then failed to write, discarding every result.
+TEST(NamesAreRefusedWhenTheFileIsRead, AVariantOrSpecimenNamedLikeAResultFileIsRefusedAtOnce) {
+  ScratchDir dir;
+  for (const char* name : {"summary.json", "comparison.csv", "experiment.json", "FAILED", "vtk",
+                           "fit_force_0.csv", "fit_target_2.vtu"}) {
+    json config = json::parse(kSmall);
+    config["variants"] = {{{"name", "fine"}}, {{"name", name}}};
+    const auto file = dir.write("sweep.json", config.dump());
+    const Outcome o = run_in(dir.path(), "run sweep.json -q");
+    EXPECT_EQ(o.status, 1) << o.output;
+    EXPECT_NE(o.output.find("sweep.json: variants[1].name: expected a name that is not one of "
+                            "the result's own files"),
+              std::string::npos)
+        << o.output;
+    EXPECT_EQ(o.output.find("step 1"), std::string::npos) << "it ran: " << o.output;
+    EXPECT_FALSE(fs::exists(dir.path() / "out")) << name;
+  }
+  // A specimen of a calibration: refused by the reader too.
+  dir.write("a.json", fit_sphere().dump());
+  const json calibration = {
+      {"name", "joint"},
+      {"kind", "calibration"},
+      {"shared", {"Y"}},
+      {"specimens",
+       {{{"name", "a"}, {"experiment", "a.json"}},
+        {{"name", "calibration.json"}, {"experiment", "a.json"}}}}};
+  dir.write("joint.json", calibration.dump());
+  const Outcome joint = run_in(dir.path(), "fit joint.json -q");
+  EXPECT_EQ(joint.status, 1) << joint.output;
+  EXPECT_NE(joint.output.find("specimens[1].name: expected a name that is not one of"),
+            std::string::npos)
+      << joint.output;
+}
+
+// The reserved names are every name a result writes at its top: a sweep's
+// and a fit's folders hold nothing else (beside the variants' folders).
+TEST(NamesAreRefusedWhenTheFileIsRead, EveryNameAResultWritesAtItsTopIsReserved) {
+  ScratchDir dir;
+  json config = json::parse(kSmall);
+  config["variants"] = {{{"name", "soft"}, {"material", {{"Y", 2000}}}}, {{"name", "stiff"}}};
+  dir.write("sweep.json", config.dump());
+  ASSERT_EQ(run_in(dir.path(), "run sweep.json -q -o sweep --plot").status, 0);
+  dir.write("fit.json", fit_sphere().dump());
+  const Outcome fitted = run_in(dir.path(), "fit fit.json -q -o fit");
+  ASSERT_EQ(fitted.status, 0) << fitted.output;
+  int seen = 0;
+  for (const char* result : {"sweep", "fit"})
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir.path() / result)) {
+      const std::string name = entry.path().filename().string();
+      if (std::string(result) == "sweep" && (name == "soft" || name == "stiff")) continue;
+      EXPECT_FALSE(experiment::reserved_name_problem(name).empty())
+          << result << "/" << name << " is written but not reserved";
+      ++seen;
+    }
+  EXPECT_GT(seen, 10);
 }
 
 TEST(CliSafety, ANameFromAFileNeverWritesOutsideTheOutputRoot) {

@@ -53,7 +53,10 @@ def test_what_the_reader_refuses_the_schema_refuses(validator):
                         (("stepping", "steps"), 2.5),           # a number for a whole number
                         (("stepping", "scheme"), "implicit"),   # outside the choices
                         (("paddles", 0, "side"), "left"),
-                        (("variants", 0, "colour"), 1)):
+                        (("variants", 0, "colour"), 1),
+                        # a variant named like a file of the result (issue 43)
+                        (("variants", 0, "name"), "summary.json"),
+                        (("variants", 0, "name"), "fit_force_3.csv")):
         bad = json.loads(json.dumps(good))
         where = bad
         for key in path[:-1]:
