@@ -216,7 +216,37 @@ fs::path output_folder(const std::string& flag, const std::string& experiment_na
     throw InputError("-o " + flag + ": expected a folder name of at most " +
                      std::to_string(kLongestTypedName) + " characters");
   check_replaceable(folder);
+  check_not_nested(folder);
   return folder;
+}
+
+// One result folder never sits inside another (issue 43): the outer one is
+// replaced as a whole when its experiment runs again, and the inner one
+// would go with it. Refused both ways: a folder inside a result, and a
+// result folder to replace that holds another result.
+void check_not_nested(const fs::path& folder) {
+  std::error_code error;
+  const fs::path absolute = fs::absolute(folder, error).lexically_normal();
+  if (error) return;
+  for (fs::path above = absolute.parent_path(); above.has_relative_path();
+       above = above.parent_path())
+    if (has_marker(above))
+      throw InputError(folder.string() + ": inside " + above.string() +
+                       ", a fiberfluid result folder (replaced as a whole when its experiment "
+                       "runs again, with everything in it): choose an output folder outside it");
+  if (!fs::is_directory(absolute, error) || fs::is_symlink(absolute, error)) return;
+  for (fs::recursive_directory_iterator it(absolute, error), end; !error && it != end;
+       it.increment(error)) {
+    if (it->is_symlink(error)) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_directory(error) && has_marker(it->path()))
+      throw InputError(folder.string() + ": holds another fiberfluid result folder (" +
+                       it->path().string() +
+                       "), which replacing it would delete: move that one out first, or "
+                       "choose another output folder");
+  }
 }
 
 void check_replaceable(const fs::path& folder) {

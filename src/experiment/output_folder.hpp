@@ -54,6 +54,9 @@ std::string folder_name_from(const std::string& stem);
 std::filesystem::path output_folder(const std::string& flag, const std::string& experiment_name);
 
 // Throws InputError naming the folder when it exists and may not be replaced.
+// Throws InputError when `folder` lies inside a fiberfluid result folder or
+// holds one below it: replacing the outer one would delete the inner.
+void check_not_nested(const std::filesystem::path& folder);
 void check_replaceable(const std::filesystem::path& folder);
 
 // A new, empty staging folder beside `target` ("TARGET.running-HOST-PID-XXXXXXXX"),

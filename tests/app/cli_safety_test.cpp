@@ -66,13 +66,12 @@ TEST(NamesAreRefusedWhenTheFileIsRead, AVariantOrSpecimenNamedLikeAResultFileIsR
   }
   // A specimen of a calibration: refused by the reader too.
   dir.write("a.json", fit_sphere().dump());
-  const json calibration = {
-      {"name", "joint"},
-      {"kind", "calibration"},
-      {"shared", {"Y"}},
-      {"specimens",
-       {{{"name", "a"}, {"experiment", "a.json"}},
-        {{"name", "calibration.json"}, {"experiment", "a.json"}}}}};
+  const json calibration = {{"name", "joint"},
+                            {"kind", "calibration"},
+                            {"shared", {"Y"}},
+                            {"specimens",
+                             {{{"name", "a"}, {"experiment", "a.json"}},
+                              {{"name", "calibration.json"}, {"experiment", "a.json"}}}}};
   dir.write("joint.json", calibration.dump());
   const Outcome joint = run_in(dir.path(), "fit joint.json -q");
   EXPECT_EQ(joint.status, 1) << joint.output;
@@ -102,6 +101,35 @@ TEST(NamesAreRefusedWhenTheFileIsRead, EveryNameAResultWritesAtItsTopIsReserved)
       ++seen;
     }
   EXPECT_GT(seen, 10);
+}
+
+// Issue 43, "one result folder never sits inside another": run A -o X, fit
+// B -o X/inner, run A -o X again deleted X/inner with X.
+TEST(OneResultFolderNeverSitsInsideAnother, AFolderInsideAResultIsRefusedAndSoIsOneHoldingAResult) {
+  ScratchDir dir;
+  dir.write("small.json", kSmall);
+  dir.write("fit.json", fit_sphere().dump());
+  ASSERT_EQ(run_in(dir.path(), "run small.json -q -o X").status, 0);
+  const Outcome inner = run_in(dir.path(), "fit fit.json -q -o X/inner");
+  EXPECT_EQ(inner.status, 1) << inner.output;
+  EXPECT_NE(inner.output.find("X/inner: inside " + (dir.path() / "X").string() +
+                              ", a fiberfluid result folder"),
+            std::string::npos)
+      << inner.output;
+  EXPECT_FALSE(fs::exists(dir.path() / "X" / "inner"));
+  EXPECT_FALSE(fs::exists(dir.path() / "X" / "inner.failed"));
+  // Deeper too, and the outer result stays as it was.
+  EXPECT_EQ(run_in(dir.path(), "run small.json -q -o X/a/b/c").status, 1);
+  EXPECT_TRUE(fs::exists(dir.path() / "X" / "summary.json"));
+  // The reverse: a result moved by hand into another one is not deleted by
+  // running the outer one again.
+  ASSERT_EQ(run_in(dir.path(), "run small.json -q -o Y").status, 0);
+  fs::rename(dir.path() / "Y", dir.path() / "X" / "kept");
+  const Outcome outer = run_in(dir.path(), "run small.json -q -o X");
+  EXPECT_EQ(outer.status, 1) << outer.output;
+  EXPECT_NE(outer.output.find("holds another fiberfluid result folder"), std::string::npos)
+      << outer.output;
+  EXPECT_TRUE(fs::exists(dir.path() / "X" / "kept" / "summary.json"));
 }
 
 TEST(CliSafety, ANameFromAFileNeverWritesOutsideTheOutputRoot) {
