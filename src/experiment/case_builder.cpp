@@ -505,13 +505,15 @@ Case build_case(const CaseSpec& spec, const geom::Surface& surface,
 }
 
 Case build_case(const CaseSpec& spec, const Case& earlier) {
+  // The earlier case's surface_key is this one's: its surface and its
+  // "fibers" section read the same, so the whole model built from them is
+  // this case's too (copying some of its settings and not others lost the
+  // influence: issue 43). ModelBuilder then sets every part that comes from
+  // the rest of the spec.
   Case c;
   c.input_surface = earlier.input_surface;
   c.model_to_input = earlier.model_to_input;
-  c.model.surface = earlier.model.surface;
-  c.model.fibers = earlier.model.fibers;
-  c.model.connection_count = earlier.model.connection_count;
-  c.model.treecode_tolerance = earlier.model.treecode_tolerance;
+  c.model = earlier.model;
   c.fibers = earlier.fibers;
   ModelBuilder(spec, c).build();
   estimate(spec, PruningWork::None, c);  // pruned once, for the earlier case
