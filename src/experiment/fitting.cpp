@@ -253,12 +253,47 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
   return figures;
 }
 
+namespace {
+
+// The values of `m` written into an experiment's "material" section in the
+// form the section already has: a law's parameters and axis factors, or the
+// linear model's Y (one, or one per axis), and gamma.
+void write_material_values(const model::Material& m, int dim, json& material) {
+  material["gamma"] = m.surface_tension;
+  if (material.contains("law")) {
+    for (const std::string& name : m.law.parameter_names())
+      material["law"][name] = m.law.parameter(name);
+    const bool factored = (m.axis_factors.head(dim).array() != 1.0).any();
+    if (factored || material.contains("axis_factors")) {
+      material["axis_factors"] = json::array();
+      for (int a = 0; a < dim; ++a) material["axis_factors"].push_back(m.axis_factors[a]);
+    }
+    return;
+  }
+  const double Y = m.law.parameter("Y");
+  const bool per_axis = (material.contains("Y") && material["Y"].is_array()) ||
+                        (m.axis_factors.head(dim).array() != 1.0).any();
+  if (!per_axis) {
+    material["Y"] = Y * m.axis_factors[0];
+    return;
+  }
+  material["Y"] = json::array();
+  for (int a = 0; a < dim; ++a) material["Y"].push_back(Y * m.axis_factors[a]);
+}
+
+}  // namespace
+
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
                                 const fit::FitResult& result) {
   Experiment fitted = experiment;
   const fit::ParameterMap& map = calibration.parameters();
   model::Material& material = fitted.cases.front().model.material;
   material = map.material(material, result.values);
+  // The folder's run is at the fitted values: so is its
+  // experiment.resolved.json, which repeats that run (it said the start's:
+  // issue 43, the run and its record built from different specs).
+  if (fitted.resolved.is_object() && fitted.resolved.contains("material"))
+    write_material_values(material, fitted.cases.front().model.dim(), fitted.resolved["material"]);
   return fitted;
 }
 

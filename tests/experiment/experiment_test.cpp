@@ -201,10 +201,8 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
 // lost (two identical variants, 0.0784189 and 0.0800808 m).
 TEST(ACaseIsBuiltFromItsOwnSpecAlone, AReusedCaseEqualsOneBuiltAfreshFieldByField) {
   nlohmann::json c = base_config();
-  c["surface"] = {{"generator", "cylinder"},
-                  {"radius", 0.02},
-                  {"length", 0.1},
-                  {"segments", {12, 8}}};
+  c["surface"] = {
+      {"generator", "cylinder"}, {"radius", 0.02}, {"length", 0.1}, {"segments", {12, 8}}};
   c["fibers"] = {{"kinematics", "central"},
                  {"horizon", 0.03},
                  {"influence", "conical"},

@@ -199,6 +199,30 @@ TEST(EveryDocumentedOptionIsHonoured, EachOptionWithEachMethodIsTakenOrRefused) 
   EXPECT_NE(b.message.find("max_evaluations"), std::string::npos) << b.message;
 }
 
+// Issue 43, "a case is built from its own spec alone", found beside the
+// sweep's: a fit's folder holds the run at the fitted values, but its
+// experiment.resolved.json (which "repeats this run") said the start's.
+TEST(ACaseIsBuiltFromItsOwnSpecAlone, AFitsResolvedExperimentIsItsRunAtTheFittedValues) {
+  for (const char* file : {"fit_sphere.json", "fit_synthetic_liver.json"}) {
+    const Experiment ex = load_experiment(testing::experiment_file(file));
+    const FitSetup setup = setup_fit(ex);
+    const fit::FitResult r = setup.calibration->run();
+    ASSERT_TRUE(r.success) << r.message;
+    const Experiment at_fit = with_fitted_material(ex, *setup.calibration, r);
+    const Experiment again =
+        parse_experiment(at_fit.resolved, testing::experiment_file("").parent_path(), "resolved");
+    const model::Material &fitted = at_fit.cases.front().model.material,
+                          &read = again.cases.front().model.material;
+    for (const std::string& name : fitted.parameter_names())
+      EXPECT_EQ(read.parameter(name), fitted.parameter(name)) << file << ": " << name;
+    for (size_t k = 0; k < r.names.size(); ++k)  // the fitted values, not the starts
+      EXPECT_EQ(read.parameter(r.names[k]), r.values[static_cast<Eigen::Index>(k)]) << file;
+    EXPECT_EQ(run_experiment(again).runs[0].summary.unknowns,
+              run_experiment(at_fit).runs[0].summary.unknowns)
+        << file;
+  }
+}
+
 TEST(FitConfig, BadFitSectionsAreNamed) {
   nlohmann::json d = sphere_fit_document();
   d["fit"]["parameters"][0]["name"] = "stiffness";
