@@ -643,6 +643,9 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
   Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian)};
   forward_runs += entry.evaluation.forward_runs;
   sensitivity_solves += entry.evaluation.sensitivity_solves;
+  // A run cut short by an interrupt did not fail: it is neither counted nor
+  // kept (the same point may be run again later).
+  if (!entry.evaluation.ok && cancel_requested()) return interrupted_ = entry.evaluation;
   if (!entry.evaluation.ok) {
     ++failed_runs;
     last_failure = entry.evaluation.message;

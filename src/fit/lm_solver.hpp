@@ -90,8 +90,10 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
   // Passes Ceres' iterations on, numbered across the solves.
   class Renumbered final : public ceres::IterationCallback {
    public:
-    explicit Renumbered(ceres::IterationCallback* inner) : inner_(inner) {}
+    Renumbered(ceres::IterationCallback* inner, const double* phi, int size)
+        : inner_(inner), phi_(phi), size_(size) {}
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+      reached = Eigen::Map<const Eigen::VectorXd>(phi_, size_);  // the current point
       radius = s.trust_region_radius;
       if (s.iteration > 0) accepted = s.step_is_successful;
       if (s.iteration == 0 && started_) return ceres::SOLVER_CONTINUE;  // the same point again
@@ -100,14 +102,17 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
       renumbered.iteration = s.iteration == 0 ? 0 : ++steps;
       return inner_ != nullptr ? (*inner_)(renumbered) : ceres::SOLVER_CONTINUE;
     }
-    int steps = 0;          // iterations after the 0th, over every solve
-    double radius = 0.0;    // Ceres' trust radius after the last one
-    bool accepted = false;  // the last step
+    int steps = 0;            // iterations after the 0th, over every solve
+    double radius = 0.0;      // Ceres' trust radius after the last one
+    bool accepted = false;    // the last step
+    Eigen::VectorXd reached;  // the current point at the last iteration
 
    private:
     ceres::IterationCallback* inner_;
+    const double* phi_;
+    int size_;
     bool started_ = false;
-  } renumbered(callback);
+  } renumbered(callback, phi, static_cast<int>(log_scaled.size()));
 
   const int P = static_cast<int>(log_scaled.size());
   const double widest = std::log(steps.max_step_factor);
@@ -147,6 +152,11 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
     options.callbacks.push_back(&renumbered);
     const int before = renumbered.steps;
     ceres::Solve(options, &problem, &summary);
+    // Stopped by the callback (an interrupt, a budget): Ceres puts the solve's
+    // start back into phi; the point its last iteration reached is the one
+    // to keep (issue 43: an interrupted fit kept its start).
+    if (summary.termination_type == ceres::USER_FAILURE && renumbered.reached.size() == P)
+      Eigen::Map<Eigen::VectorXd>(phi, P) = renumbered.reached;
     // One iteration per solve: Ceres' "no convergence" is the next step's cue.
     if (summary.termination_type != ceres::NO_CONVERGENCE) return summary;
     if (renumbered.steps == before) return summary;

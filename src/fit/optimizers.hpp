@@ -44,6 +44,7 @@ class EvaluationCache {
   };
   const Calibration& calibration_;
   std::deque<Entry> kept_;  // newest first
+  Evaluation interrupted_;  // the last evaluation an interrupt cut short (not kept)
   // The kept entry that serves (phi, with_jacobian), or end().
   std::deque<Entry>::const_iterator find(const Eigen::VectorXd& phi, bool with_jacobian) const;
 };

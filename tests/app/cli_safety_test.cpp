@@ -332,6 +332,58 @@ TEST(CliSafety, AFailedDifferenceRunEndsTheFitWithItsCause) {
 
 // SIGINT during a fit: the best point so far is kept in DIR.interrupted, and
 // "start_from" continues from it.
+// Issue 43, "an interrupted or stopped fit keeps its best point": SIGINT
+// after iteration 2 left fit.json at the start (Ceres puts its start back
+// into the parameters when a callback aborts), and start_from began again.
+TEST(AnInterruptedFitKeepsItsBestPoint, AtAnyIterationAndStartFromGoesOnFromThere) {
+  ScratchDir dir;
+  json slow = fit_sphere();
+  slow["surface"]["subdivisions"] = 3;
+  const auto file = dir.write("slow.json", slow.dump());
+  const fs::path out = dir.path() / "out", log = dir.path() / "fit.log";
+  const pid_t pid = testing::start_cli({"fit", file.string(), "-o", out.string()}, log);
+  for (int wait = 0; wait < 2400 && read_file(log).find("fit: iteration 2:") == std::string::npos;
+       ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  ASSERT_NE(read_file(log).find("fit: iteration 2:"), std::string::npos) << read_file(log);
+  const auto signalled = std::chrono::steady_clock::now();
+  kill(pid, SIGINT);
+  EXPECT_EQ(testing::wait_for(pid), 130) << read_file(log);
+  // It stops at once, wherever it was (the bending phantom, 1,418 vertices:
+  // at most 1.3 s, experiments measured by hand in the issue's note).
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count(),
+            2.0);
+  fs::path interrupted = out;
+  interrupted += ".interrupted";
+  const json report = json::parse(read_file(interrupted / "fit.json"));
+  ASSERT_EQ(report["status"], "interrupted");
+  // The best accepted point: the last accepted iteration's, not the start.
+  json last;
+  for (const json& it : report["iterations"])
+    if (it["accepted"].get<bool>()) last = it;
+  ASSERT_GE(last["iteration"].get<int>(), 2) << report["iterations"].dump();
+  const double Y = report["parameters"][0]["value"], gamma = report["parameters"][1]["value"];
+  EXPECT_EQ(Y, last["values"]["Y"].get<double>());
+  EXPECT_EQ(gamma, last["values"]["gamma"].get<double>());
+  EXPECT_NE(Y, 1000.0);
+  EXPECT_EQ(report["cost"]["final"].get<double>(), last["cost"].get<double>());
+  // An interrupted run is no failed run.
+  EXPECT_EQ(report["failed_runs"], 0) << report["failed_runs_by_cause"].dump();
+  // start_from goes on from there: its first cost is the last one reported.
+  json next = slow;
+  next["fit"]["start_from"] = (interrupted / "fit.json").string();
+  next["fit"]["parameters"][0].erase("start");
+  next["fit"]["max_iterations"] = 1;
+  const Outcome o = run_cli("fit " + dir.write("next.json", next.dump()).string() + " -o " +
+                            (dir.path() / "next").string());
+  fs::path next_out = dir.path() / "next";
+  next_out += ".failed";  // one iteration: iteration_limit
+  const json continued = json::parse(read_file(next_out / "fit.json"));
+  EXPECT_EQ(continued["iterations"][0]["cost"].get<double>(), last["cost"].get<double>())
+      << o.output;
+  EXPECT_NEAR(continued["parameters"][0]["initial"].get<double>() / Y, 1.0, 1e-12);
+}
+
 TEST(CliSafety, AnInterruptedFitKeepsItsBestPointAndCanBeContinued) {
   ScratchDir dir;
   json slow = fit_sphere();
