@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "fiberfluid/geom/surface.hpp"
@@ -60,8 +61,65 @@ std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector
   if (std::max(above, below) <= tolerance) return "the whole body lies on its plane";
   layer->point = point;
   layer->normal = above > below ? normal : Eigen::Vector3d(-normal);
+  layer->held = held;
   return {};
 }
+
+namespace {
+
+// Two layers on one plane (the halves of one clamp, given as two groups).
+bool same_plane(const MirrorLayer& a, const MirrorLayer& b, double tolerance) {
+  return a.normal.dot(b.normal) > 1.0 - 1e-9 &&
+         std::abs((b.point - a.point).dot(a.normal)) <= tolerance;
+}
+
+// Where a layer's fibers may cross its plane: within `reach` of a vertex its
+// group holds, and nearer to one of those than to any vertex that another
+// layer on the same plane holds (a layer made by hand without its held
+// vertices acts across the whole plane). A clamp on part of a face acts across that
+// part only, and the two halves of one clamp, each with its layer, make one
+// layer between them, not two on top of each other (issue 43).
+class ClampedRegion {
+ public:
+  ClampedRegion(const Model& model, const MirrorLayer& layer) {
+    const Eigen::MatrixXd& V = model.surface.V;
+    const double tolerance = 1e-6 * geom::bounding_box_diagonal(V);
+    std::vector<char> own(static_cast<size_t>(model.num_vertices()), 0);
+    for (int v : layer.held) own[static_cast<size_t>(v)] = 1;
+    for (const MirrorLayer& other : model.mirror_layers)
+      if (same_plane(layer, other, tolerance))
+        for (int v : other.held) {
+          if (&other != &layer && own[static_cast<size_t>(v)]) continue;  // shared: ours
+          points_.push_back(padded(V, v));
+          ours_.push_back(&other == &layer || own[static_cast<size_t>(v)]);
+        }
+    // The mesh's resolution on the clamp: its longest edge between two held vertices.
+    const Eigen::MatrixXi& F = model.surface.F;
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (Eigen::Index a = 0; a < F.cols(); ++a) {
+        const int u = F(f, a), w = F(f, (a + 1) % F.cols());
+        if (own[static_cast<size_t>(u)] && own[static_cast<size_t>(w)])
+          reach_ = std::max(reach_, (V.row(u) - V.row(w)).norm());
+      }
+  }
+  bool holds(const Eigen::Vector3d& crossing) const {
+    if (points_.empty()) return true;  // a layer made without its held vertices: the whole plane
+    double nearest = std::numeric_limits<double>::infinity();
+    bool ours = false;
+    for (size_t k = 0; k < points_.size(); ++k) {
+      const double d = (points_[k] - crossing).squaredNorm();
+      if (d < nearest) nearest = d, ours = ours_[k];
+    }
+    return ours && nearest <= reach_ * reach_;
+  }
+
+ private:
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<char> ours_;
+  double reach_ = 0.0;
+};
+
+}  // namespace
 
 std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLayer& layer,
                                             const PairFactors& factors,
@@ -80,13 +138,19 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
   }
   const std::vector<double> counts = factors.vertex_counts();
   const geom::FiberMask* mask = model.fibers.get();
+  const ClampedRegion region(model, layer);
   std::vector<LayerFiber> fibers;
   for (int i : near)
     for (int j : near) {
       if (i != j && mask != nullptr && !mask->kept(i, j)) continue;  // pruned or beyond the horizon
-      const Eigen::Vector3d foot = padded(V, j) - height[static_cast<size_t>(j)] * layer.normal;
+      const double hi = height[static_cast<size_t>(i)], hj = height[static_cast<size_t>(j)];
+      const Eigen::Vector3d foot = padded(V, j) - hj * layer.normal;
+      // As the term computes the fiber (b = x_i + x_j - 2 q_j): no strain at the reference.
       const double length = (padded(V, i) + padded(V, j) - 2.0 * foot).norm();
+      const Eigen::Vector3d image = 2.0 * foot - padded(V, j);
       if (length >= layer.depth) continue;
+      // Where the fiber from s_i to the image crosses the plane.
+      if (!region.holds(padded(V, i) + hi / (hi + hj) * (image - padded(V, i)))) continue;
       const auto a = static_cast<size_t>(i), b = static_cast<size_t>(j);
       const double weight = 0.5 * model.influence(length) * (area0[i] + area0[j]) /
                             ((counts[a] + counts[b]) * length);

@@ -176,6 +176,9 @@ struct MirrorLayer {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    // on the clamp plane
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  // unit, into the body
   double depth = 0.0;  // the horizon: only pairs with |s_i - mirror(s_j)| < depth are fibers
+  // The vertices the group holds on the plane: a layer acts only across the
+  // part of the plane they hold (mirror_layer.hpp).
+  std::vector<int> held;
 };
 
 // Everything the equations need: the reference surface (every vertex used by
