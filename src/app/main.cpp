@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -260,6 +261,11 @@ struct AnotherRankFailed : fiberfluid::InputError {
             "it without mpirun to see why)") {}
 };
 
+// True once every rank is failing the same way (on_every_rank, a
+// disagreement): the ranks end on their own. A failure on one rank alone
+// ends the whole job instead (main).
+bool every_rank_fails = false;
+
 // Runs `step` on every rank and ends in agreement: when it throws on one
 // rank, it throws on all (the others an AnotherRankFailed), so no rank goes on
 // to wait for work that will never be dealt.
@@ -268,9 +274,58 @@ void on_every_rank(const fiberfluid::parallel::Ranks& ranks, const std::function
     step();
   } catch (...) {
     ranks.all_ok(false);
+    every_rank_fails = true;
     throw;
   }
-  if (!ranks.all_ok(true)) throw AnotherRankFailed();
+  if (!ranks.all_ok(true)) {
+    every_rank_fails = true;
+    throw AnotherRankFailed();
+  }
+}
+
+// Fault injection for the tests of a failure on one rank alone
+// (tests/mpi/mpi_test.sh): FIBERFLUID_FAIL_RANK=r makes rank r throw once its
+// run is set up, outside any work item, while the others wait for it.
+void fail_if_injected(const fiberfluid::parallel::Ranks& ranks) {
+  const char* rank = std::getenv("FIBERFLUID_FAIL_RANK");
+  if (rank != nullptr && std::atoi(rank) == ranks.rank() && ranks.size() > 1)
+    throw std::runtime_error("a failure injected by FIBERFLUID_FAIL_RANK");
+}
+
+// A digest of what a rank will run: the resolved experiment and every
+// case's surface, bit for bit (FNV-1a, 64 bits).
+std::string experiment_digest(const experiment::Experiment& ex) {
+  std::uint64_t hash = 14695981039346656037ull;
+  const auto add = [&hash](const void* data, size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t k = 0; k < size; ++k) hash = (hash ^ bytes[k]) * 1099511628211ull;
+  };
+  const auto add_experiment = [&](const experiment::Experiment& e) {
+    const std::string resolved = e.resolved.dump();
+    add(resolved.data(), resolved.size());
+    for (const experiment::Case& c : e.cases) {
+      add(c.model.surface.V.data(), sizeof(double) * static_cast<size_t>(c.model.surface.V.size()));
+      add(c.model.surface.F.data(), sizeof(int) * static_cast<size_t>(c.model.surface.F.size()));
+    }
+  };
+  add_experiment(ex);
+  for (const experiment::Experiment& specimen : ex.specimens) add_experiment(specimen);
+  return std::to_string(hash);
+}
+
+// Every rank must run what rank 0 runs: started with other files (mpirun's
+// "A : B" form), a rank computed B's variants under A's record, or waited
+// for ever when B had fewer (issue 43). Refused on every rank, naming them.
+void require_one_experiment(const fiberfluid::parallel::Ranks& ranks,
+                            const experiment::Experiment& ex, const std::string& path) {
+  const std::vector<int> differing = ranks.differing_from_root(experiment_digest(ex));
+  if (differing.empty()) return;
+  std::string which;
+  for (int r : differing) which += (which.empty() ? "" : ", ") + std::to_string(r);
+  every_rank_fails = true;
+  throw fiberfluid::InputError(
+      "MPI rank(s) " + which + " read another experiment or surface than rank 0 (" + path +
+      "): every rank must run the same experiment file, with the same mesh");
 }
 
 int run_command(const std::string& path, const RunFlags& flags,
@@ -284,9 +339,13 @@ int run_command(const std::string& path, const RunFlags& flags,
   std::optional<experiment::OutputWriter> output;
   on_every_rank(ranks, [&] {
     loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
+  });
+  require_one_experiment(ranks, *loaded, path);
+  on_every_rank(ranks, [&] {
     if (ranks.root())
       output.emplace(*loaded, experiment::output_folder(flags.output, loaded->name));
   });
+  fail_if_injected(ranks);
   const experiment::Experiment& ex = *loaded;
   experiment::RunOptions options;
   options.jobs = flags.jobs;
@@ -545,6 +604,9 @@ int fit_command(const std::string& path, const RunFlags& flags,
   bool multistart = false;
   on_every_rank(ranks, [&] {
     loaded.emplace(load_showing_progress(path, flags.quiet || !ranks.root(), printer));
+  });
+  require_one_experiment(ranks, *loaded, path);
+  on_every_rank(ranks, [&] {
     fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
     if (ranks.root()) folder = experiment::output_folder(flags.output, loaded->name);
     if (loaded->kind == experiment::Experiment::Kind::Calibration) {
@@ -895,6 +957,19 @@ int main(int argc, char** argv) {
     return kUsage;
   }
   stop_on_interrupt();
+  // A failure: said, and the status. Under mpirun, a failure on one rank that
+  // the others cannot learn of (they wait for its work, or it for theirs)
+  // ends the whole job, naming the rank, rather than leaving it to hang.
+  const auto failure = [&ranks](int status, const std::string& message) {
+    std::cerr << message << "\n";
+    if (ranks.size() > 1 && !every_rank_fails) {
+      std::fprintf(stderr, "error: MPI rank %d of %d failed alone (%s): ending the job\n",
+                   ranks.rank(), ranks.size(), message.c_str());
+      std::fflush(stderr);
+      ranks.end_job(status);
+    }
+    return status;
+  };
   try {
     if (run->parsed()) return run_command(experiment, flags, ranks);
     if (fit->parsed()) return fit_command(experiment, fit_flags, ranks);
@@ -911,22 +986,16 @@ int main(int argc, char** argv) {
               << "result in the output folder is kept as it was\n";
     return kInterrupted;
   } catch (const fiberfluid::InputError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kBadInput;
+    return failure(kBadInput, std::string("error: ") + e.what());
   } catch (const std::filesystem::filesystem_error& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kBadInput;
+    return failure(kBadInput, std::string("error: ") + e.what());
   } catch (const std::bad_alloc&) {
-    std::cerr << "error: out of memory; use a coarser mesh\n";
-    return kSolverFailed;
+    return failure(kSolverFailed, "error: out of memory; use a coarser mesh");
   } catch (const nlohmann::json::exception& e) {
-    std::cerr << "error: bad JSON: " << e.what() << "\n";
-    return kBadInput;
+    return failure(kBadInput, std::string("error: bad JSON: ") + e.what());
   } catch (const std::exception& e) {  // the standard library's, CGAL's: a failure, never a crash
-    std::cerr << "error: " << e.what() << "\n";
-    return kSolverFailed;
+    return failure(kSolverFailed, std::string("error: ") + e.what());
   } catch (...) {
-    std::cerr << "error: an unknown failure\n";
-    return kSolverFailed;
+    return failure(kSolverFailed, "error: an unknown failure");
   }
 }

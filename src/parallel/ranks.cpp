@@ -54,6 +54,8 @@ Ranks::~Ranks() = default;
 bool Ranks::all_ok(bool ok) const { return ok; }
 void Ranks::sum(std::vector<double>&) const {}
 void Ranks::broadcast(std::string&) const {}
+std::vector<int> Ranks::differing_from_root(const std::string&) const { return {}; }
+void Ranks::end_job(int) const {}
 
 void Ranks::deal(size_t count, const WorkCompute& compute, const WorkDeliver& deliver) const {
   deal_in_order(count, compute, deliver);
@@ -235,6 +237,23 @@ void Ranks::broadcast(std::string& bytes) const {
   MPI_Request request;
   MPI_Ibcast(bytes.data(), static_cast<int>(size), MPI_BYTE, 0, MPI_COMM_WORLD, &request);
   wait_quietly(&request);
+}
+
+std::vector<int> Ranks::differing_from_root(const std::string& digest) const {
+  if (size_ == 1) return {};
+  std::string root_digest = digest;
+  broadcast(root_digest);
+  std::vector<double> differs(static_cast<size_t>(size_), 0.0);
+  differs[static_cast<size_t>(rank_)] = root_digest == digest ? 0.0 : 1.0;
+  sum(differs);
+  std::vector<int> ranks;
+  for (int r = 0; r < size_; ++r)
+    if (differs[static_cast<size_t>(r)] > 0.0) ranks.push_back(r);
+  return ranks;
+}
+
+void Ranks::end_job(int status) const {
+  if (size_ > 1) MPI_Abort(MPI_COMM_WORLD, status);
 }
 
 void Ranks::deal(size_t count, const WorkCompute& compute, const WorkDeliver& deliver) const {

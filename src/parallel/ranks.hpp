@@ -67,6 +67,13 @@ class Ranks {
   void sum(std::vector<double>& values) const;
   // `bytes` of rank 0, on every rank.
   void broadcast(std::string& bytes) const;
+  // The ranks (on every rank) whose `digest` differs from rank 0's: empty
+  // when every rank holds the same (the same experiment and surface).
+  std::vector<int> differing_from_root(const std::string& digest) const;
+  // Ends every rank of the job at once with `status` (MPI_Abort): after a
+  // failure on one rank that the others cannot learn of, so that none waits
+  // for it for ever. Returns only with one rank (it does nothing then).
+  void end_job(int status) const;
 
  private:
   int rank_ = 0, size_ = 1, local_size_ = 1;

@@ -3,7 +3,7 @@
 # Runs over MPI ranks against the same runs in one process (ctest runs each
 # case; tests/CMakeLists.txt). Usage:
 #   mpi_test.sh CASE MPIEXEC FIBERFLUID SOURCE_DIR
-# CASE: same-bits | failed-variant | interrupted (sweeps) | multistart (a fit)
+# CASE: same-bits | failed-variant | interrupted (sweeps) | multistart (a fit) | ranks-disagree
 #       | specimens (a calibration over two specimens)
 set -uo pipefail
 case_name="$1" mpiexec="$2" fiberfluid="$3" source="$4"
@@ -150,6 +150,42 @@ EOF
   for specimen in synthetic fine; do
     [ -f "$work/two/out/$specimen/fit_target_2.vtu" ] || fail "no fit files for $specimen"
   done
+  ;;
+ranks-disagree)
+  # Issue 43, "ranks agree or stop": mpirun's "A : B" form started the ranks
+  # on other experiments; rank 1 computed B's variants under A's record, or
+  # (B with fewer variants) the job hung for ever. Now every rank compares a
+  # digest of its resolved experiment and surface with rank 0's, and all
+  # stop, naming the rank. Also when only the mesh file differs.
+  mkdir -p "$work/A" "$work/B" "$work/C" "$work/D"
+  python3 "$here/disagree.py" "$work" || fail "making the experiments"
+  for other in B C D; do
+    timeout 120 "${mpirun[@]}" -np 1 "$fiberfluid" run "$work/A/exp.json" -q -o "$work/out$other" \
+      : -np 1 "$fiberfluid" run "$work/$other/exp.json" -q -o "$work/out$other" \
+      >"$work/log" 2>&1
+    status=$?
+    [ $status -ne 124 ] || fail "A : $other hung"
+    [ $status -eq 1 ] || fail "A : $other: status $status: $(cat "$work/log")"
+    grep -q "MPI rank(s) 1 read another experiment or surface than rank 0" "$work/log" ||
+      fail "A : $other: $(cat "$work/log")"
+    [ ! -e "$work/out$other" ] || fail "A : $other wrote a result"
+    [ -z "$(ls "$work" | grep running)" ] || fail "A : $other left a staging folder"
+  done
+  # A failure on one rank alone, outside any work item (injected), while the
+  # other waits for it: the whole job ends, naming the rank, and leaves no
+  # result or staging folder.
+  for rank in 0 1; do
+    FIBERFLUID_FAIL_RANK=$rank timeout 120 "${mpirun[@]}" -np 2 "$fiberfluid" run \
+      "$work/A/exp.json" -q -o "$work/fail$rank" >"$work/log" 2>&1
+    status=$?
+    [ $status -ne 124 ] || fail "a failure on rank $rank alone: the job hung"
+    [ $status -ne 0 ] || fail "a failure on rank $rank alone: status 0"
+    grep -q "MPI rank $rank of 2 failed alone" "$work/log" || fail "rank $rank: $(cat "$work/log")"
+    [ ! -e "$work/fail$rank" ] || fail "rank $rank: a result was written"
+  done
+  # The same experiment on both ranks still runs.
+  "${mpirun[@]}" -np 2 "$fiberfluid" run "$work/A/exp.json" -q -o "$work/same" >/dev/null 2>&1 ||
+    fail "the same experiment on two ranks"
   ;;
 *)
   fail "unknown case $case_name"
