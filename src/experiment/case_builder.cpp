@@ -6,6 +6,7 @@
 #include <string>
 
 #include "fiberfluid/experiment/case_spec.hpp"
+#include "fiberfluid/experiment/resources.hpp"
 #include "fiberfluid/geom/fiber_pruning.hpp"
 #include "fiberfluid/geom/horizon.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
@@ -65,6 +66,28 @@ geom::Surface remeshed(const SurfaceSpec& spec, const geom::Surface& surface,
   return out;
 }
 
+// A surface's own cost, refused before it is built when beyond the budgets:
+// making and checking about `vertices` vertices (measured: a cylinder of a
+// million vertices, generated and checked, 570 MB and 16 s; remeshing to a
+// million, 348 MiB in 30 s; so about 600 bytes and 30 us a vertex). Before,
+// such a surface grew to a gigabyte and ran past --max-time before the case's
+// own estimate could refuse it (issue 43, "budgets cover every phase").
+void require_surface_within_budget(const SurfaceSpec& spec, double vertices, const char* key) {
+  constexpr double kBytesPerVertex = 600.0, kSecondsPerVertex = 3e-5;
+  const double bytes = kBytesPerVertex * vertices, seconds = kSecondsPerVertex * vertices;
+  std::ostringstream why;
+  why << "about " << static_cast<long long>(vertices)
+      << " vertices: making and checking them alone needs about " << format_bytes(bytes) << " and "
+      << seconds_text(seconds);
+  if (bytes > memory_budget_bytes())
+    spec.field.fail(key, why.str() + ", more than the memory budget of " +
+                             format_bytes(memory_budget_bytes()) +
+                             " (--max-memory); ask for fewer vertices");
+  if (seconds > time_budget_seconds())
+    spec.field.fail(key, why.str() + ", more than --max-time " +
+                             seconds_text(time_budget_seconds()) + "; ask for fewer vertices");
+}
+
 geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* warnings) {
   if (spec.empty())
     spec.field.fail("",
@@ -78,8 +101,12 @@ geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* w
       spec.field.fail("file", e.what());  // names the experiment field as well as the mesh
     }
   } else {
+    require_surface_within_budget(spec, spec.expected_vertices, "generator");
+    throw_if_cancelled("the surface's generation");
     surface = spec.generate();
+    throw_if_cancelled("the surface's generation");
     const geom::MeshReport report = geom::inspect(surface);
+    throw_if_cancelled("the surface's checks");
     geom::require_usable(report, spec.field.file + ": " +
                                      (spec.field.path.empty() ? "" : spec.field.path + ".") +
                                      "generator");
@@ -94,7 +121,11 @@ geom::Surface build_surface(const SurfaceSpec& spec, std::vector<std::string>* w
                                        << " m across; expected a size from "
                                           "1e-100 to 1e100 m")
                      .str());
-  if (spec.remesh_vertices > 0) surface = remeshed(spec, surface, warnings);
+  if (spec.remesh_vertices > 0) {
+    require_surface_within_budget(spec, spec.remesh_vertices, "remesh_vertices");
+    surface = remeshed(spec, surface, warnings);
+    throw_if_cancelled("the surface's remeshing");
+  }
   return surface;
 }
 
@@ -414,9 +445,8 @@ class ModelBuilder {
       if (m.constraint_groups.back() != "gauge") m.constraint_groups.push_back("gauge");
       const int group = static_cast<int>(m.constraint_groups.size()) - 1;
       m.constraints.push_back({vertex, axis, 0.0, {}, group});
-      const int input = c_.model_to_input.empty()
-                            ? vertex
-                            : c_.model_to_input[static_cast<size_t>(vertex)];
+      const int input =
+          c_.model_to_input.empty() ? vertex : c_.model_to_input[static_cast<size_t>(vertex)];
       c_.notes.push_back("the supports and paddles leave the " + motion +
                          " free and the loads do not turn the body about it: vertex " +
                          std::to_string(input) + " is held along " +

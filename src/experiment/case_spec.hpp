@@ -39,6 +39,7 @@ struct SurfaceSpec {
   bool flip = false;           // the file's faces point inward: flip them
   std::function<geom::Surface()> generate;  // a generator whose parameters were checked
   std::string generator;                    // its name, for messages
+  double expected_vertices = 0.0;           // about how many it makes (0: few)
   double scale = 1.0;
   int remesh_vertices = 0;  // > 0: remeshed isotropically to about this many vertices
   bool empty() const { return file.empty() && !generate; }

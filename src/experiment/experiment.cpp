@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <istream>
@@ -28,8 +29,10 @@ namespace {
 using nlohmann::json;
 
 // ------------------------------------------------------------ surfaces
-// A generator's parameters, checked now; the surface is made when the case is built.
-std::function<geom::Surface()> read_generator(Fields& f) {
+// A generator's parameters, checked now; the surface is made when the case is
+// built. *vertices: about how many vertices it will make (its cost is
+// checked against the budgets before it is built).
+std::function<geom::Surface()> read_generator(Fields& f, double* vertices) {
   const std::string kind =
       f.choice("generator", "",
                {"icosphere", "tetrahedron", "octahedron", "icosahedron", "cube", "box", "dome",
@@ -37,6 +40,7 @@ std::function<geom::Surface()> read_generator(Fields& f) {
   if (kind == "icosphere") {
     const int subdivisions = f.integer("subdivisions", 2, 0, 7);
     const double radius = f.positive("radius", 1.0);
+    *vertices = 10.0 * std::pow(4.0, subdivisions) + 2.0;
     return [=] { return geom::icosphere(subdivisions, radius); };
   }
   if (kind == "tetrahedron" || kind == "octahedron" || kind == "icosahedron") {
@@ -54,11 +58,14 @@ std::function<geom::Surface()> read_generator(Fields& f) {
     Eigen::Vector3i segments = Eigen::Vector3i::Ones();
     if (f.has("segments")) segments = f.counts("segments", 3, 1, 200);
     if ((min.array() >= max.array()).any()) f.fail("max", "must exceed min on every axis");
+    const Eigen::Vector3d n = (segments.array() + 1).cast<double>();
+    *vertices = 2.0 * (n.x() * n.y() + n.y() * n.z() + n.z() * n.x());
     return [=] { return geom::box(min, max, segments); };
   }
   if (kind == "dome") {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
+    *vertices = 10.0 * std::pow(4.0, subdivisions) + 2.0;
     return [=] { return geom::dome(semi_axes, subdivisions); };
   }
   if (kind == "cylinder") {
@@ -67,6 +74,9 @@ std::function<geom::Surface()> read_generator(Fields& f) {
     if (f.has("segments")) segments = f.counts("segments", 2, 1, 1000);
     if (segments.y() < 3) f.fail("segments", "expected at least 3 segments around");
     const int cap_rings = f.integer("cap_rings", 0, 0, 1000);
+    const double rings =
+        segments.x() + 1.0 + 2.0 * (cap_rings > 0 ? cap_rings : segments.y() / 6.0);
+    *vertices = rings * segments.y() + 2.0;
     return [=] { return geom::cylinder(radius, length, segments.x(), segments.y(), cap_rings); };
   }
   if (kind == "torus") {
@@ -75,6 +85,7 @@ std::function<geom::Surface()> read_generator(Fields& f) {
       f.fail("minor_radius", "must be below major_radius (a ring, not a spindle)");
     Eigen::Vector2i segments(40, 20);
     if (f.has("segments")) segments = f.counts("segments", 2, 3, 1000);
+    *vertices = static_cast<double>(segments.x()) * segments.y();
     return [=] { return geom::torus(major, minor, segments.x(), segments.y()); };
   }
   if (kind == "rectangle") {
@@ -116,7 +127,7 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
     f.resolve("file", absolute_path(spec.file));
     spec.flip = f.boolean("flip", false);
   } else {
-    spec.generate = read_generator(f);
+    spec.generate = read_generator(f, &spec.expected_vertices);
     spec.generator = f.string("generator");
   }
   spec.scale = f.positive("scale", 1.0);

@@ -107,7 +107,7 @@ class OutputWriter {
 
   const Experiment& experiment_;
   std::filesystem::path target_, staging_, result_folder_;
-  std::vector<std::vector<std::pair<double, std::string>>> series_;  // per run
+  std::vector<std::vector<std::pair<double, std::string>>> series_;            // per run
   mutable std::vector<std::unique_ptr<const model::Equilibrium>> equilibria_;  // per run
   std::vector<std::string> warnings_;
 };

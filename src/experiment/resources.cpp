@@ -63,6 +63,8 @@ solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
   return solve::automatic_solver(m, b.largest, b.factors, memory_budget_bytes());
 }
 
+}  // namespace
+
 std::string seconds_text(double s) {
   char buffer[32];
   if (s < 1.0)
@@ -76,7 +78,7 @@ std::string seconds_text(double s) {
   return buffer;
 }
 
-}  // namespace
+namespace {}  // namespace
 
 std::string ResourceEstimate::describe() const {
   std::ostringstream out;
@@ -131,8 +133,8 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   // steps (issue 42: 9 and 12 for the compressed cylinder's 40 steps, 1 for the
   // bending phantom's 10).
   const bool reused_tangent = newton && tangent_kind == solve::TangentSolver::Reused;
-  const solve::SolverKind kind = dense_tangent || reused_tangent ? solve::SolverKind::DenseLU
-                                                                 : choose(model, o, blocks);
+  const solve::SolverKind kind =
+      dense_tangent || reused_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)

@@ -56,4 +56,7 @@ void require_within_budget(const ResourceEstimate& estimate, const CaseSpec& spe
 // This process's peak resident memory so far, in bytes (0 when unknown).
 double peak_resident_bytes();
 
+// A duration as an estimate prints it: "0.5 s", "40 s", "12 min", "3.6 h".
+std::string seconds_text(double seconds);
+
 }  // namespace fiberfluid::experiment

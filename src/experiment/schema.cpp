@@ -147,10 +147,11 @@ json SchemaRecorder::schema() const {
   json root = object("");
   // A variant is a patch of the experiment's simulation fields, with its name.
   // Its name makes a folder beside the result's own files: not one of them.
-  json not_reserved = {
-      {"type", "string"},
-      {"not",
-       {{"anyOf", {{{"enum", reserved_result_names()}}, {{"pattern", "^fit_(force_.+[.]csv|target_.+[.](vtu|obj))$"}}}}}}};
+  json not_reserved = {{"type", "string"},
+                       {"not",
+                        {{"anyOf",
+                          {{{"enum", reserved_result_names()}},
+                           {{"pattern", "^fit_(force_.+[.]csv|target_.+[.](vtu|obj))$"}}}}}}};
   json variant = {{"type", "object"},
                   {"properties", {{"name", not_reserved}}},
                   {"required", {"name"}},

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/geom/mesh_check.hpp"
+
 #include "fiberfluid/geom/self_intersection.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -207,6 +209,8 @@ MeshReport inspect(const Surface& s, int index_base) {
                          " vertices are referenced by no face; they are kept in place and left "
                          "out of the model");
   r.components = count_components(s, used);
+  // A large surface takes seconds to check: an interrupt stops it between parts.
+  throw_if_cancelled("the surface's checks");
 
   check_degenerate_faces(s, r);
   if (!r.ok()) return r;
@@ -220,6 +224,7 @@ MeshReport inspect(const Surface& s, int index_base) {
   r.euler_characteristic = s.dim == 3 ? r.used_vertices - r.edges + r.faces : 0;
   if (s.dim == 3 && r.closed && r.components == 1) r.genus = (2 - r.euler_characteristic) / 2;
   r.outward = r.volume > 0.0;
+  throw_if_cancelled("the surface's checks");
   // A surface that crosses itself bounds no solid: its enclosed volume (the
   // fluid's) and the exact pruning's inside test mean nothing there.
   if (r.ok())

@@ -132,6 +132,53 @@ TEST(OneResultFolderNeverSitsInsideAnother, AFolderInsideAResultIsRefusedAndSoIs
   EXPECT_TRUE(fs::exists(dir.path() / "X" / "kept" / "summary.json"));
 }
 
+// Issue 43, "budgets cover every phase": a generated surface of a million
+// vertices grew to a gigabyte and ran past --max-time before the case's own
+// estimate could refuse it; remesh_vertices 1000000 ran 30 s first; a
+// SIGTERM did not stop the generation.
+TEST(BudgetsCoverEveryPhase, ASurfaceBeyondTheBudgetsIsRefusedBeforeItIsBuiltAndStopsWhenAsked) {
+  ScratchDir dir;
+  json big = json::parse(kSmall);
+  big["surface"] = {
+      {"generator", "cylinder"}, {"radius", 0.02}, {"length", 0.1}, {"segments", {1000, 1000}}};
+  big["supports"] = {{{"where", "x <= 0"}}};
+  dir.write("big.json", big.dump());
+  for (const char* flags : {"--max-memory 100M", "--max-time 1"}) {
+    const auto began = std::chrono::steady_clock::now();
+    const Outcome o = run_in(dir.path(), std::string("run big.json -q ") + flags);
+    EXPECT_EQ(o.status, 1) << o.output;
+    EXPECT_NE(o.output.find("big.json: surface.generator: about 1334335 vertices: making and "
+                            "checking them alone needs about"),
+              std::string::npos)
+        << o.output;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(), 2.0)
+        << flags;
+  }
+  json remeshed = json::parse(kSmall);
+  remeshed["surface"]["remesh_vertices"] = 1000000;
+  dir.write("remeshed.json", remeshed.dump());
+  const Outcome r = run_in(dir.path(), "run remeshed.json -q --max-memory 100M");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("surface.remesh_vertices: about 1000000 vertices"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir.path() / "out"));
+  // Within the budgets, a SIGTERM stops the surface's making and checks
+  // (between their parts: 4 s on this 400,000-vertex one, measured).
+  big["surface"]["segments"] = {1000, 400};
+  dir.write("large.json", big.dump());
+  const fs::path log = dir.path() / "large.log";
+  const pid_t pid = testing::start_cli(
+      {"run", (dir.path() / "large.json").string(), "-q", "-o", (dir.path() / "large").string()},
+      log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  const auto signalled = std::chrono::steady_clock::now();
+  kill(pid, SIGTERM);
+  EXPECT_EQ(testing::wait_for(pid), 130) << read_file(log);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count(),
+            10.0);
+  EXPECT_FALSE(fs::exists(dir.path() / "large"));
+}
+
 TEST(CliSafety, ANameFromAFileNeverWritesOutsideTheOutputRoot) {
   ScratchDir dir;
   fs::create_directories(dir.path() / "victim");
