@@ -138,7 +138,7 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
 // ------------------------------------------------------------ selections
 model::Schedule read_schedule(Fields& f, const std::string& fallback) {
   model::Schedule schedule;
-  if (f.has("schedule") && f.raw("schedule").is_array()) {
+  if (f.has("schedule") && f.peek("schedule")->is_array()) {  // a table (typed below)
     schedule.kind = model::Schedule::Kind::Table;
     const Eigen::VectorXd values = f.vector("schedule", -1);
     schedule.values.assign(values.data(), values.data() + values.size());
@@ -321,9 +321,9 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
       spec.mirror_layer = f.choice("layer", "none", {"none", "mirror"}) == "mirror";
     }
     if (prescribed && f.has("layer"))
-      f.fail("layer",
-             "a mirror layer belongs to a fixed clamp (\"supports\"), not to a "
-             "prescribed group");
+      f.refuse("layer",
+               "a mirror layer belongs to a fixed clamp (\"supports\"), not to a "
+               "prescribed group");
     f.finish();
     groups.push_back(spec);
   };
@@ -728,8 +728,9 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
 }
 
 // Fields of the experiment that a variant may not patch.
-const char* const kExperimentFields[] = {"name",     "description", "kind", "variants",
-                                         "expected", "output",      "fit",  "fem_reference"};
+const char* const kExperimentFields[] = {"name",     "description",   "kind",
+                                         "variants", "expected",      "output",
+                                         "fit",      "fem_reference", "$schema"};
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
@@ -842,6 +843,8 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   Experiment ex;
   ex.document = document;
   Fields root(document, "", label, &ex.resolved);
+  // An editor's pointer to the schema (`fiberfluid schema --help` suggests it): taken, unused.
+  if (root.has("$schema")) root.string("$schema");
   ex.name = root.string("name", "experiment");
   if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
     root.fail("name", "expected " + problem);

@@ -45,6 +45,11 @@ class Fields {
     if (resolved_ != nullptr) (*resolved_)[key] = value;
   }
 
+  // A field the reader refuses where it is: the schema refuses it too.
+  [[noreturn]] void refuse(const std::string& key, const std::string& what) const {
+    note(key, [] { return nlohmann::json{{"not", nlohmann::json::object()}}; });
+    fail(key, what);
+  }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw InputError(file_ + ": " + name(key) + (name(key).empty() ? "" : ": ") + what);
   }
@@ -54,7 +59,10 @@ class Fields {
   }
   bool has(const std::string& key) const {
     note(key, [] { return nlohmann::json(); });  // asked for: its type, if any, comes with its read
-    return object_.contains(key);
+    const bool given = object_.contains(key);
+    if (SchemaRecorder* recorder = active_schema_recorder(); recorder != nullptr && !given)
+      recorder->asked(path_, key);
+    return given;
   }
 
   // A value as given (recorded as given unless a typed read records it).

@@ -112,6 +112,16 @@ bool SchemaRecorder::take_missing(std::string* path, std::string* key, json* fra
   return true;
 }
 
+void SchemaRecorder::asked(const std::string& path, const std::string& key) {
+  asked_.push_back({path, key, {}});
+}
+
+std::vector<SchemaRecorder::Choice> SchemaRecorder::take_asked() {
+  std::vector<Choice> out;
+  out.swap(asked_);
+  return out;
+}
+
 std::vector<SchemaRecorder::Choice> SchemaRecorder::take_choices() {
   std::vector<Choice> out;
   out.swap(choices_);
@@ -137,6 +147,16 @@ json SchemaRecorder::schema() const {
             fragment["items"] = object(name + "[]");
           if (std::find(kinds.begin(), kinds.end(), fragment) == kinds.end())
             kinds.push_back(fragment);
+        }
+        // A string read of a field that a choice read too is the same value
+        // read again: the choice's names bound it ("generator": "box2").
+        bool named = false;
+        for (const json& kind : kinds) named |= kind.contains("enum");
+        if (named) {
+          json narrowed = json::array();
+          for (const json& kind : kinds)
+            if (kind != json{{"type", "string"}}) narrowed.push_back(kind);
+          kinds = narrowed;
         }
         properties[key] = any || kinds.empty() ? json::object()
                           : kinds.size() == 1  ? kinds[0]
@@ -173,6 +193,9 @@ namespace {
 // Documents that between them have every section; each choice's other
 // values are then tried from them.
 const char* const kSeeds[] = {
+    // The forms a choice of one field excludes: a mesh file, supports by vertex.
+    R"({"name": "f", "surface": {"file": "x.obj", "flip": false},
+        "material": {"Y": 1, "gamma": 0}, "supports": [{"vertices": [0, 1]}]})",
     R"({"name": "s", "description": "", "kind": "simulate",
         "surface": {"generator": "icosphere", "subdivisions": 1, "scale": 1},
         "material": {"law": {"type": "exponential", "Y0": 1000, "beta": 1}, "gamma": 1,
@@ -186,7 +209,9 @@ const char* const kSeeds[] = {
         "loads": [{"type": "gravity", "label": "g", "acceleration": [0, 0, -1], "density": 1,
                    "schedule": "ramp", "integration": "vertex"},
                   {"type": "point", "label": "push", "vertex": 0, "force": [0, 0, 1],
-                   "schedule": "final"}],
+                   "schedule": "final"},
+                  {"type": "point", "label": "table", "vertex": 1, "force": [0, 0, 1],
+                   "schedule": [0.5, 1]}],
         "paddles": [{"label": "upper", "axis": "z", "side": "above", "compression": 0.1,
                      "contact": "frictionless", "schedule": "ramp"},
                     {"label": "lower", "axis": "z", "side": "below", "travel": 0,
@@ -261,6 +286,23 @@ json experiment_schema() {
           }
         }
       }
+    }
+    // An optional field the document lacks, given an empty object: its typed
+    // read (a section's, or a value's before its check fails) is recorded.
+    for (const SchemaRecorder::Choice& a : recorder.take_asked()) {
+      // Once per field and the object around it (a cylinder's segments
+      // are read as two counts, a box's as three).
+      const json::json_pointer at = pointer(a.path, a.key);
+      json given = document;
+      try {
+        const std::string around = document.at(at.parent_pointer()).dump();
+        if (!tried.insert("asked " + pattern(a.path) + "." + a.key + " in " + around).second)
+          continue;
+        given[at] = json::object();
+      } catch (const json::exception&) {
+        continue;
+      }
+      queue.push_back(std::move(given));
     }
     for (const SchemaRecorder::Choice& c : recorder.take_choices())
       for (const std::string& value : c.allowed) {

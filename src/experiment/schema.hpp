@@ -39,6 +39,12 @@ class SchemaRecorder {
   // The choices met since the last call.
   std::vector<Choice> take_choices();
 
+  // An optional field the reader asked for (has) and the document lacks:
+  // the explorer gives it one, so that its typed read is recorded too (issue
+  // 43: fields read only when given came out as any value).
+  void asked(const std::string& path, const std::string& key);
+  std::vector<Choice> take_asked();
+
   // The schema of everything recorded: objects closed to unknown fields.
   nlohmann::json schema() const;
 
@@ -46,6 +52,7 @@ class SchemaRecorder {
   // Per object path pattern ("fit.targets[]"), per field: its schema.
   std::map<std::string, std::map<std::string, nlohmann::json>> fields_;
   std::vector<Choice> choices_;
+  std::vector<Choice> asked_;
   std::string missing_path_, missing_key_;
   bool missing_ = false;
 };

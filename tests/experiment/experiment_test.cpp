@@ -260,6 +260,21 @@ TEST(ACaseIsBuiltFromItsOwnSpecAlone, AReusedCaseEqualsOneBuiltAfreshFieldByFiel
             1.5 * result.runs[1].summary.steps.back().max_displacement);
 }
 
+// Issue 43, "the schema refuses what the reader refuses": `schema --help`
+// suggests a "$schema" key, which the reader refused; it is taken now (and
+// tests/python/test_schema.py checks the schema side with jsonschema).
+TEST(TheSchemaRefusesWhatTheReaderRefuses, TheReaderTakesTheSchemaKeyAnEditorAdds) {
+  nlohmann::json c = base_config();
+  c["$schema"] = "fiberfluid.schema.json";
+  EXPECT_NO_THROW(parse_experiment(c, ".", "doc"));
+  c["$schema"] = 5;
+  EXPECT_THROW(parse_experiment(c, ".", "doc"), InputError);
+  // And the reader still refuses a mirror layer on a prescribed group, as the schema does.
+  nlohmann::json p = base_config();
+  p["prescribed"] = {{{"where", "z <= -0.5"}, {"displacement", {0, 0, 0.01}}, {"layer", "mirror"}}};
+  EXPECT_THROW(parse_experiment(p, ".", "doc"), InputError);
+}
+
 TEST(AFileMeansOneThing, AnExperimentKeyGivenTwiceIsRefused) {
   testing::ScratchDir dir;
   // Issue 43, "a file means one thing": a key given twice in one object

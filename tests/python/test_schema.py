@@ -73,3 +73,30 @@ def test_what_the_reader_refuses_the_schema_refuses(validator):
     assert set(laws["properties"]["type"]["enum"]) >= {"constant", "exponential", "bilinear", "tabulated"}
     targets = validator.schema["properties"]["fit"]["properties"]["targets"]["items"]["properties"]
     assert {"paddle", "support", "axis", "travel_units", "force_units", "weight"} <= set(targets)
+
+
+def test_the_schema_refuses_what_the_reader_refuses_when_given(validator):
+    """Issue 43: fields read only when given, a choice re-read as a string,
+    and a field the reader refuses where it is, came out as any value."""
+    with open(os.path.join(SOURCE, "experiments", "bending_phantom.json")) as f:
+        good = json.load(f)
+    assert validator.is_valid(good)
+
+    def changed(change):
+        d = json.loads(json.dumps(good))
+        change(d)
+        return d
+
+    for bad in (changed(lambda d: d["stepping"].update({"control": "banana"})),
+                changed(lambda d: d["surface"].update({"generator": "box2"})),
+                changed(lambda d: d["surface"].update({"segments": "many"})),
+                changed(lambda d: d["loads"][0].update({"schedule": "ramp2"})),
+                changed(lambda d: d["supports"][0].update({"vertices": "all"})),
+                changed(lambda d: d["surface"].update({"file": 5})),
+                changed(lambda d: d.update({"prescribed": [{"where": "x >= 0.1", "layer": "mirror",
+                                                            "displacement": [0, 0, 0.01]}]}))):
+        assert not validator.is_valid(bad)
+    for fine in (changed(lambda d: d["loads"][0].update({"schedule": [0.5, 1]})),
+                 changed(lambda d: d["stepping"].update({"control": "arc_length"})),
+                 changed(lambda d: d.update({"$schema": "fiberfluid.schema.json"}))):
+        assert validator.is_valid(fine), list(validator.iter_errors(fine))[:1]
