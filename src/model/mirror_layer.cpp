@@ -73,6 +73,11 @@ bool same_plane(const MirrorLayer& a, const MirrorLayer& b, double tolerance) {
          std::abs((b.point - a.point).dot(a.normal)) <= tolerance;
 }
 
+// The same layer, whether `layer` is the model's own entry or a copy of it.
+bool same_layer(const MirrorLayer& a, const MirrorLayer& b) {
+  return a.group == b.group && a.held == b.held && a.point == b.point && a.normal == b.normal;
+}
+
 // Where a layer's fibers may cross its plane: within `reach` of a vertex its
 // group holds, and nearer to one of those than to any vertex that another
 // layer on the same plane holds (a layer made by hand without its held
@@ -89,9 +94,9 @@ class ClampedRegion {
     for (const MirrorLayer& other : model.mirror_layers)
       if (same_plane(layer, other, tolerance))
         for (int v : other.held) {
-          if (&other != &layer && own[static_cast<size_t>(v)]) continue;  // shared: ours
+          if (!same_layer(other, layer) && own[static_cast<size_t>(v)]) continue;  // shared: ours
           points_.push_back(padded(V, v));
-          ours_.push_back(&other == &layer || own[static_cast<size_t>(v)]);
+          ours_.push_back(same_layer(other, layer) || own[static_cast<size_t>(v)]);
         }
     // The mesh's resolution on the clamp: its longest edge between two held vertices.
     const Eigen::MatrixXi& F = model.surface.F;
