@@ -168,9 +168,6 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   const Calibration& calibration = evaluations.calibration();
   OptimizerOutcome outcome;
   Eigen::VectorXd phi = start;
-  std::vector<bool> log_scaled;
-  for (const Parameter& parameter : calibration.parameters().parameters())
-    log_scaled.push_back(parameter.log_scale);
   CeresProblem p(evaluations, options, phi, options.max_evaluations);
   Recorder recorder(calibration, options, phi, p.shared, outcome);
   LmSteps steps;
@@ -179,9 +176,9 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   steps.parameter_tolerance = options.parameter_tolerance;
   steps.initial_trust_region_radius = options.initial_trust_region_radius;
   steps.max_step_factor = options.max_step_factor;
-  const ceres::Solver::Summary summary =
-      solve_in_moving_box(p.problem, phi.data(), log_scaled, calibration.parameters().lower_phi(),
-                          calibration.parameters().upper_phi(), steps, &recorder);
+  const ceres::Solver::Summary summary = solve_in_moving_box(
+      p.problem, phi.data(), calibration.parameters().parameters(),
+      calibration.parameters().lower_phi(), calibration.parameters().upper_phi(), steps, &recorder);
   outcome.phi = phi;  // the best point: Ceres keeps it in phi, also when stopped
   outcome.message = "levenberg-marquardt: " + summary.message;
   switch (summary.termination_type) {

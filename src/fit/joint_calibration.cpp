@@ -325,8 +325,6 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   }
   result.initial_cost = 0.5 * evaluator.residuals().squaredNorm();
 
-  std::vector<bool> log_scaled;
-  for (const Parameter& p : parameters_) log_scaled.push_back(p.log_scale);
   ceres::Problem problem;
   problem.AddResidualBlock(new JointCost(evaluator, residuals_, P), nullptr, phi.data());
   JointRecorder recorder(parameters_, phi, evaluator, options_, result.iterations);
@@ -336,7 +334,7 @@ JointFitResult JointCalibration::run(const WorkDealer& deal_given,
   steps.parameter_tolerance = options_.parameter_tolerance;
   steps.max_step_factor = options_.max_step_factor;
   const ceres::Solver::Summary summary =
-      solve_in_moving_box(problem, phi.data(), log_scaled, lower, upper, steps, &recorder);
+      solve_in_moving_box(problem, phi.data(), parameters_, lower, upper, steps, &recorder);
   result.message = "levenberg-marquardt: " + summary.message;
   result.values = values(phi);
   if (cancel_requested()) return finish(FitStatus::Interrupted, "");

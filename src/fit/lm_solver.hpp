@@ -82,7 +82,7 @@ struct LmSteps {
 // `callback` sees the iterations numbered as in one solve (iteration 0
 // once). Returns the last solve's summary.
 inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, double* phi,
-                                                  const std::vector<bool>& log_scaled,
+                                                  const std::vector<Parameter>& parameters,
                                                   const Eigen::VectorXd& lower,
                                                   const Eigen::VectorXd& upper,
                                                   const LmSteps& steps,
@@ -112,9 +112,9 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
     const double* phi_;
     int size_;
     bool started_ = false;
-  } renumbered(callback, phi, static_cast<int>(log_scaled.size()));
+  } renumbered(callback, phi, static_cast<int>(parameters.size()));
 
-  const int P = static_cast<int>(log_scaled.size());
+  const int P = static_cast<int>(parameters.size());
   const double widest = std::log(steps.max_step_factor);
   double reach = widest;
   double radius = steps.initial_trust_region_radius;
@@ -140,7 +140,7 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
     if (!held.empty()) problem.SetManifold(phi, new ceres::SubsetManifold(P, held));
     for (int k = 0; k < P; ++k) {
       double low = lower[k], high = upper[k];
-      if (log_scaled[static_cast<size_t>(k)]) {
+      if (parameters[static_cast<size_t>(k)].log_scale) {
         low = std::max(low, phi[k] - reach);
         high = std::min(high, phi[k] + reach);
       }
