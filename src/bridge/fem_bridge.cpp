@@ -37,13 +37,15 @@ struct PosedFem {
   fem::LoadPath state;
 };
 
-PosedFem pose_fem(const model::Model& m, int steps, const fem::TetMeshOptions& mesh_options) {
+PosedFem pose_fem(const model::Model& m, int steps, const fem::TetMeshOptions& mesh_options,
+                  int order) {
   if (m.dim() != 3) fail("needs a closed 3D surface (this one is 2D)");
   if (!m.paddles.empty())
     fail("paddles (contact) are not supported: use supports, prescribed displacements and loads");
   PosedFem posed;
   const auto start = std::chrono::steady_clock::now();
   posed.mesh = fem::tetrahedralize(m.surface, mesh_options);
+  if (order == 2) posed.mesh = fem::to_quadratic(posed.mesh);
   posed.mesh_seconds = seconds_since(start);
   posed.boundary = fem::boundary(posed.mesh);
   const fem::Mesh& mesh = posed.mesh;
@@ -142,8 +144,8 @@ void finish(const PosedFem& posed, const Eigen::VectorXd& u, FemOfModel* out) {
 }  // namespace
 
 FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Material& material,
-                              const fem::TetMeshOptions& mesh_options) {
-  const PosedFem posed = pose_fem(m, steps, mesh_options);
+                              const fem::TetMeshOptions& mesh_options, int order) {
+  const PosedFem posed = pose_fem(m, steps, mesh_options, order);
   const fem::LoadState last = posed.state(steps);
   FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();
@@ -160,8 +162,8 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
 FemOfModel solve_hyperelastic_fem_of_model(const model::Model& m, int steps,
                                            const fem::HyperelasticMaterial& material,
                                            const fem::TetMeshOptions& mesh_options,
-                                           fem::HyperelasticOptions options) {
-  const PosedFem posed = pose_fem(m, steps, mesh_options);
+                                           int order, fem::HyperelasticOptions options) {
+  const PosedFem posed = pose_fem(m, steps, mesh_options, order);
   options.steps = steps;
   FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();

@@ -2,7 +2,8 @@
 #pragma once
 
 // A finite-element reference for any simulation on a closed 3D surface:
-// the body filled with linear tetrahedra (fem::tetrahedralize), the same
+// the body filled with tetrahedra (fem::tetrahedralize; linear, or made
+// quadratic), the same
 // supports, prescribed displacements, point loads and gravity at their
 // final load factors, solved quasi-statically by linear elasticity; or, by
 // neo-Hookean elements (fem/hyperelastic.hpp), along the model's load steps. Its
@@ -38,14 +39,16 @@ struct FemOfModel {
 // The FEM of a model's body with every load and prescribed value at its
 // factor after step `steps` of `steps`. Throws InputError for what it cannot
 // pose (a 2D surface, paddles, a load of an unknown kind, a singular setup).
+// `order` 1: linear tetrahedra, 2: quadratic ones (fem::to_quadratic; their
+// boundary nodes are held and loaded as the corners are).
 FemOfModel solve_fem_of_model(const model::Model& model, int steps, const fem::Material& material,
-                              const fem::TetMeshOptions& mesh_options);
+                              const fem::TetMeshOptions& mesh_options, int order = 1);
 // The same body of neo-Hookean tetrahedra, solved along the model's `steps`
 // load steps (each load's schedule, each prescribed motion's); a step that
 // fails (after options.max_step_cuts halvings) throws InputError naming it.
 FemOfModel solve_hyperelastic_fem_of_model(const model::Model& model, int steps,
                                            const fem::HyperelasticMaterial& material,
                                            const fem::TetMeshOptions& mesh_options,
-                                           fem::HyperelasticOptions options = {});
+                                           int order = 2, fem::HyperelasticOptions options = {});
 
 }  // namespace fiberfluid::bridge

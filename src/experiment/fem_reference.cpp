@@ -30,6 +30,7 @@ FemReferenceSpec read_fem_reference(Fields& f) {
       f.choice("material", "linear", {"linear", "neo_hookean", "neo_hookean_incompressible"});
   spec.nonlinear = material != "linear";
   if (spec.nonlinear) spec.hyperelastic = fem::hyperelastic_from_string(material);
+  spec.order = f.integer("order", spec.nonlinear ? 2 : 1, 1, 2);
   spec.mesh.size = f.non_negative("size", 0.0);
   spec.mesh.facet_distance = f.non_negative("facet_distance", 0.0);
   spec.mesh.feature_angle = f.positive("feature_angle", spec.mesh.feature_angle);
@@ -52,9 +53,10 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
       solid.kind = spec.hyperelastic;
       solid.young = spec.young;
       solid.poisson = spec.poisson;
-      fem = bridge::solve_hyperelastic_fem_of_model(m, c.stepping.steps, solid, spec.mesh);
+      fem = bridge::solve_hyperelastic_fem_of_model(m, c.stepping.steps, solid, spec.mesh,
+                                                    spec.order);
     } else {
-      fem = bridge::solve_fem_of_model(m, c.stepping.steps, material, spec.mesh);
+      fem = bridge::solve_fem_of_model(m, c.stepping.steps, material, spec.mesh, spec.order);
     }
   } catch (const InputError& e) {
     fail(e.what());
@@ -70,6 +72,7 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
   auto& fig = out.figures;
   fig["fem_reference.nodes"] = out.mesh.num_nodes();
   fig["fem_reference.tetrahedra"] = static_cast<double>(out.mesh.elements.rows());
+  fig["fem_reference.element_order"] = spec.order;
   fig["fem_reference.mesh_seconds"] = mesh_seconds;
   fig["fem_reference.solve_seconds"] = solve_seconds;
   if (spec.nonlinear) fig["fem_reference.newton_iterations"] = fem.newton_iterations;

@@ -27,6 +27,10 @@ struct FemReferenceSpec {
   // solid solved along the case's load steps (fem::Hyperelastic).
   bool nonlinear = false;
   fem::Hyperelastic hyperelastic = fem::Hyperelastic::NeoHookean;
+  // Linear (1) or quadratic (2) tetrahedra; by default 2 for the nonlinear
+  // solid (linear tetrahedra lock in bending as nu nears 1/2) and 1 for the
+  // linear one (the references fitted so far).
+  int order = 1;
   fem::TetMeshOptions mesh;
 };
 FemReferenceSpec read_fem_reference(Fields& f);

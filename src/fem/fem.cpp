@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "fiberfluid/fem/free_unknowns.hpp"
+#include "fiberfluid/fem/tetrahedra.hpp"
 #include "fiberfluid/solve/sparse_cholesky.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -84,14 +85,44 @@ Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& dN, int dim) {
   return B;
 }
 
-// Quadrilaterals and hexahedra have 2^dim corners, triangles and tetrahedra dim + 1.
-bool is_simplex(const Eigen::MatrixXd& corners) {
-  const int dim = static_cast<int>(corners.cols());
-  if ((dim != 2 && dim != 3) || (corners.rows() != (1 << dim) && corners.rows() != dim + 1))
+enum class ElementKind { Box, Simplex, QuadraticTetrahedron };
+
+// Quadrilaterals and hexahedra have 2^dim corners, triangles and tetrahedra
+// dim + 1 nodes, quadratic tetrahedra 10.
+ElementKind element_kind(const Eigen::MatrixXd& nodes) {
+  const int dim = static_cast<int>(nodes.cols()), n = static_cast<int>(nodes.rows());
+  if (dim == 3 && n == 10) return ElementKind::QuadraticTetrahedron;
+  if ((dim != 2 && dim != 3) || (n != (1 << dim) && n != dim + 1))
     throw InputError(
         "fem: an element needs 4 corners (a quadrilateral) or 3 (a triangle) in "
-        "2D, 8 (a hexahedron) or 4 (a tetrahedron) in 3D");
-  return corners.rows() == dim + 1;
+        "2D, 8 (a hexahedron), 4 (a tetrahedron) or 10 nodes (a quadratic "
+        "tetrahedron) in 3D");
+  return n == dim + 1 ? ElementKind::Simplex : ElementKind::Box;
+}
+
+// The stiffness or the mass of a quadratic tetrahedron (straight or curved)
+// by quadrature: degree 2 for the stiffness (exact on straight edges),
+// degree 4 for the mass.
+Eigen::MatrixXd quadratic_tetrahedron_matrix(const Eigen::MatrixXd& nodes, const Material& m,
+                                             bool stiffness) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(30, 30);
+  const Eigen::MatrixXd D = elasticity_matrix(m, 3);
+  const TetrahedronRule rule = tetrahedron_rule(stiffness ? 2 : 4);
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN_dxi, dN_dx;
+  for (size_t q = 0; q < rule.points.size(); ++q) {
+    tetrahedron_shape(10, rule.points[q], &N, &dN_dxi);
+    const double dV = rule.weights[q] * physical_derivatives(nodes, dN_dxi, &dN_dx);
+    if (stiffness) {
+      const Eigen::MatrixXd B = strain_matrix(dN_dx, 3);
+      out += dV * B.transpose() * D * B;
+    } else {
+      for (int a = 0; a < 10; ++a)
+        for (int b = 0; b < 10; ++b)
+          for (int i = 0; i < 3; ++i) out(3 * a + i, 3 * b + i) += m.density * dV * N[a] * N[b];
+    }
+  }
+  return out;
 }
 
 // A linear simplex: constant shape derivatives (#nodes x dim) and its measure.
@@ -185,7 +216,9 @@ Eigen::MatrixXd elasticity_matrix(const Material& m, int dim) {
 }
 
 Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material& m) {
-  const bool simplex = is_simplex(corners);
+  const ElementKind kind = element_kind(corners);
+  if (kind == ElementKind::QuadraticTetrahedron) return quadratic_tetrahedron_matrix(corners, m, true);
+  const bool simplex = kind == ElementKind::Simplex;
   const int dim = static_cast<int>(corners.cols());
   const Eigen::MatrixXd D = elasticity_matrix(m, dim);
   if (simplex) {  // constant strain: one point is exact
@@ -207,7 +240,9 @@ Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material
 }
 
 Eigen::MatrixXd element_mass(const Eigen::MatrixXd& corners, const Material& m) {
-  const bool simplex = is_simplex(corners);
+  const ElementKind kind = element_kind(corners);
+  if (kind == ElementKind::QuadraticTetrahedron) return quadratic_tetrahedron_matrix(corners, m, false);
+  const bool simplex = kind == ElementKind::Simplex;
   const int dim = static_cast<int>(corners.cols()), n = static_cast<int>(corners.rows());
   Eigen::MatrixXd scalar = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd N;

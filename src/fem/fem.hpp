@@ -4,8 +4,9 @@
 // Linear-elastic finite elements for the accuracy benchmarks (Alterovitz and
 // Goldberg; docs: benchmarks.md): bilinear quadrilaterals (Q1, 2D) and
 // trilinear hexahedra (3D) with 2 x 2 (x 2) Gauss quadrature, linear
-// triangles and tetrahedra (P1, for organ shapes) exact with one point;
-// small strains.
+// triangles and tetrahedra (P1, for organ shapes) exact with one point, and
+// quadratic tetrahedra (P2, 10 nodes, straight or curved; fem/tetrahedra.hpp)
+// by quadrature; small strains.
 // Unknowns are ordered node by node: u = (u0x, u0y[, u0z], u1x, ...).
 
 #include <Eigen/Core>
@@ -19,7 +20,9 @@ namespace fiberfluid::fem {
 // A mesh of one element kind, told by the nodes per element: Q1
 // quadrilaterals (dim 2, 4 nodes counterclockwise), hexahedra (dim 3, 8
 // nodes: the bottom face counterclockwise seen from above, then the top face
-// above it), or positively oriented simplices (dim + 1 nodes).
+// above it), positively oriented simplices (dim + 1 nodes), or quadratic
+// tetrahedra (dim 3, 10 nodes: a positively oriented tetrahedron's corners,
+// then its edges' middle nodes in VTK's order, fem/tetrahedra.hpp).
 struct Mesh {
   int dim = 2;
   Eigen::MatrixXd nodes;     // #nodes x dim
@@ -53,7 +56,8 @@ Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material
 Eigen::MatrixXd element_mass(const Eigen::MatrixXd& corners, const Material& m);
 
 // Global matrices (symmetric, #dofs square). The lumped mass is the row sums
-// of the consistent one (positive for these elements).
+// of the consistent one (positive for linear elements; a quadratic
+// tetrahedron's corners get a negative share).
 Eigen::SparseMatrix<double> stiffness_matrix(const Mesh& mesh, const Material& m);
 Eigen::SparseMatrix<double> mass_matrix(const Mesh& mesh, const Material& m);
 Eigen::VectorXd lumped_mass(const Mesh& mesh, const Material& m);

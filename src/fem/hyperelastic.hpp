@@ -1,21 +1,24 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 
-// Geometrically nonlinear finite elements: neo-Hookean linear tetrahedra in
-// the total Lagrangian form (Bonet and Wood, "Nonlinear continuum mechanics
+// Geometrically nonlinear finite elements: neo-Hookean tetrahedra, linear (4
+// nodes, one point) or quadratic (10 nodes, four points; fem/tetrahedra.hpp),
+// in the total Lagrangian form (Bonet and Wood, "Nonlinear continuum mechanics
 // for finite element analysis", chapters 6 and 7), solved quasi-statically by
 // Newton's method with a line search in load steps. The reference that large
 // bending and compression are checked against: it rotates, stiffens and
 // conserves volume as a solid does, which the small-strain FEM (fem.hpp)
 // cannot.
 //
-// Deformation gradient F = I + grad u (constant on a linear tetrahedron),
-// J = det F. Two strain energies W(F):
+// Deformation gradient F = I + grad u (constant on a linear tetrahedron,
+// linear on a straight quadratic one), J = det F. Two strain energies W(F):
 // - compressible:          mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2;
 // - nearly incompressible: mu/2 (J^(-2/3) I1 - 3) + kappa/2 (J - 1)^2;
 // with I1 = tr(F^T F) and mu, lambda, kappa from Young's modulus and Poisson's
 // ratio. Both reduce to linear elasticity at small strain. Linear tetrahedra
-// lock as nu approaches 1/2: keep nu <= 0.45 unless the mesh is fine.
+// lock as nu approaches 1/2 (their constant strain cannot keep the volume of
+// every element and still bend); quadratic ones bend with linear strain and
+// converge at second order (docs/benchmarks.md, the FEM references).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -53,7 +56,7 @@ double strain_energy(const HyperelasticMaterial& m, const Eigen::Matrix3d& F);
 Eigen::Matrix3d first_piola_stress(const HyperelasticMaterial& m, const Eigen::Matrix3d& F);
 Eigen::Matrix<double, 9, 9> stress_tangent(const HyperelasticMaterial& m, const Eigen::Matrix3d& F);
 
-// A mesh of linear tetrahedra (Mesh with dim 3 and 4 nodes per element)
+// A mesh of tetrahedra (Mesh with dim 3 and 4 or 10 nodes per element)
 // displaced by u (node by node): the internal forces (the gradient of the
 // total strain energy) and their Jacobian, the tangent stiffness. `valid`
 // (when given) is false when an element is inverted; the forces are then NaN.

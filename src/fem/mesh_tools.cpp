@@ -4,8 +4,10 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 
+#include "fiberfluid/fem/tetrahedra.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
@@ -28,8 +30,29 @@ const std::vector<std::vector<int>>& element_faces(int dim, int corners) {
   static const std::vector<std::vector<int>> hex = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                                     {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   static const std::vector<std::vector<int>> tet = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  // A quadratic tetrahedron's faces: the corners as above, then the middle
+  // nodes of the edges (c0 c1), (c1 c2), (c2 c0).
+  static const std::vector<std::vector<int>> quadratic_tet = {
+      {1, 2, 3, 5, 9, 8}, {0, 3, 2, 7, 9, 6}, {0, 1, 3, 4, 8, 7}, {0, 2, 1, 6, 5, 4}};
   if (dim == 2) return corners == 4 ? quad : triangle;
+  if (corners == 10) return quadratic_tet;
   return corners == 8 ? hex : tet;
+}
+
+// The flat pieces of a boundary face: a quadrilateral's two triangles, a
+// 6-node triangle's four (corners c0 c1 c2, middles m01 m12 m20).
+void split_face(const std::vector<int>& face, std::vector<std::vector<int>>* kept) {
+  if (face.size() == 4) {
+    kept->push_back({face[0], face[1], face[2]});
+    kept->push_back({face[0], face[2], face[3]});
+  } else if (face.size() == 6) {
+    kept->push_back({face[0], face[3], face[5]});
+    kept->push_back({face[3], face[1], face[4]});
+    kept->push_back({face[5], face[4], face[2]});
+    kept->push_back({face[3], face[4], face[5]});
+  } else {
+    kept->push_back(face);
+  }
 }
 
 }  // namespace
@@ -79,19 +102,13 @@ Boundary boundary(const Mesh& mesh, const Eigen::MatrixXd& positions) {
     for (const std::vector<int>& local : element_faces(mesh.dim, per)) {
       std::vector<int> face;
       for (int c : local) face.push_back(mesh.elements(e, c));
-      std::vector<int> key = face;
-      std::sort(key.begin(), key.end());
+      std::vector<int> key(face.begin(), face.begin() + (face.size() == 6 ? 3 : face.size()));
+      std::sort(key.begin(), key.end());  // by its corners
       if (++count[key] == 1) faces[key] = face;
     }
   std::vector<std::vector<int>> kept;  // as mesh nodes; quadrilaterals split into triangles
   for (const auto& [key, face] : faces) {
-    if (count[key] != 1) continue;
-    if (face.size() == 4) {
-      kept.push_back({face[0], face[1], face[2]});
-      kept.push_back({face[0], face[2], face[3]});
-    } else {
-      kept.push_back(face);
-    }
+    if (count[key] == 1) split_face(face, &kept);
   }
   if (kept.empty()) throw InputError("fem: the mesh has no boundary (no elements)");
   Boundary b;
@@ -130,7 +147,84 @@ Boundary boundary(const Mesh& mesh, const Eigen::MatrixXd& positions) {
   return b;
 }
 
+Mesh to_quadratic(const Mesh& linear) {
+  if (linear.dim != 3 || linear.elements.cols() != 4)
+    throw InputError("fem: only linear tetrahedra (dim 3, 4 nodes) are made quadratic");
+  Mesh out;
+  out.dim = 3;
+  std::map<std::pair<int, int>, int> middle;  // sorted corners -> node
+  std::vector<Eigen::RowVector3d> added;
+  out.elements.resize(linear.elements.rows(), 10);
+  for (Eigen::Index e = 0; e < linear.elements.rows(); ++e) {
+    for (int k = 0; k < 4; ++k) out.elements(e, k) = linear.elements(e, k);
+    for (size_t edge = 0; edge < kTetrahedronEdges.size(); ++edge) {
+      const int a = linear.elements(e, kTetrahedronEdges[edge][0]),
+                b = linear.elements(e, kTetrahedronEdges[edge][1]);
+      const auto [it, is_new] = middle.emplace(
+          std::minmax(a, b), linear.num_nodes() + static_cast<int>(added.size()));
+      if (is_new) added.push_back(0.5 * (linear.nodes.row(a) + linear.nodes.row(b)));
+      out.elements(e, 4 + static_cast<Eigen::Index>(edge)) = it->second;
+    }
+  }
+  out.nodes.resize(linear.num_nodes() + static_cast<Eigen::Index>(added.size()), 3);
+  out.nodes.topRows(linear.num_nodes()) = linear.nodes;
+  for (size_t k = 0; k < added.size(); ++k)
+    out.nodes.row(linear.num_nodes() + static_cast<Eigen::Index>(k)) = added[k];
+  return out;
+}
+
+Mesh tube_mesh(const TubeMeshSpec& spec) {
+  if (!(spec.inner_radius > 0.0 && spec.outer_radius > spec.inner_radius && spec.length > 0.0) ||
+      spec.radial < 1 || spec.around < 3 || spec.along < 1 || (spec.order != 1 && spec.order != 2))
+    throw InputError("fem: a tube needs 0 < inner < outer radius, a positive length, at least "
+                     "1 x 3 x 1 cells and order 1 or 2");
+  const int nr = spec.radial, nt = spec.around, nz = spec.along;
+  const auto id = [&](int i, int j, int k) { return i + (nr + 1) * ((j % nt) + nt * k); };
+  Mesh hexahedra;
+  hexahedra.dim = 3;
+  hexahedra.nodes.resize((nr + 1) * nt * (nz + 1), 3);
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j < nt; ++j)
+      for (int i = 0; i <= nr; ++i) {
+        const double r = spec.inner_radius + (spec.outer_radius - spec.inner_radius) * i / nr;
+        const double theta = 2.0 * M_PI * j / nt;
+        hexahedra.nodes.row(id(i, j, k)) << r * std::cos(theta), r * std::sin(theta),
+            spec.length * k / nz;
+      }
+  hexahedra.elements.resize(nr * nt * nz, 8);
+  int e = 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < nt; ++j)  // the last ring of cells closes on the first (j % nt)
+      for (int i = 0; i < nr; ++i, ++e)
+        for (int layer = 0; layer < 2; ++layer) {
+          const int bottom[4] = {id(i, j, k + layer), id(i + 1, j, k + layer),
+                                 id(i + 1, j + 1, k + layer), id(i, j + 1, k + layer)};
+          for (int a = 0; a < 4; ++a) hexahedra.elements(e, 4 * layer + a) = bottom[a];
+        }
+  Mesh mesh = to_simplices(hexahedra);
+  if (spec.order == 1) return mesh;
+  const int corners = mesh.num_nodes();
+  mesh = to_quadratic(mesh);
+  // A middle node at the mean radius of its edge's ends, on the ray through
+  // the chord's middle: on the cylinders where both ends are.
+  for (Eigen::Index e2 = 0; e2 < mesh.elements.rows(); ++e2)
+    for (size_t edge = 0; edge < kTetrahedronEdges.size(); ++edge) {
+      const int a = mesh.elements(e2, kTetrahedronEdges[edge][0]),
+                b = mesh.elements(e2, kTetrahedronEdges[edge][1]),
+                middle = mesh.elements(e2, 4 + static_cast<Eigen::Index>(edge));
+      if (middle < corners) continue;
+      const double radius = 0.5 * (mesh.nodes.row(a).head<2>().norm() +
+                                   mesh.nodes.row(b).head<2>().norm());
+      const Eigen::Vector2d chord = mesh.nodes.row(middle).head<2>();
+      mesh.nodes.row(middle).head<2>() = radius * chord.normalized();
+    }
+  return mesh;
+}
+
 Eigen::VectorXd node_measures(const Mesh& mesh) {
+  if (mesh.dim == 3 && mesh.elements.cols() == 10)
+    throw InputError("fem: node measures are for linear elements (a quadratic tetrahedron's "
+                     "corners have negative shares)");
   Material unit;
   unit.density = 1.0;
   const Eigen::VectorXd lumped = lumped_mass(mesh, unit);

@@ -61,13 +61,16 @@ TEST(FemBridge, ASmallLoadGivesTheLinearAnswer) {
   fem::Material linear;
   linear.young = 1e9;
   linear.poisson = 0.4;
-  const FemOfModel small = solve_fem_of_model(m, 1, linear, mesh_options());
-  const FemOfModel nonlinear = solve_hyperelastic_fem_of_model(m, 1, solid(1e9), mesh_options());
-  ASSERT_EQ(small.displacement.rows(), nonlinear.displacement.rows());
-  const double size = small.displacement.norm();
-  EXPECT_GT(size, 0.0);
-  EXPECT_LT((nonlinear.displacement - small.displacement).norm(), 1e-3 * size);
-  EXPECT_EQ(nonlinear.path.size(), 1u);
+  for (int order : {1, 2}) {  // linear and quadratic tetrahedra alike
+    const FemOfModel small = solve_fem_of_model(m, 1, linear, mesh_options(), order);
+    const FemOfModel nonlinear =
+        solve_hyperelastic_fem_of_model(m, 1, solid(1e9), mesh_options(), order);
+    ASSERT_EQ(small.displacement.rows(), nonlinear.displacement.rows());
+    const double size = small.displacement.norm();
+    EXPECT_GT(size, 0.0);
+    EXPECT_LT((nonlinear.displacement - small.displacement).norm(), 1e-3 * size) << order;
+    EXPECT_EQ(nonlinear.path.size(), 1u);
+  }
 }
 
 // The clamp turned by 90 degrees about y in 6 steps, no load: the neo-Hookean
@@ -77,6 +80,7 @@ TEST(FemBridge, AClampTurnedByNinetyDegreesTurnsTheSolidRigidly) {
   const model::Model m = clamped_cylinder(true);
   const FemOfModel turned = solve_hyperelastic_fem_of_model(m, 6, solid(1e5), mesh_options());
   ASSERT_EQ(turned.path.size(), 6u);
+  ASSERT_EQ(turned.mesh.elements.cols(), 10);  // quadratic by default
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   double worst = 0.0;

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fiberfluid/fem/closed_forms.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
+
+#include "fiberfluid/util/error.hpp"
+
+namespace fiberfluid::fem {
+namespace {
+
+constexpr double kOnSurface = 1e-9;  // relative to the tube's size
+
+bool on_radius(const Mesh& mesh, int v, double radius) {
+  return std::abs(mesh.nodes.row(v).head<2>().norm() - radius) <= kOnSurface * radius;
+}
+
+// Each node's prescribed displacement (where `held` says so, per axis) at
+// load factor s, as a load path of `steps` steps with no forces.
+using Prescribed = std::function<Eigen::Vector3d(const Eigen::Vector3d& rest, double s)>;
+using HeldAxes = std::function<Eigen::Vector3i(int node)>;
+
+HyperelasticSolution solve_prescribed(const Mesh& mesh, const HyperelasticMaterial& material,
+                                      const HeldAxes& held, const Prescribed& motion, int steps,
+                                      const std::string& problem) {
+  const LoadPath path = [&](int step) {
+    LoadState state;
+    state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
+    const double s = static_cast<double>(step) / steps;
+    for (int v = 0; v < mesh.num_nodes(); ++v) {
+      const Eigen::Vector3i axes = held(v);
+      if (axes.sum() == 0) continue;
+      const Eigen::Vector3d u = motion(mesh.nodes.row(v).transpose(), s);
+      for (int a = 0; a < 3; ++a)
+        if (axes[a]) state.held.hold(3 * v + a, u[a]);
+    }
+    return state;
+  };
+  HyperelasticOptions options;
+  options.steps = steps;
+  options.tolerance = 1e-8;
+  HyperelasticSolution solution;
+  const solve::Status status = solve_hyperelastic(mesh, material, path, options, &solution);
+  if (!status.ok) throw InputError(problem + ": " + status.message);
+  return solution;
+}
+
+ClosedFormRun run_of(const Mesh& mesh, const HyperelasticSolution& solution) {
+  ClosedFormRun run;
+  run.nodes = mesh.num_nodes();
+  run.elements = static_cast<int>(mesh.elements.rows());
+  run.newton_iterations = solution.newton_iterations;
+  return run;
+}
+
+}  // namespace
+
+ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
+                           double twist, int steps) {
+  const Mesh mesh = tube_mesh(tube);
+  const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
+  const auto is_end = [&](int v) {
+    return mesh.nodes(v, 2) <= kOnSurface * L || mesh.nodes(v, 2) >= (1.0 - kOnSurface) * L;
+  };
+  const HeldAxes held = [&](int v) -> Eigen::Vector3i {
+    return is_end(v) || on_radius(mesh, v, A) ? Eigen::Vector3i::Ones() : Eigen::Vector3i::Zero();
+  };
+  const Prescribed torsion = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
+    return Eigen::AngleAxisd(s * twist * X.z(), Eigen::Vector3d::UnitZ()) * X - X;
+  };
+  const HyperelasticSolution solution =
+      solve_prescribed(mesh, material, held, torsion, steps, "torsion");
+  // The reactions on the top end: the internal forces of its held nodes.
+  const Eigen::VectorXd f = internal_forces(mesh, material, solution.u);
+  double torque = 0.0, axial = 0.0;
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    if (mesh.nodes(v, 2) < (1.0 - kOnSurface) * L) continue;
+    const Eigen::Vector3d x = mesh.nodes.row(v).transpose() + solution.u.segment<3>(3 * v);
+    torque += x.x() * f[3 * v + 1] - x.y() * f[3 * v];
+    axial += f[3 * v + 2];
+  }
+  const double mu = material.shear_modulus(), b4a4 = std::pow(B, 4) - std::pow(A, 4);
+  ClosedFormRun run = run_of(mesh, solution);
+  run.figures = {{"torque", torque, M_PI / 2.0 * mu * twist * b4a4},
+                 {"axial_force", axial,
+                  -M_PI / 4.0 * mu * twist * twist * std::pow(B * B - A * A, 2)}};
+  return run;
+}
+
+ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
+                             double inner_stretch, int steps) {
+  const Mesh mesh = tube_mesh(tube);
+  const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
+  const double a = inner_stretch * A;
+  const auto is_end = [&](int v) {
+    return mesh.nodes(v, 2) <= kOnSurface * L || mesh.nodes(v, 2) >= (1.0 - kOnSurface) * L;
+  };
+  const HeldAxes held = [&](int v) -> Eigen::Vector3i {
+    const int inner = on_radius(mesh, v, A) ? 1 : 0;
+    return {inner, inner, is_end(v) ? 1 : 0};
+  };
+  const Prescribed push = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
+    return {s * (inner_stretch - 1.0) * X.x(), s * (inner_stretch - 1.0) * X.y(), 0.0};
+  };
+  const HyperelasticSolution solution =
+      solve_prescribed(mesh, material, held, push, steps, "inflation");
+  // The pressure: the inner surface's outward reactions over its deformed
+  // area; the outer radius: the mean over the outer surface's nodes.
+  const Eigen::VectorXd f = internal_forces(mesh, material, solution.u);
+  double pushing = 0.0, outer_sum = 0.0;
+  int outer_nodes = 0;
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    const Eigen::Vector3d X = mesh.nodes.row(v).transpose();
+    const Eigen::Vector2d radial = X.head<2>().normalized();
+    if (on_radius(mesh, v, A)) pushing += radial.dot(f.segment<2>(3 * v));
+    if (on_radius(mesh, v, B)) {
+      outer_sum += (X + solution.u.segment<3>(3 * v)).head<2>().norm();
+      ++outer_nodes;
+    }
+  }
+  const double b = std::sqrt(B * B + a * a - A * A), mu = material.shear_modulus();
+  ClosedFormRun run = run_of(mesh, solution);
+  run.figures = {
+      {"pressure", pushing / (2.0 * M_PI * a * L),
+       mu * (std::log(a * B / (A * b)) + 0.5 * (a * a - A * A) * (1.0 / (a * a) - 1.0 / (b * b)))},
+      {"outer_radius", outer_sum / outer_nodes, b}};
+  return run;
+}
+
+}  // namespace fiberfluid::fem
