@@ -150,9 +150,22 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
   FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();
   Eigen::VectorXd u;
-  const solve::Status status =
-      fem::solve_static(fem::stiffness_matrix(posed.mesh, material), last.forces, last.held, &u);
-  if (!status.ok) fail(status.message);
+  if (order == 2) {  // quadratic with a linear pressure: the neo-Hookean tangent at rest
+    fem::HyperelasticMaterial solid;
+    solid.young = material.young;
+    solid.poisson = material.poisson;
+    fem::HyperelasticOptions options;
+    options.mixed = true;
+    fem::HyperelasticSolution solution;
+    const solve::Status status =
+        fem::solve_small_strain(posed.mesh, solid, last, options, &solution);
+    if (!status.ok) fail(status.message);
+    u = solution.u;
+  } else {
+    const solve::Status status =
+        fem::solve_static(fem::stiffness_matrix(posed.mesh, material), last.forces, last.held, &u);
+    if (!status.ok) fail(status.message);
+  }
   out.solve_seconds = seconds_since(solve_start);
   finish(posed, u, &out);
   out.path.push_back(out.displacement);
@@ -165,6 +178,7 @@ FemOfModel solve_hyperelastic_fem_of_model(const model::Model& m, int steps,
                                            int order, fem::HyperelasticOptions options) {
   const PosedFem posed = pose_fem(m, steps, mesh_options, order);
   options.steps = steps;
+  options.mixed = order == 2;
   FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();
   fem::HyperelasticSolution solution;

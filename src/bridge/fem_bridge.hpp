@@ -40,7 +40,9 @@ struct FemOfModel {
 // factor after step `steps` of `steps`. Throws InputError for what it cannot
 // pose (a 2D surface, paddles, a load of an unknown kind, a singular setup).
 // `order` 1: linear tetrahedra, 2: quadratic ones (fem::to_quadratic; their
-// boundary nodes are held and loaded as the corners are).
+// boundary nodes are held and loaded as the corners are) with a linear
+// pressure on their corners (the mixed form, which does not lock as nu ->
+// 1/2; fem/hyperelastic.hpp).
 FemOfModel solve_fem_of_model(const model::Model& model, int steps, const fem::Material& material,
                               const fem::TetMeshOptions& mesh_options, int order = 1);
 // The same body of neo-Hookean tetrahedra, solved along the model's `steps`

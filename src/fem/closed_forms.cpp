@@ -22,8 +22,10 @@ using Prescribed = std::function<Eigen::Vector3d(const Eigen::Vector3d& rest, do
 using HeldAxes = std::function<Eigen::Vector3i(int node)>;
 
 HyperelasticSolution solve_prescribed(const Mesh& mesh, const HyperelasticMaterial& material,
-                                      const HeldAxes& held, const Prescribed& motion, int steps,
+                                      const HeldAxes& held, const Prescribed& motion,
+                                      const HyperelasticOptions& options,
                                       const std::string& problem) {
+  const int steps = options.steps;
   const LoadPath path = [&](int step) {
     LoadState state;
     state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
@@ -37,9 +39,6 @@ HyperelasticSolution solve_prescribed(const Mesh& mesh, const HyperelasticMateri
     }
     return state;
   };
-  HyperelasticOptions options;
-  options.steps = steps;
-  options.tolerance = 1e-8;
   HyperelasticSolution solution;
   const solve::Status status = solve_hyperelastic(mesh, material, path, options, &solution);
   if (!status.ok) throw InputError(problem + ": " + status.message);
@@ -57,7 +56,7 @@ ClosedFormRun run_of(const Mesh& mesh, const HyperelasticSolution& solution) {
 }  // namespace
 
 ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
-                           double twist, int steps) {
+                           double twist, const HyperelasticOptions& options) {
   const Mesh mesh = tube_mesh(tube);
   const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
   const auto is_end = [&](int v) {
@@ -70,9 +69,9 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
     return Eigen::AngleAxisd(s * twist * X.z(), Eigen::Vector3d::UnitZ()) * X - X;
   };
   const HyperelasticSolution solution =
-      solve_prescribed(mesh, material, held, torsion, steps, "torsion");
+      solve_prescribed(mesh, material, held, torsion, options, "torsion");
   // The reactions on the top end: the internal forces of its held nodes.
-  const Eigen::VectorXd f = internal_forces(mesh, material, solution.u);
+  const Eigen::VectorXd& f = solution.forces;
   double torque = 0.0, axial = 0.0;
   for (int v = 0; v < mesh.num_nodes(); ++v) {
     if (mesh.nodes(v, 2) < (1.0 - kOnSurface) * L) continue;
@@ -89,7 +88,7 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
 }
 
 ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
-                             double inner_stretch, int steps) {
+                             double inner_stretch, const HyperelasticOptions& options) {
   const Mesh mesh = tube_mesh(tube);
   const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
   const double a = inner_stretch * A;
@@ -104,10 +103,10 @@ ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMateria
     return {s * (inner_stretch - 1.0) * X.x(), s * (inner_stretch - 1.0) * X.y(), 0.0};
   };
   const HyperelasticSolution solution =
-      solve_prescribed(mesh, material, held, push, steps, "inflation");
+      solve_prescribed(mesh, material, held, push, options, "inflation");
   // The pressure: the inner surface's outward reactions over its deformed
   // area; the outer radius: the mean over the outer surface's nodes.
-  const Eigen::VectorXd f = internal_forces(mesh, material, solution.u);
+  const Eigen::VectorXd& f = solution.forces;
   double pushing = 0.0, outer_sum = 0.0;
   int outer_nodes = 0;
   for (int v = 0; v < mesh.num_nodes(); ++v) {

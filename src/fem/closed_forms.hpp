@@ -40,10 +40,11 @@ struct ClosedFormRun {
 };
 
 // `twist` tau in radians per unit length; `inner_stretch` a / A. Both solve
-// in `steps` load steps; a failed solve throws InputError naming the problem.
+// in options.steps load steps (options.mixed: the u-p form, for quadratic
+// tetrahedra); a failed solve throws InputError naming the problem.
 ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
-                           double twist, int steps);
+                           double twist, const HyperelasticOptions& options);
 ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
-                             double inner_stretch, int steps);
+                             double inner_stretch, const HyperelasticOptions& options);
 
 }  // namespace fiberfluid::fem

@@ -25,13 +25,15 @@ double contract(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B) {
 }
 
 // One quadrature point of an element at rest: its share of the element's
-// volume and the gradients of the element's shape functions there (rows).
-// A linear tetrahedron has one point (its gradients are constant), a
-// quadratic one four (exact for the stiffness of straight edges; curved
-// edges are integrated to the same degree).
+// volume, the gradients of the element's shape functions there (rows), and
+// the corners' linear shape functions (the mixed form's pressure). A linear
+// tetrahedron has one point (its gradients are constant), a quadratic one
+// four (exact for the stiffness of straight edges; curved edges are
+// integrated to the same degree).
 struct RestPoint {
   double volume = 0.0;
   Eigen::MatrixXd gradients;  // nodes per element x 3
+  Eigen::Vector4d corner_weights;
 };
 using RestElement = std::vector<RestPoint>;
 
@@ -48,7 +50,9 @@ RestElement rest_element(const Mesh& mesh, int e, const TetrahedronRule& rule) {
     const double det = J.determinant();
     if (!(det > 0.0))
       throw InputError("fem: tetrahedron " + std::to_string(e) + " is inverted or degenerate");
-    element.push_back({rule.weights[q] * det, dN * J.inverse()});
+    const Eigen::Vector3d& xi = rule.points[q];
+    element.push_back({rule.weights[q] * det, dN * J.inverse(),
+                       Eigen::Vector4d(1.0 - xi.sum(), xi[0], xi[1], xi[2])});
   }
   return element;
 }
@@ -69,32 +73,21 @@ Eigen::Matrix3d deformation_gradient(const Mesh& mesh, int e, const RestPoint& p
   return F;
 }
 
-// Every element's rest geometry, once per mesh (checked: tetrahedra, none
-// inverted).
-std::vector<RestElement> rest_geometry(const Mesh& mesh) {
-  check_tetrahedra(mesh);
-  const TetrahedronRule rule =
-      tetrahedron_rule(is_quadratic_tetrahedron(static_cast<int>(mesh.elements.cols())) ? 2 : 1);
-  std::vector<RestElement> rest(static_cast<size_t>(mesh.elements.rows()));
-  for (int e = 0; e < mesh.elements.rows(); ++e)
-    rest[static_cast<size_t>(e)] = rest_element(mesh, e, rule);
-  return rest;
-}
-
-// The solid's energy split as W(F) = W_shape(F) + U(J): U is the part whose
-// stiffness (lambda, kappa) grows without bound as nu -> 1/2. Compressible:
-// U = lambda/2 (ln J)^2, W_shape = mu/2 (I1 - 3) - mu ln J; nearly
-// incompressible: U = kappa/2 (J - 1)^2, W_shape = mu/2 (J^(-2/3) I1 - 3).
-struct Volumetric {
-  double energy = 0.0, slope = 0.0, curvature = 0.0;  // U, U', U''
+// The solid's energy split as W(F) = W_shape(F) + k/2 theta(J)^2: the
+// volumetric part, whose modulus k grows without bound as nu -> 1/2, in a
+// measure of volume change theta. Compressible: theta = ln J, k = lambda,
+// W_shape = mu/2 (I1 - 3) - mu ln J; nearly incompressible: theta = J - 1,
+// k = kappa, W_shape = mu/2 (J^(-2/3) I1 - 3). The pressure p = k theta
+// (pointwise in the displacement form, a field of its own in the mixed one).
+struct VolumeMeasure {
+  double value = 0.0, slope = 0.0, curvature = 0.0;  // theta, theta', theta''
 };
-Volumetric volumetric(const HyperelasticMaterial& m, double J) {
-  if (m.kind == Hyperelastic::NeoHookean) {
-    const double lambda = m.lame_lambda(), log_J = std::log(J);
-    return {0.5 * lambda * log_J * log_J, lambda * log_J / J, lambda * (1.0 - log_J) / (J * J)};
-  }
-  const double kappa = m.bulk_modulus();
-  return {0.5 * kappa * (J - 1.0) * (J - 1.0), kappa * (J - 1.0), kappa};
+VolumeMeasure volume_measure(const HyperelasticMaterial& m, double J) {
+  if (m.kind == Hyperelastic::NeoHookean) return {std::log(J), 1.0 / J, -1.0 / (J * J)};
+  return {J - 1.0, 1.0, 0.0};
+}
+double volumetric_modulus(const HyperelasticMaterial& m) {
+  return m.kind == Hyperelastic::NeoHookean ? m.lame_lambda() : m.bulk_modulus();
 }
 
 double shape_energy(const HyperelasticMaterial& m, const Eigen::Matrix3d& F, double J) {
@@ -103,159 +96,229 @@ double shape_energy(const HyperelasticMaterial& m, const Eigen::Matrix3d& F, dou
   return 0.5 * mu * (std::pow(J, -2.0 / 3.0) * I1 - 3.0);
 }
 
-// dW_shape / dF, with G = F^-T.
-Eigen::Matrix3d shape_stress(const HyperelasticMaterial& m, const Eigen::Matrix3d& F, double J,
-                             const Eigen::Matrix3d& G) {
-  const double mu = m.shear_modulus();
-  if (m.kind == Hyperelastic::NeoHookean) return mu * (F - G);
-  return mu * std::pow(J, -2.0 / 3.0) * (F - contract(F, F) / 3.0 * G);
+// The state at one point: F, J, G = F^-T and the volume measure.
+struct PointState {
+  Eigen::Matrix3d F, G;
+  double J = 1.0;
+  VolumeMeasure theta;
+};
+PointState point_state(const HyperelasticMaterial& m, const Eigen::Matrix3d& F) {
+  PointState s;
+  s.F = F;
+  s.J = F.determinant();
+  if (s.J > 0.0) {
+    s.G = F.inverse().transpose();
+    s.theta = volume_measure(m, s.J);
+  }
+  return s;
 }
 
-// The differential of P_shape + dU J F^-T (the stress at a point of an
-// element whose volumetric slope is dU) in the direction dF.
-Eigen::Matrix3d stress_differential(const HyperelasticMaterial& m, const Eigen::Matrix3d& F,
-                                    double J, const Eigen::Matrix3d& G, double dU,
-                                    const Eigen::Matrix3d& dF) {
+// P = dW_shape/dF + p theta'(J) J G: the stress at a point under pressure p.
+Eigen::Matrix3d stress(const HyperelasticMaterial& m, const PointState& s, double p) {
   const double mu = m.shear_modulus();
-  const double trace_G_dF = contract(G, dF);           // d ln J
-  const Eigen::Matrix3d dG = -G * dF.transpose() * G;  // d F^-T
-  const Eigen::Matrix3d d_JG = J * (trace_G_dF * G + dG);
-  if (m.kind == Hyperelastic::NeoHookean) return mu * (dF - dG) + dU * d_JG;
+  const Eigen::Matrix3d volumetric = p * s.theta.slope * s.J * s.G;
+  if (m.kind == Hyperelastic::NeoHookean) return mu * (s.F - s.G) + volumetric;
+  return mu * std::pow(s.J, -2.0 / 3.0) * (s.F - contract(s.F, s.F) / 3.0 * s.G) + volumetric;
+}
+
+// dP/dF at fixed p (9 x 9 over F's entries in column-major order):
+// the shape part and p d(theta' J G) = p [(theta'' J + theta') J (G:dF) G +
+// theta' J dG], dG = -G dF^T G.
+Eigen::Matrix<double, 9, 9> tangent_at_fixed_pressure(const HyperelasticMaterial& m,
+                                                      const PointState& s, double p) {
+  const double mu = m.shear_modulus(), J = s.J;
+  const Eigen::Matrix3d &F = s.F, &G = s.G;
   const double a = std::pow(J, -2.0 / 3.0), I1 = contract(F, F);
-  const double da = -2.0 / 3.0 * a * trace_G_dF, dI1 = 2.0 * contract(F, dF);
-  return mu * da * (F - I1 / 3.0 * G) + mu * a * (dF - dI1 / 3.0 * G - I1 / 3.0 * dG) +
-         dU * d_JG;
-}
-
-Eigen::Matrix<double, 9, 9> point_tangent(const HyperelasticMaterial& m, const Eigen::Matrix3d& F,
-                                          double J, const Eigen::Matrix3d& G, double dU) {
   Eigen::Matrix<double, 9, 9> A;
   for (int l = 0; l < 9; ++l) {
     Eigen::Matrix3d dF = Eigen::Matrix3d::Zero();
     dF(l % 3, l / 3) = 1.0;
-    const Eigen::Matrix3d dP = stress_differential(m, F, J, G, dU, dF);
+    const double trace_G_dF = contract(G, dF);  // d ln J
+    const Eigen::Matrix3d dG = -G * dF.transpose() * G;
+    Eigen::Matrix3d dP = p * ((s.theta.curvature * J + s.theta.slope) * J * trace_G_dF * G +
+                              s.theta.slope * J * dG);
+    if (m.kind == Hyperelastic::NeoHookean) {
+      dP += mu * (dF - dG);
+    } else {
+      const double da = -2.0 / 3.0 * a * trace_G_dF, dI1 = 2.0 * contract(F, dF);
+      dP += mu * da * (F - I1 / 3.0 * G) + mu * a * (dF - dI1 / 3.0 * G - I1 / 3.0 * dG);
+    }
     A.col(l) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(dP.data());
   }
   return A;
 }
 
-// One element's energy, forces and (when asked) tangent, with the
-// volumetric energy of its mean dilatation: W_shape at each point plus
-// V U(Jbar), Jbar = (sum_q dV_q J_q) / V the ratio of the element's volumes
-// (Nagtegaal, Parks and Rice 1974; Simo, Taylor and Pister 1985; Bonet and
-// Wood, section 8.6). One pressure per element: a quadratic tetrahedron with
-// it is the stable P2-P0 pair and does not lock as nu -> 1/2, where its
-// pointwise volume terms do (a thick tube's torque 6% and its axial force
-// tenfold off at nu = 0.4999). A linear tetrahedron has one point: Jbar = J.
+// dp/dF of the displacement form's pointwise p = k theta(J): k theta' J G.
+Eigen::Matrix3d pressure_gradient(const HyperelasticMaterial& m, const PointState& s) {
+  return volumetric_modulus(m) * s.theta.slope * s.J * s.G;
+}
+
+// Where the mixed form's pressure lives: one value per corner node of the
+// quadratic tetrahedra (continuous and linear: the Taylor-Hood pair P2-P1),
+// numbered after the displacements.
+struct PressureField {
+  std::vector<int> index;  // per mesh node: its pressure unknown, or -1
+  int count = 0;
+};
+PressureField pressure_field(const Mesh& mesh, bool mixed) {
+  PressureField field;
+  if (!mixed) return field;
+  field.index.assign(static_cast<size_t>(mesh.num_nodes()), -1);
+  for (Eigen::Index e = 0; e < mesh.elements.rows(); ++e)
+    for (int c = 0; c < 4; ++c) {
+      int& k = field.index[static_cast<size_t>(mesh.elements(e, c))];
+      if (k < 0) k = mesh.num_dofs() + field.count++;
+    }
+  return field;
+}
+
+// What the solver works with: the mesh, each element's rest geometry, the
+// material, and the pressure field when the form is mixed.
+struct Discretization {
+  const Mesh& mesh;
+  const HyperelasticMaterial& m;
+  std::vector<RestElement> rest;
+  PressureField pressure;
+  bool mixed() const { return pressure.count > 0; }
+  int unknowns() const { return mesh.num_dofs() + pressure.count; }
+};
+
+Discretization discretize(const Mesh& mesh, const HyperelasticMaterial& m, bool mixed) {
+  check_tetrahedra(mesh);
+  const bool quadratic = is_quadratic_tetrahedron(static_cast<int>(mesh.elements.cols()));
+  if (mixed && !quadratic)
+    throw InputError("fem: the mixed form needs quadratic tetrahedra (linear ones with a linear "
+                     "pressure are not stable)");
+  Discretization d{mesh, m, {}, pressure_field(mesh, mixed)};
+  const TetrahedronRule rule = tetrahedron_rule(quadratic ? 2 : 1);
+  d.rest.resize(static_cast<size_t>(mesh.elements.rows()));
+  for (int e = 0; e < mesh.elements.rows(); ++e)
+    d.rest[static_cast<size_t>(e)] = rest_element(mesh, e, rule);
+  return d;
+}
+
+// One element's energy, its unknowns' global numbers, forces and (when
+// asked) tangent. Displacement form: W(F) at each point. Mixed form (u, p):
+// W_shape(F) + p theta(J) - p^2 / (2k) at each point with p interpolated
+// from the corners (Bonet and Wood, "Nonlinear continuum mechanics for
+// finite element analysis", 2nd ed., section 8.6; Taylor-Hood: Brezzi and
+// Fortin, "Mixed and hybrid finite element methods", section VI.6): its
+// pressure rows are the volume constraint's residual integral M_i (theta -
+// p/k), which the stationary point zeroes. The pair converges at second
+// order and does not lock as nu -> 1/2, where quadratic tetrahedra alone do
+// (a thick tube twisted at nu = 0.4999: torque 6% and axial force tenfold off
+// on 4 cells across).
 struct ElementResponse {
   bool valid = true;
   double energy = 0.0;
-  Eigen::VectorXd forces;   // 3 per node
+  std::vector<int> unknowns;
+  Eigen::VectorXd forces;
   Eigen::MatrixXd tangent;  // when asked
 };
 
-ElementResponse respond(const Mesh& mesh, int e, const RestElement& rest,
-                        const HyperelasticMaterial& m, const Eigen::VectorXd& u, bool tangent) {
-  const int per = static_cast<int>(mesh.elements.cols()), points = static_cast<int>(rest.size());
+ElementResponse respond(const Discretization& d, int e, const Eigen::VectorXd& x, bool tangent) {
+  const Mesh& mesh = d.mesh;
+  const int per = static_cast<int>(mesh.elements.cols()), pressures = d.mixed() ? 4 : 0;
+  const int size = 3 * per + pressures;
   ElementResponse out;
-  out.forces = Eigen::VectorXd::Zero(3 * per);
-  std::vector<Eigen::Matrix3d> F(static_cast<size_t>(points)), G(F.size());
-  std::vector<double> J(F.size());
-  double volume = 0.0, deformed = 0.0;
-  for (int q = 0; q < points; ++q) {
-    const RestPoint& p = rest[static_cast<size_t>(q)];
-    F[q] = deformation_gradient(mesh, e, p, u);
-    J[q] = F[q].determinant();
-    if (!(J[q] > 0.0)) {
+  for (int a = 0; a < per; ++a)
+    for (int i = 0; i < 3; ++i) out.unknowns.push_back(3 * mesh.elements(e, a) + i);
+  Eigen::Vector4d corner_pressure = Eigen::Vector4d::Zero();
+  for (int c = 0; c < pressures; ++c) {
+    out.unknowns.push_back(d.pressure.index[static_cast<size_t>(mesh.elements(e, c))]);
+    corner_pressure[c] = x[out.unknowns.back()];
+  }
+  out.forces = Eigen::VectorXd::Zero(size);
+  if (tangent) out.tangent = Eigen::MatrixXd::Zero(size, size);
+  const double k = volumetric_modulus(d.m);
+  Eigen::Matrix<double, 3, 9> C;
+  for (const RestPoint& point : d.rest[static_cast<size_t>(e)]) {
+    const PointState s = point_state(d.m, deformation_gradient(mesh, e, point, x));
+    if (!(s.J > 0.0)) {
       out.valid = false;
       out.energy = std::numeric_limits<double>::infinity();
       out.forces.setConstant(kNaN);
-      if (tangent) out.tangent = Eigen::MatrixXd::Constant(3 * per, 3 * per, kNaN);
+      if (tangent) out.tangent.setConstant(kNaN);
       return out;
     }
-    G[q] = F[q].inverse().transpose();
-    volume += p.volume;
-    deformed += p.volume * J[q];
-  }
-  const Volumetric U = volumetric(m, deformed / volume);
-  out.energy = volume * U.energy;
-  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(3, per);  // d(deformed volume) / du_a, per node a
-  for (int q = 0; q < points; ++q) {
-    const RestPoint& p = rest[static_cast<size_t>(q)];
-    out.energy += p.volume * shape_energy(m, F[q], J[q]);
-    const Eigen::Matrix3d P = shape_stress(m, F[q], J[q], G[q]) + U.slope * J[q] * G[q];
-    const Eigen::MatrixXd JG_grad = p.volume * J[q] * G[q] * p.gradients.transpose();
-    g += JG_grad;
-    const Eigen::MatrixXd P_grad = p.volume * P * p.gradients.transpose();  // 3 x per
+    const double dV = point.volume;
+    const double p = d.mixed() ? point.corner_weights.dot(corner_pressure) : k * s.theta.value;
+    out.energy += dV * (shape_energy(d.m, s.F, s.J) + p * s.theta.value - 0.5 * p * p / k);
+    const Eigen::MatrixXd P_grad = dV * stress(d.m, s, p) * point.gradients.transpose();
     for (int a = 0; a < per; ++a) out.forces.segment<3>(3 * a) += P_grad.col(a);
-  }
-  if (!tangent) return out;
-  out.tangent = Eigen::MatrixXd::Zero(3 * per, 3 * per);
-  Eigen::Matrix<double, 3, 9> C;
-  for (int q = 0; q < points; ++q) {
-    const RestPoint& p = rest[static_cast<size_t>(q)];
-    const Eigen::Matrix<double, 9, 9> A = p.volume * point_tangent(m, F[q], J[q], G[q], U.slope);
+    // d(theta)/du_a = theta' J G grad N_a: the volume change's gradient.
+    const Eigen::MatrixXd theta_grad =
+        s.theta.slope * s.J * s.G * point.gradients.transpose();  // 3 x per
+    for (int c = 0; c < pressures; ++c)
+      out.forces[3 * per + c] += dV * point.corner_weights[c] * (s.theta.value - p / k);
+    if (!tangent) continue;
+    const Eigen::Matrix<double, 9, 9> A = dV * tangent_at_fixed_pressure(d.m, s, p);
     // K(3a + i, 3b + k) = dV sum_jl A(i + 3j, k + 3l) dN_a/dX_j dN_b/dX_l,
     // with C_a(i, k + 3l) = sum_j A(i + 3j, k + 3l) dN_a/dX_j first.
     for (int a = 0; a < per; ++a) {
-      C = p.gradients(a, 0) * A.topRows<3>() + p.gradients(a, 1) * A.middleRows<3>(3) +
-          p.gradients(a, 2) * A.bottomRows<3>();
+      C = point.gradients(a, 0) * A.topRows<3>() + point.gradients(a, 1) * A.middleRows<3>(3) +
+          point.gradients(a, 2) * A.bottomRows<3>();
       for (int b = 0; b < per; ++b)
-        out.tangent.block<3, 3>(3 * a, 3 * b) += p.gradients(b, 0) * C.leftCols<3>() +
-                                                 p.gradients(b, 1) * C.middleCols<3>(3) +
-                                                 p.gradients(b, 2) * C.rightCols<3>();
+        out.tangent.block<3, 3>(3 * a, 3 * b) += point.gradients(b, 0) * C.leftCols<3>() +
+                                                 point.gradients(b, 1) * C.middleCols<3>(3) +
+                                                 point.gradients(b, 2) * C.rightCols<3>();
+    }
+    const Eigen::Map<const Eigen::VectorXd> g(theta_grad.data(), 3 * per);
+    if (!d.mixed()) {  // p = k theta(J) changes with u too: k (dtheta/du)(dtheta/du)^T
+      out.tangent.topLeftCorner(3 * per, 3 * per) += dV * k * g * g.transpose();
+      continue;
+    }
+    for (int c = 0; c < pressures; ++c) {
+      out.tangent.block(0, 3 * per + c, 3 * per, 1) += dV * point.corner_weights[c] * g;
+      out.tangent.block(3 * per + c, 0, 1, 3 * per) += dV * point.corner_weights[c] * g.transpose();
+      for (int c2 = 0; c2 < pressures; ++c2)
+        out.tangent(3 * per + c, 3 * per + c2) -=
+            dV * point.corner_weights[c] * point.corner_weights[c2] / k;
     }
   }
-  // U''(Jbar) / V g g^T: the volumetric slope's own change (with one point,
-  // the pointwise U'' J^2 (G : dF) G).
-  const Eigen::Map<const Eigen::VectorXd> flat(g.data(), 3 * per);
-  out.tangent += U.curvature / volume * flat * flat.transpose();
   return out;
 }
 
-Eigen::VectorXd forces_of(const Mesh& mesh, const std::vector<RestElement>& rest,
-                          const HyperelasticMaterial& m, const Eigen::VectorXd& u, bool* valid) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh.num_dofs());
+Eigen::VectorXd forces_of(const Discretization& d, const Eigen::VectorXd& x, bool* valid) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(d.unknowns());
   bool all_valid = true;
-  for (int e = 0; e < mesh.elements.rows(); ++e) {
-    const ElementResponse r = respond(mesh, e, rest[static_cast<size_t>(e)], m, u, false);
+  for (int e = 0; e < d.mesh.elements.rows(); ++e) {
+    const ElementResponse r = respond(d, e, x, false);
     all_valid = all_valid && r.valid;
-    for (int a = 0; a < mesh.elements.cols(); ++a)
-      f.segment<3>(3 * mesh.elements(e, a)) += r.forces.segment<3>(3 * a);
+    for (size_t k = 0; k < r.unknowns.size(); ++k)
+      f[r.unknowns[k]] += r.forces[static_cast<Eigen::Index>(k)];
   }
   if (valid) *valid = all_valid;
   return f;
 }
 
-Eigen::SparseMatrix<double> tangent_of(const Mesh& mesh, const std::vector<RestElement>& rest,
-                                       const HyperelasticMaterial& m, const Eigen::VectorXd& u) {
-  const int per = static_cast<int>(mesh.elements.cols());
+Eigen::SparseMatrix<double> tangent_of(const Discretization& d, const Eigen::VectorXd& x) {
   std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(static_cast<size_t>(mesh.elements.rows()) * 9 * per * per);
-  for (int e = 0; e < mesh.elements.rows(); ++e) {
-    const ElementResponse r = respond(mesh, e, rest[static_cast<size_t>(e)], m, u, true);
-    for (int a = 0; a < per; ++a)
-      for (int b = 0; b < per; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int k = 0; k < 3; ++k)
-            entries.emplace_back(3 * mesh.elements(e, a) + i, 3 * mesh.elements(e, b) + k,
-                                 r.tangent(3 * a + i, 3 * b + k));
+  for (int e = 0; e < d.mesh.elements.rows(); ++e) {
+    const ElementResponse r = respond(d, e, x, true);
+    if (entries.empty()) entries.reserve(d.mesh.elements.rows() * r.unknowns.size() * r.unknowns.size());
+    for (size_t a = 0; a < r.unknowns.size(); ++a)
+      for (size_t b = 0; b < r.unknowns.size(); ++b)
+        entries.emplace_back(r.unknowns[a], r.unknowns[b],
+                             r.tangent(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)));
   }
-  Eigen::SparseMatrix<double> K(mesh.num_dofs(), mesh.num_dofs());
+  Eigen::SparseMatrix<double> K(d.unknowns(), d.unknowns());
   K.setFromTriplets(entries.begin(), entries.end());
   return K;
 }
 
-double energy_of(const Mesh& mesh, const std::vector<RestElement>& rest,
-                 const HyperelasticMaterial& m, const Eigen::VectorXd& u) {
+double energy_of(const Discretization& d, const Eigen::VectorXd& x) {
   double energy = 0.0;
-  for (int e = 0; e < mesh.elements.rows(); ++e)
-    energy += respond(mesh, e, rest[static_cast<size_t>(e)], m, u, false).energy;
+  for (int e = 0; e < d.mesh.elements.rows(); ++e) energy += respond(d, e, x, false).energy;
   return energy;
 }
 
 // The linear system's factorization: CHOLMOD for a positive definite
-// tangent, else a sparse LU.
+// tangent, else a sparse LU (an indefinite one: the mixed form's, or past a
+// limit point) of the system scaled symmetrically by its diagonal: the
+// mixed form's pressure block is smaller than its displacement block by
+// about (h / D)^2 mu / k (1e-20 for a stiff body on millimetre elements),
+// which costs the unscaled LU three digits of the answer.
 solve::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b,
                             Eigen::VectorXd* x) {
   solve::SparseCholesky cholesky;
@@ -264,11 +327,17 @@ solve::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::V
     *x = cholesky.solve(b);
     return {};
   }
+  Eigen::VectorXd scale(K.rows());
+  for (Eigen::Index i = 0; i < K.rows(); ++i) {
+    const double diagonal = std::abs(K.coeff(i, i));
+    scale[i] = diagonal > 0.0 ? 1.0 / std::sqrt(diagonal) : 1.0;
+  }
+  const Eigen::SparseMatrix<double> scaled = scale.asDiagonal() * K * scale.asDiagonal();
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-  lu.compute(K);
+  lu.compute(scaled);
   if (lu.info() != Eigen::Success)
     return solve::Status::failure("the tangent stiffness is singular (too few supports?)");
-  *x = lu.solve(b);
+  *x = scale.asDiagonal() * lu.solve(scale.asDiagonal() * b);
   return {};
 }
 
@@ -281,39 +350,44 @@ LoadState interpolate(const LoadState& a, const LoadState& b, double s) {
   return out;
 }
 
-// Newton from u (held values already in place) to equilibrium under `state`.
-// "" when converged, else why not; u is left at the last iterate.
-std::string newton(const Mesh& mesh, const std::vector<RestElement>& rest,
-                   const HyperelasticMaterial& m, const LoadState& state, const FreeUnknowns& split,
-                   const HyperelasticOptions& options, Eigen::VectorXd& u,
+// Newton from x (held values already in place) to equilibrium under `state`.
+// "" when converged, else why not; x is left at the last iterate.
+std::string newton(const Discretization& d, const LoadState& state, const FreeUnknowns& split,
+                   const HyperelasticOptions& options, Eigen::VectorXd& x,
                    HyperelasticSolution* solution) {
+  const int n = d.mesh.num_dofs();
   const auto residual = [&](const Eigen::VectorXd& at, bool* valid) {
-    return Eigen::VectorXd(forces_of(mesh, rest, m, at, valid) - state.forces);
+    Eigen::VectorXd R = forces_of(d, at, valid);
+    R.head(n) -= state.forces;
+    return R;
   };
   // Relative to the loads and the reactions at the same state (never to a
   // scale carried over from a wild iterate), or at least to mu D^2 (D the
   // body's diagonal: the force of a unit strain across it), so that a state
-  // with no force at all (a body turned rigidly) has a scale too.
+  // with no force at all (a body turned rigidly) has a scale too. The mixed
+  // form's volume rows count as the force k / D times their volume error.
   const double diagonal =
-      (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
-  const double floor = m.shear_modulus() * diagonal * diagonal;
+      (d.mesh.nodes.colwise().maxCoeff() - d.mesh.nodes.colwise().minCoeff()).norm();
+  const double floor = d.m.shear_modulus() * diagonal * diagonal;
+  const double pressure_row_scale = volumetric_modulus(d.m) / diagonal;
   const auto relative = [&](const Eigen::VectorXd& R) {
     double held = 0.0;
-    for (int d : state.held.dofs) held += R[d] * R[d];
+    for (int k : state.held.dofs) held += R[k] * R[k];
     const double scale = std::max({state.forces.norm(), std::sqrt(held), floor});
-    return split.restrict(R).norm() / scale;
+    Eigen::VectorXd free = split.restrict(R);
+    free.tail(d.pressure.count) *= pressure_row_scale;  // the pressures are never held
+    return free.norm() / scale;
   };
   // The total potential energy: strain energy less the dead loads' work.
   const auto potential = [&](const Eigen::VectorXd& at) {
-    return energy_of(mesh, rest, m, at) - state.forces.dot(at);
+    return energy_of(d, at) - state.forces.dot(at.head(n));
   };
   bool valid = true;
-  Eigen::VectorXd R = residual(u, &valid);
+  Eigen::VectorXd R = residual(x, &valid);
   if (!valid) return "an element is inverted at the step's start";
   for (int it = 0;; ++it) {
     const double norm = relative(R);
     solution->relative_residual = norm;
-    if (std::getenv("FF_DEBUG_NEWTON")) std::fprintf(stderr, "it %d residual %.3e\n", it, norm);
     if (!std::isfinite(norm)) return "the residual is not finite";
     if (norm <= options.tolerance) return {};
     if (it == options.max_iterations) {
@@ -321,23 +395,24 @@ std::string newton(const Mesh& mesh, const std::vector<RestElement>& rest,
       out << "no convergence in " << it << " Newton iterations (relative residual " << norm << ")";
       return out.str();
     }
-    Eigen::VectorXd du_free;
+    Eigen::VectorXd dx_free;
     const solve::Status status =
-        solve_tangent(split.free_block(tangent_of(mesh, rest, m, u)), -split.restrict(R), &du_free);
+        solve_tangent(split.free_block(tangent_of(d, x)), -split.restrict(R), &dx_free);
     if (!status.ok) return status.message;
-    Eigen::VectorXd du = Eigen::VectorXd::Zero(u.size());
-    split.scatter(du_free, du);
+    Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
+    split.scatter(dx_free, dx);
     // Backtracking. The loads are dead and the solid hyperelastic, so the
     // step is judged by the total potential energy (Armijo) where it descends
     // it: a bending body's first Newton step overshoots the residual but not
     // the energy (10 times fewer iterations on a bending cylinder). Where the
-    // tangent is indefinite, by the residual norm alone.
-    const double slope = split.restrict(R).dot(du_free);  // dPi/dalpha at 0
-    const bool by_energy = slope < 0.0;
-    const double energy = by_energy ? potential(u) : 0.0;
+    // tangent is indefinite, and in the mixed form (a saddle point, not a
+    // minimum), by the residual norm alone.
+    const double slope = split.restrict(R).dot(dx_free);  // dPi/dalpha at 0
+    const bool by_energy = !d.mixed() && slope < 0.0;
+    const double energy = by_energy ? potential(x) : 0.0;
     double alpha = 1.0;
     for (int halving = 0;; ++halving) {
-      const Eigen::VectorXd trial = u + alpha * du;
+      const Eigen::VectorXd trial = x + alpha * dx;
       bool trial_valid = true;
       const Eigen::VectorXd R_trial = residual(trial, &trial_valid);
       // (The residual's decrease is accepted too: near the solution the
@@ -346,7 +421,7 @@ std::string newton(const Mesh& mesh, const std::vector<RestElement>& rest,
           trial_valid && ((by_energy && potential(trial) <= energy + 1e-4 * alpha * slope) ||
                           relative(R_trial) <= (1.0 - 1e-4 * alpha) * norm);
       if (decrease) {
-        u = trial;
+        x = trial;
         R = R_trial;
         break;
       }
@@ -354,14 +429,13 @@ std::string newton(const Mesh& mesh, const std::vector<RestElement>& rest,
         return by_energy ? "the line search found no decrease of the energy"
                          : "the line search found no decrease of the residual";
       alpha *= 0.5;
-      if (std::getenv("FF_DEBUG_NEWTON")) std::fprintf(stderr, "  halve %d by_energy %d\n", halving, by_energy);
     }
     ++solution->newton_iterations;
   }
 }
 
-// A piece's first iterate: from the last equilibrium u0 along its tangent,
-// K_ff du_f = (f - f_int(u0))_f - K_fh du_h for the held values' change du_h
+// A piece's first iterate: from the last equilibrium x0 along its tangent,
+// K_ff dx_f = (f - f_int(x0))_f - K_fh dx_h for the held values' change dx_h
 // and the loads' (Wriggers, "Nonlinear finite element methods", 2008,
 // section 5.1: the tangent predictor). The free nodes then move with the
 // held ones, where holding them still would leave the elements beside the
@@ -369,27 +443,27 @@ std::string newton(const Mesh& mesh, const std::vector<RestElement>& rest,
 // in 4 steps took hundreds of damped Newton iterations so. The plain guess
 // (the held values set, the rest kept) where the tangent cannot be solved or
 // its prediction turns an element over.
-Eigen::VectorXd predicted_start(const Mesh& mesh, const std::vector<RestElement>& rest,
-                                const HyperelasticMaterial& m, const LoadState& state,
-                                const FreeUnknowns& split, const Eigen::VectorXd& u0) {
-  Eigen::VectorXd plain = u0, held_change = Eigen::VectorXd::Zero(u0.size());
+Eigen::VectorXd predicted_start(const Discretization& d, const LoadState& state,
+                                const FreeUnknowns& split, const Eigen::VectorXd& x0) {
+  Eigen::VectorXd plain = x0, held_change = Eigen::VectorXd::Zero(x0.size());
   for (size_t k = 0; k < state.held.dofs.size(); ++k) {
-    const int d = state.held.dofs[k];
-    plain[d] = state.held.values[k];
-    held_change[d] = state.held.values[k] - u0[d];
+    const int i = state.held.dofs[k];
+    plain[i] = state.held.values[k];
+    held_change[i] = state.held.values[k] - x0[i];
   }
-  const Eigen::SparseMatrix<double> K = tangent_of(mesh, rest, m, u0);
-  const Eigen::VectorXd rhs =
-      split.restrict(state.forces - forces_of(mesh, rest, m, u0, nullptr) - K * held_change);
-  Eigen::VectorXd du_free;
-  if (!solve_tangent(split.free_block(K), rhs, &du_free).ok) return plain;
-  Eigen::VectorXd predicted = plain;
-  Eigen::VectorXd du = Eigen::VectorXd::Zero(u0.size());
-  split.scatter(du_free, du);
-  predicted += du;
+  const Eigen::SparseMatrix<double> K = tangent_of(d, x0);
+  Eigen::VectorXd unbalanced = -forces_of(d, x0, nullptr);
+  unbalanced.head(d.mesh.num_dofs()) += state.forces;
+  Eigen::VectorXd dx_free;
+  if (!solve_tangent(split.free_block(K), split.restrict(unbalanced - K * held_change), &dx_free)
+           .ok)
+    return plain;
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(x0.size());
+  split.scatter(dx_free, dx);
+  const Eigen::VectorXd predicted = plain + dx;
   bool valid = true;
-  forces_of(mesh, rest, m, predicted, &valid);
-  return valid && du.allFinite() ? predicted : plain;
+  forces_of(d, predicted, &valid);
+  return valid && dx.allFinite() ? predicted : plain;
 }
 
 }  // namespace
@@ -406,46 +480,43 @@ Hyperelastic hyperelastic_from_string(const std::string& name) {
 }
 
 double strain_energy(const HyperelasticMaterial& m, const Eigen::Matrix3d& F) {
-  const double J = F.determinant();
-  if (!(J > 0.0)) return std::numeric_limits<double>::infinity();
-  return shape_energy(m, F, J) + volumetric(m, J).energy;
+  const PointState s = point_state(m, F);
+  if (!(s.J > 0.0)) return std::numeric_limits<double>::infinity();
+  return shape_energy(m, F, s.J) + 0.5 * volumetric_modulus(m) * s.theta.value * s.theta.value;
 }
 
 Eigen::Matrix3d first_piola_stress(const HyperelasticMaterial& m, const Eigen::Matrix3d& F) {
-  const double J = F.determinant();
-  if (!(J > 0.0)) return Eigen::Matrix3d::Constant(kNaN);
-  const Eigen::Matrix3d G = F.inverse().transpose();
-  return shape_stress(m, F, J, G) + volumetric(m, J).slope * J * G;
+  const PointState s = point_state(m, F);
+  if (!(s.J > 0.0)) return Eigen::Matrix3d::Constant(kNaN);
+  return stress(m, s, volumetric_modulus(m) * s.theta.value);
 }
 
 Eigen::Matrix<double, 9, 9> stress_tangent(const HyperelasticMaterial& m,
                                            const Eigen::Matrix3d& F) {
   Eigen::Matrix<double, 9, 9> A;
-  const double J = F.determinant();
-  if (!(J > 0.0)) return A.setConstant(kNaN);
-  const Eigen::Matrix3d G = F.inverse().transpose();
-  const Volumetric U = volumetric(m, J);
-  // The pointwise U(J): its slope's own change, U'' J^2 (G : dF) G, joins
-  // the terms of point_tangent.
-  A = point_tangent(m, F, J, G, U.slope);
-  const Eigen::Map<const Eigen::Matrix<double, 9, 1>> g(G.data());
-  A += U.curvature * J * J * g * g.transpose();
-  return A;
+  const PointState s = point_state(m, F);
+  if (!(s.J > 0.0)) return A.setConstant(kNaN);
+  const double k = volumetric_modulus(m);
+  const Eigen::Matrix3d dp = pressure_gradient(m, s);  // p = k theta(J) moves with F
+  const Eigen::Map<const Eigen::Matrix<double, 9, 1>> dp_flat(dp.data());
+  const Eigen::Matrix3d JG = s.theta.slope * s.J * s.G;
+  const Eigen::Map<const Eigen::Matrix<double, 9, 1>> JG_flat(JG.data());
+  return tangent_at_fixed_pressure(m, s, k * s.theta.value) + JG_flat * dp_flat.transpose();
 }
 
 Eigen::VectorXd internal_forces(const Mesh& mesh, const HyperelasticMaterial& m,
                                 const Eigen::VectorXd& u, bool* valid) {
-  return forces_of(mesh, rest_geometry(mesh), m, u, valid);
+  return forces_of(discretize(mesh, m, false), u, valid);
 }
 
 Eigen::SparseMatrix<double> tangent_stiffness(const Mesh& mesh, const HyperelasticMaterial& m,
                                               const Eigen::VectorXd& u) {
-  return tangent_of(mesh, rest_geometry(mesh), m, u);
+  return tangent_of(discretize(mesh, m, false), u);
 }
 
 double total_strain_energy(const Mesh& mesh, const HyperelasticMaterial& m,
                            const Eigen::VectorXd& u) {
-  return energy_of(mesh, rest_geometry(mesh), m, u);
+  return energy_of(discretize(mesh, m, false), u);
 }
 
 solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
@@ -453,16 +524,22 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
                                  HyperelasticSolution* solution) {
   check_tetrahedra(mesh);
   if (options.steps < 1) return solve::Status::failure("fem: steps must be at least 1");
+  const Discretization d = discretize(mesh, m, options.mixed);
   const int n = mesh.num_dofs();
   *solution = HyperelasticSolution{};
-  solution->u = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(d.unknowns());  // u, then the pressures
   LoadState done = path(1);  // the state at load factor 0: no forces, held at 0
   done.forces.setZero();
   for (double& value : done.held.values) value = 0.0;
-  for (int d : done.held.dofs)
-    if (d < 0 || d >= n) return solve::Status::failure("fem: a held unknown is out of range");
-  const FreeUnknowns split(n, done.held.dofs);
-  const std::vector<RestElement> rest = rest_geometry(mesh);
+  for (int k : done.held.dofs)
+    if (k < 0 || k >= n) return solve::Status::failure("fem: a held unknown is out of range");
+  const FreeUnknowns split(d.unknowns(), done.held.dofs);
+  const auto keep = [&](const Eigen::VectorXd& at) {
+    solution->u = at.head(n);
+    solution->pressure = at.tail(d.pressure.count);
+    solution->forces = forces_of(d, at, nullptr).head(n);
+  };
+  keep(x);
 
   for (int step = 1; step <= options.steps; ++step) {
     const LoadState target = path(step);
@@ -475,10 +552,11 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
     while (reached < 1.0) {
       const double s = std::min(1.0, reached + piece);
       const LoadState state = interpolate(done, target, s);
-      Eigen::VectorXd u = predicted_start(mesh, rest, m, state, split, solution->u);
-      const std::string why = newton(mesh, rest, m, state, split, options, u, solution);
+      Eigen::VectorXd trial = predicted_start(d, state, split, x);
+      const std::string why = newton(d, state, split, options, trial, solution);
       if (why.empty()) {
-        solution->u = u;
+        x = trial;
+        keep(x);
         reached = s;
         continue;
       }
@@ -492,6 +570,34 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
     done = target;
     solution->path.push_back(solution->u);
   }
+  return {};
+}
+
+solve::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
+                                 const LoadState& state, const HyperelasticOptions& options,
+                                 HyperelasticSolution* solution) {
+  const Discretization d = discretize(mesh, m, options.mixed);
+  const int n = mesh.num_dofs();
+  for (int k : state.held.dofs)
+    if (k < 0 || k >= n) return solve::Status::failure("fem: a held unknown is out of range");
+  if (state.forces.size() != n) return solve::Status::failure("fem: one force per unknown needed");
+  const FreeUnknowns split(d.unknowns(), state.held.dofs);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(d.unknowns()), held = x;
+  for (size_t k = 0; k < state.held.dofs.size(); ++k) held[state.held.dofs[k]] = state.held.values[k];
+  const Eigen::SparseMatrix<double> K = tangent_of(d, x);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(d.unknowns());
+  f.head(n) = state.forces;
+  Eigen::VectorXd free;
+  const solve::Status status =
+      solve_tangent(split.free_block(K), split.restrict(f - K * held), &free);
+  if (!status.ok) return solve::Status::failure("fem: " + status.message);
+  x = held;
+  split.scatter(free, x);
+  *solution = HyperelasticSolution{};
+  solution->u = x.head(n);
+  solution->pressure = x.tail(d.pressure.count);
+  solution->forces = (K * x).head(n);
+  solution->path.push_back(solution->u);
   return {};
 }
 

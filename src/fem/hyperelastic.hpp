@@ -57,7 +57,7 @@ Eigen::Matrix3d first_piola_stress(const HyperelasticMaterial& m, const Eigen::M
 Eigen::Matrix<double, 9, 9> stress_tangent(const HyperelasticMaterial& m, const Eigen::Matrix3d& F);
 
 // A mesh of tetrahedra (Mesh with dim 3 and 4 or 10 nodes per element)
-// displaced by u (node by node): the internal forces (the gradient of the
+// displaced by u, in the displacement form (node by node): the internal forces (the gradient of the
 // total strain energy) and their Jacobian, the tangent stiffness. `valid`
 // (when given) is false when an element is inverted; the forces are then NaN.
 Eigen::VectorXd internal_forces(const Mesh& mesh, const HyperelasticMaterial& m,
@@ -81,11 +81,17 @@ struct HyperelasticOptions {
   int max_iterations = 30;  // Newton iterations per step
   double tolerance = 1e-9;  // |free residual| / force scale
   int max_step_cuts = 8;    // halvings of a step that fails
+  // The mixed (u, p) form: a linear pressure on the corners of quadratic
+  // tetrahedra (Taylor-Hood P2-P1), which does not lock as nu -> 1/2; false:
+  // the displacement form, W(F) at each point.
+  bool mixed = false;
 };
 
 struct HyperelasticSolution {
   Eigen::VectorXd u;                  // at the last step reached
   std::vector<Eigen::VectorXd> path;  // u after each load step
+  Eigen::VectorXd pressure;           // the mixed form's, per corner node (empty otherwise)
+  Eigen::VectorXd forces;  // the internal forces at u: at the held unknowns, the reactions
   int newton_iterations = 0;
   int step_cuts = 0;
   double relative_residual = 0.0;  // at the last state
@@ -99,6 +105,14 @@ struct HyperelasticSolution {
 // by CHOLMOD, or by a sparse LU where it is not positive definite.
 solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
                                  const LoadPath& path, const HyperelasticOptions& options,
+                                 HyperelasticSolution* solution);
+
+// Small strain: one solve of the tangent at rest under `state` (its forces
+// and held values), which is linear elasticity with E and nu (in the mixed
+// form when options.mixed). Fills solution->u, pressure, forces and a
+// one-entry path.
+solve::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
+                                 const LoadState& state, const HyperelasticOptions& options,
                                  HyperelasticSolution* solution);
 
 }  // namespace fiberfluid::fem

@@ -118,6 +118,9 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   c = base_config();
   c["fem_reference"] = {{"E", 1000}, {"nu", 0.3}, {"material", "mooney"}};
   expect_config_error(dir, c, "fem_reference.material: ");
+  c = base_config();
+  c["fem_reference"] = {{"E", 1000}, {"nu", 0.3}, {"order", 3}};
+  expect_config_error(dir, c, "fem_reference.order: ");
 
   // Found from outside (issue 11): each aborted, read out of bounds, or
   // silently did something else.
