@@ -8,6 +8,7 @@ namespace fiberfluid::solve {
 struct SparseCholesky::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   bool analyzed = false;
+  bool empty = false;  // no unknowns (everything held): CHOLMOD would crash on it
 };
 
 SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {
@@ -18,12 +19,14 @@ SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 void SparseCholesky::analyze_pattern(const Eigen::SparseMatrix<double>& A) {
-  impl_->llt.analyzePattern(A);
+  impl_->empty = A.rows() == 0;
+  if (!impl_->empty) impl_->llt.analyzePattern(A);
   impl_->analyzed = true;
 }
 
 Status SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
   if (!impl_->analyzed) analyze_pattern(A);
+  if (impl_->empty) return {};
   impl_->llt.factorize(A);
   if (impl_->llt.info() != Eigen::Success)
     return Status::failure("CHOLMOD: the matrix is not positive definite");
@@ -31,6 +34,7 @@ Status SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
 }
 
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
+  if (impl_->empty) return Eigen::VectorXd(0);
   return impl_->llt.solve(b);
 }
 

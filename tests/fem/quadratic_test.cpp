@@ -197,3 +197,27 @@ TEST(ClosedForms, ATwistedAndAnInflatedTubeConvergeAtSecondOrder) {
 
 }  // namespace
 }  // namespace fiberfluid::fem
+
+namespace fiberfluid::fem {
+namespace {
+
+// Every unknown held leaves no system to solve (CHOLMOD crashed on the empty
+// matrix): the answer is the held values, and their reactions.
+TEST(QuadraticTetrahedra, ABodyHeldEverywhereIsItsHeldValues) {
+  TubeMeshSpec tube;  // one cell across and along: every corner on a held surface
+  tube.order = 1;
+  HyperelasticOptions options;
+  options.steps = 2;
+  const ClosedFormRun run = tube_torsion(tube, nearly_incompressible(), 1.0, options);
+  EXPECT_GT(run.figures[0].computed, run.figures[0].exact);  // locked, but solved
+  Eigen::VectorXd u;
+  Constraints all;
+  const Mesh mesh = tube_mesh(tube);
+  for (int d = 0; d < mesh.num_dofs(); ++d) all.hold(d, 0.001 * d);
+  Material m;
+  ASSERT_TRUE(solve_static(stiffness_matrix(mesh, m), Eigen::VectorXd::Zero(mesh.num_dofs()), all, &u).ok);
+  EXPECT_DOUBLE_EQ(u[7], 0.007);
+}
+
+}  // namespace
+}  // namespace fiberfluid::fem
