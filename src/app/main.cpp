@@ -23,6 +23,7 @@
 #include "fiberfluid/experiment/compare.hpp"
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/fitting.hpp"
+#include "fiberfluid/experiment/mesh_study.hpp"
 #include "fiberfluid/experiment/output_folder.hpp"
 #include "fiberfluid/experiment/outputs.hpp"
 #include "fiberfluid/experiment/runner.hpp"
@@ -746,6 +747,51 @@ int fit_command(const std::string& path, const RunFlags& flags,
   return kOk;
 }
 
+struct StudyFlags {
+  std::string experiment, output;
+  bool fem = false;
+  int levels = 3;
+  double ratio = 1.5;
+  std::vector<std::string> figures;
+};
+
+// fiberfluid study mesh: the levels' values, observed orders and
+// extrapolations as a table, and study.csv / study.json in the output folder.
+int study_command(const StudyFlags& flags) {
+  experiment::MeshStudySpec spec;
+  spec.mesh = flags.fem ? experiment::StudiedMesh::FemReference : experiment::StudiedMesh::Surface;
+  spec.levels = flags.levels;
+  spec.ratio = flags.ratio;
+  spec.figures = flags.figures;
+  const std::filesystem::path output =
+      flags.output.empty()
+          ? std::filesystem::path("out") /
+                (std::filesystem::path(flags.experiment).stem().string() + "_mesh_study")
+          : std::filesystem::path(flags.output);
+  const experiment::MeshStudy study = experiment::run_mesh_study(
+      flags.experiment, spec, [](const std::string& line) { std::cerr << line << "\n"; });
+  std::printf("%-40s", "figure");
+  for (size_t k = 0; k < study.resolutions.size(); ++k) std::printf(" %14s", ("level " + std::to_string(k + 1)).c_str());
+  std::printf(" %8s %14s %11s\n", "order", "extrapolated", "error est.");
+  for (const experiment::StudiedFigure& f : study.figures) {
+    std::printf("%-40s", f.name.c_str());
+    for (double v : f.values) std::printf(" %14.7g", v);
+    if (f.estimate.monotone && std::isfinite(f.estimate.order))
+      std::printf(" %8.2f %14.7g %11.3g\n", f.estimate.order, f.estimate.extrapolated,
+                  f.estimate.error);
+    else
+      std::printf(" %8s %14s %11.3g\n", "-", "(not monotone)", f.estimate.error);
+  }
+  for (size_t k = 0; k < study.resolutions.size(); ++k)
+    std::printf("level %zu: %s, relative size %.4g, %.1f s\n", k + 1, study.resolutions[k].c_str(),
+                study.sizes[k], study.seconds[k]);
+  std::filesystem::create_directories(output);
+  fiberfluid::geom::write_text_file(output / "study.csv", experiment::mesh_study_csv(study));
+  fiberfluid::geom::write_text_file(output / "study.json", experiment::mesh_study_json(study).dump(2) + "\n");
+  std::printf("wrote %s and %s\n", (output / "study.csv").c_str(), (output / "study.json").c_str());
+  return kOk;
+}
+
 int compare_command(const std::string& reference, const std::string& approximation,
                     const std::string& undeformed, bool as_json) {
   const experiment::Comparison c = experiment::compare_files(
@@ -937,6 +983,31 @@ int main(int argc, char** argv) {
                       "The undeformed surface M0 (same vertices as both): adds E_n and E_i");
   compare->add_flag("--json", as_json, "Print JSON instead of text");
 
+  StudyFlags study_flags;
+  CLI::App* study = cli.add_subcommand(
+      "study", "Studies of an experiment: `study mesh` runs it at several resolutions");
+  CLI::App* mesh_study = study->add_subcommand(
+      "mesh",
+      "Run an experiment at several resolutions (its surface's, or with --fem its FEM "
+      "reference's element size) and print each figure's values, observed order and "
+      "Richardson-extrapolated value with an error estimate");
+  study->require_subcommand(1);
+  mesh_study->add_option("experiment", study_flags.experiment, "Experiment file (JSON)")
+      ->required();
+  mesh_study->add_option("-o,--output", study_flags.output,
+                         "Output folder for study.csv and study.json (default: "
+                         "out/<experiment>_mesh_study)");
+  mesh_study->add_flag("--fem", study_flags.fem,
+                       "Refine the FEM reference's element size (fem_reference.size) instead "
+                       "of the surface");
+  mesh_study->add_option("--levels", study_flags.levels, "Resolutions, coarse to fine (at least 3)")
+      ->check(CLI::Range(3, 8));
+  mesh_study->add_option("--ratio", study_flags.ratio,
+                         "Refinement between levels (element size, coarse over fine)")
+      ->check(CLI::Range(1.1, 4.0));
+  mesh_study->add_option("--figure", study_flags.figures,
+                         "A figure to study (repeatable; default: every figure)");
+
   CLI::App* schema = cli.add_subcommand(
       "schema",
       "Print the JSON Schema of experiment files (for an editor: \"$schema\" or its settings)");
@@ -980,6 +1051,7 @@ int main(int argc, char** argv) {
     }
     if (compare->parsed())
       return compare_command(compared_reference, compared, undeformed, as_json);
+    if (study->parsed()) return study_command(study_flags);
     return check_command(mesh, flip);
   } catch (const fiberfluid::Interrupted& e) {
     std::cerr << "\nerror: " << e.what() << " (Ctrl-C): nothing was written; an earlier "

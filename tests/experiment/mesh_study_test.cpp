@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fiberfluid/experiment/mesh_study.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "../app/cli_support.hpp"
+#include "../test_support.hpp"
+#include "fiberfluid/util/error.hpp"
+
+namespace fiberfluid::experiment {
+namespace {
+
+using json = nlohmann::json;
+
+TEST(MeshStudy, RichardsonFindsTheOrderAndTheLimitOfASmoothSequence) {
+  // f(h) = 2 + 0.3 h^2 - 0.1 h^3 is dominated by its h^2 term: on h = 1, 1/1.5,
+  // 1/2.25 and on the unequal h = 1, 0.6, 0.35 the order is near 2 and the
+  // extrapolation far closer to 2 than the finest value.
+  const auto f = [](double h) { return 2.0 + 0.3 * h * h - 0.01 * h * h * h; };
+  for (const auto& h : {std::vector<double>{1.0, 1.0 / 1.5, 1.0 / 2.25},
+                        std::vector<double>{1.0, 0.6, 0.35}}) {
+    const RichardsonEstimate e = richardson(f(h[0]), f(h[1]), f(h[2]), h[0], h[1], h[2]);
+    EXPECT_TRUE(e.monotone);
+    EXPECT_NEAR(e.order, 2.0, 0.1);
+    EXPECT_LT(std::abs(e.extrapolated - 2.0), 0.05 * std::abs(f(h[2]) - 2.0));
+    EXPECT_NEAR(e.error, std::abs(e.extrapolated - f(h[2])), 1e-15);
+  }
+  // Exactly second order: exact.
+  const RichardsonEstimate exact = richardson(1.0 + 1.0, 1.0 + 0.25, 1.0 + 0.0625, 1.0, 0.5, 0.25);
+  EXPECT_NEAR(exact.order, 2.0, 1e-10);
+  EXPECT_NEAR(exact.extrapolated, 1.0, 1e-12);
+  // Changes of both signs have no order: the last change is the estimate.
+  const RichardsonEstimate oscillating = richardson(1.0, 1.1, 1.05, 1.0, 0.5, 0.25);
+  EXPECT_FALSE(oscillating.monotone);
+  EXPECT_TRUE(std::isnan(oscillating.order));
+  EXPECT_NEAR(oscillating.error, 0.05, 1e-12);
+}
+
+TEST(MeshStudy, RefinesWhatTheFileGivesAndNamesWhatItLacks) {
+  std::string resolution;
+  double factor = 0.0;
+  json cylinder = {{"surface", {{"generator", "cylinder"}, {"segments", {18, 16}}}},
+                   {"fem_reference", {{"E", 1000}, {"nu", 0.3}, {"size", 0.01}}}};
+  json refined = refined_document(cylinder, StudiedMesh::Surface, 1.5, &resolution, &factor);
+  EXPECT_EQ(refined["surface"]["segments"], json({27, 24}));
+  EXPECT_EQ(resolution, "segments [27, 24]");
+  EXPECT_DOUBLE_EQ(factor, 1.5);
+  refined = refined_document(cylinder, StudiedMesh::FemReference, 2.0, &resolution, &factor);
+  EXPECT_DOUBLE_EQ(refined["fem_reference"]["size"].get<double>(), 0.005);
+  EXPECT_EQ(refined["surface"], cylinder["surface"]);  // the surface kept
+  json file = {{"surface", {{"file", "liver.obj"}, {"remesh_vertices", 1000}}}};
+  refined = refined_document(file, StudiedMesh::Surface, 2.0, &resolution, &factor);
+  EXPECT_EQ(refined["surface"]["remesh_vertices"], 4000);  // vertices as h^-2
+  EXPECT_DOUBLE_EQ(factor, 2.0);
+  const auto refusal = [&](const json& document, StudiedMesh mesh, double by) {
+    try {
+      refined_document(document, mesh, by, &resolution, &factor);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal({{"surface", {{"file", "liver.obj"}}}}, StudiedMesh::Surface, 2.0)
+                .find("surface: expected the resolution"),
+            std::string::npos);
+  EXPECT_NE(refusal({{"surface", {{"generator", "icosphere"}, {"subdivisions", 2}}}},
+                    StudiedMesh::Surface, 1.5)
+                .find("surface.subdivisions: refines by factors of 2"),
+            std::string::npos);
+  EXPECT_NE(refusal(file, StudiedMesh::FemReference, 2.0).find("fem_reference.size"),
+            std::string::npos);
+}
+
+TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
+  const testing::ScratchDir dir;
+  std::ifstream in(testing::experiment_file("sphere.json"));
+  json sphere = json::parse(in);
+  sphere["surface"]["subdivisions"] = 1;
+  sphere.erase("expected");
+  sphere["surface"]["radius"] = 1.0;
+  const auto file = dir.write("sphere.json", sphere.dump());
+  const testing::Outcome outcome =
+      testing::run_cli("study mesh " + file.string() + " --ratio 2 --figure max_displacement -o " +
+                       (dir.path() / "study").string());
+  ASSERT_EQ(outcome.status, 0) << outcome.output;
+  EXPECT_NE(outcome.output.find("level 3: subdivisions 3"), std::string::npos) << outcome.output;
+  std::ifstream study_file(dir.path() / "study" / "study.json");
+  const json study = json::parse(study_file);
+  const json& figure = study["figures"]["max_displacement"];
+  ASSERT_EQ(figure["values"].size(), 3u);
+  EXPECT_TRUE(figure["monotone"].get<bool>());
+  EXPECT_GT(figure["observed_order"].get<double>(), 1.0);  // the paper's sphere: about 1.6
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "study.csv"));
+  // A file it cannot refine: named, exit status of bad input.
+  sphere["surface"].erase("subdivisions");
+  const auto bare = dir.write("bare.json", sphere.dump());
+  const testing::Outcome refused = testing::run_cli("study mesh " + bare.string() + " --ratio 2");
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.output.find("surface: expected the resolution"), std::string::npos)
+      << refused.output;
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment
