@@ -589,6 +589,27 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
 // Every fit file is in the folder before it moves into place: DIR for a fit
 // that converged, DIR.failed for one that did not, DIR.interrupted (the best
 // point so far, for fit.start_from) for one stopped by SIGINT or SIGTERM.
+// Each parameter on the other mesh beside its statistical interval; a
+// warning where the mesh moves it further than the data pin it.
+void print_mesh_check(const fiberfluid::fit::FitResult& fitted,
+                      const experiment::MeshCheck& check) {
+  std::cout << "  mesh check (" << check.resolution << ", "
+            << fiberfluid::fit::to_string(check.fitted.status) << "):\n";
+  for (size_t k = 0; k < fitted.names.size() && k < check.fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    const double shift = check.fitted.values[i] - fitted.values[i];
+    const double half_width =
+        fitted.upper_95.size() > i ? 0.5 * (fitted.upper_95[i] - fitted.lower_95[i]) : 0.0;
+    std::printf("    %s = %.6g there: mesh shift %+.4g (%.2g%%), the 95%% interval's half-width %.4g\n",
+                fitted.names[k].c_str(), check.fitted.values[i], shift,
+                100.0 * shift / fitted.values[i], half_width);
+    if (std::isfinite(half_width) && std::abs(shift) > half_width)
+      std::cerr << "warning: the mesh moves " << fitted.names[k]
+                << " further than its statistical interval: the fitted value is this mesh's "
+                   "model's more than the material's (refine the mesh, or report the shift)\n";
+  }
+}
+
 int fit_command(const std::string& path, const RunFlags& flags,
                 const fiberfluid::parallel::Ranks& ranks) {
   namespace fit = fiberfluid::fit;
@@ -702,6 +723,7 @@ int fit_command(const std::string& path, const RunFlags& flags,
     return experiment::fit_exit_status(fitted.status);
   }
   experiment::ExperimentResult result;
+  std::optional<experiment::MeshCheck> mesh_check;
   if (fitted.status != fit::FitStatus::StartFailed) {
     result = experiment::run_experiment(
         at_fit, [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
@@ -709,6 +731,13 @@ int fit_command(const std::string& path, const RunFlags& flags,
         });
     stop_if_interrupted("the run at the fitted values");
     for (const auto& [name, value] : experiment::fit_figures(fitted)) result.figures[name] = value;
+    if (ex.fit->mesh_check != "none" && experiment::fit_result_kept(fitted.status)) {
+      if (!flags.quiet) std::cerr << "mesh check: the fit again on a " << ex.fit->mesh_check << " mesh\n";
+      mesh_check = experiment::run_mesh_check(at_fit);
+      stop_if_interrupted("the mesh check");
+      for (const auto& [name, value] : experiment::mesh_check_figures(fitted, *mesh_check))
+        result.figures[name] = value;
+    }
     if (search)
       for (const auto& [name, value] : experiment::multistart_figures(*search))
         result.figures[name] = value;
@@ -728,6 +757,7 @@ int fit_command(const std::string& path, const RunFlags& flags,
   if (!fitted.status_detail.empty()) std::cout << "  " << fitted.status_detail << "\n";
   if (search) print_optima(*search, names);
   print_fit(fitted);
+  if (mesh_check) print_mesh_check(fitted, *mesh_check);
   for (const experiment::FigureCheck& c : result.checks) std::cout << "  " << c.Describe() << "\n";
   if (!result.runs_succeeded()) {
     for (const experiment::RunResult& run : result.runs)

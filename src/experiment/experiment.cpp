@@ -647,6 +647,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     spec.parameters.push_back(parameter);
   }
   if (spec.parameters.empty()) f.fail("parameters", "expected at least one parameter to fit");
+  spec.mesh_check = f.choice("mesh_check", "none", {"none", "coarser", "finer"});
   if (f.has("start_from")) {
     spec.start_from = f.string("start_from");
     if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;

@@ -49,6 +49,10 @@ struct FitSpec {
   // several starts spread over the bounds.
   std::optional<fit::MultistartOptions> multistart;
   std::optional<SelectionSpec> exclude;  // vertices whose distances do not count
+  // "coarser" or "finer": the fit is repeated on the surface refined by 1/1.5
+  // or 1.5 (1/2 or 2 for subdivisions), from the fitted values, and each
+  // parameter's shift reported as its mesh uncertainty. "none": not.
+  std::string mesh_check = "none";
 };
 
 }  // namespace fiberfluid::experiment

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "fiberfluid/experiment/figures.hpp"
+#include "fiberfluid/experiment/mesh_study.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/geom/vtk_writer.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -249,6 +250,47 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
     figures["fit.force_rms"] = force.rms;
     figures["fit.force_largest"] = force.largest;
     figures["fit.force_rms_share"] = force.scale > 0.0 ? force.rms / force.scale : 0.0;
+  }
+  return figures;
+}
+
+MeshCheck run_mesh_check(const Experiment& at_fit) {
+  if (!at_fit.fit || at_fit.fit->mesh_check == "none")
+    throw std::logic_error("run_mesh_check: the fit asks for no mesh check");
+  // The fit as resolved, at the fitted material: Levenberg-Marquardt from
+  // there (a multi-start search has found its optimum), nothing checked.
+  json document = at_fit.resolved;
+  document.erase("expected");
+  json& fit_section = document["fit"];
+  fit_section["mesh_check"] = "none";
+  for (const char* key : {"start_from", "starts", "same_optimum"}) fit_section.erase(key);
+  if (fit_section.value("method", "") == "multistart") fit_section["method"] = "levenberg-marquardt";
+  const bool by_halves = document.contains("surface") && document["surface"].contains("subdivisions");
+  const double ratio = by_halves ? 2.0 : 1.5;
+  const double factor = at_fit.fit->mesh_check == "coarser" ? 1.0 / ratio : ratio;
+  MeshCheck check;
+  double actual = 0.0;
+  json refined;
+  try {
+    refined = refined_document(document, StudiedMesh::Surface, factor, &check.resolution, &actual);
+  } catch (const InputError& e) {
+    throw InputError("fit.mesh_check: " + std::string(e.what()));
+  }
+  const Experiment other = parse_experiment(
+      refined, at_fit.source.parent_path(),
+      at_fit.source.string() + " [mesh check, " + check.resolution + "]");
+  FitSetup setup = setup_fit(other, {});
+  check.fitted = setup.calibration->run();
+  return check;
+}
+
+std::map<std::string, double> mesh_check_figures(const fit::FitResult& fitted,
+                                                 const MeshCheck& check) {
+  std::map<std::string, double> figures;
+  for (size_t k = 0; k < fitted.names.size() && k < check.fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    figures["fit.mesh_check." + fitted.names[k]] = check.fitted.values[i];
+    figures["fit.mesh_shift." + fitted.names[k]] = check.fitted.values[i] - fitted.values[i];
   }
   return figures;
 }

@@ -51,6 +51,24 @@ nlohmann::json fit_json(const Experiment& experiment, const FitSetup& setup,
                         const fit::MultistartResult* search = nullptr);
 
 // The experiment with the fitted material (to run and write as usual).
+// fit.mesh_check: the same fit on the surface one step coarser or finer
+// (mesh_study.hpp's refinement: 1.5 for segments and remesh_vertices, 2 for
+// subdivisions), from the fitted values (`at_fit`: with_fitted_material's).
+// Its parameters' shifts from the fit are the mesh's share of their
+// uncertainty: what the data pin is one mesh's model, and this says how far
+// the material moves with the mesh. Throws InputError naming the field when
+// the surface has no resolution to change.
+struct MeshCheck {
+  std::string resolution;  // the other mesh's, e.g. "segments [12, 11]"
+  fit::FitResult fitted;   // on it
+};
+MeshCheck run_mesh_check(const Experiment& at_fit);
+
+// The mesh check's figures: fit.mesh_check.NAME (the value on the other mesh)
+// and fit.mesh_shift.NAME (that less the fit's).
+std::map<std::string, double> mesh_check_figures(const fit::FitResult& fitted,
+                                                 const MeshCheck& check);
+
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
                                 const fit::FitResult& result);
 

@@ -225,6 +225,9 @@ TEST(ACaseIsBuiltFromItsOwnSpecAlone, AFitsResolvedExperimentIsItsRunAtTheFitted
 
 TEST(FitConfig, BadFitSectionsAreNamed) {
   nlohmann::json d = sphere_fit_document();
+  d["fit"]["mesh_check"] = "sideways";
+  expect_fit_error(d, "doc: fit.mesh_check: ");
+  d = sphere_fit_document();
   d["fit"]["parameters"][0]["name"] = "stiffness";
   expect_fit_error(d, "doc: fit.parameters[0].name: \"stiffness\" is not a parameter");
   // A fit's figure that names no fitted parameter, once the parameters are good.

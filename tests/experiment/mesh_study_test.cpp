@@ -103,5 +103,36 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
       << refused.output;
 }
 
+// fit.mesh_check: the paper's sphere fitted exactly on its own mesh
+// (subdivisions 2) and again on the next coarser (1): the coarse sphere needs
+// other parameters, and the shift, far beyond the exact fit's interval, is
+// reported and warned of.
+TEST(FitMeshCheck, AFitReportsHowFarItsParametersMoveOnACoarserMesh) {
+  const testing::ScratchDir dir;
+  std::ifstream in(testing::experiment_file("fit_sphere.json"));
+  json fit = json::parse(in);
+  fit["fit"]["mesh_check"] = "coarser";
+  fit.erase("expected");
+  fit["fit"]["targets"][0]["file"] =
+      (testing::experiment_file("fit_sphere.json").parent_path() /
+       fit["fit"]["targets"][0]["file"].get<std::string>())
+          .string();
+  const auto file = dir.write("fit.json", fit.dump());
+  const testing::Outcome outcome =
+      testing::run_cli("fit " + file.string() + " -q -o " + (dir.path() / "out").string());
+  ASSERT_EQ(outcome.status, 0) << outcome.output;
+  EXPECT_NE(outcome.output.find("mesh check (subdivisions 1"), std::string::npos) << outcome.output;
+  EXPECT_NE(outcome.output.find("warning: the mesh moves gamma further than its statistical"),
+            std::string::npos)
+      << outcome.output;
+  std::ifstream summary_file(dir.path() / "out" / "summary.json");
+  const json figures = json::parse(summary_file)["figures"];
+  EXPECT_NEAR(figures["fit.gamma"].get<double>(), 3000.0, 1e-3);  // the fit itself: exact
+  const double shift = figures["fit.mesh_shift.gamma"].get<double>();
+  EXPECT_GT(std::abs(shift), 10.0);
+  EXPECT_NEAR(figures["fit.mesh_check.gamma"].get<double>(),
+              figures["fit.gamma"].get<double>() + shift, 1e-9);
+}
+
 }  // namespace
 }  // namespace fiberfluid::experiment
