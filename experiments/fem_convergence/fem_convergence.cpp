@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The nonlinear FEM reference against closed forms at large strain (issue
-// 44): torsion of a thick tube and its inflation in plane strain
+// 44): torsion of a thick tube, its inflation in plane strain, and a thick
+// sphere's inflation
 // (fem/closed_forms.hpp): linear tetrahedra (P1), quadratic ones (P2) and
 // quadratic ones with a linear pressure (the mixed form, P2-P1), at four
 // refinements. Prints each figure's relative error and the observed order
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   std::string csv = "out/fem_convergence.csv";
   std::vector<std::string> elements = {"P1", "P2", "P2-P1"};
   int steps = 16;
+  std::vector<std::string> problems = {"torsion", "inflation", "sphere"};
   app.add_option("--levels", levels, "refinements (cells 1, 2, 3, ... across the wall)")
       ->check(CLI::Range(2, 8));
   app.add_option("--nu", nu, "Poisson's ratio of the nearly incompressible solid")
@@ -51,6 +53,10 @@ int main(int argc, char** argv) {
                  "P1 (linear tetrahedra), P2 (quadratic), P2-P1 (quadratic with a linear "
                  "pressure: the mixed form)")
       ->check(CLI::IsMember({"P1", "P2", "P2-P1"}));
+  app.add_option("--problems", problems,
+                 "torsion (a tube twisted), inflation (a tube in plane strain), sphere (a thick "
+                 "sphere inflated)")
+      ->check(CLI::IsMember({"torsion", "inflation", "sphere"}));
   app.add_option("--steps", steps, "load steps")->check(CLI::Range(1, 1000));
   app.add_option("--csv", csv, "where to write the table");
   CLI11_PARSE(app, argc, argv);
@@ -62,7 +68,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   std::printf("%-10s %-12s %6s %5s %7s %8s %14s %14s %10s %6s %7s %6s\n", "problem", "figure",
               "element", "level", "nodes", "h", "computed", "exact", "rel.error", "rate", "s", "newton");
-  for (const std::string problem : {"torsion", "inflation"})
+  for (const std::string& problem : problems)
     for (const std::string& element : elements) {
       std::vector<Row> previous;
       for (int level = 1; level <= levels; ++level) {
@@ -79,9 +85,14 @@ int main(int argc, char** argv) {
         options.tolerance = 1e-8;
         options.mixed = element == "P2-P1";
         const auto start = std::chrono::steady_clock::now();
+        ff::ShellMeshSpec shell;  // radii 0.5 and 1 as the tube's
+        shell.around = 2 * level;
+        shell.radial = level;
+        shell.order = tube.order;
         const ff::ClosedFormRun run =
-            problem == "torsion" ? ff::tube_torsion(tube, material, 1.0, options)  // 100% shear at B
-                                 : ff::tube_inflation(tube, material, 2.0, options);  // a = 2 A
+            problem == "torsion"     ? ff::tube_torsion(tube, material, 1.0, options)  // 100% shear at B
+            : problem == "inflation" ? ff::tube_inflation(tube, material, 2.0, options)  // a = 2 A
+                                     : ff::sphere_inflation(shell, material, 1.5, options);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double h = 0.5 / level;

@@ -127,4 +127,44 @@ ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMateria
   return run;
 }
 
+ClosedFormRun sphere_inflation(const ShellMeshSpec& shell, const HyperelasticMaterial& material,
+                               double inner_stretch, const HyperelasticOptions& options) {
+  const Mesh mesh = shell_octant_mesh(shell);
+  const double A = shell.inner_radius, B = shell.outer_radius, a = inner_stretch * A;
+  const auto on_sphere = [&](int v, double radius) {
+    return std::abs(mesh.nodes.row(v).norm() - radius) <= kOnSurface * radius;
+  };
+  // The symmetry planes hold their normal displacement; the inner surface
+  // is pushed out along its radii.
+  const HeldAxes held = [&](int v) -> Eigen::Vector3i {
+    if (on_sphere(v, A)) return Eigen::Vector3i::Ones();
+    Eigen::Vector3i axes;
+    for (int k = 0; k < 3; ++k) axes[k] = std::abs(mesh.nodes(v, k)) <= kOnSurface * B ? 1 : 0;
+    return axes;
+  };
+  const Prescribed push = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
+    return s * (inner_stretch - 1.0) * X;
+  };
+  const HyperelasticSolution solution =
+      solve_prescribed(mesh, material, held, push, options, "sphere inflation");
+  const Eigen::VectorXd& f = solution.forces;
+  double pushing = 0.0, outer_sum = 0.0;
+  int outer_nodes = 0;
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    const Eigen::Vector3d X = mesh.nodes.row(v).transpose();
+    if (on_sphere(v, A)) pushing += X.normalized().dot(f.segment<3>(3 * v));
+    if (on_sphere(v, B)) {
+      outer_sum += (X + solution.u.segment<3>(3 * v)).norm();
+      ++outer_nodes;
+    }
+  }
+  const double b = std::cbrt(B * B * B + a * a * a - A * A * A), mu = material.shear_modulus();
+  const double la = a / A, lb = b / B;
+  ClosedFormRun run = run_of(mesh, solution);
+  run.figures = {{"pressure", pushing / (M_PI * a * a / 2.0),  // an octant's share of 4 pi a^2
+                  mu * (2.0 / lb + 0.5 / std::pow(lb, 4) - 2.0 / la - 0.5 / std::pow(la, 4))},
+                 {"outer_radius", outer_sum / outer_nodes, b}};
+  return run;
+}
+
 }  // namespace fiberfluid::fem

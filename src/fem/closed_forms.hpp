@@ -19,6 +19,10 @@
 //   the ends held along z, the outer surface free; r^2 = R^2 + a^2 - A^2, so
 //   the outer surface moves to b = sqrt(B^2 + a^2 - A^2), under the inner
 //   pressure mu [ln(a B / (A b)) + (a^2 - A^2) / 2 (1 / a^2 - 1 / b^2)].
+// - Inflation of a thick sphere (an octant on its symmetry planes): the
+//   inner surface pushed out from A to a, the outer free; r^3 = R^3 + a^3 -
+//   A^3, the outer surface at b = (B^3 + a^3 - A^3)^(1/3), under the inner
+//   pressure mu [2/l_b + 1/(2 l_b^4) - 2/l_a - 1/(2 l_a^4)], l = r/R.
 
 #include <string>
 #include <vector>
@@ -46,5 +50,7 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
                            double twist, const HyperelasticOptions& options);
 ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMaterial& material,
                              double inner_stretch, const HyperelasticOptions& options);
+ClosedFormRun sphere_inflation(const ShellMeshSpec& shell, const HyperelasticMaterial& material,
+                               double inner_stretch, const HyperelasticOptions& options);
 
 }  // namespace fiberfluid::fem

@@ -55,6 +55,30 @@ void split_face(const std::vector<int>& face, std::vector<std::vector<int>>* kep
   }
 }
 
+// Middle nodes (numbered from `corners`) at the mean distance of their
+// edge's ends from the origin (a sphere's centre) or from the z axis (a
+// cylinder's), on the ray through the chord's middle.
+void curve_middle_nodes(Mesh& mesh, int corners, bool about_axis) {
+  const auto reach = [&](int v) -> double {
+    return about_axis ? mesh.nodes.row(v).head<2>().norm() : mesh.nodes.row(v).norm();
+  };
+  for (Eigen::Index e = 0; e < mesh.elements.rows(); ++e)
+    for (size_t edge = 0; edge < kTetrahedronEdges.size(); ++edge) {
+      const int a = mesh.elements(e, kTetrahedronEdges[edge][0]),
+                b = mesh.elements(e, kTetrahedronEdges[edge][1]),
+                middle = mesh.elements(e, 4 + static_cast<Eigen::Index>(edge));
+      if (middle < corners) continue;
+      const double radius = 0.5 * (reach(a) + reach(b));
+      if (about_axis) {
+        const Eigen::Vector2d chord = mesh.nodes.row(middle).head<2>();
+        mesh.nodes.row(middle).head<2>() = radius * chord.normalized();
+      } else {
+        const Eigen::RowVector3d chord = mesh.nodes.row(middle);
+        mesh.nodes.row(middle) = radius * chord.normalized();
+      }
+    }
+}
+
 }  // namespace
 
 Mesh to_simplices(const Mesh& mesh) {
@@ -205,19 +229,74 @@ Mesh tube_mesh(const TubeMeshSpec& spec) {
   if (spec.order == 1) return mesh;
   const int corners = mesh.num_nodes();
   mesh = to_quadratic(mesh);
-  // A middle node at the mean radius of its edge's ends, on the ray through
-  // the chord's middle: on the cylinders where both ends are.
-  for (Eigen::Index e2 = 0; e2 < mesh.elements.rows(); ++e2)
-    for (size_t edge = 0; edge < kTetrahedronEdges.size(); ++edge) {
-      const int a = mesh.elements(e2, kTetrahedronEdges[edge][0]),
-                b = mesh.elements(e2, kTetrahedronEdges[edge][1]),
-                middle = mesh.elements(e2, 4 + static_cast<Eigen::Index>(edge));
-      if (middle < corners) continue;
-      const double radius = 0.5 * (mesh.nodes.row(a).head<2>().norm() +
-                                   mesh.nodes.row(b).head<2>().norm());
-      const Eigen::Vector2d chord = mesh.nodes.row(middle).head<2>();
-      mesh.nodes.row(middle).head<2>() = radius * chord.normalized();
+  curve_middle_nodes(mesh, corners, true);
+  return mesh;
+}
+
+Mesh shell_octant_mesh(const ShellMeshSpec& spec) {
+  if (!(spec.inner_radius > 0.0 && spec.outer_radius > spec.inner_radius) || spec.around < 1 ||
+      spec.radial < 1 || (spec.order != 1 && spec.order != 2))
+    throw InputError("fem: a shell needs 0 < inner < outer radius, at least 1 x 1 cells and "
+                     "order 1 or 2");
+  const int n = spec.around, layers = spec.radial;
+  // The octant's sphere triangle: points (i, j) with i + j <= n.
+  std::vector<Eigen::RowVector3d> directions;
+  std::map<std::pair<int, int>, int> point;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i + j <= n; ++i) {
+      point[{i, j}] = static_cast<int>(directions.size());
+      directions.push_back(Eigen::RowVector3d(i, j, n - i - j).normalized());
     }
+  std::vector<std::array<int, 3>> triangles;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i + j < n; ++i) {
+      triangles.push_back({point[{i, j}], point[{i + 1, j}], point[{i, j + 1}]});
+      if (i + j + 1 < n) triangles.push_back({point[{i + 1, j}], point[{i + 1, j + 1}], point[{i, j + 1}]});
+    }
+  const int per_layer = static_cast<int>(directions.size());
+  Mesh mesh;
+  mesh.dim = 3;
+  mesh.nodes.resize(per_layer * (layers + 1), 3);
+  for (int k = 0; k <= layers; ++k) {
+    const double r = spec.inner_radius + (spec.outer_radius - spec.inner_radius) * k / layers;
+    for (int v = 0; v < per_layer; ++v) mesh.nodes.row(k * per_layer + v) = r * directions[v];
+  }
+  std::vector<std::array<int, 4>> tets;
+  for (int k = 0; k < layers; ++k)
+    for (const auto& t : triangles) {
+      std::array<int, 6> prism = {t[0] + k * per_layer,       t[1] + k * per_layer,
+                                  t[2] + k * per_layer,       t[0] + (k + 1) * per_layer,
+                                  t[1] + (k + 1) * per_layer, t[2] + (k + 1) * per_layer};
+      // Renumber the prism so that its smallest node is V0 (a rotation of the
+      // triangles, and a swap of bottom and top), then split by the smaller
+      // of the two diagonals through V0's opposite quadrilateral.
+      const int smallest = static_cast<int>(std::min_element(prism.begin(), prism.end()) - prism.begin());
+      static const int rotations[6][6] = {{0, 1, 2, 3, 4, 5}, {1, 2, 0, 4, 5, 3},
+                                          {2, 0, 1, 5, 3, 4}, {3, 5, 4, 0, 2, 1},
+                                          {4, 3, 5, 1, 0, 2}, {5, 4, 3, 2, 1, 0}};
+      std::array<int, 6> V;
+      for (int a = 0; a < 6; ++a) V[a] = prism[rotations[smallest][a]];
+      if (std::min(V[1], V[5]) < std::min(V[2], V[4]))
+        for (const auto& tet : {std::array<int, 4>{V[0], V[1], V[2], V[5]},
+                                std::array<int, 4>{V[0], V[1], V[5], V[4]},
+                                std::array<int, 4>{V[0], V[4], V[5], V[3]}})
+          tets.push_back(tet);
+      else
+        for (const auto& tet : {std::array<int, 4>{V[0], V[1], V[2], V[4]},
+                                std::array<int, 4>{V[0], V[4], V[2], V[5]},
+                                std::array<int, 4>{V[0], V[4], V[5], V[3]}})
+          tets.push_back(tet);
+    }
+  mesh.elements.resize(static_cast<Eigen::Index>(tets.size()), 4);
+  for (size_t e = 0; e < tets.size(); ++e) {
+    std::vector<int> s(tets[e].begin(), tets[e].end());
+    if (simplex_orientation(mesh.nodes, s) < 0.0) std::swap(s[1], s[2]);
+    for (int k = 0; k < 4; ++k) mesh.elements(static_cast<Eigen::Index>(e), k) = s[static_cast<size_t>(k)];
+  }
+  if (spec.order == 1) return mesh;
+  const int corners = mesh.num_nodes();
+  mesh = to_quadratic(mesh);
+  curve_middle_nodes(mesh, corners, false);
   return mesh;
 }
 

@@ -55,6 +55,20 @@ struct TubeMeshSpec {
 };
 Mesh tube_mesh(const TubeMeshSpec& spec);
 
+// An octant (x, y, z >= 0) of a thick spherical shell: the octant's sphere
+// triangle cut into `around`^2 triangles (no pole: every cell is well
+// shaped), extruded through `radial` layers into prisms, each split into 3
+// tetrahedra by the smallest-index rule (Dompierre et al., "How to subdivide
+// pyramids, prisms and hexahedra into tetrahedra", 1999: neighbours then
+// split their shared faces alike). Order 2 puts the middle nodes on the
+// spheres (isoparametric), as tube_mesh does.
+struct ShellMeshSpec {
+  double inner_radius = 0.5, outer_radius = 1.0;
+  int around = 4, radial = 2;
+  int order = 1;
+};
+Mesh shell_octant_mesh(const ShellMeshSpec& spec);
+
 // Displacements u (node by node) as #nodes x dim, and positions x0 + u.
 Eigen::MatrixXd displacement_rows(const Eigen::VectorXd& u, int dim);
 
