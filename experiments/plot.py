@@ -10,6 +10,10 @@ displacement and the pressure of every run, one curve per variant; the
 reactions of the supports; for paddle experiments, the force of each moving
 paddle against its travel (the force-compression curve), one curve per variant;
 and for a round-trip sweep, Eq. 9 against n for each scheme.
+
+Given a mesh study's study.json (fiberfluid study mesh) instead: each figure
+against the relative element size h, with its Richardson-extrapolated value
+at h = 0 and the error estimate drawn as a band.
 """
 import csv
 import json
@@ -117,9 +121,38 @@ def run_folder(folder, run):
     return os.path.join(folder, run["variant"]) if run["variant"] else folder
 
 
+def plot_study(study, png_path):
+    figures = study["figures"]
+    h = study["relative_sizes"]
+    n = len(figures)
+    cols = min(3, n)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows), squeeze=False)
+    for ax, (name, f) in zip(axes.flat, sorted(figures.items())):
+        ax.plot(h, f["values"], "o-", label="levels")
+        if f["monotone"] and f["observed_order"] is not None:
+            x = f["extrapolated"]
+            ax.plot([0.0], [x], "s", color="C3", label=f"extrapolated (order {f['observed_order']:.2f})")
+            ax.axhspan(x - f["error_estimate"], x + f["error_estimate"], color="C3", alpha=0.15)
+        else:
+            ax.set_title("not monotone: no order", fontsize=8, loc="right")
+        ax.set_xlim(left=-0.04)
+        ax.set_xlabel("element size, relative to the coarsest")
+        ax.set_ylabel(name, fontsize=8)
+        ax.legend(fontsize=7)
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    fig.suptitle(os.path.basename(study["experiment"]) + ": mesh study (" + study["refined"] + ")")
+    fig.tight_layout()
+    fig.savefig(png_path, dpi=110)
+
+
 def main(summary_path, png_path):
     with open(summary_path) as f:
         summary = json.load(f)
+    if "relative_sizes" in summary:  # a mesh study
+        plot_study(summary, png_path)
+        return
     folder = os.path.dirname(summary_path) or "."
     runs = [r for r in summary.get("runs", []) if r["steps"]]
     if not runs:

@@ -231,7 +231,7 @@ std::filesystem::path plot_script() {
 // --plot: DIR/plot.png from DIR/summary.json, drawn by the plot script with
 // the first python3 that has matplotlib (the one on PATH, else Debian's). A
 // plot that cannot be drawn is a warning: the results are written already.
-void draw_plot(const std::filesystem::path& folder) {
+void draw_plot(const std::filesystem::path& folder, const std::string& input = "summary.json") {
   const std::filesystem::path script = plot_script();
   if (!std::filesystem::exists(script)) {
     std::cerr << "warning: no plot: the plot script " << script.string() << " is missing\n";
@@ -242,7 +242,7 @@ void draw_plot(const std::filesystem::path& folder) {
       continue;
     const std::filesystem::path png = folder / "plot.png";
     const std::string command = std::string(python) + " " + shell_quoted(script.string()) + " " +
-                                shell_quoted((folder / "summary.json").string()) + " " +
+                                shell_quoted((folder / input).string()) + " " +
                                 shell_quoted(png.string());
     if (std::system(command.c_str()) == 0 && std::filesystem::exists(png))
       std::cout << "  plot: " << png.string() << "\n";
@@ -783,6 +783,7 @@ struct StudyFlags {
   int levels = 3;
   double ratio = 1.5;
   std::vector<std::string> figures;
+  bool plot = false;
 };
 
 // fiberfluid study mesh: the levels' values, observed orders and
@@ -819,6 +820,7 @@ int study_command(const StudyFlags& flags) {
   fiberfluid::geom::write_text_file(output / "study.csv", experiment::mesh_study_csv(study));
   fiberfluid::geom::write_text_file(output / "study.json", experiment::mesh_study_json(study).dump(2) + "\n");
   std::printf("wrote %s and %s\n", (output / "study.csv").c_str(), (output / "study.json").c_str());
+  if (flags.plot) draw_plot(output, "study.json");
   return kOk;
 }
 
@@ -1037,6 +1039,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.1, 4.0));
   mesh_study->add_option("--figure", study_flags.figures,
                          "A figure to study (repeatable; default: every figure)");
+  mesh_study->add_flag("--plot", study_flags.plot,
+                       "Also draw DIR/plot.png: each figure against the element size, with its "
+                       "extrapolation (python3 with matplotlib)");
 
   CLI::App* schema = cli.add_subcommand(
       "schema",

@@ -83,7 +83,8 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   sphere["surface"]["radius"] = 1.0;
   const auto file = dir.write("sphere.json", sphere.dump());
   const testing::Outcome outcome =
-      testing::run_cli("study mesh " + file.string() + " --ratio 2 --figure max_displacement -o " +
+      testing::run_cli("study mesh " + file.string() +
+                       " --ratio 2 --figure max_displacement --plot -o " +
                        (dir.path() / "study").string());
   ASSERT_EQ(outcome.status, 0) << outcome.output;
   EXPECT_NE(outcome.output.find("level 3: subdivisions 3"), std::string::npos) << outcome.output;
@@ -94,6 +95,7 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   EXPECT_TRUE(figure["monotone"].get<bool>());
   EXPECT_GT(figure["observed_order"].get<double>(), 1.0);  // the paper's sphere: about 1.6
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "study.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "plot.png")) << outcome.output;
   // A file it cannot refine: named, exit status of bad input.
   sphere["surface"].erase("subdivisions");
   const auto bare = dir.write("bare.json", sphere.dump());
