@@ -206,8 +206,8 @@ Discretization discretize(const Mesh& mesh, const HyperelasticMaterial& m, bool 
 // pressure rows are the volume constraint's residual integral M_i (theta -
 // p/k), which the stationary point zeroes. The pair converges at second
 // order and does not lock as nu -> 1/2, where quadratic tetrahedra alone do
-// (a thick tube twisted at nu = 0.4999: torque 6% and axial force tenfold off
-// on 4 cells across).
+// (a thick tube twisted at nu = 0.4999, 2 cells across its wall: torque 6%
+// and axial force tenfold off; docs/model.md has the table).
 struct ElementResponse {
   bool valid = true;
   double energy = 0.0;
