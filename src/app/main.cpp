@@ -794,11 +794,12 @@ int study_command(const StudyFlags& flags) {
   spec.levels = flags.levels;
   spec.ratio = flags.ratio;
   spec.figures = flags.figures;
-  const std::filesystem::path output =
-      flags.output.empty()
-          ? std::filesystem::path("out") /
-                (std::filesystem::path(flags.experiment).stem().string() + "_mesh_study")
-          : std::filesystem::path(flags.output);
+  // A result folder like run's and fit's: checked before the study runs,
+  // staged, and put in place whole.
+  const std::string name =
+      experiment::folder_name_from(std::filesystem::path(flags.experiment).stem().string()) +
+      "_mesh_study";
+  const std::filesystem::path output = experiment::output_folder(flags.output, name);
   const experiment::MeshStudy study = experiment::run_mesh_study(
       flags.experiment, spec, [](const std::string& line) { std::cerr << line << "\n"; });
   std::printf("%-40s", "figure");
@@ -816,9 +817,13 @@ int study_command(const StudyFlags& flags) {
   for (size_t k = 0; k < study.resolutions.size(); ++k)
     std::printf("level %zu: %s, relative size %.4g, %.1f s\n", k + 1, study.resolutions[k].c_str(),
                 study.sizes[k], study.seconds[k]);
-  std::filesystem::create_directories(output);
-  fiberfluid::geom::write_text_file(output / "study.csv", experiment::mesh_study_csv(study));
-  fiberfluid::geom::write_text_file(output / "study.json", experiment::mesh_study_json(study).dump(2) + "\n");
+  const std::filesystem::path staging = experiment::create_staging_folder(output, name);
+  fiberfluid::geom::write_text_file(staging / "study.csv", experiment::mesh_study_csv(study));
+  fiberfluid::geom::write_text_file(staging / "study.json",
+                                    experiment::mesh_study_json(study).dump(2) + "\n");
+  std::vector<std::string> warnings;
+  experiment::move_into_place(staging, output, &warnings);
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
   std::printf("wrote %s and %s\n", (output / "study.csv").c_str(), (output / "study.json").c_str());
   if (flags.plot) draw_plot(output, "study.json");
   return kOk;

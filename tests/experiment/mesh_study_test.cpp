@@ -96,6 +96,18 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   EXPECT_GT(figure["observed_order"].get<double>(), 1.0);  // the paper's sphere: about 1.6
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "study.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "plot.png")) << outcome.output;
+  // Run again into the same folder: replaced whole. Into a folder fiberfluid
+  // did not write: refused before anything runs, the folder kept.
+  const testing::Outcome again = testing::run_cli(
+      "study mesh " + file.string() + " --ratio 2 --figure max_displacement -o " +
+      (dir.path() / "study").string());
+  EXPECT_EQ(again.status, 0) << again.output;
+  dir.write("notes.txt", "mine");
+  const testing::Outcome foreign = testing::run_cli(
+      "study mesh " + file.string() + " --ratio 2 -o " + dir.path().string());
+  EXPECT_NE(foreign.status, 0);
+  EXPECT_EQ(foreign.output.find("level 1 of 3"), std::string::npos) << foreign.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "notes.txt"));
   // A file it cannot refine: named, exit status of bad input.
   sphere["surface"].erase("subdivisions");
   const auto bare = dir.write("bare.json", sphere.dump());
