@@ -12,8 +12,38 @@ namespace {
 
 constexpr double kOnSurface = 1e-9;  // relative to the tube's size
 
-bool on_radius(const Mesh& mesh, int v, double radius) {
-  return std::abs(mesh.nodes.row(v).head<2>().norm() - radius) <= kOnSurface * radius;
+// A point's distance from the z axis (a tube's) or from the origin (a
+// sphere's centre), and the unit vector away from it.
+enum class Centre { Axis, Point };
+Eigen::Vector3d outward(const Eigen::Vector3d& x, Centre centre) {
+  return centre == Centre::Axis ? Eigen::Vector3d(x.x(), x.y(), 0.0) : x;
+}
+bool on_radius(const Mesh& mesh, int v, double radius, Centre centre = Centre::Axis) {
+  return std::abs(outward(mesh.nodes.row(v).transpose(), centre).norm() - radius) <=
+         kOnSurface * radius;
+}
+
+// What an inflation measures: the inner surface's outward reactions summed
+// (the pressure times the deformed area), and the outer surface's mean
+// deformed radius.
+struct Inflated {
+  double pushing = 0.0, outer_radius = 0.0;
+};
+Inflated measure_inflation(const Mesh& mesh, const HyperelasticSolution& solution, double inner,
+                           double outer, Centre centre) {
+  Inflated out;
+  int outer_nodes = 0;
+  for (int v = 0; v < mesh.num_nodes(); ++v) {
+    const Eigen::Vector3d X = mesh.nodes.row(v).transpose();
+    if (on_radius(mesh, v, inner, centre))
+      out.pushing += outward(X, centre).normalized().dot(solution.forces.segment<3>(3 * v));
+    if (on_radius(mesh, v, outer, centre)) {
+      out.outer_radius += outward(X + solution.u.segment<3>(3 * v), centre).norm();
+      ++outer_nodes;
+    }
+  }
+  out.outer_radius /= outer_nodes;
+  return out;
 }
 
 // Each node's prescribed displacement (where `held` says so, per axis) at
@@ -106,24 +136,13 @@ ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMateria
       solve_prescribed(mesh, material, held, push, options, "inflation");
   // The pressure: the inner surface's outward reactions over its deformed
   // area; the outer radius: the mean over the outer surface's nodes.
-  const Eigen::VectorXd& f = solution.forces;
-  double pushing = 0.0, outer_sum = 0.0;
-  int outer_nodes = 0;
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    const Eigen::Vector3d X = mesh.nodes.row(v).transpose();
-    const Eigen::Vector2d radial = X.head<2>().normalized();
-    if (on_radius(mesh, v, A)) pushing += radial.dot(f.segment<2>(3 * v));
-    if (on_radius(mesh, v, B)) {
-      outer_sum += (X + solution.u.segment<3>(3 * v)).head<2>().norm();
-      ++outer_nodes;
-    }
-  }
+  const Inflated inflated = measure_inflation(mesh, solution, A, B, Centre::Axis);
   const double b = std::sqrt(B * B + a * a - A * A), mu = material.shear_modulus();
   ClosedFormRun run = run_of(mesh, solution);
   run.figures = {
-      {"pressure", pushing / (2.0 * M_PI * a * L),
+      {"pressure", inflated.pushing / (2.0 * M_PI * a * L),
        mu * (std::log(a * B / (A * b)) + 0.5 * (a * a - A * A) * (1.0 / (a * a) - 1.0 / (b * b)))},
-      {"outer_radius", outer_sum / outer_nodes, b}};
+      {"outer_radius", inflated.outer_radius, b}};
   return run;
 }
 
@@ -131,13 +150,10 @@ ClosedFormRun sphere_inflation(const ShellMeshSpec& shell, const HyperelasticMat
                                double inner_stretch, const HyperelasticOptions& options) {
   const Mesh mesh = shell_octant_mesh(shell);
   const double A = shell.inner_radius, B = shell.outer_radius, a = inner_stretch * A;
-  const auto on_sphere = [&](int v, double radius) {
-    return std::abs(mesh.nodes.row(v).norm() - radius) <= kOnSurface * radius;
-  };
   // The symmetry planes hold their normal displacement; the inner surface
   // is pushed out along its radii.
   const HeldAxes held = [&](int v) -> Eigen::Vector3i {
-    if (on_sphere(v, A)) return Eigen::Vector3i::Ones();
+    if (on_radius(mesh, v, A, Centre::Point)) return Eigen::Vector3i::Ones();
     Eigen::Vector3i axes;
     for (int k = 0; k < 3; ++k) axes[k] = std::abs(mesh.nodes(v, k)) <= kOnSurface * B ? 1 : 0;
     return axes;
@@ -147,23 +163,13 @@ ClosedFormRun sphere_inflation(const ShellMeshSpec& shell, const HyperelasticMat
   };
   const HyperelasticSolution solution =
       solve_prescribed(mesh, material, held, push, options, "sphere inflation");
-  const Eigen::VectorXd& f = solution.forces;
-  double pushing = 0.0, outer_sum = 0.0;
-  int outer_nodes = 0;
-  for (int v = 0; v < mesh.num_nodes(); ++v) {
-    const Eigen::Vector3d X = mesh.nodes.row(v).transpose();
-    if (on_sphere(v, A)) pushing += X.normalized().dot(f.segment<3>(3 * v));
-    if (on_sphere(v, B)) {
-      outer_sum += (X + solution.u.segment<3>(3 * v)).norm();
-      ++outer_nodes;
-    }
-  }
+  const Inflated inflated = measure_inflation(mesh, solution, A, B, Centre::Point);
   const double b = std::cbrt(B * B * B + a * a * a - A * A * A), mu = material.shear_modulus();
   const double la = a / A, lb = b / B;
   ClosedFormRun run = run_of(mesh, solution);
-  run.figures = {{"pressure", pushing / (M_PI * a * a / 2.0),  // an octant's share of 4 pi a^2
+  run.figures = {{"pressure", inflated.pushing / (M_PI * a * a / 2.0),  // an octant's 4 pi a^2
                   mu * (2.0 / lb + 0.5 / std::pow(lb, 4) - 2.0 / la - 0.5 / std::pow(la, 4))},
-                 {"outer_radius", outer_sum / outer_nodes, b}};
+                 {"outer_radius", inflated.outer_radius, b}};
   return run;
 }
 
