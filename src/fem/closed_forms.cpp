@@ -23,6 +23,12 @@ bool on_radius(const Mesh& mesh, int v, double radius, Centre centre = Centre::A
          kOnSurface * radius;
 }
 
+// On the tube's end z = 0 or z = length.
+bool on_end(const Mesh& mesh, int v, double length) {
+  return mesh.nodes(v, 2) <= kOnSurface * length ||
+         mesh.nodes(v, 2) >= (1.0 - kOnSurface) * length;
+}
+
 // What an inflation measures: the inner surface's outward reactions summed
 // (the pressure times the deformed area), and the outer surface's mean
 // deformed radius.
@@ -89,11 +95,8 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
                            double twist, const HyperelasticOptions& options) {
   const Mesh mesh = tube_mesh(tube);
   const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
-  const auto is_end = [&](int v) {
-    return mesh.nodes(v, 2) <= kOnSurface * L || mesh.nodes(v, 2) >= (1.0 - kOnSurface) * L;
-  };
   const HeldAxes held = [&](int v) -> Eigen::Vector3i {
-    return is_end(v) || on_radius(mesh, v, A) ? Eigen::Vector3i::Ones() : Eigen::Vector3i::Zero();
+    return on_end(mesh, v, L) || on_radius(mesh, v, A) ? Eigen::Vector3i::Ones() : Eigen::Vector3i::Zero();
   };
   const Prescribed torsion = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
     return Eigen::AngleAxisd(s * twist * X.z(), Eigen::Vector3d::UnitZ()) * X - X;
@@ -122,12 +125,9 @@ ClosedFormRun tube_inflation(const TubeMeshSpec& tube, const HyperelasticMateria
   const Mesh mesh = tube_mesh(tube);
   const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
   const double a = inner_stretch * A;
-  const auto is_end = [&](int v) {
-    return mesh.nodes(v, 2) <= kOnSurface * L || mesh.nodes(v, 2) >= (1.0 - kOnSurface) * L;
-  };
   const HeldAxes held = [&](int v) -> Eigen::Vector3i {
     const int inner = on_radius(mesh, v, A) ? 1 : 0;
-    return {inner, inner, is_end(v) ? 1 : 0};
+    return {inner, inner, on_end(mesh, v, L) ? 1 : 0};
   };
   const Prescribed push = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
     return {s * (inner_stretch - 1.0) * X.x(), s * (inner_stretch - 1.0) * X.y(), 0.0};

@@ -4,8 +4,6 @@
 #include <Eigen/LU>
 #include <Eigen/SparseLU>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -148,11 +146,6 @@ Eigen::Matrix<double, 9, 9> tangent_at_fixed_pressure(const HyperelasticMaterial
   return A;
 }
 
-// dp/dF of the displacement form's pointwise p = k theta(J): k theta' J G.
-Eigen::Matrix3d pressure_gradient(const HyperelasticMaterial& m, const PointState& s) {
-  return volumetric_modulus(m) * s.theta.slope * s.J * s.G;
-}
-
 // Where the mixed form's pressure lives: one value per corner node of the
 // quadratic tetrahedra (continuous and linear: the Taylor-Hood pair P2-P1),
 // numbered after the displacements.
@@ -246,12 +239,12 @@ ElementResponse respond(const Discretization& d, int e, const Eigen::VectorXd& x
     out.energy += dV * (shape_energy(d.m, s.F, s.J) + p * s.theta.value - 0.5 * p * p / k);
     const Eigen::MatrixXd P_grad = dV * stress(d.m, s, p) * point.gradients.transpose();
     for (int a = 0; a < per; ++a) out.forces.segment<3>(3 * a) += P_grad.col(a);
-    // d(theta)/du_a = theta' J G grad N_a: the volume change's gradient.
-    const Eigen::MatrixXd theta_grad =
-        s.theta.slope * s.J * s.G * point.gradients.transpose();  // 3 x per
     for (int c = 0; c < pressures; ++c)
       out.forces[3 * per + c] += dV * point.corner_weights[c] * (s.theta.value - p / k);
     if (!tangent) continue;
+    // d(theta)/du_a = theta' J G grad N_a: the volume change's gradient.
+    const Eigen::MatrixXd theta_grad =
+        s.theta.slope * s.J * s.G * point.gradients.transpose();  // 3 x per
     const Eigen::Matrix<double, 9, 9> A = dV * tangent_at_fixed_pressure(d.m, s, p);
     // K(3a + i, 3b + k) = dV sum_jl A(i + 3j, k + 3l) dN_a/dX_j dN_b/dX_l,
     // with C_a(i, k + 3l) = sum_j A(i + 3j, k + 3l) dN_a/dX_j first.
@@ -351,10 +344,12 @@ LoadState interpolate(const LoadState& a, const LoadState& b, double s) {
 }
 
 // Newton from x (held values already in place) to equilibrium under `state`.
-// "" when converged, else why not; x is left at the last iterate.
+// "" when converged (`internal` then holds the internal forces at x, which
+// the next piece and the reactions need), else why not; x is left at the
+// last iterate.
 std::string newton(const Discretization& d, const LoadState& state, const FreeUnknowns& split,
                    const HyperelasticOptions& options, Eigen::VectorXd& x,
-                   HyperelasticSolution* solution) {
+                   HyperelasticSolution* solution, Eigen::VectorXd* internal) {
   const int n = d.mesh.num_dofs();
   const auto residual = [&](const Eigen::VectorXd& at, bool* valid) {
     Eigen::VectorXd R = forces_of(d, at, valid);
@@ -389,7 +384,11 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
     const double norm = relative(R);
     solution->relative_residual = norm;
     if (!std::isfinite(norm)) return "the residual is not finite";
-    if (norm <= options.tolerance) return {};
+    if (norm <= options.tolerance) {
+      *internal = R;
+      internal->head(n) += state.forces;
+      return {};
+    }
     if (it == options.max_iterations) {
       std::ostringstream out;
       out << "no convergence in " << it << " Newton iterations (relative residual " << norm << ")";
@@ -434,7 +433,8 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
   }
 }
 
-// A piece's first iterate: from the last equilibrium x0 along its tangent,
+// A piece's first iterate: from the last equilibrium x0 (internal forces
+// internal0) along its tangent,
 // K_ff dx_f = (f - f_int(x0))_f - K_fh dx_h for the held values' change dx_h
 // and the loads' (Wriggers, "Nonlinear finite element methods", 2008,
 // section 5.1: the tangent predictor). The free nodes then move with the
@@ -444,7 +444,8 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
 // (the held values set, the rest kept) where the tangent cannot be solved or
 // its prediction turns an element over.
 Eigen::VectorXd predicted_start(const Discretization& d, const LoadState& state,
-                                const FreeUnknowns& split, const Eigen::VectorXd& x0) {
+                                const FreeUnknowns& split, const Eigen::VectorXd& x0,
+                                const Eigen::VectorXd& internal0) {
   Eigen::VectorXd plain = x0, held_change = Eigen::VectorXd::Zero(x0.size());
   for (size_t k = 0; k < state.held.dofs.size(); ++k) {
     const int i = state.held.dofs[k];
@@ -452,7 +453,7 @@ Eigen::VectorXd predicted_start(const Discretization& d, const LoadState& state,
     held_change[i] = state.held.values[k] - x0[i];
   }
   const Eigen::SparseMatrix<double> K = tangent_of(d, x0);
-  Eigen::VectorXd unbalanced = -forces_of(d, x0, nullptr);
+  Eigen::VectorXd unbalanced = -internal0;
   unbalanced.head(d.mesh.num_dofs()) += state.forces;
   Eigen::VectorXd dx_free;
   if (!solve_tangent(split.free_block(K), split.restrict(unbalanced - K * held_change), &dx_free)
@@ -496,12 +497,11 @@ Eigen::Matrix<double, 9, 9> stress_tangent(const HyperelasticMaterial& m,
   Eigen::Matrix<double, 9, 9> A;
   const PointState s = point_state(m, F);
   if (!(s.J > 0.0)) return A.setConstant(kNaN);
+  // p = k theta(J) moves with F too: dp/dF = k theta' J G, times P's theta' J G.
   const double k = volumetric_modulus(m);
-  const Eigen::Matrix3d dp = pressure_gradient(m, s);  // p = k theta(J) moves with F
-  const Eigen::Map<const Eigen::Matrix<double, 9, 1>> dp_flat(dp.data());
   const Eigen::Matrix3d JG = s.theta.slope * s.J * s.G;
   const Eigen::Map<const Eigen::Matrix<double, 9, 1>> JG_flat(JG.data());
-  return tangent_at_fixed_pressure(m, s, k * s.theta.value) + JG_flat * dp_flat.transpose();
+  return tangent_at_fixed_pressure(m, s, k * s.theta.value) + k * JG_flat * JG_flat.transpose();
 }
 
 Eigen::VectorXd internal_forces(const Mesh& mesh, const HyperelasticMaterial& m,
@@ -534,12 +534,13 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
   for (int k : done.held.dofs)
     if (k < 0 || k >= n) return solve::Status::failure("fem: a held unknown is out of range");
   const FreeUnknowns split(d.unknowns(), done.held.dofs);
-  const auto keep = [&](const Eigen::VectorXd& at) {
-    solution->u = at.head(n);
-    solution->pressure = at.tail(d.pressure.count);
-    solution->forces = forces_of(d, at, nullptr).head(n);
+  Eigen::VectorXd internal = forces_of(d, x, nullptr);  // at x, the last equilibrium
+  const auto keep = [&] {
+    solution->u = x.head(n);
+    solution->pressure = x.tail(d.pressure.count);
+    solution->forces = internal.head(n);
   };
-  keep(x);
+  keep();
 
   for (int step = 1; step <= options.steps; ++step) {
     const LoadState target = path(step);
@@ -552,11 +553,11 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
     while (reached < 1.0) {
       const double s = std::min(1.0, reached + piece);
       const LoadState state = interpolate(done, target, s);
-      Eigen::VectorXd trial = predicted_start(d, state, split, x);
-      const std::string why = newton(d, state, split, options, trial, solution);
+      Eigen::VectorXd trial = predicted_start(d, state, split, x, internal);
+      const std::string why = newton(d, state, split, options, trial, solution, &internal);
       if (why.empty()) {
         x = trial;
-        keep(x);
+        keep();
         reached = s;
         continue;
       }
