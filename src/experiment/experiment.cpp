@@ -483,9 +483,6 @@ FiberSpec read_fibers(Fields& root) {
   spec.field = {root.file(), root.name("fibers")};
   Fields f = root.object_or_empty("fibers");
   spec.pruning = f.choice("pruning", "auto", {"auto", "off"}) == "auto";
-  spec.count = f.choice("connection_count", "symmetric", {"symmetric", "global"}) == "global"
-                   ? model::ConnectionCount::Global
-                   : model::ConnectionCount::Symmetric;
   spec.write = f.choice("write", "none", {"none", "kept", "pruned"});
   const std::string kinematics = f.choice("kinematics", model::VectorSpring::name,
                                           {model::VectorSpring::name, model::CentralFiber::name});
@@ -496,7 +493,20 @@ FiberSpec read_fibers(Fields& root) {
     if (!(spec.horizon > 0.0) || !std::isfinite(spec.horizon))
       f.fail("horizon", "expected a positive length (m), got " + std::to_string(spec.horizon));
   }
-  if (f.choice("influence", "constant", {"constant", "conical"}) == "conical") {
+  // Central fibers default to the settings under which their response
+  // converges as the mesh is refined (model.md, "Parameters that do not move
+  // with the mesh"): each vertex's count is the area its fibers reach, and
+  // within a horizon the fibers fade out conically. The vector spring keeps
+  // the paper's count, so that its figures are reproduced as published.
+  const bool central = spec.kinematics == model::FiberKinematics::Central;
+  const std::string count = f.choice("connection_count", central ? "area" : "symmetric",
+                                     {"symmetric", "global", "area"});
+  spec.count = count == "global" ? model::ConnectionCount::Global
+               : count == "area" ? model::ConnectionCount::Area
+                                 : model::ConnectionCount::Symmetric;
+  const bool fades = central && spec.horizon > 0.0;
+  if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) ==
+      "conical") {
     if (!(spec.horizon > 0.0))
       f.fail("influence", "a conical influence (1 - L / horizon) needs a \"horizon\"");
     spec.influence = model::Influence::Kind::Conical;

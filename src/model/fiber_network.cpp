@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -19,38 +20,63 @@ double checked_fiber_length(const Eigen::MatrixXd& X, int i, int j) {
 }
 
 const char* to_string(ConnectionCount count) {
-  return count == ConnectionCount::Global ? "global" : "symmetric";
+  switch (count) {
+    case ConnectionCount::Global: return "global";
+    case ConnectionCount::Area: return "area";
+    case ConnectionCount::Symmetric: break;
+  }
+  return "symmetric";
 }
 
 PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices)
     : PairFactors(fibers, count, num_vertices, Influence{}, nullptr) {}
 
+namespace {
+// |S_i| at the reference, for the area count (empty otherwise: not needed).
+Eigen::VectorXd counting_areas(const Model& model) {
+  if (model.connection_count != ConnectionCount::Area) return {};
+  return geom::vertex_area_vectors(model.surface.V, model.surface.F).magnitude;
+}
+}  // namespace
+
 PairFactors::PairFactors(const Model& model)
     : PairFactors(model.fibers.get(), model.connection_count, model.num_vertices(), model.influence,
-                  &model.surface.V) {}
+                  &model.surface.V, counting_areas(model)) {}
 
 PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
-                         const Influence& influence, const Eigen::MatrixXd* reference)
+                         const Influence& influence, const Eigen::MatrixXd* reference,
+                         const Eigen::VectorXd& areas)
     : fibers_(fibers), count_(count), n_(num_vertices), influence_(influence) {
   // The paper divides by N-1, the fibers per vertex, so that Y does not
   // depend on the discretisation; with pruning, by the fibers that exist;
-  // with a weighing influence, by their summed weights.
+  // with a weighing influence, by their summed weights; with the area count,
+  // by the area the fibers reach, in units of the vertex's own.
   global_ = n_ - 1;
+  const bool by_area = count_ == ConnectionCount::Area;
+  if (by_area && areas.size() != n_)
+    throw std::invalid_argument("the area connection count needs every vertex's area");
   if (influence_.weighs()) {
     if (reference == nullptr || reference->rows() != n_)
       throw std::invalid_argument("a weighing influence needs the reference positions");
     if (!(influence_.horizon > 0.0))
       throw std::invalid_argument("a conical influence needs a positive horizon");
     reference_ = *reference;
+  }
+  if (influence_.weighs() || by_area) {
+    // Each kept pair adds omega(L_ij), times |S_j| / |S_i| for the area count.
+    const auto counted = [&](int i, int j) {
+      return weight(i, j) * (by_area ? areas[j] / areas[i] : 1.0);
+    };
     kept_.assign(static_cast<size_t>(n_), 0.0);
     if (fibers_ != nullptr && fibers_->sparse()) {  // only the pairs listed
       for (int i = 0; i < n_; ++i)
-        fibers_->for_each_kept(i, [&](int j) { kept_[static_cast<size_t>(i)] += weight(i, j); });
+        fibers_->for_each_kept(i, [&](int j) { kept_[static_cast<size_t>(i)] += counted(i, j); });
     } else {
-      std::vector<double> row(static_cast<size_t>(n_));
       for (int i = 0; i < n_; ++i) {
-        weights(i, row.data());
-        for (int j = 0; j < n_; ++j) kept_[static_cast<size_t>(i)] += row[static_cast<size_t>(j)];
+        const uint8_t* kept = fibers_ != nullptr ? fibers_->row(i) : nullptr;
+        for (int j = 0; j < n_; ++j)
+          if (j != i && (kept == nullptr || kept[j] != 0))
+            kept_[static_cast<size_t>(i)] += counted(i, j);
       }
     }
   } else if (fibers_ != nullptr) {
@@ -91,12 +117,12 @@ double PairFactors::factor(int i, int j) const {
 }
 
 std::vector<double> PairFactors::vertex_counts() const {
-  if (!kept_.empty() && count_ == ConnectionCount::Symmetric) return kept_;
+  if (!kept_.empty() && count_ != ConnectionCount::Global) return kept_;
   return std::vector<double>(static_cast<size_t>(n_), global_);
 }
 
 void PairFactors::row(int i, double* row) const {
-  if (fibers_ == nullptr && !influence_.weighs()) {
+  if (kept_.empty()) {  // every pair, one count
     std::fill(row, row + n_, connection_factor(1.0, global_, global_));
   } else {
     weights(i, row);

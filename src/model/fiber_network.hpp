@@ -18,7 +18,10 @@ class PairFactors {
   // kept_ij omega(L_ij), L_ij from `reference` (#V by dim, copied),
   // and the counts c_i the sums of those weights.
   PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
-              const Influence& influence, const Eigen::MatrixXd* reference);
+              const Influence& influence, const Eigen::MatrixXd* reference,
+              const Eigen::VectorXd& areas = {});
+  // With ConnectionCount::Area, `areas` are the reference |S_i| and c_i =
+  // sum_j kept_ij omega(L_ij) |S_j| / |S_i| (model.hpp).
   // The factors of a model: its fibers, count and influence at its reference.
   explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.

@@ -147,6 +147,12 @@ struct Paddle {
 enum class ConnectionCount {
   Symmetric,  // (n_i + n_j) / 2 for the pair, n_i = kept fibers at i (default)
   Global,     // one count for all pairs: the mean of n_i (the paper's reading)
+  // The area the fibers at i reach, in units of i's own: c_i = sum_j kept_ij
+  // omega(L_ij) |S_j| / |S_i|. On a uniform mesh it is n_i; on any mesh the
+  // force on i becomes |S_i| times the area-weighted mean of Y e over what
+  // its fibers reach, so that the response converges as the mesh is refined
+  // (the default for central fibers with a horizon: model.md).
+  Area,
 };
 const char* to_string(ConnectionCount count);
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <string>
 
 #include "fiberfluid/fem/mesh_tools.hpp"
 
@@ -154,41 +155,68 @@ Uniaxial closed_form_uniaxial(const HyperelasticMaterial& m, double lambda1) {
   return {l2, principal_stress(m, lambda1, l2, 0)};
 }
 
+// The two element kinds the FEM reference offers: linear tetrahedra in the
+// displacement form, and quadratic ones with a linear pressure (P2-P1). A
+// homogeneous deformation lies in both spaces, so both must hold it exactly
+// on any mesh (the large-strain patch test): no order of convergence to
+// observe, the error is Newton's tolerance.
+struct ElementKind {
+  const char* name;
+  int order;
+};
+const ElementKind kElements[] = {{"P1", 1}, {"P2-P1", 2}};
+
+Mesh cube_of(const ElementKind& element, int cells) {
+  const Mesh linear = unit_cube(cells);
+  return element.order == 2 ? to_quadratic(linear) : linear;
+}
+
+HyperelasticOptions options_of(const ElementKind& element, int steps) {
+  HyperelasticOptions options;
+  options.steps = steps;
+  options.mixed = element.order == 2;
+  return options;
+}
+
 TEST(Hyperelastic, UniaxialStretchToTwiceTheLengthMatchesTheClosedForm) {
-  const Mesh mesh = unit_cube(2);
   const double lambda1 = 2.0;  // 100% stretch
-  const LoadPath path = [&](int step) {
-    LoadState state;
-    state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      for (int a = 0; a < 3; ++a) {
-        if (mesh.nodes(v, a) < 1e-12) state.held.hold(3 * v + a, 0.0);
-        if (a == 0 && mesh.nodes(v, 0) > 1.0 - 1e-12)
-          state.held.hold(3 * v, (lambda1 - 1.0) * step / 10.0);
-      }
-    return state;
-  };
-  for (Hyperelastic kind : kKinds) {
-    const HyperelasticMaterial m = material(kind);
-    HyperelasticSolution solution;
-    const solve::Status status = solve_hyperelastic(mesh, m, path, {}, &solution);
-    ASSERT_TRUE(status.ok) << status.message;
-    ASSERT_EQ(solution.path.size(), 10u);
-    const Uniaxial exact = closed_form_uniaxial(m, lambda1);
-    // The lateral stretch at the corner (1, 1, 1), and the pulling force.
-    int corner = 0;
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      if ((mesh.nodes.row(v).array() > 1.0 - 1e-12).all()) corner = v;
-    EXPECT_NEAR(1.0 + solution.u[3 * corner + 1], exact.lateral, 1e-8) << to_string(kind);
-    EXPECT_NEAR(1.0 + solution.u[3 * corner + 2], exact.lateral, 1e-8) << to_string(kind);
-    const Eigen::VectorXd f = internal_forces(mesh, m, solution.u);
-    double pull = 0.0;
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      if (mesh.nodes(v, 0) > 1.0 - 1e-12) pull += f[3 * v];
-    EXPECT_NEAR(pull, exact.force, 1e-8 * exact.force) << to_string(kind);
-    // Far from the small-strain answer E (lambda1 - 1): the nominal stress
-    // of a neo-Hookean solid softens in tension.
-    EXPECT_LT(exact.force, 0.7 * m.young) << to_string(kind);
+  for (const ElementKind& element : kElements) {
+    const Mesh mesh = cube_of(element, 2);
+    const LoadPath path = [&](int step) {
+      LoadState state;
+      state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        for (int a = 0; a < 3; ++a) {
+          if (mesh.nodes(v, a) < 1e-12) state.held.hold(3 * v + a, 0.0);
+          if (a == 0 && mesh.nodes(v, 0) > 1.0 - 1e-12)
+            state.held.hold(3 * v, (lambda1 - 1.0) * step / 10.0);
+        }
+      return state;
+    };
+    for (Hyperelastic kind : kKinds) {
+      const std::string label = std::string(element.name) + ", " + to_string(kind);
+      const HyperelasticMaterial m = material(kind);
+      HyperelasticSolution solution;
+      const solve::Status status =
+          solve_hyperelastic(mesh, m, path, options_of(element, 10), &solution);
+      ASSERT_TRUE(status.ok) << label << ": " << status.message;
+      ASSERT_EQ(solution.path.size(), 10u);
+      const Uniaxial exact = closed_form_uniaxial(m, lambda1);
+      // The lateral stretch at the corner (1, 1, 1), and the pulling force
+      // (the reactions Newton converged with: the mixed form's include p).
+      int corner = 0;
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        if ((mesh.nodes.row(v).array() > 1.0 - 1e-12).all()) corner = v;
+      EXPECT_NEAR(1.0 + solution.u[3 * corner + 1], exact.lateral, 1e-8) << label;
+      EXPECT_NEAR(1.0 + solution.u[3 * corner + 2], exact.lateral, 1e-8) << label;
+      double pull = 0.0;
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        if (mesh.nodes(v, 0) > 1.0 - 1e-12) pull += solution.forces[3 * v];
+      EXPECT_NEAR(pull, exact.force, 1e-8 * exact.force) << label;
+      // Far from the small-strain answer E (lambda1 - 1): the nominal stress
+      // of a neo-Hookean solid softens in tension.
+      EXPECT_LT(exact.force, 0.7 * m.young) << label;
+    }
   }
 }
 
@@ -197,38 +225,40 @@ TEST(Hyperelastic, SimpleShearGivesShearStressMuGamma) {
   // free. They stay on it, and the force on the top face y = 1 along x is
   // P12 = mu gamma (both forms: J = 1), the normal one P22: 0 for the
   // compressible form, -mu gamma^2 / 3 for the nearly incompressible one.
-  const Mesh mesh = unit_cube(3);
   const double gamma = 0.5;
-  const auto on_boundary = [&](int v) {
-    return (mesh.nodes.row(v).array() < 1e-12).any() ||
-           (mesh.nodes.row(v).array() > 1.0 - 1e-12).any();
-  };
-  const LoadPath path = [&](int step) {
-    LoadState state;
-    state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      if (on_boundary(v))
-        for (int a = 0; a < 3; ++a)
-          state.held.hold(3 * v + a, a == 0 ? gamma * mesh.nodes(v, 1) * step / 4.0 : 0.0);
-    return state;
-  };
-  HyperelasticOptions options;
-  options.steps = 4;
-  for (Hyperelastic kind : kKinds) {
-    const HyperelasticMaterial m = material(kind);
-    HyperelasticSolution solution;
-    ASSERT_TRUE(solve_hyperelastic(mesh, m, path, options, &solution).ok);
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      EXPECT_NEAR(solution.u[3 * v], gamma * mesh.nodes(v, 1), 1e-9);
-    const Eigen::VectorXd f = internal_forces(mesh, m, solution.u);
-    double shear = 0.0, normal = 0.0;
-    for (int v = 0; v < mesh.num_nodes(); ++v)
-      if (mesh.nodes(v, 1) > 1.0 - 1e-12) shear += f[3 * v], normal += f[3 * v + 1];
-    const double mu = m.shear_modulus();
-    EXPECT_NEAR(shear, mu * gamma, 1e-9 * mu);
-    const double expected_normal =
-        kind == Hyperelastic::NeoHookean ? 0.0 : -mu * gamma * gamma / 3.0;
-    EXPECT_NEAR(normal, expected_normal, 1e-9 * mu) << to_string(kind);
+  for (const ElementKind& element : kElements) {
+    const Mesh mesh = cube_of(element, element.order == 2 ? 2 : 3);
+    const auto on_boundary = [&](int v) {
+      return (mesh.nodes.row(v).array() < 1e-12).any() ||
+             (mesh.nodes.row(v).array() > 1.0 - 1e-12).any();
+    };
+    const LoadPath path = [&](int step) {
+      LoadState state;
+      state.forces = Eigen::VectorXd::Zero(mesh.num_dofs());
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        if (on_boundary(v))
+          for (int a = 0; a < 3; ++a)
+            state.held.hold(3 * v + a, a == 0 ? gamma * mesh.nodes(v, 1) * step / 4.0 : 0.0);
+      return state;
+    };
+    for (Hyperelastic kind : kKinds) {
+      const std::string label = std::string(element.name) + ", " + to_string(kind);
+      const HyperelasticMaterial m = material(kind);
+      HyperelasticSolution solution;
+      ASSERT_TRUE(solve_hyperelastic(mesh, m, path, options_of(element, 4), &solution).ok)
+          << label;
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        EXPECT_NEAR(solution.u[3 * v], gamma * mesh.nodes(v, 1), 1e-9) << label;
+      double shear = 0.0, normal = 0.0;
+      for (int v = 0; v < mesh.num_nodes(); ++v)
+        if (mesh.nodes(v, 1) > 1.0 - 1e-12)
+          shear += solution.forces[3 * v], normal += solution.forces[3 * v + 1];
+      const double mu = m.shear_modulus();
+      EXPECT_NEAR(shear, mu * gamma, 1e-9 * mu) << label;
+      const double expected_normal =
+          kind == Hyperelastic::NeoHookean ? 0.0 : -mu * gamma * gamma / 3.0;
+      EXPECT_NEAR(normal, expected_normal, 1e-9 * mu) << label;
+    }
   }
 }
 
