@@ -200,11 +200,6 @@ FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) 
                         std::to_string(std::find(per_vertex.begin(), per_vertex.end(), 0) -
                                        per_vertex.begin()) +
                         " keeps no fiber: is the mesh self-intersecting?");
-  if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Area)
-    spec.field.fail("product",
-                    "\"treecode\" needs one connection count for every fiber: set "
-                    "\"connection_count\": \"global\" (the area count differs from vertex to "
-                    "vertex) or \"product\": \"exact\"");
   if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Symmetric)
     spec.field.fail("product",
                     "\"treecode\" needs one connection count for every fiber: this "

@@ -518,6 +518,11 @@ FiberSpec read_fibers(Fields& root) {
                                        std::to_string(spec.treecode_tolerance));
   } else if (f.has("treecode_tolerance"))
     f.fail("treecode_tolerance", "applies to \"product\": \"treecode\" only");
+  if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Area)
+    f.fail("product",
+           "\"treecode\" needs one connection count for every fiber: set "
+           "\"connection_count\": \"global\" (the area count differs from vertex to vertex) "
+           "or \"product\": \"exact\"");
   if (spec.treecode_tolerance > 0.0 && spec.horizon > 0.0)
     f.fail("product",
            "\"treecode\" approximates the sum over every pair; with a \"horizon\" most pairs "

@@ -16,7 +16,8 @@ const std::vector<std::string> kOptionalRunFigures = {
     "step_cuts",         "max_equilibrium_residual",
     "limit_load_factor", "system_matrix"};
 
-const std::vector<std::string> kFemFigures = {"nodes",
+const std::vector<std::string> kFemFigures = {"element_order",
+                                              "nodes",
                                               "tetrahedra",
                                               "mesh_seconds",
                                               "solve_seconds",

@@ -198,6 +198,43 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   EXPECT_THROW(load_experiment(broken), InputError);
 }
 
+// Central fibers default to the settings under which they converge with the
+// mesh (the area count; the conical influence within a horizon); the vector
+// spring keeps the paper's; either may be named.
+TEST(ExperimentConfig, CentralFibersDefaultToTheAreaCountAndAConicalInfluence) {
+  const auto model_of = [](const nlohmann::json& fibers) {
+    nlohmann::json c = base_config();
+    c["fibers"] = fibers;
+    c["stepping"] = {{"scheme", "newton"}, {"steps", 1}};
+    return parse_experiment(c, ".", "doc").cases.at(0).model;
+  };
+  model::Model m = model_of({{"kinematics", "central"}, {"horizon", 1.5}});
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Area);
+  EXPECT_EQ(m.influence.kind, model::Influence::Kind::Conical);
+  EXPECT_EQ(m.influence.horizon, 1.5);
+  m = model_of({{"kinematics", "central"}});  // every pair: nothing to fade
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Area);
+  EXPECT_EQ(m.influence.kind, model::Influence::Kind::Constant);
+  m = model_of(nlohmann::json::object());
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Symmetric);
+  EXPECT_EQ(m.influence.kind, model::Influence::Kind::Constant);
+  m = model_of({{"kinematics", "central"},
+                {"horizon", 1.5},
+                {"connection_count", "symmetric"},
+                {"influence", "constant"}});
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Symmetric);
+  EXPECT_EQ(m.influence.kind, model::Influence::Kind::Constant);
+  m = model_of({{"connection_count", "area"}});
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Area);
+
+  testing::ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["fibers"] = {{"connection_count", "area"}, {"product", "treecode"}};
+  expect_config_error(dir, c, "fibers.product: \"treecode\" needs one connection count");
+  c["fibers"] = {{"connection_count", "by_area"}};
+  expect_config_error(dir, c, "fibers.connection_count");
+}
+
 // Issue 43, "a case is built from its own spec alone": in a sweep, a
 // variant that shares the surface and fibers with an earlier one reused its
 // model but copied only some of its settings: "influence": "conical" was

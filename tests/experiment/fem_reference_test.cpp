@@ -166,15 +166,30 @@ TEST(FemReference, TheCommittedLiverTargetIsCurrent) {
       "liver_fem_reference.obj");
 }
 
-// The neo-Hookean FEM along its load steps (fit_cantilever_large.json's target).
-// And the fiber model fitted to it (central fibers within 5 cm, the clamp's
-// mirror layer) turns its tip as the FEM does: within 2.5 degrees of 56.
-TEST(FemReference, TheCommittedCantileverTargetIsCurrent) {
+// The cantilever's committed target is the converged reference: quadratic
+// mixed elements (P2-P1) at 5 mm, 755 s to regenerate (SOURCES.md). The
+// experiment runs the same FEM at 10 mm (about 40 s), which the mesh study
+// puts 0.5% above the extrapolated largest displacement (docs/model.md), so
+// the fresh surface must lie within that mesh difference of the committed
+// one: 1.7 mm at most, 0.3 mm on average, measured. And the fiber model
+// fitted to it (central fibers within 5 cm, the clamp's mirror layer) turns
+// its tip nearly as the FEM does (56.4 against 60.1 degrees).
+TEST(FemReference, TheCommittedCantileverTargetAgreesWithTheCoarserReference) {
   const Experiment ex = load_experiment(testing::experiment_file("cantilever_large.json"));
-  const ExperimentResult result =
-      expect_committed_target_is_current(ex, "cantilever_large_fem.obj");
+  const ExperimentResult result = run_experiment(ex);
   ASSERT_TRUE(result.fem_reference && result.runs_succeeded());
   const FemReferenceResult& fem = *result.fem_reference;
+  const geom::Surface& fresh = fem.deformed_boundary;
+  const fit::Target committed =
+      fit::read_target(testing::experiment_file("../data/targets/cantilever_large_fem_p2.obj"));
+  const fit::TargetDistance to_committed(committed);
+  double largest = 0.0, sum = 0.0;
+  for (const auto& c : to_committed.closest(fresh.V)) {
+    largest = std::max(largest, c.distance);
+    sum += c.distance;
+  }
+  EXPECT_LT(largest, 2.5e-3) << "regenerate data/targets/cantilever_large_fem_p2.obj (SOURCES.md)";
+  EXPECT_LT(sum / static_cast<double>(fresh.V.rows()), 0.5e-3);
   const model::Model& fibers = ex.cases[0].model;
   const double length = 0.18;
   const double fem_turn = end_face_rotation(fem.rest_boundary, fem.deformed_boundary.V, length);
@@ -182,9 +197,12 @@ TEST(FemReference, TheCommittedCantileverTargetIsCurrent) {
       fibers.surface, model::positions(fibers, result.runs[0].summary.unknowns), length);
   std::printf("tip face turned %.1f degrees (FEM) and %.1f (fitted fibers)\n", fem_turn,
               fiber_turn);
-  EXPECT_NEAR(fem_turn, 56.2, 1.0);
-  EXPECT_NEAR(fiber_turn, fem_turn, 2.5);
+  EXPECT_NEAR(fem_turn, 60.1, 1.0);  // linear tetrahedra: 56.2
+  // 3.7 degrees short, measured: the fitted fibers bend a little more near
+  // the clamp and less towards the tip than the solid (docs/model.md).
+  EXPECT_NEAR(fiber_turn, fem_turn, 4.5);
 }
+
 
 }  // namespace
 }  // namespace fiberfluid::experiment

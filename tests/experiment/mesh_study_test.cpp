@@ -121,6 +121,49 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
 // (subdivisions 2) and again on the next coarser (1): the coarse sphere needs
 // other parameters, and the shift, far beyond the exact fit's interval, is
 // reported and warned of.
+// Issue 44, "fibers whose parameters converge": the soft cylinder under its
+// weight at fixed parameters (central fibers within 5 cm, the clamp's mirror
+// layer, 4 Newton steps) on segments [18, 16], [23, 20], [28, 25]. With the
+// paper's count and a constant influence its largest displacement jumps
+// (0.1344, 0.1239, 0.1282 m: the cap's rings and the horizon's edge take in
+// vertices unevenly as the mesh changes); with the central fibers' defaults
+// (the area count and the conical influence) it falls monotonically by
+// shrinking steps (0.14443, 0.14350, 0.14340 m; at [35, 31] 0.14321).
+TEST(MeshStudy, CentralFibersByDefaultConvergeMonotonicallyWithTheMesh) {
+  testing::ScratchDir dir;
+  nlohmann::json doc = nlohmann::json::parse(R"({
+    "name": "cylinder_study",
+    "surface": {"generator": "cylinder", "radius": 0.02, "length": 0.18, "segments": [18, 16]},
+    "material": {"Y": 100000, "gamma": 0},
+    "fibers": {"kinematics": "central", "horizon": 0.05},
+    "supports": [{"label": "clamp", "where": "x <= 0", "layer": "mirror"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81], "density": 1000,
+               "integration": "exact"}],
+    "stepping": {"scheme": "newton", "steps": 4}
+  })");
+  MeshStudySpec spec;
+  spec.ratio = 1.25;
+  spec.figures = {"max_displacement"};
+  const auto study = [&](const nlohmann::json& d) {
+    const MeshStudy s = run_mesh_study(dir.write("study.json", d.dump()), spec);
+    return s.figures.at(0).values;
+  };
+  const std::vector<double> converging = study(doc);
+  ASSERT_EQ(converging.size(), 3u);
+  EXPECT_NEAR(converging[0], 0.14443, 2e-5);
+  EXPECT_GT(converging[0], converging[1]);
+  EXPECT_GT(converging[1], converging[2]);
+  EXPECT_LT(converging[1] - converging[2], converging[0] - converging[1]);
+  EXPECT_LT((converging[1] - converging[2]) / converging[2], 0.003);
+
+  doc["fibers"]["connection_count"] = "symmetric";
+  doc["fibers"]["influence"] = "constant";
+  const std::vector<double> paper = study(doc);
+  EXPECT_NEAR(paper[0], 0.13439, 2e-5);
+  EXPECT_LT(paper[1], paper[0]);  // down by 8%, then up by 3%: not monotone
+  EXPECT_GT(paper[2], paper[1]);
+}
+
 TEST(FitMeshCheck, AFitReportsHowFarItsParametersMoveOnACoarserMesh) {
   const testing::ScratchDir dir;
   std::ifstream in(testing::experiment_file("fit_sphere.json"));

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/geom/horizon.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -171,6 +172,57 @@ TEST(PairFactors, AConicalInfluenceWeighsEachPairAndEachCount) {
   short_reach.row(0, row.data());
   EXPECT_EQ(row[3], 0.0);  // |s_0 - s_3| = 3 > 2.5
   EXPECT_GT(row[2], 0.0);  // 2 < 2.5
+}
+
+// The area count: c_i = sum_j omega_ij |S_j| / |S_i|, the area the fibers at
+// i reach in units of its own. Where every vertex has the same area it is the
+// symmetric count n_i; where areas differ, each pair's weight makes the force
+// on i |S_i| times the area-weighted mean over what its fibers reach.
+TEST(PairFactors, TheAreaCountWeighsEachPartnerByItsArea) {
+  Eigen::MatrixXd S(4, 3);
+  S << 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3;
+  Eigen::VectorXd area(4);
+  area << 1.0, 2.0, 0.5, 4.0;
+  const Influence conical{Influence::Kind::Conical, 4.0};
+  const PairFactors factors(nullptr, ConnectionCount::Area, 4, conical, &S, area);
+  const auto omega = [&](int i, int j) { return 1.0 - (S.row(i) - S.row(j)).norm() / 4.0; };
+  const std::vector<double> counts = factors.vertex_counts();
+  for (int i = 0; i < 4; ++i) {
+    double expected = 0.0;
+    for (int j = 0; j < 4; ++j)
+      if (j != i) expected += omega(i, j) * area[j] / area[i];
+    EXPECT_NEAR(counts[static_cast<size_t>(i)], expected, 1e-14);
+  }
+  std::vector<double> row(4);
+  factors.row(2, row.data());
+  for (int j : {0, 1, 3})
+    EXPECT_NEAR(row[static_cast<size_t>(j)],
+                omega(2, j) / (counts[2] + counts[static_cast<size_t>(j)]), 1e-15);
+  EXPECT_NEAR(factors.factor(2, 3), row[3], 1e-15);
+  // Equal areas: the symmetric count, pair for pair (with and without a mask).
+  const Eigen::VectorXd equal = Eigen::VectorXd::Constant(4, 0.7);
+  const PairFactors by_area(nullptr, ConnectionCount::Area, 4, Influence{}, &S, equal);
+  for (double c : by_area.vertex_counts()) EXPECT_NEAR(c, 3.0, 1e-14);
+  // Without the areas it cannot count.
+  EXPECT_THROW(PairFactors(nullptr, ConnectionCount::Area, 4, Influence{}, &S),
+               std::invalid_argument);
+}
+
+// On a real mesh the model's factors count by its reference |S_i|, and the
+// residual, tangent and the linear system agree on them (one PairFactors).
+TEST(PairFactors, TheAreaCountOfAModelUsesItsReferenceAreas) {
+  Model m;
+  m.surface = geom::cylinder(0.02, 0.18, 9, 8);
+  m.connection_count = ConnectionCount::Area;
+  const PairFactors factors(m);
+  const Eigen::VectorXd area = geom::vertex_area_vectors(m.surface.V, m.surface.F).magnitude;
+  const std::vector<double> counts = factors.vertex_counts();
+  for (int i : {0, 17, m.num_vertices() - 1}) {
+    double expected = 0.0;
+    for (int j = 0; j < m.num_vertices(); ++j)
+      if (j != i) expected += area[j] / area[i];
+    EXPECT_NEAR(counts[static_cast<size_t>(i)], expected, 1e-12 * expected);
+  }
 }
 
 TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
