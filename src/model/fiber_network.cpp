@@ -2,6 +2,7 @@
 #include "fiberfluid/model/fiber_network.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -55,6 +56,11 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
   const bool by_area = count_ == ConnectionCount::Area;
   if (by_area && areas.size() != n_)
     throw std::invalid_argument("the area connection count needs every vertex's area");
+  for (Eigen::Index i = 0; by_area && i < areas.size(); ++i)
+    if (!(areas[i] > 0.0) || !std::isfinite(areas[i]))
+      throw InputError("vertex " + std::to_string(i) + " has no area vector (|S_" +
+                       std::to_string(i) + "| = " + std::to_string(areas[i]) +
+                       "): \"connection_count\": \"area\" weighs each vertex by it");
   if (influence_.weighs()) {
     if (reference == nullptr || reference->rows() != n_)
       throw std::invalid_argument("a weighing influence needs the reference positions");

@@ -206,6 +206,16 @@ TEST(PairFactors, TheAreaCountWeighsEachPartnerByItsArea) {
   // Without the areas it cannot count.
   EXPECT_THROW(PairFactors(nullptr, ConnectionCount::Area, 4, Influence{}, &S),
                std::invalid_argument);
+  // A vertex whose area vectors cancel cannot be weighed: named, not divided by.
+  Eigen::VectorXd flat = equal;
+  flat[2] = 0.0;
+  try {
+    PairFactors(nullptr, ConnectionCount::Area, 4, Influence{}, &S, flat);
+    ADD_FAILURE() << "no error for a vertex without area";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 2 has no area vector"), std::string::npos)
+        << e.what();
+  }
 }
 
 // On a real mesh the model's factors count by its reference |S_i|, and the
