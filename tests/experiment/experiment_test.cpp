@@ -39,7 +39,8 @@ INSTANTIATE_TEST_SUITE_P(
                       "nonlinear_round_trip.json", "liver_paddles.json", "stress_strain.json",
                       "benchmark_block_mp1.json", "benchmark_block_mp2.json", "benchmark_rod.json",
                       "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
-                      "compression_large.json", "liver_interactive.json"));
+                      "compression_large.json", "liver_interactive.json",
+                      "cylinder_mesh_study.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
