@@ -98,6 +98,8 @@ struct MaterialSpec {
 
 struct FiberSpec {
   bool pruning = true;  // "auto": prune the fibers that leave a concave body
+  // "connection_count": the reader's default is "area" for central fibers,
+  // "symmetric" for the vector spring.
   model::ConnectionCount count = model::ConnectionCount::Symmetric;
   std::string write = "none";       // "kept" or "pruned": DIR/fibers.vtu
   double treecode_tolerance = 0.0;  // "product": "treecode": its relative error
@@ -106,7 +108,8 @@ struct FiberSpec {
   // "horizon" (m): only vertices at most this far apart are joined; 0: every
   // pair (the paper's).
   double horizon = 0.0;
-  // "influence": "constant" (default) or "conical" (1 - L / horizon).
+  // "influence": "constant" or "conical" (1 - L / horizon), the default for
+  // central fibers with a horizon.
   model::Influence::Kind influence = model::Influence::Kind::Constant;
   FieldName field;
 };
