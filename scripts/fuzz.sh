@@ -23,6 +23,7 @@ targets=("${@:-${all[@]}}")
 
 scripts/install-deps.sh
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
   -DFIBERFLUID_FUZZ=ON -DFIBERFLUID_BUILD_TESTS=OFF -DFIBERFLUID_BUILD_PYTHON=OFF \
   -DFIBERFLUID_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" >/dev/null

@@ -2,19 +2,25 @@
 #include "fiberfluid/experiment/benchmark.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "fiberfluid/bridge/scene_model.hpp"
 #include "fiberfluid/experiment/json_fields.hpp"
+#include "fiberfluid/experiment/mesh_study.hpp"
 #include "fiberfluid/fem/mesh_tools.hpp"
 #include "fiberfluid/fit/calibration.hpp"
 #include "fiberfluid/fit/golden_section.hpp"
+#include "fiberfluid/geom/horizon.hpp"
 #include "fiberfluid/metrics/metrics.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/solve/load_stepper.hpp"
 
@@ -138,6 +144,22 @@ BenchmarkSpec read_benchmark(Fields& root) {
     if (block) root.fail("gravity", "only the bending-rod scene has gravity");
     spec.rod.gravity = root.positive("gravity", spec.rod.gravity);
   }
+  if (root.has("static_reference")) {
+    if (block)
+      root.fail("static_reference", "only the bending-rod scene has a static reference on finer grids");
+    Fields r = root.object("static_reference");
+    spec.static_reference.levels = r.integer("levels", 3, 1, 5);
+    spec.static_reference.ratio = r.integer("ratio", 2, 2, 4);
+    r.finish();
+    const double finest =
+        std::pow(spec.static_reference.ratio, spec.static_reference.levels);
+    const Eigen::Vector3d cells = spec.rod.cells.cast<double>() * finest;
+    // A sparse Cholesky of the finest grid: 3 unknowns per node, fill ~ n^(4/3).
+    if ((cells.array() + 1.0).prod() > 150000.0)
+      root.fail("static_reference",
+                "the finest grid (cells x " + std::to_string(static_cast<long long>(finest)) +
+                    ") has over 150,000 nodes; give fewer levels or a smaller ratio");
+  }
   if (root.has("time")) {
     Fields t = root.object("time");
     spec.step = t.positive("step", spec.step);
@@ -185,7 +207,22 @@ BenchmarkSpec read_benchmark(Fields& root) {
       f.fail("fit", "give Y and gamma, or fit them, not both");
     }
     spec.fiber.steps = f.integer("steps", spec.fiber.steps, 1, 10000);
-    spec.fiber.newton = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton";
+    spec.fiber.central = f.choice("kinematics", "vector", {"vector", "central"}) == "central";
+    spec.fiber.newton =
+        f.choice("scheme", spec.fiber.central ? "newton" : "incremental", {"incremental", "newton"}) ==
+        "newton";
+    if (spec.fiber.central && !spec.fiber.newton)
+      f.fail("scheme", "central fibers run with the Newton scheme only");
+    if (f.has("horizon")) {
+      if (!spec.fiber.central) f.fail("horizon", "only central fibers have a horizon");
+      spec.fiber.horizon = f.positive("horizon", 1.0);
+    }
+    if (f.has("mirror_layer")) {
+      if (block) f.fail("mirror_layer", "only the bending-rod scene has a clamp to mirror");
+      if (!(spec.fiber.horizon > 0.0))
+        f.fail("mirror_layer", "a mirror layer is as deep as the fibers' horizon: set horizon");
+    }
+    spec.fiber.mirror_layer = spec.fiber.horizon > 0.0 && !block && f.boolean("mirror_layer", true);
     f.finish();
   }
   return spec;
@@ -271,6 +308,31 @@ MetricSeries compare_fem(const ReferenceFrames& frames, const fem::Trajectory& r
   return out;
 }
 
+// The scene's fiber model with central fibers (model.md: they bend): the
+// area count, and within a horizon its pairs with the conical influence and
+// the clamp's mirror layer, as an experiment's fibers default to.
+void use_central_fibers(model::Model& m, const BenchmarkSpec::FiberModel& spec) {
+  m.material.kinematics = model::FiberKinematics::Central;
+  m.connection_count = model::ConnectionCount::Area;
+  if (!(spec.horizon > 0.0)) return;
+  if (spec.horizon < geom::longest_edge(m.surface))
+    throw InputError("benchmark: fiber_model.horizon: expected at least the longest mesh edge, " +
+                     std::to_string(geom::longest_edge(m.surface)) + " m");
+  if (m.fibers) throw std::logic_error("benchmark: a scene's box is convex: nothing is pruned");
+  m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, spec.horizon));
+  m.influence = {model::Influence::Kind::Conical, spec.horizon};
+  if (!spec.mirror_layer) return;
+  model::MirrorLayer layer;
+  layer.group = 0;  // the supports
+  layer.depth = spec.horizon;
+  std::vector<int> held;
+  for (const model::Constraint& c : m.constraints)
+    if (c.group == 0 && (held.empty() || held.back() != c.vertex)) held.push_back(c.vertex);
+  const std::string why = model::find_clamp_plane(m.surface.V, held, &layer);
+  if (!why.empty()) throw InputError("benchmark: the rod's clamp has no plane: " + why);
+  m.mirror_layers.push_back(layer);
+}
+
 struct FiberRun {
   bool ok = false;
   std::string message;
@@ -285,6 +347,7 @@ FiberRun run_fiber_model(const model::Model& scene_model, double Y, double gamma
   const auto start = std::chrono::steady_clock::now();
   model::Model m = scene_model;
   m.material = model::Material::linear(Y, gamma);
+  m.material.kinematics = scene_model.material.kinematics;
   solve::SteppingOptions stepping;
   stepping.steps = steps;
   stepping.scheme = newton ? solve::Scheme::Newton : solve::Scheme::Incremental;
@@ -329,6 +392,72 @@ Eigen::MatrixXd boundary_rows(const fem::Boundary& b, const Eigen::MatrixXd& nod
   return out;
 }
 
+// Each row of `points` (nodes of a coarser grid over the same box) as a node
+// of `grid`, whose lattice spacing per axis is `spacing`.
+std::vector<int> grid_nodes_at(const Eigen::MatrixXd& grid, const Eigen::MatrixXd& points,
+                               const Eigen::Vector3d& spacing) {
+  const auto key = [&](const Eigen::MatrixXd& rows, Eigen::Index v) {
+    std::array<long, 3> k{};
+    for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::lround(rows(v, a) / spacing[a]);
+    return k;
+  };
+  std::map<std::array<long, 3>, int> index;
+  for (Eigen::Index v = 0; v < grid.rows(); ++v) index[key(grid, v)] = static_cast<int>(v);
+  std::vector<int> out(static_cast<size_t>(points.rows()));
+  for (Eigen::Index v = 0; v < points.rows(); ++v) {
+    const auto it = index.find(key(points, v));
+    if (it == index.end() || (grid.row(it->second) - points.row(v)).norm() > 1e-9 * spacing.norm())
+      throw std::logic_error("benchmark: a node of the rod is not a node of its refined grid");
+    out[static_cast<size_t>(v)] = it->second;
+  }
+  return out;
+}
+
+// The rod's static state on grids refined ratio^k times (k = 1..levels), at
+// this mesh's nodes. Adds per grid its largest displacement (the same points
+// on every grid: a pointwise study), the three finest's observed order and
+// Richardson extrapolation (mesh_study.hpp), and E_n of this mesh's static
+// boundary against the finest's. Returns the finest grid's displacements.
+Eigen::MatrixXd refined_statics(const BenchmarkSpec& spec, const fem::Scene& scene,
+                                const fem::Boundary& rest, const Eigen::VectorXd& statics,
+                                std::map<std::string, double>& figures) {
+  const Eigen::MatrixXd& X0 = scene.mesh.nodes;
+  const Eigen::Vector3d box = X0.colwise().maxCoeff().transpose();  // the grid starts at 0
+  const Eigen::MatrixXd coarse = fem::displacement_rows(statics, 3);
+  std::vector<double> largest{coarse.rowwise().norm().maxCoeff()}, sizes{1.0};
+  figures["static.refine_1.max_displacement"] = largest[0];
+  Eigen::MatrixXd finest;
+  int refine = 1;
+  for (int k = 1; k <= spec.static_reference.levels; ++k) {
+    refine *= spec.static_reference.ratio;
+    fem::RodOptions options = spec.rod;
+    options.cells = spec.rod.cells * refine;
+    const fem::Scene fine = fem::bending_rod(options);
+    const Eigen::MatrixXd u = fem::displacement_rows(static_state(fine), 3);
+    const Eigen::Vector3d spacing = box.cwiseQuotient(options.cells.cast<double>());
+    const std::vector<int> at = grid_nodes_at(fine.mesh.nodes, X0, spacing);
+    finest.resize(X0.rows(), 3);
+    for (Eigen::Index v = 0; v < X0.rows(); ++v) finest.row(v) = u.row(at[static_cast<size_t>(v)]);
+    largest.push_back(finest.rowwise().norm().maxCoeff());
+    sizes.push_back(1.0 / refine);
+    figures["static.refine_" + std::to_string(refine) + ".max_displacement"] = largest.back();
+  }
+  const size_t n = largest.size();
+  if (n >= 3) {
+    const RichardsonEstimate e = richardson(largest[n - 3], largest[n - 2], largest[n - 1],
+                                            sizes[n - 3], sizes[n - 2], sizes[n - 1]);
+    figures["static.monotone"] = e.monotone ? 1.0 : 0.0;
+    if (e.monotone) {
+      figures["static.order"] = e.order;
+      figures["static.extrapolated_max_displacement"] = e.extrapolated;
+      figures["static.gci"] = e.gci;
+    }
+  }
+  figures["reference.static_E_n_to_converged"] =
+      metrics::relative_energy_norm(boundary_rows(rest, finest), boundary_rows(rest, coarse));
+  return finest;
+}
+
 // Y and gamma of the fiber model whose static shape is closest to the FEM's.
 // The block is driven by a displacement alone: its shape depends on gamma /
 // Y only, so Y = E and gamma is found by a golden-section search on E_n
@@ -363,6 +492,7 @@ FiberModelReport choose_fiber_material(const BenchmarkSpec& spec, const fem::Sce
   }
   model::Model start = scene_model;
   start.material = model::Material::linear(E, 0.01 * E);
+  start.material.kinematics = scene_model.material.kinematics;
   solve::SteppingOptions stepping;
   stepping.steps = steps;
   stepping.scheme = spec.fiber.newton ? solve::Scheme::Newton : solve::Scheme::Incremental;
@@ -443,7 +573,9 @@ void add_series_figures(const BenchmarkSpec& spec, const MetricSeries& s,
 
 BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
                               const std::function<void(int, int)>& progress) {
-  int total = 1 + static_cast<int>(spec.solvers.size()) + (spec.fiber.enabled ? 1 : 0), done = 0;
+  int total = 1 + static_cast<int>(spec.solvers.size()) + (spec.fiber.enabled ? 1 : 0) +
+              (spec.static_reference.levels > 0 ? 1 : 0),
+      done = 0;
   for (const BenchmarkSpec::OtherMaterial& other : spec.other_materials)
     total += static_cast<int>(other.solvers.size());
   auto tell = [&](const std::string&) {
@@ -487,6 +619,11 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
   result.figures["reference.seconds"] = result.reference_seconds;
   result.reference_final =
       deformed_boundary(frames, scene.mesh.nodes + fem::displacement_rows(reference.u.back(), dim));
+  std::optional<Eigen::MatrixXd> converged;  // the finest refined grid's static displacements
+  if (spec.static_reference.levels > 0) {
+    tell("static reference on finer grids");
+    converged = refined_statics(spec, scene, frames.rest, statics, result.figures);
+  }
 
   // One solver on a scene (this one, or another material's) whose static state is given.
   auto run_one = [&](const fem::Scene& on, const Eigen::VectorXd& on_statics, Integrator kind,
@@ -521,13 +658,23 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
         block ? std::max(1, static_cast<int>(std::lround(scene.push_time / spec.step)))
               : spec.fiber.steps;
     const Eigen::MatrixXd X0 = scene.mesh.nodes;
-    const Eigen::MatrixXd target =
+    // The static shape it is fitted to and measured against: this mesh's, or
+    // the finest refined grid's at this mesh's nodes.
+    const Eigen::MatrixXd own_static =
         boundary_rows(frames.rest, X0 + fem::displacement_rows(statics, dim));
-    const model::Model scene_model =
+    const Eigen::MatrixXd target =
+        converged ? boundary_rows(frames.rest, X0 + *converged) : own_static;
+    model::Model scene_model =
         bridge::fiber_model_of_scene(scene, frames.rest, model::Material::linear(1.0));
+    if (spec.fiber.central) use_central_fibers(scene_model, spec.fiber);
     FiberModelReport report;
+    report.target = converged ? "cells x " + std::to_string(static_cast<int>(std::lround(std::pow(
+                                    spec.static_reference.ratio, spec.static_reference.levels))))
+                              : "this mesh";
     if (spec.fiber.fit) {
+      const std::string fitted_to = report.target;
       report = choose_fiber_material(spec, scene, scene_model, frames.rest, target, fiber_steps);
+      report.target = fitted_to;
     } else {
       report.Y = spec.fiber.Y;
       report.gamma = spec.fiber.gamma;
@@ -558,6 +705,9 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
       }
       report.static_energy_norm =
           metrics::relative_energy_norm(target - rest, run.positions.back() - rest);
+      if (converged)
+        result.figures["fiber-model.static_E_n_this_mesh"] =
+            metrics::relative_energy_norm(own_static - rest, run.positions.back() - rest);
       result.fiber_final = frames.rest.surface;
       result.fiber_final.V = run.positions.back();
     }
@@ -591,9 +741,26 @@ std::string benchmark_report(const BenchmarkResult& result) {
     if (!s.ok) out << "; stopped: " << s.message;
     out << "\n";
   }
+  const auto figure = [&](const std::string& name) {
+    const auto it = result.figures.find(name);
+    return it == result.figures.end() ? std::string("-")
+                                      : (std::ostringstream() << std::setprecision(4) << it->second).str();
+  };
+  if (result.figures.count("reference.static_E_n_to_converged") != 0) {
+    out << "  static shape, largest displacement by grid:";
+    for (int refine = 1; refine <= 1024; ++refine)
+      if (const auto it = result.figures.find("static.refine_" + std::to_string(refine) +
+                                              ".max_displacement");
+          it != result.figures.end())
+        out << " x" << refine << " " << std::setprecision(5) << it->second;
+    out << " m; order " << figure("static.order") << ", extrapolated "
+        << figure("static.extrapolated_max_displacement") << " m; this mesh's static E_n against "
+        << "the finest " << figure("reference.static_E_n_to_converged") << "\n";
+  }
   if (result.fiber)
     out << "  fiber model: Y = " << result.fiber->Y << ", gamma = " << result.fiber->gamma << " ("
-        << result.fiber->how << ")\n";
+        << result.fiber->how << "; static shape of " << result.fiber->target << ", E_n "
+        << result.fiber->static_energy_norm << ")\n";
   return out.str();
 }
 
@@ -650,7 +817,8 @@ std::string benchmark_json(const BenchmarkSpec& spec, const BenchmarkResult& res
                           {"gamma", result.fiber->gamma},
                           {"how", result.fiber->how},
                           {"vertices", result.fiber->vertices},
-                          {"static_E_n", result.fiber->static_energy_norm}};
+                          {"static_E_n", result.fiber->static_energy_norm},
+                          {"static_target", result.fiber->target}};
   return doc.dump(2) + "\n";
 }
 

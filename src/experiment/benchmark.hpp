@@ -50,8 +50,24 @@ struct BenchmarkSpec {
     double Y = 0.0, gamma = 0.0;
     int steps = 10;  // load steps of the rod's gravity (the block: one per time step of the push)
     bool newton = false;  // the Newton scheme instead of the paper's incremental one
+    // Central fibers (they bend; Newton only) instead of the paper's vector
+    // spring, within a horizon (m; 0: every pair), with the rod's clamp as a
+    // mirror layer as deep as the horizon.
+    bool central = false;
+    double horizon = 0.0;
+    bool mirror_layer = false;
   };
   FiberModel fiber;
+  // The rod's static state again on finer grids, each cell split ratio^k
+  // times per axis (k = 1..levels), sampled at this mesh's nodes (a refined
+  // grid keeps them): how far the benchmark's mesh is from a converged static
+  // shape, with the observed order; the fiber model is then fitted to the
+  // finest. levels = 0: none.
+  struct StaticReference {
+    int levels = 0;
+    int ratio = 2;
+  };
+  StaticReference static_reference;
 };
 
 // Reads the benchmark fields of an experiment document (everything but
@@ -73,7 +89,8 @@ struct FiberModelReport {
   double Y = 0.0, gamma = 0.0;
   std::string how;  // "given" or how the fit went
   int vertices = 0;
-  double static_energy_norm = 0.0;  // E_n of its static state against the FEM's
+  double static_energy_norm = 0.0;  // E_n of its static state against the FEM's it was fitted to
+  std::string target;               // that static state: "this mesh" or "cells x R"
 };
 
 struct BenchmarkResult {

@@ -34,7 +34,16 @@ json refined_surface(json document, double factor, std::string* resolution,
   if (!document.contains("surface") || !document["surface"].is_object())
     refuse("surface", "the experiment has no surface to refine");
   json& surface = document["surface"];
-  if (surface.contains("segments")) {
+  if (surface.contains("remesh_vertices")) {
+    // Remeshing comes last (a file's or a generator's surface remeshed): its
+    // vertex count is the resolution, whatever made the surface. A surface's
+    // vertices grow as the square of the refinement.
+    const double vertices = surface["remesh_vertices"].get<double>();
+    const long refined = std::lround(vertices * factor * factor);
+    surface["remesh_vertices"] = refined;
+    *actual_factor = std::sqrt(static_cast<double>(refined) / vertices);
+    *resolution = "remesh_vertices " + std::to_string(refined);
+  } else if (surface.contains("segments")) {
     json& segments = surface["segments"];
     if (!segments.is_array() || segments.empty() || !segments[0].is_number_integer())
       refuse("surface.segments", "expected a list of counts");
@@ -51,16 +60,9 @@ json refined_surface(json document, double factor, std::string* resolution,
     surface["subdivisions"] = surface["subdivisions"].get<int>() + more;
     *actual_factor = std::pow(2.0, more);
     *resolution = "subdivisions " + surface["subdivisions"].dump();
-  } else if (surface.contains("remesh_vertices")) {
-    // A surface's vertices grow as the square of the refinement.
-    const double vertices = surface["remesh_vertices"].get<double>();
-    const long refined = std::lround(vertices * factor * factor);
-    surface["remesh_vertices"] = refined;
-    *actual_factor = std::sqrt(static_cast<double>(refined) / vertices);
-    *resolution = "remesh_vertices " + std::to_string(refined);
   } else {
     refuse("surface", "expected the resolution to refine written out: a generator's "
-                      "\"segments\" or \"subdivisions\", or \"remesh_vertices\" for a file");
+                      "\"segments\" or \"subdivisions\", or \"remesh_vertices\"");
   }
   return document;
 }

@@ -78,11 +78,13 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
       for (int i = 0; i < n_; ++i)
         fibers_->for_each_kept(i, [&](int j) { kept_[static_cast<size_t>(i)] += counted(i, j); });
     } else {
+      std::vector<double> row(static_cast<size_t>(n_));
       for (int i = 0; i < n_; ++i) {
-        const uint8_t* kept = fibers_ != nullptr ? fibers_->row(i) : nullptr;
+        weights(i, row.data());
         for (int j = 0; j < n_; ++j)
-          if (j != i && (kept == nullptr || kept[j] != 0))
-            kept_[static_cast<size_t>(i)] += counted(i, j);
+          if (row[static_cast<size_t>(j)] != 0.0)
+            kept_[static_cast<size_t>(i)] +=
+                row[static_cast<size_t>(j)] * (by_area ? areas[j] / areas[i] : 1.0);
       }
     }
   } else if (fibers_ != nullptr) {

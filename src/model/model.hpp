@@ -151,7 +151,7 @@ enum class ConnectionCount {
   // omega(L_ij) |S_j| / |S_i|. On a uniform mesh it is n_i; on any mesh the
   // force on i becomes |S_i| times the area-weighted mean of Y e over what
   // its fibers reach, so that the response converges as the mesh is refined
-  // (the default for central fibers with a horizon: model.md).
+  // (the default for central fibers: model.md).
   Area,
 };
 const char* to_string(ConnectionCount count);

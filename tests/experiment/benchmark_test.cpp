@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -81,6 +82,103 @@ TEST(Benchmark, BadFieldsAreNamed) {
   rod.erase("mesh");
   rod["needle"] = {{"speed", 0.1}};
   expect_error(rod, "needle: only the block-needle scene");
+  expect_error(with("static_reference", {{"levels", 2}}),
+               "static_reference: only the bending-rod scene");
+  rod.erase("needle");
+  rod["static_reference"] = {{"levels", 6}};
+  expect_error(rod, "static_reference.levels");
+  rod["static_reference"] = {{"ratio", 5}};
+  expect_error(rod, "static_reference.ratio");
+  rod["mesh"] = {{"cells", {40, 20, 20}}};
+  rod["static_reference"] = {{"levels", 3}};
+  expect_error(rod, "static_reference: the finest grid (cells x 8) has over 150,000 nodes");
+}
+
+// A short rod: 4 x 2 x 2 hexahedra, 1 s, quasi-static only.
+nlohmann::json small_rod() {
+  return nlohmann::json::parse(R"({
+    "name": "small_rod",
+    "kind": "benchmark",
+    "scene": "bending-rod",
+    "mesh": {"cells": [4, 2, 2]},
+    "time": {"step": 0.0333333333333333, "duration": 1},
+    "solvers": ["quasi-static"]
+  })");
+}
+
+// The rod's static shape on refined grids converges at the trilinear
+// hexahedron's second order to the Timoshenko cantilever's deflection, and
+// the paper's 4 x 2 x 2 grid is far from it (its elements lock in bending).
+TEST(Benchmark, TheRodsStaticShapeConvergesOnRefinedGrids) {
+  nlohmann::json d = small_rod();
+  d["static_reference"] = {{"levels", 3}, {"ratio", 2}};
+  const BenchmarkResult r = run_benchmark(*parse(d).benchmark);
+  ASSERT_TRUE(r.ok) << r.message;
+  const auto& f = r.figures;
+  std::vector<double> largest;
+  for (const char* refine : {"1", "2", "4", "8"})
+    largest.push_back(f.at(std::string("static.refine_") + refine + ".max_displacement"));
+  for (size_t k = 1; k < largest.size(); ++k) EXPECT_GT(largest[k], largest[k - 1]);  // locking
+  EXPECT_EQ(f.at("static.monotone"), 1.0);
+  EXPECT_NEAR(f.at("static.order"), 2.0, 0.3);
+  EXPECT_GT(f.at("static.extrapolated_max_displacement"), largest.back());
+  // Timoshenko: q L^4 / (8 E I) + q L^2 / (2 kappa G A), q = rho g A, a
+  // square of side a (I = a^4 / 12, kappa = 5/6), MP3: E = 7000 Pa, nu = 0.2,
+  // 10,000 kg/m^3, g = 0.05 m/s^2, L = 0.5 m, a = 0.25 m. A beam as short as
+  // twice its depth is held at its clamped face more stiffly than the
+  // beam's clamp, and the corner moves a little more than the axis.
+  const double E = 7000.0, G = E / 2.4, a = 0.25, L = 0.5, A = a * a, I = a * a * a * a / 12.0;
+  const double q = 10000.0 * 0.05 * A;
+  const double timoshenko = q * std::pow(L, 4) / (8 * E * I) + q * L * L / (2 * 5.0 / 6.0 * G * A);
+  EXPECT_NEAR(f.at("static.extrapolated_max_displacement") / timoshenko, 1.0, 0.1);
+  // The paper's grid against the converged shape, on its boundary.
+  EXPECT_GT(f.at("reference.static_E_n_to_converged"), 0.1);
+  EXPECT_NE(benchmark_report(r).find("static shape, largest displacement by grid: x1 "),
+            std::string::npos);
+}
+
+// The fiber model is fitted to the finest grid's static shape when there is
+// one, and measured against both. (Central fibers: the vector spring cannot
+// bend, and its fits to either shape stop at Y's lower bound.)
+TEST(Benchmark, TheRodsFiberModelIsFittedToTheConvergedShape) {
+  nlohmann::json d = small_rod();
+  d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"kinematics", "central"}, {"horizon", 0.3}};
+  const BenchmarkResult own = run_benchmark(*parse(d).benchmark);
+  d["static_reference"] = {{"levels", 2}};
+  const BenchmarkResult converged = run_benchmark(*parse(d).benchmark);
+  ASSERT_TRUE(own.ok && converged.ok && own.fiber && converged.fiber);
+  EXPECT_EQ(own.fiber->target, "this mesh");
+  EXPECT_EQ(converged.fiber->target, "cells x 4");
+  EXPECT_EQ(own.figures.count("fiber-model.static_E_n_this_mesh"), 0u);
+  // Fitted to the softer converged shape: a softer Y, closer to its own
+  // target than to the locked grid's.
+  EXPECT_LT(converged.fiber->Y, own.fiber->Y);
+  EXPECT_LT(converged.figures.at("fiber-model.static_E_n"),
+            converged.figures.at("fiber-model.static_E_n_this_mesh"));
+}
+
+// The paper's vector spring cannot bend (its best fit drives Y to its lower
+// bound); central fibers within a horizon, with the clamp's mirror layer, can:
+// fitted to the same static shape, they come several times closer.
+TEST(Benchmark, TheRodsCentralFibersBendWhereTheVectorSpringCannot) {
+  nlohmann::json d = small_rod();
+  d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"scheme", "newton"}};
+  const BenchmarkResult vector = run_benchmark(*parse(d).benchmark);
+  d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"kinematics", "central"}, {"horizon", 0.3}};
+  const BenchmarkResult central = run_benchmark(*parse(d).benchmark);
+  ASSERT_TRUE(vector.ok && central.ok && vector.fiber && central.fiber) << central.message;
+  ASSERT_TRUE(central.series.back().ok) << central.series.back().message;
+  EXPECT_LT(central.figures.at("fiber-model.static_E_n"),
+            0.5 * vector.figures.at("fiber-model.static_E_n"));
+  EXPECT_GT(central.fiber->Y, 0.01 * 7000.0);  // a modulus, not a bound
+
+  nlohmann::json bad = small_rod();
+  bad["fiber_model"] = {{"kinematics", "central"}, {"scheme", "incremental"}};
+  expect_error(bad, "fiber_model.scheme: central fibers run with the Newton scheme only");
+  bad["fiber_model"] = {{"horizon", 0.3}};
+  expect_error(bad, "fiber_model.horizon: only central fibers");
+  bad["fiber_model"] = {{"kinematics", "central"}, {"mirror_layer", true}};
+  expect_error(bad, "fiber_model.mirror_layer: a mirror layer is as deep");
 }
 
 // Each series has one row per time step, is measured against the reference

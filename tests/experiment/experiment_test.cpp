@@ -38,6 +38,7 @@ INSTANTIATE_TEST_SUITE_P(
                       "liver_gravity.json", "bunny_gravity.json", "liver_sweep.json",
                       "nonlinear_round_trip.json", "liver_paddles.json", "stress_strain.json",
                       "benchmark_block_mp1.json", "benchmark_block_mp2.json", "benchmark_rod.json",
+                      "benchmark_rod_converged.json",
                       "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
                       "compression_large.json", "liver_interactive.json",
                       "cylinder_mesh_study.json"));

@@ -55,6 +55,13 @@ TEST(MeshStudy, RefinesWhatTheFileGivesAndNamesWhatItLacks) {
   refined = refined_document(file, StudiedMesh::Surface, 2.0, &resolution, &factor);
   EXPECT_EQ(refined["surface"]["remesh_vertices"], 4000);  // vertices as h^-2
   EXPECT_DOUBLE_EQ(factor, 2.0);
+  // A generator's surface remeshed: the remeshing sets the resolution, so a
+  // ratio that is no power of 2 refines it and leaves the subdivisions.
+  json remeshed = {{"surface", {{"generator", "icosphere"}, {"subdivisions", 5}, {"remesh_vertices", 600}}}};
+  refined = refined_document(remeshed, StudiedMesh::Surface, 1.25, &resolution, &factor);
+  EXPECT_EQ(refined["surface"]["remesh_vertices"], 938);
+  EXPECT_EQ(refined["surface"]["subdivisions"], 5);
+  EXPECT_EQ(resolution, "remesh_vertices 938");
   const auto refusal = [&](const json& document, StudiedMesh mesh, double by) {
     try {
       refined_document(document, mesh, by, &resolution, &factor);
