@@ -668,18 +668,16 @@ BenchmarkResult run_benchmark(const BenchmarkSpec& spec,
         bridge::fiber_model_of_scene(scene, frames.rest, model::Material::linear(1.0));
     if (spec.fiber.central) use_central_fibers(scene_model, spec.fiber);
     FiberModelReport report;
-    report.target = converged ? "cells x " + std::to_string(static_cast<int>(std::lround(std::pow(
-                                    spec.static_reference.ratio, spec.static_reference.levels))))
-                              : "this mesh";
     if (spec.fiber.fit) {
-      const std::string fitted_to = report.target;
       report = choose_fiber_material(spec, scene, scene_model, frames.rest, target, fiber_steps);
-      report.target = fitted_to;
     } else {
       report.Y = spec.fiber.Y;
       report.gamma = spec.fiber.gamma;
       report.how = "given";
     }
+    report.target = converged ? "cells x " + std::to_string(static_cast<int>(std::lround(std::pow(
+                                    spec.static_reference.ratio, spec.static_reference.levels))))
+                              : "this mesh";
     const FiberRun run =
         run_fiber_model(scene_model, report.Y, report.gamma, fiber_steps, spec.fiber.newton);
     MetricSeries s;
