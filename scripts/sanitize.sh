@@ -13,7 +13,7 @@ phase_start=$SECONDS
 # The sanitized run (ASan + UBSan; every finding is fatal). Left out, with
 # their reasons: the Python module and the installed example (a shared object
 # loaded by an unsanitized interpreter or toolchain), and the two longest
-# experiments, which the run above covers: bunny_gravity (930k fiber pairs
+# experiments, which the plain run (scripts/test.sh) covers: bunny_gravity (930k fiber pairs
 # pruned: minutes under ASan; the pruning tests run here on smaller bodies)
 # and benchmark_rod (a calibration loop of the rod's fiber model); the
 # central-fiber bar on its finer mesh and under its weight (bar_bending: dense
@@ -32,7 +32,7 @@ phase_start=$SECONDS
 # pruning against brute force on the shared meshes (100 s under ASan; the same
 # comparison on generated bodies runs here), the finer liver's force-curve fit
 # (fit_liver_force.json; ForceCurveFit.* fits force curves here), the resolved
-# experiment's bit-for-bit round trip (three whole runs; the run above checks
+# experiment's bit-for-bit round trip (three whole runs; the plain run checks
 # the bits) and the fitted benchmark (Benchmark.TheFittedFiberModelIsTheClosest;
 # the other Benchmark.* tests run here).
 # Line tables only (-g1): ASan's reports keep their file and line, and the
