@@ -12,7 +12,11 @@ and runs experiments/bending_phantom.json (Y = 100 kPa, gamma = 0.001 N/m) for a
 final surface, as make_synthetic_targets.py makes its scans (every triangle split in four,
 vertices shuffled, Gaussian noise of 0.5 mm per coordinate):
   phantom_step10_scan.obj           what experiments/fit_bending_phantom.json fits
-Usage: /usr/bin/python3 experiments/make_specimen_targets.py [build-release/src/app/fiberfluid]
+and the same for experiments/bending_phantom_gripped.json (no mirror layer, gripped 6 mm):
+  phantom_gripped_step10_scan.obj   what experiments/fit_bending_phantom_gripped.json fits
+Usage: /usr/bin/python3 experiments/make_specimen_targets.py [FIBERFLUID [TARGET ...]]
+TARGET: compression, phantom, phantom_gripped (default all; each keeps its own noise seed, so
+remaking one leaves the others as they were).
 """
 import os
 import subprocess
@@ -35,9 +39,7 @@ def read_steps(path):
         return [dict(zip(header, line.strip().split(","))) for line in f if line.strip()]
 
 
-def main():
-    binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build-release/src/app/fiberfluid")
-    out_dir = os.path.join(ROOT, "data", "targets")
+def make_compression(binary, out_dir):
     rng = np.random.default_rng(SEED)
     with tempfile.TemporaryDirectory() as tmp:
         subprocess.run([binary, "run", os.path.join(ROOT, "experiments/compression_cylinder.json"),
@@ -53,14 +55,30 @@ def main():
     with open(os.path.join(out_dir, "compression_force_first_half.csv"), "w") as f:
         f.write(comment + ", the first 20 steps (to 10 mm)\nstep,travel,force\n" +
                 "".join(lines[:len(lines) // 2]))
+
+
+def make_scan(binary, out_dir, experiment, target, seed):
     with tempfile.TemporaryDirectory() as tmp:
-        subprocess.run([binary, "run", os.path.join(ROOT, "experiments/bending_phantom.json"),
+        subprocess.run([binary, "run", os.path.join(ROOT, "experiments", experiment),
                         "-o", os.path.join(tmp, "p"), "-q"], check=True, stdout=subprocess.DEVNULL)
         points, triangles = read_vtu(os.path.join(tmp, "p", "vtk", "step_0010.vtu"))
-    scan, faces = resampled_scan(points, triangles, np.random.default_rng(SEED + 1))
-    write_obj(os.path.join(out_dir, "phantom_step10_scan.obj"), scan, faces,
-              "experiments/bending_phantom.json at load step 10: resampled (midpoint subdivision, "
+    scan, faces = resampled_scan(points, triangles, np.random.default_rng(seed))
+    write_obj(os.path.join(out_dir, target), scan, faces,
+              f"experiments/{experiment} at load step 10: resampled (midpoint subdivision, "
               "shuffled), Gaussian noise 0.5 mm per coordinate")
+
+
+def main():
+    binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build-release/src/app/fiberfluid")
+    wanted = set(sys.argv[2:]) or {"compression", "phantom", "phantom_gripped"}
+    out_dir = os.path.join(ROOT, "data", "targets")
+    if "compression" in wanted:
+        make_compression(binary, out_dir)
+    if "phantom" in wanted:
+        make_scan(binary, out_dir, "bending_phantom.json", "phantom_step10_scan.obj", SEED + 1)
+    if "phantom_gripped" in wanted:
+        make_scan(binary, out_dir, "bending_phantom_gripped.json",
+                  "phantom_gripped_step10_scan.obj", SEED + 2)
     print("targets in", out_dir)
 
 

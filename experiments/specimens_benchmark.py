@@ -20,7 +20,7 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-EXPERIMENTS = ["compression_cylinder.json", "bending_phantom.json"]
+EXPERIMENTS = ["compression_cylinder.json", "bending_phantom.json", "bending_phantom_gripped.json"]
 
 
 def runs(summary, name):

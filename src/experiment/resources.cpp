@@ -47,14 +47,17 @@ constexpr double kSparseFactorEntries = 2.76e7, kSparseFactorSeconds = 3.7;
 // dim^2 (N + 2 pairs); the factors' fill grows as sqrt(N) and the flops as
 // the fill^1.5, from a measurement at 10,242 vertices (a horizon of a tenth
 // of the radius: 2.28 million entries, 27.6 million in L and U, 3.7 s).
+// A solve with the factors reads them once (12 bytes an entry) at about
+// 4 GB/s.
 struct SparseTangentCost {
-  double bytes, factor_seconds;
+  double bytes, factor_seconds, solve_seconds;
 };
 SparseTangentCost sparse_tangent_cost(double N, double dim, double pairs) {
   const double entries = dim * dim * (N + 2.0 * pairs);
   const double factor_entries = kSparseFillPerEntry * entries * std::sqrt(N / 10242.0);
   return {12.0 * factor_entries + 3.0 * 16.0 * entries,
-          kSparseFactorSeconds * std::pow(factor_entries / kSparseFactorEntries, 1.5)};
+          kSparseFactorSeconds * std::pow(factor_entries / kSparseFactorEntries, 1.5),
+          12.0 * factor_entries / 4e9};
 }
 
 solve::SolverKind choose(const model::Model& m, const solve::SteppingOptions& o,
@@ -133,8 +136,11 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   // steps (issue 42: 9 and 12 for the compressed cylinder's 40 steps, 1 for the
   // bending phantom's 10).
   const bool reused_tangent = newton && tangent_kind == solve::TangentSolver::Reused;
-  const solve::SolverKind kind =
-      dense_tangent || reused_tangent ? solve::SolverKind::DenseLU : choose(model, o, blocks);
+  // A horizon's lists: the reused factor is the sparse tangent's LU.
+  const bool reused_sparse = reused_tangent && sparse_fibers;
+  const solve::SolverKind kind = dense_tangent || (reused_tangent && !reused_sparse)
+                                     ? solve::SolverKind::DenseLU
+                                     : choose(model, o, blocks);
   e.solver = solve::to_string(kind);
 
   // One factorisation of the structured system (or the Newton preconditioner)
@@ -155,12 +161,20 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
     } else {
       // The stored pair coefficients (when they fit a quarter of the
       // budget), the preconditioner once per step, GMRES products.
-      const double stored = 2.0 * 8.0 * N * N;
+      const double stored = 2.0 * 8.0 * (sparse_fibers ? 2.0 * pairs : N * N);
+      double factor_seconds = factor.seconds, preconditioner_solve = solve_seconds;
+      if (reused_sparse) {
+        const SparseTangentCost c = sparse_tangent_cost(N, d, pairs);
+        tangent.bytes = c.bytes;
+        factor_seconds = c.factor_seconds;
+        preconditioner_solve = c.solve_seconds;
+      }
       tangent.bytes += (stored < 0.25 * memory_budget_bytes() ? stored : 0.0) +
                        8.0 * unknowns * (o.newton.krylov_restart + 2);
       const double factorizations = reused_tangent ? 1.0 + 0.25 * steps : steps;
-      tangent.seconds = factorizations * factor.seconds +
-                        iterations * (residual + kKrylovProducts * (3.0 * product + solve_seconds));
+      tangent.seconds =
+          factorizations * factor_seconds +
+          iterations * (residual + kKrylovProducts * (3.0 * product + preconditioner_solve));
     }
     e.parts.push_back(tangent);
   } else {

@@ -73,10 +73,15 @@ std::string singular_setup_reason(const Model& model) {
   const char* names = "xyz";
   for (int a = 0; a < model.dim(); ++a) {
     const bool held = std::any_of(model.constraints.begin(), model.constraints.end(),
-                                  [a](const Constraint& c) { return c.axis == a; });
+                                  [a](const Constraint& c) { return c.axis == a; }) ||
+                      std::any_of(model.paddles.begin(), model.paddles.end(),
+                                  [&](const Paddle& p) {
+                                    return p.axis == a && !touching_at_start(model, p).empty();
+                                  });
     if (!held)
       return std::string("no support along ") + names[a] + ": the body can translate along " +
-             names[a] + ", so the system is singular";
+             names[a] + ", so the system is singular (a support, or a paddle on " + names[a] +
+             " touching the body at its start, holds it)";
     // Zero stiffness is singular; a negative one is left to the solvers,
     // which report a matrix that is not positive definite.
     if (model.material.young_modulus()[a] == 0.0 && model.material.surface_tension == 0.0)
@@ -84,6 +89,17 @@ std::string singular_setup_reason(const Model& model) {
              ": Y and gamma are both zero, so the system is singular";
   }
   return {};
+}
+
+std::vector<int> touching_at_start(const Model& model, const Paddle& paddle) {
+  const Eigen::MatrixXd& V = model.surface.V;
+  if (paddle.axis < 0 || paddle.axis >= model.dim() || V.rows() == 0) return {};
+  const double diagonal = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  std::vector<int> touching;
+  for (int v = 0; v < V.rows(); ++v)
+    if (std::abs(paddle.penetration(V(v, paddle.axis), paddle.position)) <= 1e-9 * diagonal)
+      touching.push_back(v);
+  return touching;
 }
 
 Eigen::Vector3d RigidMotion::displacement(const Eigen::Vector3d& s, double factor) const {

@@ -38,7 +38,14 @@ double held_value(const Model& model, const Constraint& constraint, int step, in
 // ---------------------------------------------------------------- checking
 // Empty when the constraints remove rigid motion; otherwise why the system
 // is singular (e.g. no axis-x constraint: the body can translate along x).
+// A paddle on an axis that no support holds counts when it touches the body
+// at its start: its contact then holds the body along its axis from the
+// first iterate (a body resting on a floor).
 std::string singular_setup_reason(const Model& model);
+
+// The vertices a paddle touches before the first step: on its starting
+// plane, within a billionth of the body's diagonal.
+std::vector<int> touching_at_start(const Model& model, const Paddle& paddle);
 
 // ---------------------------------------------------------------- reduction
 // The constrained and free unknowns of the paper's layout (P is always free).

@@ -14,6 +14,7 @@
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/geom/self_intersection.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/dof_map.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/fiber_system.hpp"
@@ -82,6 +83,12 @@ class NewtonSolver {
     tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
     summary_.tangent = kind;
     summary_.solver = tangent_->preconditioner_kind();
+    // A body resting on a paddle is held by it from the first iterate.
+    for (size_t p = 0; p < model.paddles.size(); ++p)
+      for (int v : model::touching_at_start(model, model.paddles[p]))
+        if (contact_paddle_[static_cast<size_t>(v)] < 0 &&
+            !supports_.held(model.paddles[p].axis * model.num_vertices() + v))
+          contact_paddle_[static_cast<size_t>(v)] = static_cast<int>(p);
   }
 
   const model::Equilibrium& equilibrium() const { return *equilibrium_; }

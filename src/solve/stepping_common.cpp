@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/folds.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/solve/linear_solver.hpp"
 
@@ -21,15 +22,21 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
                            double reference_volume, Eigen::MatrixXd& last_face_areas) {
   if (!unknowns.allFinite()) return "the solution (displacements or pressure) is not finite";
   if (options.stop_on_inverted_faces) {
-    // Against the last accepted step, not the reference: a face that turns
-    // over passes through zero area, so its normal reverses within a step,
-    // while a body that rotates far (central fibers) turns its faces slowly.
-    const Eigen::MatrixXd now = geom::face_area_vectors(X, model.surface.F);
-    for (Eigen::Index f = 0; f < now.rows(); ++f)
-      if (now.row(f).dot(last_face_areas.row(f)) <= 0.0)
-        return "face " + std::to_string(f) +
-               " turned over (its normal reversed): the load is too large for the material";
-    last_face_areas = now;
+    // Against the last accepted step, not the reference: only a fold since
+    // then stops the run, not a body that rotated far (find_fold).
+    geom::Surface now = model.surface;
+    now.V = X;
+    if (const auto fold = geom::find_fold(now, last_face_areas)) {
+      const std::string face = "face " + std::to_string(fold->face) + " turned over ";
+      if (!fold->crossing)
+        return face + "(its normal reversed against its neighbours'): the load is too large for "
+                      "the material";
+      return face + "and the surface passes through itself (faces " +
+             std::to_string(fold->crossing->first) + " and " +
+             std::to_string(fold->crossing->second) +
+             " cross): the load is too large for the material";
+    }
+    last_face_areas = geom::face_area_vectors(X, model.surface.F);
   }
   const double change = (volume - reference_volume) / reference_volume;
   if (!std::isfinite(change) || std::abs(change) > options.max_volume_change) {

@@ -43,9 +43,10 @@ inline SteppingSummary failed(SteppingSummary& summary, const std::string& why,
 std::string setup_problem(const model::Model& model, const SteppingOptions& options);
 
 // Why the state reached after a step is a runaway rather than a result, or
-// "": non-finite unknowns, a face turned over since the last accepted step
-// (last_face_areas, the face area vectors then: updated when the faces are
-// checked and none turned), a volume change beyond options.max_volume_change.
+// "": non-finite unknowns, a fold since the last accepted step (a face whose
+// normal reversed and now faces against its neighbours, or a surface that
+// crosses itself; last_face_areas, the face area vectors then: updated when
+// the faces pass), a volume change beyond options.max_volume_change.
 std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
                            const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
                            double reference_volume, Eigen::MatrixXd& last_face_areas);

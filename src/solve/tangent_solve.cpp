@@ -92,6 +92,8 @@ TangentSolve::TangentSolve(std::shared_ptr<const model::Equilibrium> equilibrium
   preconditioner_kind_ = kind_ == TangentSolver::Dense || kind_ == TangentSolver::Reused
                              ? SolverKind::DenseLU
                              : options.solver;
+  reuses_sparse_lu_ = kind_ == TangentSolver::Reused && equilibrium_->sparse_fibers();
+  if (reuses_sparse_lu_) preconditioner_kind_ = options.solver;  // as the sparse tangent's
 }
 
 Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
@@ -146,7 +148,7 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
 // correction. An unknown released since (a contact let go) would be missing
 // from its solve: refactor.
 bool TangentSolve::reused_factor_still_serves() const {
-  if (!lu_ || refactor_) return false;
+  if (!reused_factor_ok_ || refactor_) return false;
   const std::vector<char>& now = dofs_.held_flags();
   if (now.size() != preconditioned_held_.size()) return false;
   size_t added = 0;
@@ -299,18 +301,33 @@ Status TangentSolve::solve_full(const Eigen::VectorXd& b, Eigen::VectorXd* y, do
 
 Status TangentSolve::preconditioner_solve(const Eigen::VectorXd& in, Eigen::VectorXd* out) const {
   if (kind_ != TangentSolver::Reused) return preconditioner_->solve(in, out);
-  *out = column_scale_.cwiseProduct(lu_->solve(row_scale_.cwiseProduct(in)));
+  const Eigen::VectorXd scaled = row_scale_.cwiseProduct(in);
+  *out = column_scale_.cwiseProduct(reuses_sparse_lu_ ? sparse_lu_->solve(scaled)
+                                                      : lu_->solve(scaled));
   return out->allFinite() ? Status{} : Status::failure("the tangent's LU solve is not finite");
 }
 
-// The reused preconditioner: the equilibrated dense LU of the exact tangent
-// at the current state over the current held set.
+// The reused preconditioner: the equilibrated LU of the exact tangent at the
+// current state over the current held set; sparse (UMFPACK, its symbolic
+// analysis kept while the pattern stays) for a horizon's lists, whose dense
+// tangent would be mostly zeros.
 Status TangentSolve::factor_tangent_preconditioner() {
-  Eigen::MatrixXd J = preconditioner_dofs_.reduce(equilibrium_->tangent(x_, factors_));
-  equilibrate(J, &row_scale_, &column_scale_);
-  lu_ = std::make_unique<DenseLU>();
-  const Status status = lu_->factorize(J);
+  reused_factor_ok_ = false;
+  Status status;
+  if (reuses_sparse_lu_) {
+    Eigen::SparseMatrix<double> J =
+        reduce(preconditioner_dofs_, equilibrium_->sparse_tangent(x_, factors_));
+    equilibrate(J, &row_scale_, &column_scale_);
+    if (!sparse_lu_) sparse_lu_ = std::make_unique<SparseLU>();
+    status = sparse_lu_->factorize(J);
+  } else {
+    Eigen::MatrixXd J = preconditioner_dofs_.reduce(equilibrium_->tangent(x_, factors_));
+    equilibrate(J, &row_scale_, &column_scale_);
+    lu_ = std::make_unique<DenseLU>();
+    status = lu_->factorize(J);
+  }
   if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
+  reused_factor_ok_ = true;
   note_new_factor();
   return {};
 }

@@ -22,8 +22,9 @@ namespace fiberfluid::solve {
 // DofMap leaves free: the dense LU of the reduced tangent, the sparse LU of
 // it (fibers within a horizon: N times the neighbours entries), or GMRES on the
 // tangent as an operator (its pair coefficients stored), right-preconditioned
-// by the dense LU of the tangent at an earlier state (`reused`: a modified
-// Newton's factor, whose GMRES restores the exact Newton step) or by the
+// by the LU of the tangent at an earlier state (`reused`: a modified
+// Newton's factor, whose GMRES restores the exact Newton step; dense, or
+// sparse where the fibers are a horizon's lists) or by the
 // structured secant solve (the reference bordered system with each
 // bulk weight times Y(e_ij); for central fibers each axis block's weights
 // also times that axis's share of the fiber's direction). The preconditioner is kept between states and
@@ -91,8 +92,12 @@ class TangentSolve {
   bool ready_ = false;
   // Dense (and reused: the LU of the tangent at an earlier state).
   std::unique_ptr<DenseLU> lu_;
-  // Sparse (its scaling in row_scale_, column_scale_ as the dense one's).
+  // Sparse (its scaling in row_scale_, column_scale_ as the dense one's),
+  // and reused where the fibers are a horizon's lists: the sparse LU of the
+  // tangent at an earlier state.
   std::unique_ptr<SparseLU> sparse_lu_;
+  bool reuses_sparse_lu_ = false;
+  bool reused_factor_ok_ = false;  // the reused factor succeeded (and is current)
   // The dense tangent is equilibrated before its LU (rows, then columns, by
   // their largest entries): force rows of a stiff material and the volume
   // row differ by many orders, which would make a sound system look singular.

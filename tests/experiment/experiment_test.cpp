@@ -660,7 +660,9 @@ TEST(ExperimentConfig, AFreeRotationIsHeldByAGaugeOrRefused) {
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
   const solve::SteppingSummary& s = r.runs[0].summary;
   EXPECT_LE(s.steps[0].contact_rounds, 4);
-  EXPECT_GT(s.steps[0].contacts_added, 0);
+  // The platens touch the end faces at the start: in contact from the first iterate.
+  EXPECT_GT(s.steps[0].paddles[0].contacts, 0);
+  EXPECT_GT(s.steps[0].paddles[1].contacts, 0);
   const solve::StepRecord& last = s.steps.back();
   const double pressing = std::abs(last.paddles[1].force.x());
   EXPECT_GT(pressing, 0.1);
@@ -674,6 +676,36 @@ TEST(ExperimentConfig, AFreeRotationIsHeldByAGaugeOrRefused) {
   expect_config_error(dir, turned,
                       "supports[0]: the supports leave the rotation about the axis x through "
                       "(0.015, 0, 0) free, and the loads turn the body about it");
+}
+
+// A body resting on a floor: no support holds it along the floor's axis,
+// the floor it touches at its start does, and carries its weight.
+TEST(ExperimentConfig, ABodyRestingOnAFloorPaddleIsHeldByIt) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {
+      {"generator", "cylinder"}, {"radius", 0.025}, {"length", 0.03}, {"segments", {4, 16}}};
+  c["material"] = {{"Y", 100000}, {"gamma", 0.001}};
+  c["supports"] = {{{"label", "centre"},
+                    {"axes", "yz"},
+                    {"box", {{"min", {-1e-7, -1e-7, -1e-7}}, {"max", {1e-7, 1e-7, 1e-7}}}}}};
+  c["loads"] = {{{"type", "gravity"}, {"acceleration", {-9.81, 0, 0}}, {"density", 1000}}};
+  c["paddles"] = {{{"label", "floor"}, {"axis", "x"}, {"side", "below"}, {"travel", 0}}};
+  c["stepping"] = {{"scheme", "newton"}, {"steps", 2}};
+  const ExperimentResult r = run_experiment(load_experiment(write_config(dir, c)));
+  ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+  const solve::StepRecord& last = r.runs[0].summary.steps.back();
+  const double weight = -last.applied_force.x();
+  EXPECT_GT(weight, 0.1);
+  EXPECT_NEAR(last.paddles[0].force.x(), weight, 1e-8 * weight);  // the floor's push on the body
+  EXPECT_GT(last.paddles[0].contacts, 0);
+
+  nlohmann::json clear = c;  // a floor below the body holds nothing at the start
+  clear["paddles"][0]["position"] = -0.001;
+  const ExperimentResult falls = run_experiment(load_experiment(write_config(dir, clear)));
+  ASSERT_FALSE(falls.runs_succeeded());
+  EXPECT_NE(falls.runs[0].summary.message.find("no support along x"), std::string::npos)
+      << falls.runs[0].summary.message;
 }
 
 TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
