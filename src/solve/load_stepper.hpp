@@ -35,8 +35,9 @@ enum class TangentSolver {
   Dense,   // LU of the dense tangent (LAPACK) at every iteration
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
   Sparse,  // LU of the sparse tangent (UMFPACK): N times the neighbours entries
-  Reused,  // GMRES on the exact tangent, preconditioned by the dense LU of an earlier
-           // one, reused across iterations and steps while GMRES needs few iterations
+  Reused,  // GMRES on the exact tangent, preconditioned by the LU of an earlier one
+           // (dense; sparse for a horizon's lists), reused across iterations and steps
+           // while GMRES needs few iterations
 };
 const char* to_string(TangentSolver solver);
 // What `requested` means for a Newton run with `reduced_unknowns` (the

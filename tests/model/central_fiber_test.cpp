@@ -214,12 +214,49 @@ TEST(CentralFibers, AStiffBarGivesTheSoftBarsProfile) {
 TEST(CentralFibers, EveryTangentSolverGivesTheBarsProfile) {
   const std::vector<double> dense = bar_profile(40, 2, 0.011, FiberKinematics::Central);
   for (solve::TangentSolver tangent :
-       {solve::TangentSolver::Sparse, solve::TangentSolver::Krylov}) {
+       {solve::TangentSolver::Sparse, solve::TangentSolver::Krylov, solve::TangentSolver::Reused}) {
     const std::vector<double> other =
         bar_profile(40, 2, 0.011, FiberKinematics::Central, 1e5, tangent);
     for (size_t k = 0; k < dense.size(); ++k)
       EXPECT_NEAR(other[k], dense[k], 1e-6) << solve::to_string(tangent);
   }
+}
+
+// A horizon's lists reuse the sparse LU of an earlier tangent as GMRES's
+// preconditioner: the same equilibria as a sparse LU per iteration, over
+// steps that bend the bar far, with fewer factorisations.
+TEST(CentralFibers, TheReusedSparseFactorGivesTheSparseTangentsAnswerWithFewerFactorisations) {
+  const double length = 0.2, thickness = 0.01, Y = 1e5;
+  Model m;
+  m.surface = geom::box({0.0, 0.0, 0.0}, {length, thickness, thickness}, Eigen::Vector3i(40, 2, 2));
+  m.material.law = FiberLaw::constant(Y);
+  m.material.kinematics = FiberKinematics::Central;
+  m.fibers = std::make_shared<const geom::FiberMask>(geom::horizon_fibers(m.surface, 0.011));
+  ASSERT_TRUE(m.fibers->sparse());
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    if (m.surface.V(v, 0) < 1e-9)
+      for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
+    if (m.surface.V(v, 0) > length - 1e-9) {
+      Load load;
+      load.vertex = v;
+      load.force = {0.0, 0.0, -3e-9 * Y};
+      m.loads.push_back(load);
+    }
+  }
+  solve::SteppingSummary runs[2];
+  const solve::TangentSolver kinds[2] = {solve::TangentSolver::Sparse, solve::TangentSolver::Reused};
+  for (int k = 0; k < 2; ++k) {
+    solve::SteppingOptions newton = dense_newton(4);
+    newton.newton.tangent = kinds[k];
+    runs[k] = solve::solve_load_steps(m, newton);
+    ASSERT_TRUE(runs[k].success) << runs[k].message;
+  }
+  const Eigen::MatrixXd U = displacements(m, runs[0].unknowns);
+  const double tip = U.col(2).cwiseAbs().maxCoeff();
+  EXPECT_GT(tip, 0.1 * length) << "the load bends the bar far";
+  EXPECT_LT((displacements(m, runs[1].unknowns) - U).cwiseAbs().maxCoeff(), 1e-6 * tip);
+  EXPECT_LT(runs[1].factorizations, runs[0].factorizations);
+  EXPECT_GT(runs[1].krylov_iterations, 0);
 }
 
 // A clamp turned by 90 degrees about an axis across the bar, no load: with
