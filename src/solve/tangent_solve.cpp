@@ -104,16 +104,10 @@ Status TangentSolve::prepare(const Eigen::VectorXd& x, const std::vector<double>
   preconditioner_dofs_ = preconditioner_dofs ? *preconditioner_dofs : dofs;
   ready_ = false;
   if (kind_ == TangentSolver::Dense) {
-    lu_ = std::make_unique<DenseLU>();
-    Eigen::MatrixXd J = dofs_.reduce(equilibrium_->tangent(x_, factors_));
-    equilibrate(J, &row_scale_, &column_scale_);
-    const Status status = lu_->factorize(J);
+    const Status status = factor_dense_tangent(dofs_);
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   } else if (kind_ == TangentSolver::Sparse) {
-    if (!sparse_lu_) sparse_lu_ = std::make_unique<SparseLU>();
-    Eigen::SparseMatrix<double> J = reduce(dofs_, equilibrium_->sparse_tangent(x_, factors_));
-    equilibrate(J, &row_scale_, &column_scale_);
-    const Status status = sparse_lu_->factorize(J);
+    const Status status = factor_sparse_tangent(dofs_);
     ++factorizations_;
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   } else if (kind_ == TangentSolver::Reused) {
@@ -308,28 +302,33 @@ Status TangentSolve::preconditioner_solve(const Eigen::VectorXd& in, Eigen::Vect
 }
 
 // The reused preconditioner: the equilibrated LU of the exact tangent at the
-// current state over the current held set; sparse (UMFPACK, its symbolic
-// analysis kept while the pattern stays) for a horizon's lists, whose dense
-// tangent would be mostly zeros.
+// current state over the current held set; sparse for a horizon's lists,
+// whose dense tangent would be mostly zeros.
 Status TangentSolve::factor_tangent_preconditioner() {
   reused_factor_ok_ = false;
-  Status status;
-  if (reuses_sparse_lu_) {
-    Eigen::SparseMatrix<double> J =
-        reduce(preconditioner_dofs_, equilibrium_->sparse_tangent(x_, factors_));
-    equilibrate(J, &row_scale_, &column_scale_);
-    if (!sparse_lu_) sparse_lu_ = std::make_unique<SparseLU>();
-    status = sparse_lu_->factorize(J);
-  } else {
-    Eigen::MatrixXd J = preconditioner_dofs_.reduce(equilibrium_->tangent(x_, factors_));
-    equilibrate(J, &row_scale_, &column_scale_);
-    lu_ = std::make_unique<DenseLU>();
-    status = lu_->factorize(J);
-  }
+  const Status status = reuses_sparse_lu_ ? factor_sparse_tangent(preconditioner_dofs_)
+                                          : factor_dense_tangent(preconditioner_dofs_);
   if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   reused_factor_ok_ = true;
   note_new_factor();
   return {};
+}
+
+// The equilibrated LU of the exact tangent at x_ over the unknowns `dofs`
+// leaves free, dense (LAPACK) or sparse (UMFPACK, its symbolic analysis
+// kept while the pattern stays).
+Status TangentSolve::factor_dense_tangent(const model::DofMap& dofs) {
+  Eigen::MatrixXd J = dofs.reduce(equilibrium_->tangent(x_, factors_));
+  equilibrate(J, &row_scale_, &column_scale_);
+  lu_ = std::make_unique<DenseLU>();
+  return lu_->factorize(J);
+}
+
+Status TangentSolve::factor_sparse_tangent(const model::DofMap& dofs) {
+  Eigen::SparseMatrix<double> J = reduce(dofs, equilibrium_->sparse_tangent(x_, factors_));
+  equilibrate(J, &row_scale_, &column_scale_);
+  if (!sparse_lu_) sparse_lu_ = std::make_unique<SparseLU>();
+  return sparse_lu_->factorize(J);
 }
 
 Status TangentSolve::factor_preconditioner() {

@@ -75,6 +75,8 @@ class TangentSolve {
  private:
   Status factor_preconditioner();
   Status factor_tangent_preconditioner();
+  Status factor_dense_tangent(const model::DofMap& dofs);
+  Status factor_sparse_tangent(const model::DofMap& dofs);
   void note_new_factor();  // a preconditioner factored: counts, caches and the refresh rule reset
   bool reused_factor_still_serves() const;
   Status preconditioner_solve(const Eigen::VectorXd& in, Eigen::VectorXd* out) const;
