@@ -479,6 +479,8 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
     else
       std::cout << " (no standard error";
     std::cout << "; start " << fitted.initial[i] << ")\n";
+    if (k < fitted.interval_notes.size() && !fitted.interval_notes[k].empty())
+      std::cout << "    interval: " << fitted.interval_notes[k] << "\n";
   }
   if (!fitted.statistics.empty()) {
     const auto& d = fitted.overall;
@@ -493,8 +495,12 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
               << " N), largest " << m.largest << " N\n";
   std::cout << "  " << fitted.forward_runs << " forward runs";
   if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed)";
+  if (fitted.warm_started_runs > 0)
+    std::cout << " (" << fitted.warm_started_runs << " solved from a nearby point's state)";
   std::cout << ", " << fitted.sensitivity_solves << " sensitivity solves, " << fitted.seconds
             << " s\n";
+  if (!fitted.warm_start_note.empty())
+    std::cerr << "warning: " << fitted.warm_start_note << "\n";
   for (const auto& [cause, count] : fitted.failures_by_cause)
     std::cout << "  failed forward runs: " << count << " x " << cause << "\n";
   if (!fitted.failed_examples.empty()) {

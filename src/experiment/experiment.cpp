@@ -732,6 +732,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   o.initial_trust_region_radius =
       f.number("initial_trust_region_radius", o.initial_trust_region_radius);
   o.max_step_factor = f.number("max_step_factor", o.max_step_factor);
+  o.warm_start = f.boolean("warm_start", o.warm_start);
   try {
     fit::check_options(o);
   } catch (const InputError& e) {

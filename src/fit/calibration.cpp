@@ -4,6 +4,7 @@
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cctype>
@@ -191,6 +192,7 @@ struct Calibration::Impl {
   std::vector<int> counted;       // model vertices whose distances count
   std::vector<int> target_steps;  // the distinct steps, ascending
   bool analytic = true;
+  bool warm_starts = false;  // Calibration::warm_starts()
   double length = 0.0;
   int residuals = 0;
 
@@ -339,6 +341,13 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
     throw InputError("fewer distances (" + std::to_string(m.residuals) + ") than parameters (" +
                      std::to_string(m.map.size()) + ")");
   m.stepping.keep_final_tangent = false;
+  {
+    solve::SteppingOptions probe = m.stepping;  // any start of the right size
+    probe.warm_start = Eigen::VectorXd::Zero(m.model.dim() * m.model.num_vertices() + 1);
+    m.warm_starts = m.options.warm_start && m.stepping.scheme == solve::Scheme::Newton &&
+                    m.state_steps == std::vector<int>{m.stepping.steps} &&
+                    solve::warm_start_problem(m.model, probe).empty();
+  }
   // The material with the starts, so that model() shows what the fit begins from.
   m.model.material = m.map.material(m.model.material, m.map.values(m.map.initial_phi()));
   const std::string why = m.model.material.law.check();
@@ -351,6 +360,7 @@ const ParameterMap& Calibration::parameters() const { return impl_->map; }
 const FitOptions& Calibration::options() const { return impl_->options; }
 const model::Model& Calibration::model() const { return impl_->model; }
 bool Calibration::analytic_jacobian() const { return impl_->analytic; }
+bool Calibration::warm_starts() const { return impl_->warm_starts; }
 int Calibration::num_residuals() const { return impl_->residuals; }
 int Calibration::num_counted_vertices() const { return static_cast<int>(impl_->counted.size()); }
 double Calibration::body_length() const { return impl_->length; }
@@ -377,7 +387,19 @@ double Calibration::cost(const Eigen::VectorXd& r) const {
   return 0.5 * sum;
 }
 
-Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian) const {
+namespace {
+
+// The record of step k in a run (a warm-started run holds its last step only).
+const solve::StepRecord& record_of(const solve::SteppingSummary& summary, int k) {
+  for (const solve::StepRecord& record : summary.steps)
+    if (record.step == k) return record;
+  throw std::logic_error("calibration: the run has no record of step " + std::to_string(k));
+}
+
+}  // namespace
+
+Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
+                                 const Eigen::VectorXd& warm_start) const {
   const Impl& m = *impl_;
   const ParameterMap& map = m.map;
   const int P = map.size(), nv = m.model.num_vertices();
@@ -396,6 +418,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   solve::SteppingOptions stepping = m.stepping;
   if (sensitivities_wanted && m.analytic)
     stepping.sensitivities = {map.material_names(), m.state_steps};
+  if (m.warm_starts) stepping.warm_start = warm_start;
   // Per step read: the state, and each force curve's force.
   struct StepState {
     Eigen::VectorXd x;
@@ -415,6 +438,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   };
   e.summary = run(changed, stepping, states);
   e.forward_runs = 1;
+  e.warm_started_runs = e.summary.warm_started ? 1 : 0;
   if (!e.summary.success) {
     e.message = e.summary.message;
     return e;
@@ -426,7 +450,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
   std::map<int, std::vector<Eigen::RowVectorXd>> force_sensitivity;
   if (sensitivities_wanted && m.analytic) {
     for (int step : m.state_steps) {
-      const solve::StepRecord& record = e.summary.steps[static_cast<size_t>(step - 1)];
+      const solve::StepRecord& record = record_of(e.summary, step);
       sensitivity[step] = record.sensitivities;
       e.sensitivity_solves += static_cast<int>(sensitivity[step].cols());
       for (const ForceCurve& curve : m.curves) {
@@ -456,8 +480,11 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian)
         shifted[k] += sign * h;
         model::Model moved = m.model;
         moved.material = map.material(m.model.material, map.values(shifted));
-        const solve::SteppingSummary s = run(moved, m.stepping, sign > 0 ? plus : minus);
+        solve::SteppingOptions shifted_stepping = m.stepping;
+        if (m.warm_starts) shifted_stepping.warm_start = e.summary.unknowns;  // phi's, next door
+        const solve::SteppingSummary s = run(moved, shifted_stepping, sign > 0 ? plus : minus);
         ++e.forward_runs;
+        e.warm_started_runs += s.warm_started ? 1 : 0;
         if (!s.success) {
           e.message = "a finite-difference run failed: " + s.message;
           return e;
@@ -640,8 +667,9 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
     if (position != kept_.begin()) std::rotate(kept_.begin(), position, std::next(position));
     return kept_.front().evaluation;
   }
-  Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian)};
+  Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian, nearest_state(phi))};
   forward_runs += entry.evaluation.forward_runs;
+  warm_started_runs += entry.evaluation.warm_started_runs;
   sensitivity_solves += entry.evaluation.sensitivity_solves;
   // A run cut short by an interrupt did not fail: it is neither counted nor
   // kept (the same point may be run again later).
@@ -656,6 +684,16 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
   kept_.push_front(std::move(entry));
   if (kept_.size() > kKept) kept_.pop_back();
   return kept_.front().evaluation;
+}
+
+Eigen::VectorXd EvaluationCache::nearest_state(const Eigen::VectorXd& phi) const {
+  if (!calibration_.warm_starts()) return {};
+  const Entry* nearest = nullptr;
+  for (const Entry& entry : kept_)
+    if (entry.evaluation.ok && entry.phi.size() == phi.size() &&
+        (nearest == nullptr || (entry.phi - phi).norm() < (nearest->phi - phi).norm()))
+      nearest = &entry;
+  return nearest != nullptr ? nearest->evaluation.summary.unknowns : Eigen::VectorXd();
 }
 
 const char* to_string(FitStatus status) {
@@ -746,6 +784,142 @@ void Calibration::describe_at(const Evaluation& best, FitResult& result) const {
     }
     misfit.rms = std::sqrt(squares / static_cast<double>(misfit.simulated.size()));
     result.force_misfits.push_back(misfit);
+  }
+}
+
+void Calibration::check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
+                                   FitResult& result) const {
+  const Evaluation path = evaluate(phi, false);
+  if (!path.ok) {
+    if (cancel_requested()) return;
+    result.warm_start_note = "the run along the load path at the fitted values failed (" +
+                             path.message +
+                             "): the fit's warm-started equilibrium is not reached from the "
+                             "unloaded body";
+    return;
+  }
+  // Both are equilibria to Newton's tolerance: the same one agrees far below
+  // the distances' scale; another one (a branch) differs at it.
+  const double gap = (path.residuals - warm.residuals).lpNorm<Eigen::Infinity>();
+  const double scale = std::max(warm.residuals.lpNorm<Eigen::Infinity>(), 1e-9 * impl_->length);
+  if (gap > 1e-4 * scale) {
+    std::ostringstream note;
+    note << "the run along the load path at the fitted values differs from the warm-started one "
+            "by up to "
+         << gap << " m in a residual (the residuals reach " << scale
+         << " m): another equilibrium; the path's is reported (fit with \"warm_start\": false)";
+    result.warm_start_note = note.str();
+  }
+  describe_at(path, result);  // the path's run: every step's record
+}
+
+// A linearised interval is the quadratic model's: where a parameter's
+// effect fades (gamma far below what the load feels, so the cost flattens
+// as it goes to zero) the quadratic closes an interval the data leave open,
+// and the truth can lie outside it; where parameters trade off along a
+// curved valley (a modulus against gamma) it can be too wide or too narrow.
+// Each end is checked on the profile likelihood (Venzon and Moolgavkar
+// 1988, Appl. Stat. 37:87; Raue et al. 2009, Bioinformatics 25:1923): phi_k
+// moved by t, the other parameters re-fitted (from the linearised profile
+// phi + t c_k / c_kk, c the covariance, by Gauss-Newton steps). The 95% end
+// is where the cost has risen by chi^2_1(0.95)/2 s^2 (s^2 the residual
+// variance). The linearised end stands when the rise there is within a
+// factor 2 of that; else the end is searched: outwards by doubling (to the
+// bound, where the cost never rises enough), then by interpolation in
+// sqrt(rise), which is linear in t for a quadratic cost.
+void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
+                                      const Eigen::MatrixXd& covariance, double variance,
+                                      FitResult& result) const {
+  const Impl& m = *impl_;
+  const int P = m.map.size();
+  const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
+  const double level = 0.5 * 3.841458820694124 * variance;
+  constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
+  constexpr int kDoublings = 10, kRefinements = 4, kRefits = 3;
+  const bool refit = m.analytic && P > 1;  // finite-difference Jacobians: the linearised path
+  result.interval_notes.assign(static_cast<size_t>(P), "");
+  for (int k = 0; k < P && !cancel_requested(); ++k) {
+    const Parameter& parameter = m.map.parameters()[static_cast<size_t>(k)];
+    const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
+    if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
+    const Eigen::VectorXd path = covariance.col(k) / covariance(k, k);
+    auto value = [&](double phi_k) { return parameter.log_scale ? std::exp(phi_k) : phi_k; };
+    std::ostringstream note;
+    for (const int side : {-1, 1}) {
+      const double farthest = side < 0 ? lower[k] - phi[k] : upper[k] - phi[k];
+      auto clip = [&](double t) { return side < 0 ? std::max(t, farthest) : std::min(t, farthest); };
+      // The profile's rise at t: phi_k moved by t, the others from the
+      // linearised profile re-fitted by Gauss-Newton steps (analytic
+      // Jacobians: one run each) while the cost still falls by a tenth of
+      // the level; infinite where a run fails (no parameters there).
+      auto rise = [&](double t) {
+        Eigen::VectorXd at = (phi + t * path).cwiseMax(lower).cwiseMin(upper);
+        const double failed = std::numeric_limits<double>::infinity();
+        for (int step = 0; step < kRefits; ++step) {
+          const Evaluation& e = evaluations.at(at, refit);
+          if (!e.ok) return step == 0 ? failed : cost(evaluations.at(at, false).residuals);
+          const double here = cost(e.residuals);
+          if (!refit || cancel_requested()) return here - result.final_cost;
+          Eigen::MatrixXd J = e.jacobian;
+          J.col(k).setZero();  // phi_k stays where the profile puts it
+          const Eigen::VectorXd g = J.transpose() * e.residuals;
+          Eigen::MatrixXd H = J.transpose() * J;
+          H(k, k) = 1.0;
+          const Eigen::LDLT<Eigen::MatrixXd> solve(H);
+          if (solve.info() != Eigen::Success) return here - result.final_cost;
+          const Eigen::VectorXd next = (at - solve.solve(g)).cwiseMax(lower).cwiseMin(upper);
+          const Evaluation& moved = evaluations.at(next, false);
+          if (!moved.ok || !(cost(moved.residuals) < here)) return here - result.final_cost;
+          const bool settled = here - cost(moved.residuals) < 0.1 * level;
+          at = next;
+          if (settled) return cost(moved.residuals) - result.final_cost;
+        }
+        return cost(evaluations.at(at, false).residuals) - result.final_cost;
+      };
+      double t_in = 0.0, rise_in = 0.0, t = clip(side * half), r = rise(t);
+      if (r >= 0.5 * level && r <= 2.0 * level) continue;  // the linearised end stands
+      bool unbounded = false;
+      for (int d = 0; d < kDoublings && r < level && !cancel_requested(); ++d) {
+        if (t == farthest) {
+          unbounded = true;
+          break;
+        }
+        t_in = t, rise_in = r;
+        t = clip(2.0 * t);
+        r = rise(t);
+      }
+      if (r < level) unbounded = true;
+      double end = t;
+      if (!unbounded) {  // the crossing lies between t_in and t
+        for (int i = 0; i < kRefinements && !cancel_requested(); ++i) {
+          const double a = std::sqrt(std::max(0.0, rise_in));
+          const double b = std::isfinite(r) ? std::sqrt(r) : 2.0 * std::sqrt(level) + a;
+          double s = (std::sqrt(level) - a) / (b - a);
+          s = std::clamp(std::isfinite(s) ? s : 0.5, 0.1, 0.9);  // keep the bracket shrinking
+          const double mid = t_in + s * (t - t_in), r_mid = rise(mid);
+          if (r_mid < level) {
+            t_in = mid, rise_in = r_mid;
+          } else {
+            t = mid, r = r_mid;
+          }
+          if (std::abs(r_mid / level - 1.0) < 0.1) break;
+        }
+        end = std::isfinite(r) && std::abs(r / level - 1.0) < std::abs(rise_in / level - 1.0)
+                  ? t
+                  : t_in;
+      }
+      (side < 0 ? result.lower_95 : result.upper_95)[k] = value(phi[k] + end);
+      note << (note.tellp() > 0 ? "; " : "") << (side < 0 ? "lower" : "upper") << " end ";
+      if (unbounded)
+        note << "at the " << (side < 0 ? "lower" : "upper") << " bound, " << value(phi[k] + end)
+             << ": the cost rises by less than the 95% level there (the data do not bound "
+             << parameter.name << (side < 0 ? " from below" : " from above") << ")";
+      else
+        note << "moved to " << value(phi[k] + end)
+             << " (the cost is not quadratic out to the linearised end, "
+             << value(phi[k] + side * half) << ")";
+    }
+    result.interval_notes[static_cast<size_t>(k)] = note.str();
   }
 }
 
@@ -841,6 +1015,7 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
     result.success = converged(status);
     if (!message.empty()) result.message = std::move(message);
     result.forward_runs = evaluations.forward_runs;
+    result.warm_started_runs = evaluations.warm_started_runs;
     result.sensitivity_solves = evaluations.sensitivity_solves;
     result.failed_runs = evaluations.failed_runs;
     result.failures_by_cause = evaluations.failures_by_cause;
@@ -900,6 +1075,10 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
                   "the forward run at the fitted parameters failed: " + best.message);
   }
   describe_at(best, result);
+  if (best.summary.warm_started) {
+    check_along_path(outcome.phi, best, result);
+    evaluations.forward_runs += 1;
+  }
   // The parameters on a bound, said whatever the ending (a fit that ran out
   // of iterations against a bound is the usual sign of a wrong model).
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
@@ -959,6 +1138,10 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
     result.lower_95[k] = log ? std::exp(phi - 1.96 * sigma) : phi - 1.96 * sigma;
     result.upper_95[k] = log ? std::exp(phi + 1.96 * sigma) : phi + 1.96 * sigma;
   }
+  const int runs_before = evaluations.forward_runs;
+  check_interval_ends(evaluations, outcome.phi, covariance, variance, result);
+  result.interval_runs = evaluations.forward_runs - runs_before;
+  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
   return finish(result.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
 }
 

@@ -114,6 +114,13 @@ struct FitOptions {
   // without a forward run, and the region shrinks): a far start takes a few
   // more steps instead of trial runs at the bounds that fail slowly.
   double max_step_factor = 4.0;
+  // Solve each trial point's final state from the nearest point already run
+  // (SteppingOptions::warm_start) instead of walking the load path again:
+  // where every target and force curve reads the final step only and the
+  // path's end does not depend on the way there (solve::warm_start_problem).
+  // A trial whose warm start fails walks the path; the optimum is run along
+  // the path once more and checked against its warm-started run.
+  bool warm_start = true;
   // Called after every iteration (LM) or every improvement (NLopt).
   std::function<void(const IterationRecord&)> progress;
 };
@@ -134,6 +141,7 @@ struct Evaluation {
   std::vector<std::vector<double>> forces;  // per force curve: the simulated force per row (N)
   int forward_runs = 0;
   int sensitivity_solves = 0;
+  int warm_started_runs = 0;  // of forward_runs: solved from a nearby point's final state
 };
 
 // How a fitted force curve misses its measurement.
@@ -157,6 +165,12 @@ struct FitResult {
   // a stiffer start that runs: what failed and where it started ("" when the
   // given start ran).
   std::string start_note;
+  // Forward runs whose final state was solved from a nearby point's
+  // (FitOptions::warm_start), and, when the path's run at the optimum does
+  // not reproduce its warm-started one (another equilibrium: a branch the
+  // path does not follow), what differs ("" when it does, or none ran).
+  int warm_started_runs = 0;
+  std::string warm_start_note;
   std::vector<std::string> at_bounds;  // the parameters on a bound (ConvergedAtBounds)
   Method method = Method::LevenbergMarquardt;
   bool analytic_jacobian = true;
@@ -168,6 +182,12 @@ struct FitResult {
   bool covariance_ok = false;
   Eigen::VectorXd standard_errors, lower_95, upper_95;
   Eigen::MatrixXd correlation;
+  // The intervals' ends are checked on the cost itself (check_interval_ends):
+  // per parameter, "" where the linearised end held, else how the end moved
+  // (the data do not bound it on that side, or the cost is not quadratic out
+  // there); the forward runs the checks took (in forward_runs too).
+  std::vector<std::string> interval_notes;
+  int interval_runs = 0;
   std::vector<IterationRecord> iterations;
   double initial_cost = 0.0, final_cost = 0.0;
   int forward_runs = 0, sensitivity_solves = 0;
@@ -216,8 +236,16 @@ class Calibration {
   const std::vector<ForceCurve>& force_curves() const;
   double force_weight(size_t curve) const;
 
-  // The residuals (and with_jacobian, their Jacobian) at the fitted variables phi.
-  Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian) const;
+  // The residuals (and with_jacobian, their Jacobian) at the fitted variables
+  // phi. `warm_start`: the unknowns of a nearby point's final state
+  // (Evaluation::summary.unknowns) to solve this one's from, used when
+  // warm_starts() (else, or empty, the load path is walked).
+  Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
+                      const Eigen::VectorXd& warm_start = {}) const;
+  // Whether evaluate() takes warm starts: FitOptions::warm_start, every
+  // target and force curve on the final step, and a path whose end does not
+  // depend on the way there.
+  bool warm_starts() const;
   // 1/2 sum rho(r^2) under the chosen loss.
   double cost(const Eigen::VectorXd& residuals) const;
 
@@ -238,6 +266,18 @@ class Calibration {
   // The distances, their statistics, the run and the force misfits of an
   // evaluation, into result.
   void describe_at(const Evaluation& at, FitResult& result) const;
+  // The linearised 95% intervals' ends checked on the profile likelihood
+  // (the other parameters re-fitted): each end is moved to where the cost
+  // has risen by the 95% level, out to the parameter's bound where it never
+  // does.
+  void check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
+                           const Eigen::MatrixXd& covariance, double variance,
+                           FitResult& result) const;
+  // The optimum's warm-started evaluation run again along the load path: its
+  // run described (every step's record) and, where the two equilibria
+  // differ, FitResult::warm_start_note says so.
+  void check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
+                        FitResult& result) const;
   // Where the start's forward run fails: the softest start with every
   // modulus and gamma 2, 4, ... 1024 times the start's (within the bounds)
   // whose run succeeds, and that factor; nullopt when none runs.

@@ -28,6 +28,7 @@ class EvaluationCache {
   const Evaluation* kept(const Eigen::VectorXd& phi, bool with_jacobian) const;
 
   int forward_runs = 0, sensitivity_solves = 0;
+  int warm_started_runs = 0;  // of forward_runs (Calibration::warm_starts)
   int failed_runs = 0;  // points whose forward run failed (rejected, not fatal)
   std::map<std::string, int> failures_by_cause;
   std::vector<FailedRun> failed_examples;  // the first kKeptFailures
@@ -45,6 +46,9 @@ class EvaluationCache {
   const Calibration& calibration_;
   std::deque<Entry> kept_;  // newest first
   Evaluation interrupted_;  // the last evaluation an interrupt cut short (not kept)
+  // The final state of the kept point nearest phi whose run succeeded, to
+  // warm-start phi's run from (empty: none, or the calibration takes none).
+  Eigen::VectorXd nearest_state(const Eigen::VectorXd& phi) const;
   // The kept entry that serves (phi, with_jacobian), or end().
   std::deque<Entry>::const_iterator find(const Eigen::VectorXd& phi, bool with_jacobian) const;
 };

@@ -110,6 +110,14 @@ struct SteppingOptions {
     std::vector<std::string> parameters;
     std::vector<int> steps;  // 1..steps
   } sensitivities;
+  // Newton: unknowns [u.. P] near the solution at the path's end, from a
+  // nearby problem already solved (a fit's previous trial point). The final
+  // load point is solved from them in one piece, and the summary holds that
+  // step alone (SteppingSummary::warm_started); where the piece fails, the
+  // path is walked from the unloaded start as usual. Only where the end of
+  // the path does not depend on the way there: load control, no sticking
+  // paddle (warm_start_problem). Empty: walk the path.
+  Eigen::VectorXd warm_start;
 
   bool IsValid(std::string* why) const;
 };
@@ -184,6 +192,10 @@ struct SteppingSummary {
   SolverKind solver = SolverKind::Auto;  // the backend that ran (newton: the preconditioner's)
   TangentSolver tangent = TangentSolver::Auto;  // newton: how the tangent was solved
   int newton_iterations = 0;                    // newton: over all steps
+  // Newton: the final step was solved from SteppingOptions::warm_start alone
+  // (steps holds step n only); false when there was none or it failed and
+  // the path was walked.
+  bool warm_started = false;
   // Arc length: the largest load reached before the path turned back, as a
   // share of the final load (the limit load), or NaN when it never turned.
   double limit_load_factor = std::numeric_limits<double>::quiet_NaN();
@@ -234,6 +246,12 @@ std::string kinematics_problem(const model::Model& model, const SteppingOptions&
 // paddle holds each vertex where it first touched, and that place moves with
 // the parameters, which the sensitivities take as fixed.
 std::string sensitivity_problem(const model::Model& model);
+
+// "" when SteppingOptions::warm_start can be used for this model, else why
+// not: the Newton scheme by load control, a start of the model's size with
+// finite values, and no sticking paddle (where a vertex sticks depends on
+// the way there).
+std::string warm_start_problem(const model::Model& model, const SteppingOptions& options);
 
 // "" when the model's mirror layers (model::MirrorLayer) can run with these
 // options, else why not: they need the Newton scheme.

@@ -248,6 +248,11 @@ class NewtonSolver {
     }
     return supports_.with_held(contacts);
   }
+  // A warm start's contact set: the vertices that stand on a paddle's plane
+  // (a nearby solution held them there) or past it.
+  void touch_planes(const LoadPoint& at, const Eigen::VectorXd& x) {
+    add_penetrating(at, x, true, -1e-9);
+  }
   // Snapshot and restore of the contact state, for a step that is cut.
   struct ContactState {
     std::vector<int> paddle;
@@ -280,8 +285,11 @@ class NewtonSolver {
   }
 
   // Vertices past a paddle join its contact set; how many did (with `apply`
-  // false, 1 when any would).
-  int add_penetrating(const LoadPoint& at, const Eigen::VectorXd& x, bool apply = true) {
+  // false, 1 when any would). `reach` (a share of the body's diagonal): how
+  // far past the plane a vertex must be; a negative one takes in vertices
+  // that stand that close in front of it.
+  int add_penetrating(const LoadPoint& at, const Eigen::VectorXd& x, bool apply = true,
+                      double reach = 1e-12) {
     const int n = model_.num_vertices();
     int added = 0;
     for (size_t p = 0; p < model_.paddles.size(); ++p) {
@@ -290,7 +298,7 @@ class NewtonSolver {
         if (contact_paddle_[static_cast<size_t>(v)] >= 0 || supports_.held(paddle.axis * n + v))
           continue;
         const double coordinate = model_.surface.V(v, paddle.axis) + x[paddle.axis * n + v];
-        if (paddle.penetration(coordinate, at.planes[p]) > 1e-12 * diagonal_) {
+        if (paddle.penetration(coordinate, at.planes[p]) > reach * diagonal_) {
           if (!apply) return 1;
           contact_paddle_[static_cast<size_t>(v)] = static_cast<int>(p);
           for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
@@ -703,6 +711,24 @@ std::string sensitivity_problem(const Model& model) {
   return {};
 }
 
+std::string warm_start_problem(const Model& model, const SteppingOptions& options) {
+  if (options.warm_start.size() == 0) return {};
+  if (options.scheme != Scheme::Newton) return "a warm start needs the Newton scheme";
+  if (options.newton.control != NewtonOptions::Control::Load)
+    return "a warm start needs load control (arc length follows the path from its start)";
+  const Eigen::Index expected = static_cast<Eigen::Index>(model.dim()) * model.num_vertices() + 1;
+  if (options.warm_start.size() != expected)
+    return "expected " + std::to_string(expected) + " unknowns (displacements and pressure), got " +
+           std::to_string(options.warm_start.size());
+  if (!options.warm_start.allFinite()) return "the start has non-finite values";
+  for (const model::Paddle& paddle : model.paddles)
+    if (paddle.sticking)
+      return "paddle " + paddle.label +
+             " sticks: where a vertex sticks depends on the way there, so the end of the path "
+             "cannot be solved from elsewhere";
+  return {};
+}
+
 namespace {
 
 // Why paddles at these planes cannot work, or "": two on one axis, on
@@ -761,6 +787,12 @@ class StepFinisher {
         reference_volume_(solver.equilibrium().reference_volume()),
         last_face_areas_(geom::face_area_vectors(model.surface.V, model.surface.F)),
         groups_(std::max<size_t>(1, model.constraint_groups.size())) {}
+
+  // The state the next step's runaway checks compare with (a warm start's;
+  // the unloaded body at first).
+  void compare_with(const Eigen::VectorXd& x) {
+    last_face_areas_ = geom::face_area_vectors(model::positions(model_, x), model_.surface.F);
+  }
 
   // "" or why the run stops (a runaway, failed sensitivities).
   std::string finish(const LoadPoint& at, const Eigen::VectorXd& x, StepRecord& record) {
@@ -893,6 +925,35 @@ std::string arc_length_problem(const Model& model, int steps) {
   return {};
 }
 
+// The final load point n solved from `start` in one piece (a Newton solve
+// inside the active-set loop, no cuts): true, with summary.unknowns and step
+// n's record kept, when it converged and passed the runaway checks. Else the
+// solver, the finisher and the summary are as they were before (the Newton
+// iterations spent stay counted), and the caller walks the path.
+template <class KeepStep>
+bool solve_from_warm_start(NewtonSolver& solver, StepFinisher& finisher,
+                           const Eigen::VectorXd& start, int n, const KeepStep& keep,
+                           SteppingSummary& summary) {
+  const Clock::time_point step_start = Clock::now();
+  const auto contact = solver.contact_state();
+  const LoadPoint end = scheduled_point(solver.model(), n, n);
+  Eigen::VectorXd x = start;
+  solver.touch_planes(end, x);
+  finisher.compare_with(x);
+  StepRecord record;
+  record.step = n;
+  Eigen::VectorXd& kept = summary.unknowns;
+  const Eigen::VectorXd unloaded = kept;
+  if (solver.solve(end, x, record).empty()) {
+    kept = x;
+    if (keep(record, n, step_start).empty()) return summary.warm_started = true;
+  }
+  kept = unloaded;
+  solver.restore(contact);
+  finisher.compare_with(unloaded);
+  return false;
+}
+
 }  // namespace
 
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
@@ -934,6 +995,15 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     if (observer) observer(record, x);
     return std::string();
   };
+
+  if (options.warm_start.size() > 0) {
+    if (!(why = warm_start_problem(model, options)).empty()) return fail("warm_start: " + why);
+    if (solve_from_warm_start(*solver, finisher, options.warm_start, n, keep, summary)) {
+      summary.success = true;
+      summary.total_seconds = seconds_since(start);
+      return summary;
+    }
+  }
 
   PathPredictor predictor(options.newton.predictor ? 2 : 0);
   predictor.add(0.0, x);

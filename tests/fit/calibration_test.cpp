@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "fit/fit_fixtures.hpp"
 #include "model/model_fixtures.hpp"
 
@@ -172,6 +174,75 @@ TEST(Calibration, RecoversTheParametersOfANoiseFreeTargetWithCeresAndBobyqa) {
   EXPECT_EQ(b.sensitivity_solves, 3 * 2);
 }
 
+// Targets on the final step only: each trial point's run is solved from the
+// nearest point already run (a warm start) instead of walking the load path,
+// and the fit finds what it finds without them. The optimum is run along the
+// path once more: its report has every step, and agrees with the warm run.
+TEST(Calibration, TrialPointsAreSolvedFromTheNearestPointsState) {
+  const model::Model m = hanging_sphere();
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(4), {4});
+  const std::vector<Parameter> parameters = {parameter("Y0", 9000.0), parameter("gamma", 100.0)};
+  FitOptions walking;
+  walking.warm_start = false;
+  const Calibration cold(m, newton(4), targets, parameters, walking);
+  const Calibration warm(m, newton(4), targets, parameters);
+  EXPECT_FALSE(cold.warm_starts());
+  EXPECT_TRUE(warm.warm_starts());
+  const FitResult a = cold.run(), b = warm.run();
+  ASSERT_TRUE(a.success) << a.message;
+  ASSERT_TRUE(b.success) << b.message;
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_NEAR(b.values[k] / a.values[k], 1.0, 1e-7) << b.names[static_cast<size_t>(k)];
+    EXPECT_NEAR(b.standard_errors[k] / a.standard_errors[k], 1.0, 1e-3);
+  }
+  EXPECT_NEAR(b.values[0] / 3000.0, 1.0, 1e-6);
+  EXPECT_EQ(a.warm_started_runs, 0);
+  EXPECT_GT(b.warm_started_runs, b.forward_runs / 2);  // all but the start's and the check's
+  EXPECT_EQ(b.warm_start_note, "");
+  EXPECT_EQ(b.summary.steps.size(), 4u);  // the path's run at the optimum, reported
+  EXPECT_FALSE(b.summary.warm_started);
+
+  // Targets that read an earlier step too: the path every time.
+  EXPECT_FALSE(Calibration(m, newton(4), synthetic_targets(m, newton(4), {2, 4}), parameters)
+                   .warm_starts());
+}
+
+// A parameter the data barely see: a sphere pressed by a paddle, its force
+// read at 5 steps with 1% noise, and gamma 0.3 N/m against Y = 3000, which
+// moves the force by a ten-thousandth. The cost flattens as gamma goes to
+// zero, so the linearised interval closes below where the data do not (in
+// log scale its lower end sits a few decades down, where the cost has hardly
+// risen). The checked interval runs to gamma's lower bound and says why,
+// and holds the truth.
+TEST(Calibration, AnIntervalTheDataLeaveOpenRunsToItsBound) {
+  model::Model m = testing::pressed_sphere(false);
+  m.material.surface_tension = 0.3;
+  const solve::SteppingSummary truth = solve::solve_load_steps(m, newton(5));
+  ASSERT_TRUE(truth.success) << truth.message;
+  ForceCurve curve;
+  curve.label = "pressed sphere";
+  curve.by_step = true;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (const solve::StepRecord& r : truth.steps) {
+    curve.at.push_back(r.step);
+    curve.force.push_back(curve_force(curve, m, r.paddles[0].force) * (1.0 + noise(rng)));
+  }
+  Parameter y = parameter("Y", 6000.0), gamma = parameter("gamma", 30.0);
+  y.lower = 100.0, y.upper = 1e6;
+  gamma.lower = 1e-6, gamma.upper = 1e4;
+  const FitResult r = Calibration(m, newton(5), {}, {y, gamma}, {}, {curve}).run();
+  ASSERT_TRUE(converged(r.status)) << r.message << " " << r.status_detail;
+  ASSERT_EQ(r.interval_notes.size(), 2u);
+  EXPECT_LT(r.lower_95[0], r.values[0]);
+  EXPECT_GT(r.upper_95[0], r.values[0]);
+  EXPECT_NEAR(r.lower_95[1], 1e-6, 1e-12) << r.interval_notes[1];
+  EXPECT_NE(r.interval_notes[1].find("the data do not bound gamma from below"), std::string::npos)
+      << r.interval_notes[1];
+  EXPECT_GT(r.upper_95[1], 0.3);
+  EXPECT_GT(r.interval_runs, 2);
+}
+
 // A point asked for twice costs one forward run; with the Jacobian after
 // without it, a second.
 TEST(Calibration, EvaluationsAreKeptAndCounted) {
@@ -320,11 +391,20 @@ TEST(Calibration, AForwardRunThatFailsInsideTheFitIsARejectedStep) {
   const std::vector<MeasuredStep> targets = synthetic_targets(soft, newton(2), {2});
   FitOptions bobyqa;
   bobyqa.method = Method::Bobyqa;
+  bobyqa.warm_start = false;  // every trial walks the path, as a failing one must show
   const FitResult b =
       Calibration(soft, newton(2), targets, {parameter("Y0", 1.2 * ok)}, bobyqa).run();
   EXPECT_GT(b.failed_runs, 0);
   ASSERT_TRUE(b.success) << b.message;
   EXPECT_NEAR(b.values[0] / (1.3 * ok), 1.0, 1e-5);
+  // Warm-started, a trial point past where the path fails may still reach an
+  // equilibrium from its neighbour's state; the optimum is the path's.
+  bobyqa.warm_start = true;
+  const FitResult w =
+      Calibration(soft, newton(2), targets, {parameter("Y0", 1.2 * ok)}, bobyqa).run();
+  ASSERT_TRUE(w.success) << w.message;
+  EXPECT_NEAR(w.values[0] / (1.3 * ok), 1.0, 1e-5);
+  EXPECT_EQ(w.warm_start_note, "");
   // Levenberg-Marquardt from a factor 3 above: whatever its trial points, it recovers.
   const FitResult lm = Calibration(soft, newton(2), targets, {parameter("Y0", 3.9 * ok)}).run();
   ASSERT_TRUE(lm.success) << lm.message;

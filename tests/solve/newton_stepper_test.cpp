@@ -418,6 +418,66 @@ TEST(Newton, PaddleContactPushesHoldsAndBalances) {
   }
 }
 
+// A warm start (a fit's previous trial point's final state) solves the end
+// of the path in one piece and lands on the equilibrium the path reaches:
+// on the hanging sphere, and pressed by a frictionless paddle (the contact
+// set taken from the vertices on the plane). A sticking paddle, whose end
+// depends on the way there, refuses one; a start that does not converge
+// falls back on the path.
+TEST(Newton, AWarmStartSolvesThePathsEndFromANearbyState) {
+  for (const bool pressed : {false, true}) {
+    model::Model m = pressed ? testing::pressed_sphere(false)
+                             : hanging_sphere(model::FiberLaw::exponential(3000.0, 5.0));
+    const SteppingOptions path = newton(5);
+    const SteppingSummary near = solve_load_steps(m, path);
+    ASSERT_TRUE(near.success) << near.message;
+    for (const std::string& name : m.material.law.parameter_names())  // the next trial point
+      if (name[0] == 'Y') m.material.law.set_parameter(name, 1.25 * m.material.law.parameter(name));
+    m.material.surface_tension *= 0.8;
+    const SteppingSummary walked = solve_load_steps(m, path);
+    ASSERT_TRUE(walked.success) << walked.message;
+    SteppingOptions warm = path;
+    warm.warm_start = near.unknowns;
+    std::vector<int> observed;
+    const SteppingSummary s =
+        solve_load_steps(m, warm, [&](const StepRecord& r, const Eigen::VectorXd&) {
+          observed.push_back(r.step);
+        });
+    ASSERT_TRUE(s.success) << s.message;
+    EXPECT_TRUE(s.warm_started) << "pressed " << pressed;
+    EXPECT_EQ(observed, std::vector<int>{5});
+    ASSERT_EQ(s.steps.size(), 1u);
+    EXPECT_EQ(s.steps[0].step, 5);
+    EXPECT_LT((s.unknowns - walked.unknowns).norm(), 1e-8 * walked.unknowns.norm())
+        << "pressed " << pressed;
+    EXPECT_LT(s.newton_iterations, walked.newton_iterations) << "pressed " << pressed;
+    if (pressed) {
+      EXPECT_EQ(s.steps[0].paddles[0].contacts, walked.steps.back().paddles[0].contacts);
+      EXPECT_NEAR(s.steps[0].paddles[0].force.z(), walked.steps.back().paddles[0].force.z(),
+                  1e-8 * std::abs(walked.steps.back().paddles[0].force.z()));
+    }
+    // A start from nowhere near (a thousand times the displacement) fails
+    // its piece: the path is walked and gives the same answer.
+    warm.warm_start = 1000.0 * near.unknowns;
+    const SteppingSummary fallen_back = solve_load_steps(m, warm);
+    ASSERT_TRUE(fallen_back.success) << fallen_back.message;
+    EXPECT_FALSE(fallen_back.warm_started);
+    EXPECT_EQ(fallen_back.steps.size(), 5u);
+    EXPECT_LT((fallen_back.unknowns - walked.unknowns).norm(), 1e-8 * walked.unknowns.norm());
+  }
+  const model::Model sticking = testing::pressed_sphere(true);
+  SteppingOptions warm = newton(5);
+  warm.warm_start = Eigen::VectorXd::Zero(sticking.num_unknowns());
+  const SteppingSummary refused = solve_load_steps(sticking, warm);
+  EXPECT_FALSE(refused.success);
+  EXPECT_NE(refused.message.find("warm_start: paddle"), std::string::npos) << refused.message;
+  warm.warm_start = Eigen::VectorXd::Zero(7);
+  const SteppingSummary wrong_size = solve_load_steps(testing::pressed_sphere(false), warm);
+  EXPECT_FALSE(wrong_size.success);
+  EXPECT_NE(wrong_size.message.find("warm_start: expected"), std::string::npos)
+      << wrong_size.message;
+}
+
 // The forces' sensitivities (the paddle's and the supports' reaction, read
 // off the held rows of K_T du/dtheta + dR/dtheta) against central
 // differences of whole runs.
