@@ -4,7 +4,6 @@
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
-#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cctype>
@@ -753,6 +752,9 @@ void Calibration::describe_at(const Evaluation& best, FitResult& result) const {
   result.final_cost = cost(best.residuals);
   result.summary = best.summary;
   result.positions = best.positions;
+  result.vertex_distances.clear();  // described afresh (a warm start's check describes twice)
+  result.statistics.clear();
+  result.force_misfits.clear();
   const int nv = m.model.num_vertices();
   Eigen::Index row = 0;
   std::vector<double> all;
@@ -811,116 +813,6 @@ void Calibration::check_along_path(const Eigen::VectorXd& phi, const Evaluation&
     result.warm_start_note = note.str();
   }
   describe_at(path, result);  // the path's run: every step's record
-}
-
-// A linearised interval is the quadratic model's: where a parameter's
-// effect fades (gamma far below what the load feels, so the cost flattens
-// as it goes to zero) the quadratic closes an interval the data leave open,
-// and the truth can lie outside it; where parameters trade off along a
-// curved valley (a modulus against gamma) it can be too wide or too narrow.
-// Each end is checked on the profile likelihood (Venzon and Moolgavkar
-// 1988, Appl. Stat. 37:87; Raue et al. 2009, Bioinformatics 25:1923): phi_k
-// moved by t, the other parameters re-fitted (from the linearised profile
-// phi + t c_k / c_kk, c the covariance, by Gauss-Newton steps). The 95% end
-// is where the cost has risen by chi^2_1(0.95)/2 s^2 (s^2 the residual
-// variance). The linearised end stands when the rise there is within a
-// factor 2 of that; else the end is searched: outwards by doubling (to the
-// bound, where the cost never rises enough), then by interpolation in
-// sqrt(rise), which is linear in t for a quadratic cost.
-void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
-                                      const Eigen::MatrixXd& covariance, double variance,
-                                      FitResult& result) const {
-  const Impl& m = *impl_;
-  const int P = m.map.size();
-  const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
-  const double level = 0.5 * 3.841458820694124 * variance;
-  constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
-  constexpr int kDoublings = 10, kRefinements = 4, kRefits = 3;
-  const bool refit = m.analytic && P > 1;  // finite-difference Jacobians: the linearised path
-  result.interval_notes.assign(static_cast<size_t>(P), "");
-  for (int k = 0; k < P && !cancel_requested(); ++k) {
-    const Parameter& parameter = m.map.parameters()[static_cast<size_t>(k)];
-    const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
-    if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
-    const Eigen::VectorXd path = covariance.col(k) / covariance(k, k);
-    auto value = [&](double phi_k) { return parameter.log_scale ? std::exp(phi_k) : phi_k; };
-    std::ostringstream note;
-    for (const int side : {-1, 1}) {
-      const double farthest = side < 0 ? lower[k] - phi[k] : upper[k] - phi[k];
-      auto clip = [&](double t) { return side < 0 ? std::max(t, farthest) : std::min(t, farthest); };
-      // The profile's rise at t: phi_k moved by t, the others from the
-      // linearised profile re-fitted by Gauss-Newton steps (analytic
-      // Jacobians: one run each) while the cost still falls by a tenth of
-      // the level; infinite where a run fails (no parameters there).
-      auto rise = [&](double t) {
-        Eigen::VectorXd at = (phi + t * path).cwiseMax(lower).cwiseMin(upper);
-        const double failed = std::numeric_limits<double>::infinity();
-        for (int step = 0; step < kRefits; ++step) {
-          const Evaluation& e = evaluations.at(at, refit);
-          if (!e.ok) return step == 0 ? failed : cost(evaluations.at(at, false).residuals);
-          const double here = cost(e.residuals);
-          if (!refit || cancel_requested()) return here - result.final_cost;
-          Eigen::MatrixXd J = e.jacobian;
-          J.col(k).setZero();  // phi_k stays where the profile puts it
-          const Eigen::VectorXd g = J.transpose() * e.residuals;
-          Eigen::MatrixXd H = J.transpose() * J;
-          H(k, k) = 1.0;
-          const Eigen::LDLT<Eigen::MatrixXd> solve(H);
-          if (solve.info() != Eigen::Success) return here - result.final_cost;
-          const Eigen::VectorXd next = (at - solve.solve(g)).cwiseMax(lower).cwiseMin(upper);
-          const Evaluation& moved = evaluations.at(next, false);
-          if (!moved.ok || !(cost(moved.residuals) < here)) return here - result.final_cost;
-          const bool settled = here - cost(moved.residuals) < 0.1 * level;
-          at = next;
-          if (settled) return cost(moved.residuals) - result.final_cost;
-        }
-        return cost(evaluations.at(at, false).residuals) - result.final_cost;
-      };
-      double t_in = 0.0, rise_in = 0.0, t = clip(side * half), r = rise(t);
-      if (r >= 0.5 * level && r <= 2.0 * level) continue;  // the linearised end stands
-      bool unbounded = false;
-      for (int d = 0; d < kDoublings && r < level && !cancel_requested(); ++d) {
-        if (t == farthest) {
-          unbounded = true;
-          break;
-        }
-        t_in = t, rise_in = r;
-        t = clip(2.0 * t);
-        r = rise(t);
-      }
-      if (r < level) unbounded = true;
-      double end = t;
-      if (!unbounded) {  // the crossing lies between t_in and t
-        for (int i = 0; i < kRefinements && !cancel_requested(); ++i) {
-          const double a = std::sqrt(std::max(0.0, rise_in));
-          const double b = std::isfinite(r) ? std::sqrt(r) : 2.0 * std::sqrt(level) + a;
-          double s = (std::sqrt(level) - a) / (b - a);
-          s = std::clamp(std::isfinite(s) ? s : 0.5, 0.1, 0.9);  // keep the bracket shrinking
-          const double mid = t_in + s * (t - t_in), r_mid = rise(mid);
-          if (r_mid < level) {
-            t_in = mid, rise_in = r_mid;
-          } else {
-            t = mid, r = r_mid;
-          }
-          if (std::abs(r_mid / level - 1.0) < 0.1) break;
-        }
-        end = std::isfinite(r) && std::abs(r / level - 1.0) < std::abs(rise_in / level - 1.0)
-                  ? t
-                  : t_in;
-      }
-      (side < 0 ? result.lower_95 : result.upper_95)[k] = value(phi[k] + end);
-      note << (note.tellp() > 0 ? "; " : "") << (side < 0 ? "lower" : "upper") << " end ";
-      if (unbounded)
-        note << "at the " << (side < 0 ? "lower" : "upper") << " bound, " << value(phi[k] + end)
-             << ": the cost rises by less than the 95% level there (the data do not bound "
-             << parameter.name << (side < 0 ? " from below" : " from above") << ")";
-      else
-        note << "moved to " << value(phi[k] + end)
-             << " (the cost is not quadratic out to the linearised end, "
-             << value(phi[k] + side * half) << ")";
-    }
-    result.interval_notes[static_cast<size_t>(k)] = note.str();
-  }
 }
 
 FitResult Calibration::result_from(const Eigen::VectorXd& phi) const {
@@ -1138,10 +1030,6 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
     result.lower_95[k] = log ? std::exp(phi - 1.96 * sigma) : phi - 1.96 * sigma;
     result.upper_95[k] = log ? std::exp(phi + 1.96 * sigma) : phi + 1.96 * sigma;
   }
-  const int runs_before = evaluations.forward_runs;
-  check_interval_ends(evaluations, outcome.phi, covariance, variance, result);
-  result.interval_runs = evaluations.forward_runs - runs_before;
-  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
   return finish(result.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
 }
 

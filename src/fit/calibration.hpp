@@ -182,12 +182,6 @@ struct FitResult {
   bool covariance_ok = false;
   Eigen::VectorXd standard_errors, lower_95, upper_95;
   Eigen::MatrixXd correlation;
-  // The intervals' ends are checked on the cost itself (check_interval_ends):
-  // per parameter, "" where the linearised end held, else how the end moved
-  // (the data do not bound it on that side, or the cost is not quadratic out
-  // there); the forward runs the checks took (in forward_runs too).
-  std::vector<std::string> interval_notes;
-  int interval_runs = 0;
   std::vector<IterationRecord> iterations;
   double initial_cost = 0.0, final_cost = 0.0;
   int forward_runs = 0, sensitivity_solves = 0;
@@ -266,13 +260,6 @@ class Calibration {
   // The distances, their statistics, the run and the force misfits of an
   // evaluation, into result.
   void describe_at(const Evaluation& at, FitResult& result) const;
-  // The linearised 95% intervals' ends checked on the profile likelihood
-  // (the other parameters re-fitted): each end is moved to where the cost
-  // has risen by the 95% level, out to the parameter's bound where it never
-  // does.
-  void check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
-                           const Eigen::MatrixXd& covariance, double variance,
-                           FitResult& result) const;
   // The optimum's warm-started evaluation run again along the load path: its
   // run described (every step's record) and, where the two equilibria
   // differ, FitResult::warm_start_note says so.
