@@ -479,6 +479,8 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
     else
       std::cout << " (no standard error";
     std::cout << "; start " << fitted.initial[i] << ")\n";
+    if (k < fitted.interval_notes.size() && !fitted.interval_notes[k].empty())
+      std::cout << "    interval: " << fitted.interval_notes[k] << "\n";
   }
   if (!fitted.statistics.empty()) {
     const auto& d = fitted.overall;

@@ -733,6 +733,7 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
       f.number("initial_trust_region_radius", o.initial_trust_region_radius);
   o.max_step_factor = f.number("max_step_factor", o.max_step_factor);
   o.warm_start = f.boolean("warm_start", o.warm_start);
+  o.check_intervals = f.boolean("check_intervals", o.check_intervals);
   try {
     fit::check_options(o);
   } catch (const InputError& e) {

@@ -409,6 +409,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
                           {"at_bound", at_bound},
                           {"standard_error", number(r.standard_errors[i])},
                           {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}},
+                          {"interval_note", k < r.interval_notes.size() ? r.interval_notes[k] : ""},
                           {"bounds", {number(p.lower), number(p.upper)}},
                           {"log_scale", p.log_scale}});
   }
@@ -490,6 +491,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
       {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
       {"iterations", iterations},
       {"forward_runs", r.forward_runs},
+      {"interval_runs", r.interval_runs},
       {"sensitivity_solves", r.sensitivity_solves},
       {"failed_runs", r.failed_runs},
       {"failed_runs_by_cause", failures},

@@ -4,6 +4,7 @@
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cctype>
@@ -815,6 +816,125 @@ void Calibration::check_along_path(const Eigen::VectorXd& phi, const Evaluation&
   describe_at(path, result);  // the path's run: every step's record
 }
 
+// A linearised interval is the quadratic model's: where a parameter's
+// effect fades (gamma far below what the load feels, so the cost flattens
+// as it goes to zero) the quadratic closes an interval the data leave open,
+// and the truth can lie outside it. Each end is checked on the profile
+// likelihood (Venzon and Moolgavkar 1988, Appl. Stat. 37:87; Raue et al.
+// 2009, Bioinformatics 25:1923): phi_k moved by t, the other parameters
+// re-fitted by Gauss-Newton steps. The 95% level is a rise of the cost by
+// chi^2_1(0.95)/2 s^2 (s^2 the residual variance). Where the profile at the
+// linearised end has risen by less than half of it, the end is moved out:
+// by doubling (to the bound, where the cost never rises enough), then by
+// interpolation in sqrt(rise), which is linear for a quadratic cost. An end
+// is only moved out: a re-fit that stops early leaves the profile above its
+// true value, so it can show that an end lies further out, never that it
+// lies further in.
+void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
+                                      const Eigen::MatrixXd& covariance, double variance,
+                                      FitResult& result) const {
+  const Impl& m = *impl_;
+  const int P = m.map.size();
+  const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
+  const double level = 0.5 * 3.841458820694124 * variance;
+  constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
+  constexpr int kDoublings = 10, kRefinements = 3, kRefits = 2;
+  const bool refit = m.analytic && P > 1;  // else the others stay at the optimum
+  // How far one move may take each other parameter: a log-scaled one by
+  // max_step_factor (as a Levenberg-Marquardt step), a linear one by its
+  // linearised 95% half-width (nothing for one on its bound). A parameter
+  // the data barely see has a huge variance, and an uncapped move would
+  // throw the run far off, to where it may not even run.
+  Eigen::VectorXd reach(P);
+  for (int j = 0; j < P; ++j)
+    reach[j] = on_bound(phi[j], lower[j], upper[j]) ? 0.0
+               : m.map.parameters()[static_cast<size_t>(j)].log_scale
+                   ? std::log(m.options.max_step_factor)
+                   : 1.96 * std::sqrt(std::max(0.0, variance * covariance(j, j)));
+  result.interval_notes.assign(static_cast<size_t>(P), "");
+  for (int k = 0; k < P && !cancel_requested(); ++k) {
+    const Parameter& parameter = m.map.parameters()[static_cast<size_t>(k)];
+    const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
+    if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
+    const Eigen::VectorXd path = covariance.col(k) / covariance(k, k);  // the linearised profile
+    auto value = [&](double phi_k) { return parameter.log_scale ? std::exp(phi_k) : phi_k; };
+    std::ostringstream note;
+    for (const int side : {-1, 1}) {
+      const double farthest = side < 0 ? lower[k] - phi[k] : upper[k] - phi[k];
+      auto clip = [&](double t) { return side < 0 ? std::max(t, farthest) : std::min(t, farthest); };
+      auto capped = [&](const Eigen::VectorXd& from, Eigen::VectorXd to) {
+        for (int j = 0; j < P; ++j)
+          if (j != k) to[j] = from[j] + std::clamp(to[j] - from[j], -reach[j], reach[j]);
+        return Eigen::VectorXd(to.cwiseMax(lower).cwiseMin(upper));
+      };
+      // The profile's rise at t (infinite where the run fails: no parameters
+      // there): from the linearised profile, re-fitted while the cost falls.
+      auto rise = [&](double t) {
+        Eigen::VectorXd at = capped(phi, phi + t * path);
+        double best = std::numeric_limits<double>::infinity();
+        for (int step = 0; step <= kRefits && !cancel_requested(); ++step) {
+          const bool more = refit && step < kRefits;
+          const Evaluation& e = evaluations.at(at, more);
+          if (!e.ok) break;
+          best = cost(e.residuals) - result.final_cost;
+          if (!more) break;
+          Eigen::MatrixXd J = e.jacobian;
+          J.col(k).setZero();  // phi_k stays where the profile puts it
+          Eigen::MatrixXd H = J.transpose() * J;
+          H(k, k) = 1.0;
+          const Eigen::VectorXd g = J.transpose() * e.residuals;
+          const Eigen::LDLT<Eigen::MatrixXd> normal(H);
+          if (normal.info() != Eigen::Success) break;
+          at = capped(at, at - normal.solve(g));
+        }
+        return best;
+      };
+      double t_in = clip(side * half), rise_in = rise(t_in);
+      if (!(rise_in < 0.5 * level)) continue;  // the linearised end stands
+      double t = t_in, r = rise_in;
+      bool unbounded = false;
+      for (int d = 0; d < kDoublings && r < level && !cancel_requested(); ++d) {
+        if (t == farthest) {
+          unbounded = true;
+          break;
+        }
+        t_in = t, rise_in = r;
+        t = clip(2.0 * t);
+        r = rise(t);
+      }
+      if (r < level) unbounded = true;
+      double end = t;
+      if (!unbounded) {  // the crossing lies between t_in and t
+        for (int i = 0; i < kRefinements && !cancel_requested(); ++i) {
+          const double a = std::sqrt(std::max(0.0, rise_in));
+          const double b = std::isfinite(r) ? std::sqrt(r) : 2.0 * std::sqrt(level) + a;
+          double s = (std::sqrt(level) - a) / (b - a);
+          s = std::clamp(std::isfinite(s) ? s : 0.5, 0.1, 0.9);  // keep the bracket shrinking
+          const double mid = t_in + s * (t - t_in), r_mid = rise(mid);
+          if (r_mid < level) {
+            t_in = mid, rise_in = r_mid;
+          } else {
+            t = mid, r = r_mid;
+          }
+          if (std::abs(r_mid / level - 1.0) < 0.1) break;
+        }
+        end = t_in;  // the profile is below the level here: inside the 95% region
+      }
+      (side < 0 ? result.lower_95 : result.upper_95)[k] = value(phi[k] + end);
+      note << (note.tellp() > 0 ? "; " : "") << (side < 0 ? "lower" : "upper") << " end ";
+      if (unbounded)
+        note << "at the " << (side < 0 ? "lower" : "upper") << " bound, " << value(phi[k] + end)
+             << ": the cost rises by less than the 95% level out there (the data do not bound "
+             << parameter.name << (side < 0 ? " from below" : " from above") << ")";
+      else
+        note << "moved out to at least " << value(phi[k] + end)
+             << " (the cost rises more slowly than the quadratic's out to the linearised end, "
+             << value(phi[k] + side * half) << ")";
+    }
+    result.interval_notes[static_cast<size_t>(k)] = note.str();
+  }
+}
+
 FitResult Calibration::result_from(const Eigen::VectorXd& phi) const {
   const Impl& m = *impl_;
   const int P = m.map.size();
@@ -1029,6 +1149,12 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
     result.standard_errors[k] = log ? result.values[k] * sigma : sigma;
     result.lower_95[k] = log ? std::exp(phi - 1.96 * sigma) : phi - 1.96 * sigma;
     result.upper_95[k] = log ? std::exp(phi + 1.96 * sigma) : phi + 1.96 * sigma;
+  }
+  if (m.options.check_intervals) {
+    const int runs_before = evaluations.forward_runs;
+    check_interval_ends(evaluations, outcome.phi, covariance, variance, result);
+    result.interval_runs = evaluations.forward_runs - runs_before;
+    if (cancel_requested()) return finish(FitStatus::Interrupted, "");
   }
   return finish(result.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
 }

@@ -121,6 +121,10 @@ struct FitOptions {
   // A trial whose warm start fails walks the path; the optimum is run along
   // the path once more and checked against its warm-started run.
   bool warm_start = true;
+  // After a converged fit, check each linearised 95% interval's ends on the
+  // profile likelihood and move out an end the data leave open (a few
+  // forward runs per parameter; FitResult::interval_notes).
+  bool check_intervals = true;
   // Called after every iteration (LM) or every improvement (NLopt).
   std::function<void(const IterationRecord&)> progress;
 };
@@ -182,6 +186,13 @@ struct FitResult {
   bool covariance_ok = false;
   Eigen::VectorXd standard_errors, lower_95, upper_95;
   Eigen::MatrixXd correlation;
+  // The intervals' ends checked on the profile (FitOptions::check_intervals):
+  // per parameter, "" where the linearised ends stand, else how an end moved
+  // out (the data do not bound it on that side, or the cost rises more
+  // slowly than the quadratic's); the forward runs the checks took (in
+  // forward_runs too).
+  std::vector<std::string> interval_notes;
+  int interval_runs = 0;
   std::vector<IterationRecord> iterations;
   double initial_cost = 0.0, final_cost = 0.0;
   int forward_runs = 0, sensitivity_solves = 0;
@@ -260,6 +271,12 @@ class Calibration {
   // The distances, their statistics, the run and the force misfits of an
   // evaluation, into result.
   void describe_at(const Evaluation& at, FitResult& result) const;
+  // The linearised 95% intervals' ends checked on the profile likelihood:
+  // an end where it has risen by less than half the 95% level is moved out
+  // to where it reaches the level, or to the parameter's bound.
+  void check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
+                           const Eigen::MatrixXd& covariance, double variance,
+                           FitResult& result) const;
   // The optimum's warm-started evaluation run again along the load path: its
   // run described (every step's record) and, where the two equilibria
   // differ, FitResult::warm_start_note says so.

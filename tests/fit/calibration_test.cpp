@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "fit/fit_fixtures.hpp"
 #include "model/model_fixtures.hpp"
 
@@ -205,6 +207,46 @@ TEST(Calibration, TrialPointsAreSolvedFromTheNearestPointsState) {
   // Targets that read an earlier step too: the path every time.
   EXPECT_FALSE(Calibration(m, newton(4), synthetic_targets(m, newton(4), {2, 4}), parameters)
                    .warm_starts());
+}
+
+// A parameter the data barely see: a sphere pressed by a paddle, its force
+// read at 5 steps with 1% noise, and gamma 0.3 N/m against Y = 3000, which
+// moves the force by a ten-thousandth. Re-fitting Y, the cost flattens as
+// gamma goes to zero, so the linearised interval (in log scale) closes
+// below where the data do not. The checked interval runs to gamma's lower
+// bound, says why, and holds the truth.
+TEST(Calibration, AnIntervalTheDataLeaveOpenRunsToItsBound) {
+  model::Model m = testing::pressed_sphere(false);
+  m.material.surface_tension = 0.3;
+  const solve::SteppingSummary truth = solve::solve_load_steps(m, newton(5));
+  ASSERT_TRUE(truth.success) << truth.message;
+  ForceCurve curve;
+  curve.label = "pressed sphere";
+  curve.by_step = true;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (const solve::StepRecord& r : truth.steps) {
+    curve.at.push_back(r.step);
+    curve.force.push_back(curve_force(curve, m, r.paddles[0].force) * (1.0 + noise(rng)));
+  }
+  Parameter y = parameter("Y", 6000.0), gamma = parameter("gamma", 30.0);
+  y.lower = 100.0, y.upper = 1e6;
+  gamma.lower = 1e-6, gamma.upper = 1e4;
+  FitOptions unchecked;
+  unchecked.check_intervals = false;
+  const FitResult linear = Calibration(m, newton(5), {}, {y, gamma}, unchecked, {curve}).run();
+  const FitResult r = Calibration(m, newton(5), {}, {y, gamma}, {}, {curve}).run();
+  ASSERT_TRUE(converged(r.status)) << r.message << " " << r.status_detail;
+  ASSERT_EQ(r.interval_notes.size(), 2u);
+  EXPECT_GT(linear.lower_95[1], 0.01) << "the linearised interval closes below: 0.11 here";
+  EXPECT_NEAR(r.lower_95[1], 1e-6, 1e-12) << r.interval_notes[1];
+  EXPECT_NE(r.interval_notes[1].find("the data do not bound gamma from below"), std::string::npos)
+      << r.interval_notes[1];
+  EXPECT_EQ(r.upper_95[1], linear.upper_95[1]);  // an end is only ever moved out
+  EXPECT_GT(r.upper_95[1], 0.3);
+  EXPECT_EQ(r.values, linear.values);
+  EXPECT_GT(r.interval_runs, 2);
+  EXPECT_EQ(r.forward_runs, linear.forward_runs + r.interval_runs);
 }
 
 // A point asked for twice costs one forward run; with the Jacobian after
