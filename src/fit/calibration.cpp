@@ -838,7 +838,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
   const double level = 0.5 * 3.841458820694124 * variance;
   constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
-  constexpr int kDoublings = 10, kRefinements = 3, kRefits = 2;
+  constexpr int kDoublings = 10, kRefinements = 3, kRefits = 3;
   const bool refit = m.analytic && P > 1;  // else the others stay at the optimum
   // How far one move may take each other parameter: a log-scaled one by
   // max_step_factor (as a Levenberg-Marquardt step), a linear one by its
@@ -868,16 +868,30 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
         return Eigen::VectorXd(to.cwiseMax(lower).cwiseMin(upper));
       };
       // The profile's rise at t (infinite where the run fails: no parameters
-      // there): from the linearised profile, re-fitted while the cost falls.
+      // there), re-fitted from the nearest profile point already found (a
+      // continuation along the profile), the first from the linearised one.
+      std::vector<std::pair<double, Eigen::VectorXd>> found;  // (t, the re-fitted point)
       auto rise = [&](double t) {
         Eigen::VectorXd at = capped(phi, phi + t * path);
+        const auto nearest = std::min_element(found.begin(), found.end(), [&](auto& a, auto& b) {
+          return std::abs(a.first - t) < std::abs(b.first - t);
+        });
+        if (nearest != found.end()) {
+          at = nearest->second;
+          at[k] = std::clamp(phi[k] + t, lower[k], upper[k]);
+        }
         double best = std::numeric_limits<double>::infinity();
+        Eigen::VectorXd best_at = at;
         for (int step = 0; step <= kRefits && !cancel_requested(); ++step) {
           const bool more = refit && step < kRefits;
           const Evaluation& e = evaluations.at(at, more);
           if (!e.ok) break;
-          best = cost(e.residuals) - result.final_cost;
-          if (!more) break;
+          const double before = best, here = cost(e.residuals) - result.final_cost;
+          if (here < best) best = here, best_at = at;
+          if (!more || before - here < 0.05 * level) {  // re-fitted, or as good as
+            found.emplace_back(t, best_at);
+            break;
+          }
           Eigen::MatrixXd J = e.jacobian;
           J.col(k).setZero();  // phi_k stays where the profile puts it
           Eigen::MatrixXd H = J.transpose() * J;
@@ -889,7 +903,8 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
         }
         return best;
       };
-      double t_in = clip(side * half), rise_in = rise(t_in);
+      const double linearised = clip(side * half);
+      double t_in = linearised, rise_in = rise(t_in);
       if (!(rise_in < 0.5 * level)) continue;  // the linearised end stands
       double t = t_in, r = rise_in;
       bool unbounded = false;
@@ -919,6 +934,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
           if (std::abs(r_mid / level - 1.0) < 0.1) break;
         }
         end = t_in;  // the profile is below the level here: inside the 95% region
+        if (end == linearised) continue;  // no point further out was found below the level
       }
       (side < 0 ? result.lower_95 : result.upper_95)[k] = value(phi[k] + end);
       note << (note.tellp() > 0 ? "; " : "") << (side < 0 ? "lower" : "upper") << " end ";
