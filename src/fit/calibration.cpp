@@ -899,7 +899,12 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
           const Eigen::VectorXd g = J.transpose() * e.residuals;
           const Eigen::LDLT<Eigen::MatrixXd> normal(H);
           if (normal.info() != Eigen::Success) break;
-          at = capped(at, at - normal.solve(g));
+          const Eigen::VectorXd move = normal.solve(g);
+          if (0.5 * g.dot(move) < 0.05 * level) {  // the step would hardly gain: re-fitted
+            found.emplace_back(t, best_at);
+            break;
+          }
+          at = capped(at, at - move);
         }
         return best;
       };
