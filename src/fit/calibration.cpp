@@ -908,9 +908,15 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
         }
         return best;
       };
+      // The first probe goes at most two Levenberg-Marquardt steps out: the
+      // linearised end of a parameter the data barely see lies decades
+      // away, where runs are slow or fail.
       const double linearised = clip(side * half);
-      double t_in = linearised, rise_in = rise(t_in);
-      if (!(rise_in < 0.5 * level)) continue;  // the linearised end stands
+      const double first = clip(side * std::min(half, parameter.log_scale
+                                                          ? 2.0 * std::log(m.options.max_step_factor)
+                                                          : half));
+      double t_in = first, rise_in = rise(t_in);
+      if (!(rise_in < 0.5 * level)) continue;  // the profile's end lies inside the linearised one
       double t = t_in, r = rise_in;
       bool unbounded = false;
       for (int d = 0; d < kDoublings && r < level && !cancel_requested(); ++d) {
@@ -923,6 +929,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
         r = rise(t);
       }
       if (r < level) unbounded = true;
+      if (!unbounded && std::abs(t) <= std::abs(linearised)) continue;  // crossed inside it
       double end = t;
       if (!unbounded) {  // the crossing lies between t_in and t
         for (int i = 0; i < kRefinements && !cancel_requested(); ++i) {
@@ -939,7 +946,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
           if (std::abs(r_mid / level - 1.0) < 0.1) break;
         }
         end = t_in;  // the profile is below the level here: inside the 95% region
-        if (end == linearised) continue;  // no point further out was found below the level
+        if (std::abs(end) <= std::abs(linearised)) continue;  // none further out below the level
       }
       (side < 0 ? result.lower_95 : result.upper_95)[k] = value(phi[k] + end);
       note << (note.tellp() > 0 ? "; " : "") << (side < 0 ? "lower" : "upper") << " end ";
