@@ -838,7 +838,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
   const Eigen::VectorXd lower = m.map.lower_phi(), upper = m.map.upper_phi();
   const double level = 0.5 * 3.841458820694124 * variance;
   constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
-  constexpr int kDoublings = 10, kRefinements = 3, kRefits = 3;
+  constexpr int kDoublings = 10, kRefinements = 3, kRefits = 3, kRunsPerParameter = 8;
   const bool refit = m.analytic && P > 1;  // else the others stay at the optimum
   // How far one move may take each other parameter: a log-scaled one by
   // max_step_factor (as a Levenberg-Marquardt step), a linear one by its
@@ -851,8 +851,14 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
                : m.map.parameters()[static_cast<size_t>(j)].log_scale
                    ? std::log(m.options.max_step_factor)
                    : 1.96 * std::sqrt(std::max(0.0, variance * covariance(j, j)));
+  // The checks' forward runs, at most kRunsPerParameter per parameter: past
+  // it a profile point is not run, and an end moves out only as far as the
+  // points already run show (each run's cost is an upper bound of the
+  // profile there, so what they show holds).
+  const int budget = kRunsPerParameter;
   result.interval_notes.assign(static_cast<size_t>(P), "");
   for (int k = 0; k < P && !cancel_requested(); ++k) {
+    const int runs_before = evaluations.forward_runs;
     const Parameter& parameter = m.map.parameters()[static_cast<size_t>(k)];
     const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
     if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
@@ -883,6 +889,7 @@ void Calibration::check_interval_ends(EvaluationCache& evaluations, const Eigen:
         double best = std::numeric_limits<double>::infinity();
         Eigen::VectorXd best_at = at;
         for (int step = 0; step <= kRefits && !cancel_requested(); ++step) {
+          if (evaluations.forward_runs - runs_before >= budget) break;
           const bool more = refit && step < kRefits;
           const Evaluation& e = evaluations.at(at, more);
           if (!e.ok) break;
