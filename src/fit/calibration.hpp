@@ -122,9 +122,11 @@ struct FitOptions {
   // the path once more and checked against its warm-started run.
   bool warm_start = true;
   // After a converged fit, check each linearised 95% interval's ends on the
-  // profile likelihood and move out an end the data leave open (a few
-  // forward runs per parameter; FitResult::interval_notes).
-  bool check_intervals = true;
+  // profile likelihood and move out an end the data leave open (at most 8
+  // forward runs per parameter; FitResult::interval_notes). Off by default:
+  // a profile point far from every run so far walks the whole load path,
+  // which on a slow body costs more than the fit.
+  bool check_intervals = false;
   // Called after every iteration (LM) or every improvement (NLopt).
   std::function<void(const IterationRecord&)> progress;
 };

@@ -232,10 +232,10 @@ TEST(Calibration, AnIntervalTheDataLeaveOpenRunsToItsBound) {
   Parameter y = parameter("Y", 6000.0), gamma = parameter("gamma", 30.0);
   y.lower = 100.0, y.upper = 1e6;
   gamma.lower = 1e-6, gamma.upper = 1e4;
-  FitOptions unchecked;
-  unchecked.check_intervals = false;
-  const FitResult linear = Calibration(m, newton(5), {}, {y, gamma}, unchecked, {curve}).run();
-  const FitResult r = Calibration(m, newton(5), {}, {y, gamma}, {}, {curve}).run();
+  FitOptions checked;
+  checked.check_intervals = true;
+  const FitResult linear = Calibration(m, newton(5), {}, {y, gamma}, {}, {curve}).run();
+  const FitResult r = Calibration(m, newton(5), {}, {y, gamma}, checked, {curve}).run();
   ASSERT_TRUE(converged(r.status)) << r.message << " " << r.status_detail;
   ASSERT_EQ(r.interval_notes.size(), 2u);
   EXPECT_GT(linear.lower_95[1], 0.01) << "the linearised interval closes below: 0.11 here";
