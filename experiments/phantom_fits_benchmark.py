@@ -36,8 +36,11 @@ def with_start(name, start_y, folder):
 
 
 def interval(parameter):
+    """The value and its 95% interval (null in fit.json: none, or not finite)."""
     low, high = parameter["interval_95"]
-    holds = low is not None and high is not None and low <= TRUTH[parameter["name"]] <= high
+    if low is None or high is None:
+        return f"{parameter['value']:.4g} (no finite interval)"
+    holds = low <= TRUTH[parameter["name"]] <= high
     return f"{parameter['value']:.4g} ({low:.3g} .. {high:.3g}) {'holds' if holds else 'MISSES'}"
 
 
