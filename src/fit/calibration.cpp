@@ -400,6 +400,26 @@ const solve::StepRecord& record_of(const solve::SteppingSummary& summary, int k)
 
 Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
                                  const Eigen::VectorXd& warm_start) const {
+  solve::SteppingOptions stepping = impl_->stepping;
+  if (impl_->warm_starts) stepping.warm_start = warm_start;
+  return evaluate_with(phi, with_jacobian, std::move(stepping), false);
+}
+
+namespace {
+
+// The steps nearest n/2, n/4, ... n/1024 (at least 1): where a start probe's
+// run is kept, for the starts stiffened 2, 4, ... 1024 times (stiffer_start).
+bool near_a_halving(int step, int n) {
+  for (double share = 0.5; share >= 1.0 / 1024.0; share /= 2.0)
+    if (std::max(1L, std::lround(share * n)) == step) return true;
+  return false;
+}
+
+}  // namespace
+
+Evaluation Calibration::evaluate_with(const Eigen::VectorXd& phi, bool with_jacobian,
+                                      solve::SteppingOptions stepping,
+                                      bool keep_path_states) const {
   const Impl& m = *impl_;
   const ParameterMap& map = m.map;
   const int P = map.size(), nv = m.model.num_vertices();
@@ -415,10 +435,8 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
   // Sensitivities du/dtheta of the states at the target steps: from the
   // Newton stepper, or central differences of whole runs in phi.
   const bool sensitivities_wanted = with_jacobian && !map.material_names().empty();
-  solve::SteppingOptions stepping = m.stepping;
   if (sensitivities_wanted && m.analytic)
     stepping.sensitivities = {map.material_names(), m.state_steps};
-  if (m.warm_starts) stepping.warm_start = warm_start;
   // Per step read: the state, and each force curve's force.
   struct StepState {
     Eigen::VectorXd x;
@@ -429,6 +447,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
                  std::map<int, StepState>& at) {
     return solve::solve_load_steps(
         model, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+          if (keep_path_states && near_a_halving(r.step, options.steps)) e.path_states[r.step] = x;
           if (!std::binary_search(m.state_steps.begin(), m.state_steps.end(), r.step)) return;
           StepState& state = at[r.step];
           state.x = x;
@@ -443,6 +462,7 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
     e.message = e.summary.message;
     return e;
   }
+  e.path_states.clear();  // only a failed probe's are wanted
   const Eigen::VectorXd dvalue = map.value_derivatives(phi);
   const int nm = static_cast<int>(map.material_names().size());
   std::map<int, Eigen::MatrixXd> sensitivity;  // per target step: #unknowns x material parameters
@@ -667,7 +687,18 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
     if (position != kept_.begin()) std::rotate(kept_.begin(), position, std::next(position));
     return kept_.front().evaluation;
   }
-  Entry entry{phi, with_jacobian, calibration_.evaluate(phi, with_jacobian, nearest_state(phi))};
+  return count({phi, with_jacobian, calibration_.evaluate(phi, with_jacobian, nearest_state(phi))},
+               true);
+}
+
+const Evaluation* EvaluationCache::add(const Eigen::VectorXd& phi, bool with_jacobian,
+                                       Evaluation evaluation) {
+  const bool keep = evaluation.ok;
+  const Evaluation& counted = count({phi, with_jacobian, std::move(evaluation)}, keep);
+  return keep ? &counted : nullptr;
+}
+
+const Evaluation& EvaluationCache::count(Entry entry, bool keep) {
   forward_runs += entry.evaluation.forward_runs;
   warm_started_runs += entry.evaluation.warm_started_runs;
   sensitivity_solves += entry.evaluation.sensitivity_solves;
@@ -679,8 +710,9 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
     last_failure = entry.evaluation.message;
     ++failures_by_cause[failure_cause(last_failure)];
     if (failed_examples.size() < kKeptFailures)
-      failed_examples.push_back({calibration_.parameters().values(phi), last_failure});
+      failed_examples.push_back({calibration_.parameters().values(entry.phi), last_failure});
   }
+  if (!keep) return unkept_ = std::move(entry.evaluation);
   kept_.push_front(std::move(entry));
   if (kept_.size() > kKept) kept_.pop_back();
   return kept_.front().evaluation;
@@ -1013,17 +1045,42 @@ bool scales_stiffness(const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// A start probe's limits: a step cut at most twice, a piece given at most 12
+// Newton iterations. A start that needs more is too soft for its load more
+// often than not, and a stiffer start is found for far less than the minute
+// a failing step's full cuts can take (the layered phantom from Y/5).
+constexpr int kProbeCuts = 2;
+constexpr int kProbeIterations = 12;
+
+}  // namespace
+
+Evaluation Calibration::probe_start(const Eigen::VectorXd& phi, bool with_jacobian,
+                                    const Eigen::VectorXd& warm_start) const {
+  solve::SteppingOptions stepping = impl_->stepping;
+  stepping.newton.max_step_cuts = std::min(stepping.newton.max_step_cuts, kProbeCuts);
+  stepping.newton.max_iterations = std::min(stepping.newton.max_iterations, kProbeIterations);
+  if (impl_->warm_starts) stepping.warm_start = warm_start;
+  return evaluate_with(phi, with_jacobian, std::move(stepping), true);
+}
+
 // A forward run that fails at the start is most often a material too soft
 // for its load: a face turns over, or the run runs away. With every modulus
-// and gamma times s the small-load response is 1/s of the start's (the same
-// body at 1/s of the load), so the start is stiffened by 2, 4, ... 1024,
-// within the bounds, until its run succeeds. The softest start that runs is
-// returned (nullopt when none does, or nothing scales the stiffness).
+// and gamma times s the equilibrium at the full load is the start's at 1/s
+// of it (the pressure times s): the same body with the load divided by s.
+// So the start is stiffened by 2, 4, ... 1024, within the bounds, and each
+// stiffened start warm-started from the failed probe's state near n/s; a
+// factor whose end the probe's path never reached (s * reached < n, by load
+// control) is skipped, its run would fail as the probe's did. A body moved
+// only by prescribed motions and paddles has nothing to stiffen against.
 std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd& start_phi,
+                                                          const Evaluation& failed_probe,
                                                           EvaluationCache& evaluations,
                                                           bool with_sensitivities,
                                                           double* factor) const {
   const Impl& m = *impl_;
+  if (m.model.loads.empty()) return std::nullopt;
   const std::vector<Parameter>& parameters = m.map.parameters();
   const Eigen::VectorXd upper = m.map.upper_phi();
   std::vector<int> stiffness;
@@ -1031,7 +1088,11 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
     if (scales_stiffness(parameters[static_cast<size_t>(k)].name)) stiffness.push_back(k);
   if (stiffness.empty()) return std::nullopt;
   const Eigen::VectorXd start = m.map.values(start_phi);
+  const int n = m.stepping.steps;
+  const bool by_load = m.stepping.newton.control == solve::NewtonOptions::Control::Load;
+  const int reached = failed_probe.summary.steps.empty() ? 0 : failed_probe.summary.steps.back().step;
   for (double s = 2.0; s <= 1024.0 && !cancel_requested(); s *= 2.0) {
+    if (by_load && reached > 0 && s * reached < n) continue;
     Eigen::VectorXd phi = start_phi;
     bool moved = false;
     for (int k : stiffness) {
@@ -1042,7 +1103,15 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
       moved |= phi[k] > start_phi[k];
     }
     if (!moved) return std::nullopt;  // every stiffness on its upper bound
-    if (evaluations.at(phi, with_sensitivities).ok) {
+    Eigen::VectorXd warm;  // the probe's state nearest n/s, its pressure times s
+    double off = 0.0;
+    for (const auto& [step, x] : failed_probe.path_states)
+      if (warm.size() == 0 || std::abs(step - n / s) < off) {
+        warm = x;
+        off = std::abs(step - n / s);
+      }
+    if (warm.size() > 0) warm[warm.size() - 1] *= s;
+    if (evaluations.add(phi, with_sensitivities, probe_start(phi, with_sensitivities, warm))) {
       *factor = s;
       return phi;
     }
@@ -1076,25 +1145,37 @@ FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
   const bool levenberg_marquardt = m.options.method == Method::LevenbergMarquardt;
   Eigen::VectorXd phi0 = start_phi;
   const bool with_sensitivities = levenberg_marquardt && m.analytic;
-  if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities); !given.ok) {
-    if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-    const std::string why = given.message;  // `given` moves as the cache grows
-    double factor = 1.0;
-    const std::optional<Eigen::VectorXd> stiffer =
-        stiffer_start(start_phi, evaluations, with_sensitivities, &factor);
-    if (!stiffer) {
+  // A start too soft for its load fails fast in a probe, and a stiffer start
+  // is looked for; only when none runs is the start run in full.
+  if (evaluations.kept(start_phi, with_sensitivities) == nullptr) {
+    const Evaluation probe = probe_start(start_phi, with_sensitivities);
+    if (evaluations.add(start_phi, with_sensitivities, probe) == nullptr) {
       if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-      return finish(FitStatus::StartFailed,
-                    "the forward run at the starting parameters failed: " + why +
-                        " (and with the moduli and gamma up to 1024 times the start's, within "
-                        "their bounds)");
+      double factor = 1.0;
+      const std::optional<Eigen::VectorXd> stiffer =
+          stiffer_start(start_phi, probe, evaluations, with_sensitivities, &factor);
+      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+      if (stiffer) {
+        phi0 = *stiffer;
+        std::ostringstream note;
+        note << "the forward run at the starting parameters failed, in a probe that gives up "
+                "after "
+             << kProbeCuts << " halvings of a step or " << kProbeIterations
+             << " Newton iterations (" << probe.message
+             << "); the fit started from the moduli and gamma times " << factor
+             << ", the softest such start whose run succeeds";
+        result.start_note = note.str();
+      } else if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities);
+                 !given.ok) {
+        if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+        return finish(FitStatus::StartFailed,
+                      "the forward run at the starting parameters failed: " + given.message +
+                          (m.model.loads.empty()
+                               ? ""
+                               : " (and with the moduli and gamma up to 1024 times the start's, "
+                                 "within their bounds)"));
+      }
     }
-    phi0 = *stiffer;
-    std::ostringstream note;
-    note << "the forward run at the starting parameters failed (" << why
-         << "); the fit started from the moduli and gamma times " << factor
-         << ", the softest such start whose run succeeds";
-    result.start_note = note.str();
   }
   const Evaluation& first = evaluations.at(phi0, with_sensitivities);
   result.initial_cost = cost(first.residuals);

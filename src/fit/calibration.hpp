@@ -148,6 +148,9 @@ struct Evaluation {
   int forward_runs = 0;
   int sensitivity_solves = 0;
   int warm_started_runs = 0;  // of forward_runs: solved from a nearby point's final state
+  // A failed start probe's converged states at the steps nearest n/2, n/4,
+  // ... (step -> unknowns): Calibration::stiffer_start warm-starts from them.
+  std::map<int, Eigen::VectorXd> path_states;
 };
 
 // How a fitted force curve misses its measurement.
@@ -284,10 +287,21 @@ class Calibration {
   // differ, FitResult::warm_start_note says so.
   void check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
                         FitResult& result) const;
-  // Where the start's forward run fails: the softest start with every
-  // modulus and gamma 2, 4, ... 1024 times the start's (within the bounds)
-  // whose run succeeds, and that factor; nullopt when none runs.
+  // evaluate() with these stepping options (a warm start in them is used as
+  // given); keep_path_states: a failed run's Evaluation::path_states.
+  Evaluation evaluate_with(const Eigen::VectorXd& phi, bool with_jacobian,
+                           solve::SteppingOptions stepping, bool keep_path_states) const;
+  // A start's run that gives up early (at most kProbeCuts halvings of a step
+  // and kProbeIterations Newton iterations per piece; a success is the full
+  // run's, to the bit), keeping a failed path's states near n/2, n/4, ...
+  Evaluation probe_start(const Eigen::VectorXd& phi, bool with_jacobian,
+                         const Eigen::VectorXd& warm_start = {}) const;
+  // Where the start's probe failed: the softest start with every modulus
+  // and gamma 2, 4, ... 1024 times the start's (within the bounds) whose
+  // probe succeeds, and that factor; nullopt when none does, or none can
+  // help. Each is warm-started from the failed probe's state near n/s.
   std::optional<Eigen::VectorXd> stiffer_start(const Eigen::VectorXd& start_phi,
+                                               const Evaluation& failed_probe,
                                                EvaluationCache& evaluations,
                                                bool with_sensitivities, double* factor) const;
 

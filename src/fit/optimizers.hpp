@@ -24,6 +24,11 @@ class EvaluationCache {
   // it is evaluated again). The reference stays valid until the next call.
   const Evaluation& at(const Eigen::VectorXd& phi, bool with_jacobian);
 
+  // An evaluation made elsewhere (a start probe), counted as at() counts its
+  // own and kept only when it succeeded (a probe's failure says nothing of
+  // the full run at phi). Null when not kept.
+  const Evaluation* add(const Eigen::VectorXd& phi, bool with_jacobian, Evaluation evaluation);
+
   // The evaluation at phi if it was kept (with the Jacobian when asked), or null.
   const Evaluation* kept(const Eigen::VectorXd& phi, bool with_jacobian) const;
 
@@ -46,9 +51,13 @@ class EvaluationCache {
   const Calibration& calibration_;
   std::deque<Entry> kept_;  // newest first
   Evaluation interrupted_;  // the last evaluation an interrupt cut short (not kept)
+  Evaluation unkept_;       // the last evaluation add() did not keep
   // The final state of the kept point nearest phi whose run succeeded, to
   // warm-start phi's run from (empty: none, or the calibration takes none).
   Eigen::VectorXd nearest_state(const Eigen::VectorXd& phi) const;
+  // Counts the entry's runs and failures, and keeps it (when `keep`):
+  // the kept entry, or an interrupted or unkept one's evaluation.
+  const Evaluation& count(Entry entry, bool keep);
   // The kept entry that serves (phi, with_jacobian), or end().
   std::deque<Entry>::const_iterator find(const Eigen::VectorXd& phi, bool with_jacobian) const;
 };

@@ -104,6 +104,66 @@ TEST(Calibration, AStartWhoseRunFailsIsStiffenedUntilItRuns) {
   EXPECT_NEAR(r.initial[0], 150.0, 1e-9);  // the start reported is the one given
 }
 
+// A start that fails late on its path (issue 42: the layered phantom from
+// Y/5 folds at its last step). Every modulus and gamma times s carries the
+// full load as the start carries 1/s of it (the pressure times s), so the
+// start stiffened twice is solved from the failed probe's state at half the
+// load, warm, and the fit goes on to the truth as from a cold start.
+TEST(Calibration, AStiffenedStartIsSolvedFromTheFailedStartsPath) {
+  const model::Model m = hanging_sphere();
+  const int n = 8;
+  // Stiffness times 2 at the full load is the body at half of it.
+  model::Model stiff = m;
+  for (const char* name : {"Y0", "gamma"})
+    stiff.material.set_parameter(name, 2.0 * m.material.parameter(name));
+  Eigen::VectorXd half;
+  ASSERT_TRUE(solve::solve_load_steps(m, newton(n), [&](const solve::StepRecord& r,
+                                                        const Eigen::VectorXd& x) {
+                if (r.step == n / 2) half = x;
+              }).success);
+  const solve::SteppingSummary doubled = solve::solve_load_steps(stiff, newton(n));
+  ASSERT_TRUE(doubled.success) << doubled.message;
+  half[half.size() - 1] *= 2.0;
+  EXPECT_LT((doubled.unknowns - half).cwiseAbs().maxCoeff(),
+            1e-8 * std::max(1.0, half.cwiseAbs().maxCoeff()));
+
+  // The softest start (Y0 and gamma in proportion) that runs, by bisection;
+  // just below it the run fails part of the way (at 0.95: a face turns over
+  // at step 4).
+  const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(n), {n});
+  auto start = [](double f) {
+    return std::vector<Parameter>{parameter("Y0", 3000.0 * f), parameter("gamma", 300.0 * f)};
+  };
+  double ok = 1.0, fails = 1e-4;
+  for (int k = 0; k < 30; ++k) {
+    const double mid = std::sqrt(ok * fails);
+    const Calibration c(m, newton(n), targets, start(mid));
+    (c.evaluate(c.parameters().initial_phi(), false).ok ? ok : fails) = mid;
+  }
+  const Calibration c(m, newton(n), targets, start(0.95 * ok));
+  const Evaluation failed = c.evaluate(c.parameters().initial_phi(), false);
+  ASSERT_FALSE(failed.ok);
+  const int reached = static_cast<int>(failed.summary.steps.size());
+  ASSERT_GE(reached, 2) << failed.message;
+  // The softest factor whose end the failed path reached: s * reached >= n.
+  int s = 2;
+  while (s * reached < n) s *= 2;
+  const FitResult r = c.run();
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_NE(r.start_note.find("times " + std::to_string(s) + ","), std::string::npos)
+      << r.start_note;
+  EXPECT_NEAR(r.values[0] / 3000.0, 1.0, 1e-6);
+  EXPECT_NEAR(r.values[1] / 300.0, 1.0, 1e-6);
+  // The warm start reached the stiffened start's own equilibrium: the cost
+  // there is the one a walk of its path gives.
+  Eigen::VectorXd stiffened = c.parameters().initial_phi();
+  stiffened.array() += std::log(static_cast<double>(s));
+  EXPECT_NEAR(r.initial_cost / c.cost(c.evaluate(stiffened, false).residuals), 1.0, 1e-8);
+  // The failed probe, and the path's run at the optimum: the rest were warm.
+  EXPECT_EQ(r.failed_runs, 1);
+  EXPECT_EQ(r.warm_started_runs, r.forward_runs - 2);
+}
+
 // Levenberg-Marquardt moves a log-scaled parameter by at most
 // max_step_factor per step (a box around the current point), and still
 // reaches the truth from 30 times it.
