@@ -1069,11 +1069,12 @@ Evaluation Calibration::probe_start(const Eigen::VectorXd& phi, bool with_jacobi
 // for its load: a face turns over, or the run runs away. With every modulus
 // and gamma times s the equilibrium at the full load is the start's at 1/s
 // of it (the pressure times s): the same body with the load divided by s.
-// So the start is stiffened by 2, 4, ... 1024, within the bounds, and each
-// stiffened start warm-started from the failed probe's state near n/s; a
-// factor whose end the probe's path never reached (s * reached < n, by load
-// control) is skipped, its run would fail as the probe's did. A body moved
-// only by prescribed motions and paddles has nothing to stiffen against.
+// So the start is stiffened by 2, 4, ... 1024, within the bounds, and a
+// stiffened start whose end the failed probe passed (its state at step n/s)
+// is solved from there, warm; the others walk their paths (a runaway at a
+// step too large for a soft body need not recur on a stiffer one). A body
+// moved only by prescribed motions and paddles has nothing to stiffen
+// against.
 std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd& start_phi,
                                                           const Evaluation& failed_probe,
                                                           EvaluationCache& evaluations,
@@ -1089,10 +1090,7 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
   if (stiffness.empty()) return std::nullopt;
   const Eigen::VectorXd start = m.map.values(start_phi);
   const int n = m.stepping.steps;
-  const bool by_load = m.stepping.newton.control == solve::NewtonOptions::Control::Load;
-  const int reached = failed_probe.summary.steps.empty() ? 0 : failed_probe.summary.steps.back().step;
   for (double s = 2.0; s <= 1024.0 && !cancel_requested(); s *= 2.0) {
-    if (by_load && reached > 0 && s * reached < n) continue;
     Eigen::VectorXd phi = start_phi;
     bool moved = false;
     for (int k : stiffness) {
@@ -1103,14 +1101,12 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
       moved |= phi[k] > start_phi[k];
     }
     if (!moved) return std::nullopt;  // every stiffness on its upper bound
-    Eigen::VectorXd warm;  // the probe's state nearest n/s, its pressure times s
-    double off = 0.0;
-    for (const auto& [step, x] : failed_probe.path_states)
-      if (warm.size() == 0 || std::abs(step - n / s) < off) {
-        warm = x;
-        off = std::abs(step - n / s);
-      }
-    if (warm.size() > 0) warm[warm.size() - 1] *= s;
+    Eigen::VectorXd warm;  // the probe's state at n/s, its pressure times s
+    if (const auto at = failed_probe.path_states.find(std::max(1L, std::lround(n / s)));
+        at != failed_probe.path_states.end()) {
+      warm = at->second;
+      warm[warm.size() - 1] *= s;
+    }
     if (evaluations.add(phi, with_sensitivities, probe_start(phi, with_sensitivities, warm))) {
       *factor = s;
       return phi;

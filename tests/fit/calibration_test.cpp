@@ -111,7 +111,7 @@ TEST(Calibration, AStartWhoseRunFailsIsStiffenedUntilItRuns) {
 // load, warm, and the fit goes on to the truth as from a cold start.
 TEST(Calibration, AStiffenedStartIsSolvedFromTheFailedStartsPath) {
   const model::Model m = hanging_sphere();
-  const int n = 8;
+  const int n = 4;
   // Stiffness times 2 at the full load is the body at half of it.
   model::Model stiff = m;
   for (const char* name : {"Y0", "gamma"})
@@ -128,8 +128,8 @@ TEST(Calibration, AStiffenedStartIsSolvedFromTheFailedStartsPath) {
             1e-8 * std::max(1.0, half.cwiseAbs().maxCoeff()));
 
   // The softest start (Y0 and gamma in proportion) that runs, by bisection;
-  // just below it the run fails part of the way (at 0.95: a face turns over
-  // at step 4).
+  // just below it a run fails part of the way: the first, going down, that
+  // fails past half the load (0.99 of it, at step 3 of 4).
   const std::vector<MeasuredStep> targets = synthetic_targets(m, newton(n), {n});
   auto start = [](double f) {
     return std::vector<Parameter>{parameter("Y0", 3000.0 * f), parameter("gamma", 300.0 * f)};
@@ -140,14 +140,15 @@ TEST(Calibration, AStiffenedStartIsSolvedFromTheFailedStartsPath) {
     const Calibration c(m, newton(n), targets, start(mid));
     (c.evaluate(c.parameters().initial_phi(), false).ok ? ok : fails) = mid;
   }
-  const Calibration c(m, newton(n), targets, start(0.95 * ok));
-  const Evaluation failed = c.evaluate(c.parameters().initial_phi(), false);
-  ASSERT_FALSE(failed.ok);
-  const int reached = static_cast<int>(failed.summary.steps.size());
-  ASSERT_GE(reached, 2) << failed.message;
-  // The softest factor whose end the failed path reached: s * reached >= n.
-  int s = 2;
-  while (s * reached < n) s *= 2;
+  double f = 0.99;
+  for (; f > 0.5; f -= 0.01) {
+    const Calibration c(m, newton(n), targets, start(f * ok));
+    const Evaluation e = c.evaluate(c.parameters().initial_phi(), false);
+    if (!e.ok && e.summary.steps.size() >= static_cast<size_t>(n / 2)) break;
+  }
+  ASSERT_GT(f, 0.5) << "no start that fails past half the load";
+  const Calibration c(m, newton(n), targets, start(f * ok));
+  const int s = 2;  // its end is the failed path's state at step n/2
   const FitResult r = c.run();
   ASSERT_TRUE(r.success) << r.message;
   EXPECT_NE(r.start_note.find("times " + std::to_string(s) + ","), std::string::npos)
