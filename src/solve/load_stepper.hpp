@@ -31,7 +31,7 @@ const char* to_string(Scheme scheme);
 enum class TangentSolver {
   Auto,    // dense up to 600 unknowns (about 200 vertices), then krylov for the vector
            // spring; for central fibers up to 50,000 unknowns: within a horizon stored
-           // as lists dense up to 4,000 then sparse, else reused; above, krylov
+           // as lists sparse up to 4,000 then reused, else reused; above, krylov
   Dense,   // LU of the dense tangent (LAPACK) at every iteration
   Krylov,  // matrix-free GMRES, preconditioned by the structured secant solve
   Sparse,  // LU of the sparse tangent (UMFPACK): N times the neighbours entries
@@ -43,10 +43,10 @@ const char* to_string(TangentSolver solver);
 // What `requested` means for a Newton run with `reduced_unknowns` (the
 // unknowns left after the supports): Auto is dense up to 600 then Krylov
 // for the vector spring. Central fibers, whose tangent the secant
-// preconditioner fits poorly, up to 50,000 unknowns: stored as neighbour
-// lists (`sparse_fibers`, a horizon) dense up to 4,000 then the sparse LU;
-// else dense up to 600 then the reused dense LU (20 GB at 50,000). Above
-// 50,000, Krylov.
+// preconditioner fits poorly, up to 50,000 unknowns: dense up to 600; then
+// stored as neighbour lists (`sparse_fibers`, a horizon) the sparse LU up to
+// 4,000 and the reused sparse LU above; else the reused dense LU (20 GB at
+// 50,000). Above 50,000, Krylov.
 TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
                              model::FiberKinematics kinematics, bool sparse_fibers);
 

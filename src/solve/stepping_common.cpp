@@ -156,18 +156,23 @@ TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
   if (kinematics == model::FiberKinematics::VectorSpring)
     return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
   // Krylov's secant preconditioner is far from a central tangent (GMRES
-  // stalls once contact and large rotations couple the axes). A horizon's
-  // central tangent has N times the neighbours entries: its exact LU beats
-  // the dense one above 4,000 unknowns and takes seconds up to 50,000 (about
-  // 4 s at 30,000). Where the fibers are many (every pair, or a horizon that
-  // keeps more than an eighth of them), one dense LU of the tangent
-  // preconditions GMRES on the exact tangent over many iterations and steps:
-  // above 600 unknowns that beats an LU per iteration (issue 42: a bending
-  // phantom of 1,418 vertices in 10 s with one LU, against 70 s with 34).
+  // stalls once contact and large rotations couple the axes). Where the
+  // fibers are many (every pair, or a horizon that keeps more than an eighth
+  // of them), one dense LU of the tangent preconditions GMRES on the exact
+  // tangent over many iterations and steps: above 600 unknowns that beats an
+  // LU per iteration (issue 42: a bending phantom of 1,418 vertices in 10 s
+  // with one LU, against 70 s with 34).
   if (reduced_unknowns > 50000) return TangentSolver::Krylov;
-  if (sparse_fibers)
-    return reduced_unknowns <= 4000 ? TangentSolver::Dense : TangentSolver::Sparse;
-  return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Reused;
+  if (reduced_unknowns <= 600) return TangentSolver::Dense;
+  if (!sparse_fibers) return TangentSolver::Reused;
+  // A horizon's lists: the tangent has N times the neighbours entries, and
+  // its sparse LU beats the dense one above 600 unknowns (2,600: 0.3 s an
+  // iteration against 0.8 s). Reusing that LU pays once its factorisation
+  // outweighs GMRES's products (6,000 unknowns: 1.4 s a factorisation; the
+  // reuse 2.6 times faster at small strains, 1.2 times on a cylinder bending
+  // under its weight), not below (a bar of 729 unknowns bent to 37%: 2.3
+  // times slower). docs/model.md, the table of `auto`.
+  return reduced_unknowns <= 4000 ? TangentSolver::Sparse : TangentSolver::Reused;
 }
 
 std::string SteppingSummary::BriefReport() const {
