@@ -70,7 +70,7 @@ def best_times(fiberfluid, path, repeats):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("fiberfluid")
-    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--phantom", action="store_true",
                         help="the bending phantom (a real specimen's size) instead")
     args = parser.parse_args()
