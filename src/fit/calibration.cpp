@@ -407,11 +407,15 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
 
 namespace {
 
-// The steps nearest n/2, n/4, ... n/1024 (at least 1): where a start probe's
-// run is kept, for the starts stiffened 2, 4, ... 1024 times (stiffer_start).
+// The step of n nearest the load share 1/s (at least 1): where the start
+// stiffened s times ends on the start's own path (stiffer_start).
+long step_at_share(int n, double s) { return std::max(1L, std::lround(n / s)); }
+
+// The steps nearest n/2, n/4, ... n/1024: where a start probe's run is kept,
+// for the starts stiffened 2, 4, ... 1024 times.
 bool near_a_halving(int step, int n) {
-  for (double share = 0.5; share >= 1.0 / 1024.0; share /= 2.0)
-    if (std::max(1L, std::lround(share * n)) == step) return true;
+  for (double s = 2.0; s <= 1024.0; s *= 2.0)
+    if (step_at_share(n, s) == step) return true;
   return false;
 }
 
@@ -1043,14 +1047,11 @@ bool scales_stiffness(const std::string& name) {
   return (!name.empty() && name[0] == 'Y') || name == "gamma" || name.rfind("factor_", 0) == 0;
 }
 
-}  // namespace
-
-namespace {
-
 // A start probe's limits: a step cut at most twice, a piece given at most 12
 // Newton iterations. A start that needs more is too soft for its load more
-// often than not, and a stiffer start is found for far less than the minute
-// a failing step's full cuts can take (the layered phantom from Y/5).
+// often than not, and a stiffer start costs less than the failing step's
+// remaining cuts (the layered phantom from Y/5: the probe gives up after
+// 72 s, the full run after 109 s).
 constexpr int kProbeCuts = 2;
 constexpr int kProbeIterations = 12;
 
@@ -1102,7 +1103,7 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
     }
     if (!moved) return std::nullopt;  // every stiffness on its upper bound
     Eigen::VectorXd warm;  // the probe's state at n/s, its pressure times s
-    if (const auto at = failed_probe.path_states.find(std::max(1L, std::lround(n / s)));
+    if (const auto at = failed_probe.path_states.find(static_cast<int>(step_at_share(n, s)));
         at != failed_probe.path_states.end()) {
       warm = at->second;
       warm[warm.size() - 1] *= s;

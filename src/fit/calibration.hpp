@@ -299,7 +299,8 @@ class Calibration {
   // Where the start's probe failed: the softest start with every modulus
   // and gamma 2, 4, ... 1024 times the start's (within the bounds) whose
   // probe succeeds, and that factor; nullopt when none does, or none can
-  // help. Each is warm-started from the failed probe's state near n/s.
+  // help. One whose end the failed probe passed (its state at step n/s) is
+  // solved from there, warm.
   std::optional<Eigen::VectorXd> stiffer_start(const Eigen::VectorXd& start_phi,
                                                const Evaluation& failed_probe,
                                                EvaluationCache& evaluations,
