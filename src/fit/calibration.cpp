@@ -407,6 +407,10 @@ Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
 
 namespace {
 
+// The stiffest start tried: the moduli and gamma 2, 4, ... this many times
+// the start's (stiffer_start; the probe keeps its states for each).
+constexpr double kStiffest = 1024.0;
+
 // The step of n nearest the load share 1/s (at least 1): where the start
 // stiffened s times ends on the start's own path (stiffer_start).
 long step_at_share(int n, double s) { return std::max(1L, std::lround(n / s)); }
@@ -414,7 +418,7 @@ long step_at_share(int n, double s) { return std::max(1L, std::lround(n / s)); }
 // The steps nearest n/2, n/4, ... n/1024: where a start probe's run is kept,
 // for the starts stiffened 2, 4, ... 1024 times.
 bool near_a_halving(int step, int n) {
-  for (double s = 2.0; s <= 1024.0; s *= 2.0)
+  for (double s = 2.0; s <= kStiffest; s *= 2.0)
     if (step_at_share(n, s) == step) return true;
   return false;
 }
@@ -1091,7 +1095,7 @@ std::optional<Eigen::VectorXd> Calibration::stiffer_start(const Eigen::VectorXd&
   if (stiffness.empty()) return std::nullopt;
   const Eigen::VectorXd start = m.map.values(start_phi);
   const int n = m.stepping.steps;
-  for (double s = 2.0; s <= 1024.0 && !cancel_requested(); s *= 2.0) {
+  for (double s = 2.0; s <= kStiffest && !cancel_requested(); s *= 2.0) {
     Eigen::VectorXd phi = start_phi;
     bool moved = false;
     for (int k : stiffness) {
