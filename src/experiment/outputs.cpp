@@ -178,6 +178,7 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"success", run.summary.success},
           {"message", run.summary.message},
           {"factorizations", run.summary.factorizations},
+          {"single_precision_factorizations", run.summary.single_precision_factorizations},
           {"seconds",
            {{"assemble", run.summary.assemble_seconds},
             {"factorize", run.summary.factorize_seconds},

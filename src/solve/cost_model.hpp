@@ -22,6 +22,8 @@ struct KernelSpeed {
                                               // (clusters culled: 10,242 vertices in 0.054 s)
   double factor_flops_per_second = 6.5e10;    // LAPACK dgetrf / dpotrf (69 GFLOP/s measured)
   double triangular_flops_per_second = 1e10;  // solves with a dense factor (memory-bound)
+  double factor_bytes_read_per_second = 9e9;  // the same, bytes of a large factor (4,254
+                                              // unknowns in single precision: 72 MB in 8 ms)
   double pair_updates_per_second = 4.5e9;     // one fiber pair in one axis block's product (tiled)
   double residual_pairs_per_second = 8e8;     // one ordered pair of the Newton residual (tiled)
   double sparse_flops_per_second = 3e9;       // CHOLMOD on dense bulk blocks

@@ -211,6 +211,9 @@ struct SteppingSummary {
   std::shared_ptr<class TangentSolve> final_tangent;
   SolverStatistics solver_statistics;
   int factorizations = 0;
+  // Newton's reused dense tangent LU: the factorisations whose factors were
+  // rounded to single precision for GMRES's preconditioner solves.
+  int single_precision_factorizations = 0;
   double assemble_seconds = 0.0;
   double factorize_seconds = 0.0;
   double solve_seconds = 0.0;

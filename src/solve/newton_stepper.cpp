@@ -422,6 +422,7 @@ class NewtonSolver {
     Status status = tangent_->prepare(x, factors, dofs, &supports_);
     if (status.ok) status = solve_prepared(b, forcing, record, y);
     summary_.factorizations = tangent_->factorizations();
+    summary_.single_precision_factorizations = tangent_->single_precision_factorizations();
     summary_.solver = tangent_->preconditioner_kind();
     return status;
   }

@@ -186,6 +186,8 @@ std::string SteppingSummary::BriefReport() const {
       out << ", " << krylov_iterations << " gmres iterations, " << factorizations
           << (tangent == TangentSolver::Reused ? " tangent LU" : " preconditioner")
           << " factorizations";
+    if (single_precision_factorizations > 0)
+      out << " (" << single_precision_factorizations << " rounded to single precision)";
     if (tangent == TangentSolver::Sparse)
       out << ", " << factorizations << " sparse LU factorizations";
   } else {

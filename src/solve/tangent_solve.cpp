@@ -270,7 +270,11 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
     baseline_rate_ = rate;
   else if (rate > std::max(2.0 * baseline_rate_ + 1.0, floor))
     refactor_ = true;
-  if (!result.status.ok && !just_factored_) {
+  // A failure just after a factorisation is final, unless that factor was
+  // rounded to single precision: then the rest of the run factors in double.
+  const bool rounded = kind_ == TangentSolver::Reused && lu_ && lu_->single();
+  if (!result.status.ok && (!just_factored_ || rounded)) {
+    if (just_factored_) single_factor_ = false;
     if (kind_ == TangentSolver::Reused) preconditioner_dofs_ = dofs_;
     Status status = kind_ == TangentSolver::Reused ? factor_tangent_preconditioner()
                                                    : factor_preconditioner();
@@ -306,8 +310,11 @@ Status TangentSolve::preconditioner_solve(const Eigen::VectorXd& in, Eigen::Vect
 // whose dense tangent would be mostly zeros.
 Status TangentSolve::factor_tangent_preconditioner() {
   reused_factor_ok_ = false;
-  const Status status = reuses_sparse_lu_ ? factor_sparse_tangent(preconditioner_dofs_)
-                                          : factor_dense_tangent(preconditioner_dofs_);
+  // Only a preconditioner, so the dense factor may be single precision:
+  // GMRES restores the exact step from the rounded one.
+  const Status status = reuses_sparse_lu_
+                            ? factor_sparse_tangent(preconditioner_dofs_)
+                            : factor_dense_tangent(preconditioner_dofs_, single_factor_);
   if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   reused_factor_ok_ = true;
   note_new_factor();
@@ -315,13 +322,16 @@ Status TangentSolve::factor_tangent_preconditioner() {
 }
 
 // The equilibrated LU of the exact tangent at x_ over the unknowns `dofs`
-// leaves free, dense (LAPACK) or sparse (UMFPACK, its symbolic analysis
+// leaves free, dense (LAPACK; its factors rounded to single precision when
+// asked and DenseLU's check allows) or sparse (UMFPACK, its symbolic analysis
 // kept while the pattern stays).
-Status TangentSolve::factor_dense_tangent(const model::DofMap& dofs) {
+Status TangentSolve::factor_dense_tangent(const model::DofMap& dofs, bool single) {
   Eigen::MatrixXd J = dofs.reduce(equilibrium_->tangent(x_, factors_));
   equilibrate(J, &row_scale_, &column_scale_);
   lu_ = std::make_unique<DenseLU>();
-  return lu_->factorize(J);
+  const Status status = lu_->factorize(std::move(J));
+  if (status.ok && single && lu_->round_to_single()) ++single_precision_factorizations_;
+  return status;
 }
 
 Status TangentSolve::factor_sparse_tangent(const model::DofMap& dofs) {

@@ -50,6 +50,7 @@ class TangentSolve {
   TangentSolver kind() const { return kind_; }
   SolverKind preconditioner_kind() const { return preconditioner_kind_; }
   int factorizations() const { return factorizations_; }
+  int single_precision_factorizations() const { return single_precision_factorizations_; }
   const model::DofMap& dofs() const { return dofs_; }
   const Eigen::VectorXd& state() const { return x_; }
 
@@ -75,7 +76,7 @@ class TangentSolve {
  private:
   Status factor_preconditioner();
   Status factor_tangent_preconditioner();
-  Status factor_dense_tangent(const model::DofMap& dofs);
+  Status factor_dense_tangent(const model::DofMap& dofs, bool single = false);
   Status factor_sparse_tangent(const model::DofMap& dofs);
   void note_new_factor();  // a preconditioner factored: counts, caches and the refresh rule reset
   bool reused_factor_still_serves() const;
@@ -92,7 +93,8 @@ class TangentSolve {
   model::DofMap dofs_;
   model::DofMap preconditioner_dofs_;
   bool ready_ = false;
-  // Dense (and reused: the LU of the tangent at an earlier state).
+  // Dense (and reused: the LU of the tangent at an earlier state, single
+  // precision where it serves).
   std::unique_ptr<DenseLU> lu_;
   // Sparse (its scaling in row_scale_, column_scale_ as the dense one's),
   // and reused where the fibers are a horizon's lists: the sparse LU of the
@@ -100,6 +102,9 @@ class TangentSolve {
   std::unique_ptr<SparseLU> sparse_lu_;
   bool reuses_sparse_lu_ = false;
   bool reused_factor_ok_ = false;  // the reused factor succeeded (and is current)
+  // The reused dense factor is rounded to single precision until GMRES
+  // fails just after such a factorisation.
+  bool single_factor_ = true;
   // The dense tangent is equilibrated before its LU (rows, then columns, by
   // their largest entries): force rows of a stiff material and the volume
   // row differ by many orders, which would make a sound system look singular.
@@ -121,7 +126,7 @@ class TangentSolve {
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
   double baseline_rate_ = -1.0;  // gmres iterations per decade after the last factorisation
   bool refactor_ = false, just_factored_ = false;
-  int factorizations_ = 0;
+  int factorizations_ = 0, single_precision_factorizations_ = 0;
 };
 
 }  // namespace fiberfluid::solve

@@ -279,6 +279,44 @@ TEST(DenseLU, ReportsASingularMatrix) {
   EXPECT_NEAR((A * lu.solve(b) - b).norm(), 0.0, 1e-14);
 }
 
+// A preconditioner's LU rounded to single precision: its solves within
+// float's rounding of the double LU's on a well-conditioned matrix; not
+// rounded where the rounded solves would be off by over 1%.
+TEST(DenseLU, RoundsToSinglePrecisionOnlyWhereItsSolvesServe) {
+  const int n = 300;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n);
+  A.diagonal().array() += 20.0;
+  DenseLU exact, rounded;
+  EXPECT_THROW(rounded.round_to_single(), std::logic_error);  // nothing factored yet
+  ASSERT_TRUE(exact.factorize(A).ok);
+  ASSERT_TRUE(rounded.factorize(A).ok);
+  EXPECT_FALSE(rounded.single());
+  ASSERT_TRUE(rounded.round_to_single());
+  EXPECT_TRUE(rounded.single());
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  const Eigen::VectorXd x = exact.solve(b), y = rounded.solve(b);
+  EXPECT_LT((y - x).norm(), 1e-5 * x.norm());
+  EXPECT_GT((y - x).norm(), 1e-12 * x.norm());  // it did round
+  EXPECT_LT((A * y - b).norm(), 1e-5 * b.norm());
+  EXPECT_GT(rounded.rounding_stretch(), 1e-9);
+  EXPECT_LT(rounded.rounding_stretch(), 1e-5);
+  // A new factorisation is in double again.
+  ASSERT_TRUE(rounded.factorize(A).ok);
+  EXPECT_FALSE(rounded.single());
+  EXPECT_LT((rounded.solve(b) - x).norm(), 1e-13 * x.norm());
+
+  // Hilbert's matrix of order 7 (condition 4.8e8): double serves, single
+  // does not (rounding stretches by up to 4.8e8 times float's 6e-8).
+  Eigen::MatrixXd hilbert(7, 7);
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 7; ++j) hilbert(i, j) = 1.0 / (i + j + 1);
+  ASSERT_TRUE(rounded.factorize(hilbert).ok);
+  EXPECT_FALSE(rounded.round_to_single());
+  EXPECT_FALSE(rounded.single());
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(7);
+  EXPECT_LT((hilbert * rounded.solve(ones) - ones).norm(), 1e-7);
+}
+
 }  // namespace
 }  // namespace fiberfluid::solve
 
