@@ -39,6 +39,7 @@ template <class A>
 void fields(A& a, SteppingSummary& s) {
   a(s.success, s.message, s.steps, s.unknowns, s.reaction_forces, s.scheme, s.solver, s.tangent,
     s.newton_iterations, s.warm_started, s.limit_load_factor, s.krylov_iterations, s.solver_statistics,
-    s.factorizations, s.single_precision_factorizations, s.assemble_seconds, s.factorize_seconds, s.solve_seconds, s.total_seconds);
+    s.factorizations, s.single_precision_factorizations, s.assemble_seconds, s.factorize_seconds,
+    s.solve_seconds, s.total_seconds);
 }
 }  // namespace fiberfluid::solve
