@@ -270,10 +270,12 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
     baseline_rate_ = rate;
   else if (rate > std::max(2.0 * baseline_rate_ + 1.0, floor))
     refactor_ = true;
-  // A failure just after a factorisation is final, unless that factor was
-  // rounded to single precision: then the rest of the run factors in double.
-  const bool rounded = kind_ == TangentSolver::Reused && lu_ && lu_->single();
-  if (!result.status.ok && (!just_factored_ || rounded)) {
+  // A failure with an aged factor refactors and tries again. One just after a
+  // factorisation is final, unless that factor was rounded to single
+  // precision: then it and the rest of the run's are factored in double.
+  while (!result.status.ok) {
+    const bool rounded = kind_ == TangentSolver::Reused && lu_ && lu_->single();
+    if (just_factored_ && !rounded) break;
     if (just_factored_) single_factor_ = false;
     if (kind_ == TangentSolver::Reused) preconditioner_dofs_ = dofs_;
     Status status = kind_ == TangentSolver::Reused ? factor_tangent_preconditioner()
