@@ -41,7 +41,7 @@ INSTANTIATE_TEST_SUITE_P(
                       "benchmark_rod_converged.json",
                       "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
                       "compression_large.json", "liver_interactive.json",
-                      "cylinder_mesh_study.json"));
+                      "cylinder_mesh_study.json", "dome_mesh_study.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
