@@ -167,8 +167,7 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
       // budget), the preconditioner once per step, GMRES products.
       const double stored = 2.0 * 8.0 * (sparse_fibers ? 2.0 * pairs : N * N);
       double factor_seconds = factor.seconds, preconditioner_solve = solve_seconds;
-      double krylov_products = kKrylovProducts;
-      if (reused_tangent) krylov_products = kReusedKrylovProducts;
+      const double krylov_products = reused_tangent ? kReusedKrylovProducts : kKrylovProducts;
       if (reused_tangent && !reused_sparse) {
         // Its factors rounded to single precision (where that serves, as on
         // every specimen measured): a solve reads 4 bytes an entry.
