@@ -65,8 +65,12 @@ std::function<geom::Surface()> read_generator(Fields& f, double* vertices) {
   if (kind == "dome") {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
-    *vertices = 10.0 * std::pow(4.0, subdivisions) + 2.0;
-    return [=] { return geom::dome(semi_axes, subdivisions); };
+    const bool octahedral = f.choice("base", "icosahedron", {"icosahedron", "octahedron"}) ==
+                            "octahedron";
+    *vertices = (octahedral ? 4.0 : 10.0) * std::pow(4.0, subdivisions) + 2.0;
+    const geom::DomeBase base = octahedral ? geom::DomeBase::Octahedron
+                                           : geom::DomeBase::Icosahedron;
+    return [=] { return geom::dome(semi_axes, subdivisions, base); };
   }
   if (kind == "cylinder") {
     const double radius = f.positive("radius", 1.0), length = f.positive("length", 1.0);

@@ -79,13 +79,11 @@ Surface icosahedron(double radius) {
   return s;
 }
 
-Surface icosphere(int subdivisions, double radius) {
-  if (subdivisions < 0 || subdivisions > 8)
-    throw InputError("icosphere subdivisions must be between 0 and 8, got " +
-                     std::to_string(subdivisions));
-  require_positive(radius, "icosphere radius");
-  Surface s = icosahedron(1.0);
-  for (int level = 0; level < subdivisions; ++level) {
+namespace {
+// Splits every triangle of a unit sphere's polyhedron into four, `times`
+// times, each new midpoint pushed to the unit sphere.
+Surface subdivided_to_sphere(Surface s, int times) {
+  for (int level = 0; level < times; ++level) {
     std::vector<Eigen::Vector3d> vertices;
     for (int i = 0; i < s.num_vertices(); ++i) vertices.emplace_back(s.V.row(i).transpose());
     std::map<std::pair<int, int>, int> midpoint;
@@ -104,6 +102,16 @@ Surface icosphere(int subdivisions, double radius) {
     }
     s = from_lists(vertices, faces);
   }
+  return s;
+}
+}  // namespace
+
+Surface icosphere(int subdivisions, double radius) {
+  if (subdivisions < 0 || subdivisions > 8)
+    throw InputError("icosphere subdivisions must be between 0 and 8, got " +
+                     std::to_string(subdivisions));
+  require_positive(radius, "icosphere radius");
+  Surface s = subdivided_to_sphere(icosahedron(1.0), subdivisions);
   s.V *= radius;
   return s;
 }
@@ -158,9 +166,13 @@ Surface cube(double edge) {
   return box(-half, half);
 }
 
-Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions) {
+Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions, DomeBase base) {
   for (int a = 0; a < 3; ++a) require_positive(semi_axes[a], "dome semi-axes");
-  Surface s = icosphere(subdivisions, 1.0);
+  if (subdivisions < 0 || subdivisions > 8)
+    throw InputError("dome subdivisions must be between 0 and 8, got " +
+                     std::to_string(subdivisions));
+  Surface s = subdivided_to_sphere(
+      base == DomeBase::Octahedron ? octahedron(1.0) : icosahedron(1.0), subdivisions);
   for (int i = 0; i < s.num_vertices(); ++i) {
     Eigen::Vector3d p = s.V.row(i).transpose();
     if (p.z() < 0.0) {

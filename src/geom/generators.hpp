@@ -23,11 +23,18 @@ Surface box(const Eigen::Vector3d& min, const Eigen::Vector3d& max,
             const Eigen::Vector3i& segments = Eigen::Vector3i::Ones());
 Surface cube(double edge = 1.0);
 
-// Half-ellipsoid on the plane z = 0, closed by a flat wall there: an
-// icosphere whose lower half is laid flat onto the disk (azimuthal
+// Half-ellipsoid on the plane z = 0, closed by a flat wall there: a
+// subdivided sphere whose lower half is laid flat onto the disk (azimuthal
 // equidistant map, so the wall is evenly meshed), then scaled by the
 // semi-axes. The wall vertices have z = 0 exactly.
-Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions);
+// The icosahedron's sphere (the default) has no circle of edges at z = 0, so
+// its rim zig-zags by up to half an edge: faces there slant between the wall
+// and the shell and the rim is slightly concave. The octahedron's equator is
+// a loop of edges at every subdivision, so its rim is the ellipse itself, a
+// crease the mesh follows exactly (what a resolution study needs: model.md).
+enum class DomeBase { Icosahedron, Octahedron };
+Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions,
+             DomeBase base = DomeBase::Icosahedron);
 
 // Closed cylinder along the x axis from x = 0 to x = length, of radius r:
 // `along` segments along it, `around` around it, each end cap a disk of

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/geom/generators.hpp"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/fiber_pruning.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -58,6 +61,37 @@ TEST(Generators, ACylindersVolumeAndCountsAreThePrismsInItsCircle) {
 TEST(Generators, VerticesLieOnTheCircumsphere) {
   for (const Surface& s : {tetrahedron(2.5), octahedron(2.5), icosahedron(2.5), icosphere(3, 2.5)})
     EXPECT_NEAR((s.V.rowwise().norm().array() - 2.5).abs().maxCoeff(), 0.0, 1e-12);
+}
+
+// The octahedron's dome puts its rim on a loop of edges: every vertex on the
+// wall's ellipse is a rim vertex, no face slants between the wall and the
+// shell, and the body is convex (the icosahedron's rim zig-zags and is not).
+TEST(Generators, OctahedralDomeHasItsRimOnALoopOfEdges) {
+  const double a = 0.07, b = 0.05, c = 0.06;
+  for (int subdivisions : {0, 1, 3}) {
+    const Surface s = dome({a, b, c}, subdivisions, DomeBase::Octahedron);
+    expect_closed_outward(s);
+    const int twos = 1 << subdivisions;
+    EXPECT_EQ(s.num_vertices(), 4 * twos * twos + 2);
+    auto on_rim = [&](int v) {
+      const double x = s.V(v, 0) / a, y = s.V(v, 1) / b;
+      return s.V(v, 2) == 0.0 && std::abs(x * x + y * y - 1.0) < 1e-12;
+    };
+    int rim = 0;
+    for (int v = 0; v < s.num_vertices(); ++v) rim += on_rim(v);
+    EXPECT_EQ(rim, 4 * twos);
+    for (int f = 0; f < s.num_faces(); ++f) {
+      int on_wall = 0, rim_corners = 0;
+      for (int k = 0; k < 3; ++k) {
+        on_wall += s.V(s.F(f, k), 2) == 0.0;
+        rim_corners += on_rim(s.F(f, k));
+      }
+      // A face touches the wall only along the rim, or lies in it.
+      EXPECT_TRUE(on_wall == 3 || on_wall == rim_corners) << "face " << f;
+    }
+    EXPECT_TRUE(is_convex(s)) << subdivisions << " subdivisions";
+  }
+  EXPECT_FALSE(is_convex(dome({a, b, c}, 3)));  // the icosahedron's zig-zag rim
 }
 
 TEST(Generators, DomeHasAFlatOutwardChestWall) {
