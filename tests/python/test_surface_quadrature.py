@@ -1,0 +1,36 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""experiments/surface_quadrature_check.py: the central fibers' one-point quadrature is second
+order on a sphere away from supports (docs/model.md, issue 44's sphere study)."""
+import importlib.util
+import os
+
+SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def load_check():
+    path = os.path.join(SOURCE, "experiments", "surface_quadrature_check.py")
+    spec = importlib.util.spec_from_file_location("surface_quadrature_check", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_force_density_at_the_pole_converges_at_second_order():
+    check = load_check()
+    V, F = check.octahedron()
+    values = {}
+    for level in range(1, 6):
+        V, F = check.subdivided(V, F)
+        if level >= 2:
+            pole = int(V[:, 2].argmax())
+            for kind in ("barycentric", "area-vector"):
+                values.setdefault(kind, []).append(
+                    check.force_density(V, check.vertex_areas(V, F, kind), pole, 1.2)[2])
+    for kind, series in values.items():
+        differences = [a - b for a, b in zip(series, series[1:])]
+        ratios = [a / b for a, b in zip(differences, differences[1:])]
+        assert all(ratio > 3.5 for ratio in ratios), (kind, series, ratios)
+    # The two vertex areas converge to the same density (docs/model.md: -0.06976 at 16,386).
+    assert abs(values["barycentric"][-1] - values["area-vector"][-1]) < 2e-5
+    assert abs(values["barycentric"][-1] + 0.06984) < 1e-5
