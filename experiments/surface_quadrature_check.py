@@ -94,7 +94,8 @@ def main():
         values.append(value)
         line = "%6d vertices: force density at the pole (z) %.6f" % (len(V), value)
         if len(values) >= 3:
-            line += "   difference ratio %.2f" % ((values[-3] - values[-2]) / (values[-2] - values[-1]))
+            ratio = (values[-3] - values[-2]) / (values[-2] - values[-1])
+            line += "   difference ratio %.2f" % ratio
         print(line, flush=True)
 
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -81,8 +82,11 @@ Surface icosahedron(double radius) {
 
 namespace {
 // Splits every triangle of a unit sphere's polyhedron into four, `times`
-// times, each new midpoint pushed to the unit sphere.
-Surface subdivided_to_sphere(Surface s, int times) {
+// times (0 to 8; `what` names the generator in the error), each new midpoint
+// pushed to the unit sphere.
+Surface subdivided_to_sphere(Surface s, int times, const std::string& what) {
+  if (times < 0 || times > 8)
+    throw InputError(what + " subdivisions must be between 0 and 8, got " + std::to_string(times));
   for (int level = 0; level < times; ++level) {
     std::vector<Eigen::Vector3d> vertices;
     for (int i = 0; i < s.num_vertices(); ++i) vertices.emplace_back(s.V.row(i).transpose());
@@ -107,11 +111,8 @@ Surface subdivided_to_sphere(Surface s, int times) {
 }  // namespace
 
 Surface icosphere(int subdivisions, double radius) {
-  if (subdivisions < 0 || subdivisions > 8)
-    throw InputError("icosphere subdivisions must be between 0 and 8, got " +
-                     std::to_string(subdivisions));
   require_positive(radius, "icosphere radius");
-  Surface s = subdivided_to_sphere(icosahedron(1.0), subdivisions);
+  Surface s = subdivided_to_sphere(icosahedron(1.0), subdivisions, "icosphere");
   s.V *= radius;
   return s;
 }
@@ -168,11 +169,8 @@ Surface cube(double edge) {
 
 Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions, DomeBase base) {
   for (int a = 0; a < 3; ++a) require_positive(semi_axes[a], "dome semi-axes");
-  if (subdivisions < 0 || subdivisions > 8)
-    throw InputError("dome subdivisions must be between 0 and 8, got " +
-                     std::to_string(subdivisions));
   Surface s = subdivided_to_sphere(
-      base == DomeBase::Octahedron ? octahedron(1.0) : icosahedron(1.0), subdivisions);
+      base == DomeBase::Octahedron ? octahedron(1.0) : icosahedron(1.0), subdivisions, "dome");
   for (int i = 0; i < s.num_vertices(); ++i) {
     Eigen::Vector3d p = s.V.row(i).transpose();
     if (p.z() < 0.0) {
