@@ -77,22 +77,28 @@ def force_density(V, areas, i, horizon):
     return (w[:, None] * n * along[:, None]).sum(0) / areas[i]
 
 
+def pole_densities(levels, horizon, kind):
+    """(vertices, z force density at the pole) at subdivisions 2 to `levels`."""
+    V, F = octahedron()
+    densities = []
+    for level in range(1, levels + 1):
+        V, F = subdivided(V, F)
+        if level >= 2:
+            pole = int(np.argmax(V[:, 2]))
+            densities.append((len(V), force_density(V, vertex_areas(V, F, kind), pole, horizon)[2]))
+    return densities
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, default=6)
     parser.add_argument("--horizon", type=float, default=1.2)
     parser.add_argument("--areas", choices=["barycentric", "area-vector"], default="barycentric")
     args = parser.parse_args()
-    V, F = octahedron()
     values = []
-    for level in range(1, args.levels + 1):
-        V, F = subdivided(V, F)
-        if level < 2:
-            continue
-        pole = int(np.argmax(V[:, 2]))
-        value = force_density(V, vertex_areas(V, F, args.areas), pole, args.horizon)[2]
+    for vertices, value in pole_densities(args.levels, args.horizon, args.areas):
         values.append(value)
-        line = "%6d vertices: force density at the pole (z) %.6f" % (len(V), value)
+        line = "%6d vertices: force density at the pole (z) %.6f" % (vertices, value)
         if len(values) >= 3:
             ratio = (values[-3] - values[-2]) / (values[-2] - values[-1])
             line += "   difference ratio %.2f" % ratio

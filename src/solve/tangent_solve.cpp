@@ -256,9 +256,13 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
   gmres_options.tolerance = tolerance;
   gmres_options.restart = options_.newton.krylov_restart;
   gmres_options.max_iterations = options_.newton.krylov_max_iterations;
-  y->resize(0);
-  GmresResult result = gmres(apply_tangent, precondition, b, *y, gmres_options);
-  if (iterations != nullptr) *iterations += result.iterations;
+  const auto run_gmres = [&] {
+    y->resize(0);
+    GmresResult run = gmres(apply_tangent, precondition, b, *y, gmres_options);
+    if (iterations != nullptr) *iterations += run.iterations;
+    return run;
+  };
+  GmresResult result = run_gmres();
   // The factor ages as the strains move: refactor when gmres needs clearly
   // more iterations per decade of residual reduction than it did just after
   // the last factorisation. A reused tangent LU costs about n / 3 of its own
@@ -282,9 +286,7 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
                                                    : factor_preconditioner();
     if (status.ok) status = update_capacitance();
     if (!status.ok) return status;
-    y->resize(0);
-    result = gmres(apply_tangent, precondition, b, *y, gmres_options);
-    if (iterations != nullptr) *iterations += result.iterations;
+    result = run_gmres();
   }
   just_factored_ = false;
   return result.status.ok ? Status{} : Status::failure("newton: " + result.status.message);

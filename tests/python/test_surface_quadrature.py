@@ -18,15 +18,8 @@ def load_check():
 
 def test_the_force_density_at_the_pole_converges_at_second_order():
     check = load_check()
-    V, F = check.octahedron()
-    values = {}
-    for level in range(1, 6):
-        V, F = check.subdivided(V, F)
-        if level >= 2:
-            pole = int(V[:, 2].argmax())
-            for kind in ("barycentric", "area-vector"):
-                values.setdefault(kind, []).append(
-                    check.force_density(V, check.vertex_areas(V, F, kind), pole, 1.2)[2])
+    values = {kind: [value for _, value in check.pole_densities(5, 1.2, kind)]
+              for kind in ("barycentric", "area-vector")}
     for kind, series in values.items():
         differences = [a - b for a, b in zip(series, series[1:])]
         ratios = [a / b for a, b in zip(differences, differences[1:])]
