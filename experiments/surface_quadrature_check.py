@@ -8,8 +8,8 @@ settings (the area count c_i = sum_j omega_ij |S_j| / |S_i|, the conical influen
 omega = 1 - L/delta, w_ij = omega_ij (|S_i| + |S_j|) / ((c_i + c_j) L_ij); docs/model.md) for a
 smooth field u = (0, x z, z^2) on a whole unit sphere (the octahedron subdivided, every
 midpoint pushed to the sphere, as geom::dome's base), at the pole. No wall, no support, no
-load: the quadrature alone. Prints the density at each level and the ratios of successive
-differences (4 for second order).
+load: the quadrature alone. Prints the density at each level, the ratios of successive
+differences (4 for second order), and the integral the sums approximate.
 Usage: /usr/bin/python3 experiments/surface_quadrature_check.py [--levels 6] [--horizon 1.2]
        [--areas barycentric|area-vector]
 """
@@ -77,6 +77,24 @@ def force_density(V, areas, i, horizon):
     return (w[:, None] * n * along[:, None]).sum(0) / areas[i]
 
 
+def continuum_pole_density(horizon, n=500):
+    """The same density as an integral over the sphere, (1/M) int omega/r n n . (u(y) - u(x)) dA
+    with M = int omega dA (on a whole sphere every count is the same), by the midpoint rule in
+    the angles about the pole: the integrand is bounded there (u(y) - u(x) = O(r))."""
+    theta = (np.arange(n) + 0.5) * np.pi / n
+    phi = (np.arange(2 * n) + 0.5) * np.pi / n
+    T, P = np.meshgrid(theta, phi, indexing="ij")
+    Y = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
+    dA = (np.sin(T) * (np.pi / n) ** 2).reshape(-1)
+    pole = np.array([0.0, 0.0, 1.0])
+    r = np.linalg.norm(Y - pole, axis=1)
+    omega = np.clip(1 - r / horizon, 0, None)
+    n_ = (Y - pole) / r[:, None]
+    u = np.stack([0 * Y[:, 0], Y[:, 0] * Y[:, 2], Y[:, 2] ** 2], 1) - np.array([0.0, 0.0, 1.0])
+    along = np.sum(n_ * u, 1)
+    return ((omega / r * along * dA)[:, None] * n_).sum(0)[2] / (omega * dA).sum()
+
+
 def pole_densities(levels, horizon, kind):
     """(vertices, z force density at the pole) at subdivisions 2 to `levels`."""
     V, F = octahedron()
@@ -103,6 +121,7 @@ def main():
             ratio = (values[-3] - values[-2]) / (values[-2] - values[-1])
             line += "   difference ratio %.2f" % ratio
         print(line, flush=True)
+    print("the integral itself: %.6f" % continuum_pole_density(args.horizon))
 
 
 if __name__ == "__main__":

@@ -27,3 +27,7 @@ def test_the_force_density_at_the_pole_converges_at_second_order():
     # The two vertex areas converge to the same density (docs/model.md: -0.06976 at 16,386).
     assert abs(values["barycentric"][-1] - values["area-vector"][-1]) < 2e-5
     assert abs(values["barycentric"][-1] + 0.06984) < 1e-5
+    # ... and the sums converge to the integral they stand for, not to another value.
+    integral = check.continuum_pole_density(1.2)
+    assert abs(integral + 0.069737) < 1e-6
+    assert abs(values["area-vector"][-1] - integral) < 1.5e-4
