@@ -2,19 +2,7 @@
 """experiments/dome_rim_model.py: on the held dome, a rim held whole leaves the scalar
 nonlocal model at first order and a split rim (a ghost for the shell's share) restores
 second order (docs/model.md, A sphere under gravity)."""
-import importlib.util
-import os
-
-SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-
-
-def load_model():
-    path = os.path.join(SOURCE, "experiments", "dome_rim_model.py")
-    spec = importlib.util.spec_from_file_location("dome_rim_model", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from experiment_scripts import load
 
 
 def pole_ratios(model, split):
@@ -23,7 +11,7 @@ def pole_ratios(model, split):
 
 
 def test_a_split_rim_converges_at_second_order_and_a_held_one_does_not():
-    model = load_model()
+    model = load("dome_rim_model")
     held, held_ratios = pole_ratios(model, split=False)
     split, split_ratios = pole_ratios(model, split=True)
     assert all(r < 3.0 for r in held_ratios), (held, held_ratios)
@@ -36,7 +24,7 @@ def test_a_split_rim_converges_at_second_order_and_a_held_one_does_not():
 
 
 def test_a_ghost_moves_with_a_free_neighbour_and_keeps_the_shell_share():
-    model = load_model()
+    model = load("dome_rim_model")
     X, F = model.dome(2)
     held = X[:, 2] <= 1e-12
     ghosts = model.rim_ghosts(X, F, held)

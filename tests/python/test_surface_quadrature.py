@@ -1,23 +1,11 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """experiments/surface_quadrature_check.py: the central fibers' one-point quadrature is second
 order on a sphere away from supports (docs/model.md, issue 44's sphere study)."""
-import importlib.util
-import os
-
-SOURCE = os.environ.get("FIBERFLUID_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-
-
-def load_check():
-    path = os.path.join(SOURCE, "experiments", "surface_quadrature_check.py")
-    spec = importlib.util.spec_from_file_location("surface_quadrature_check", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from experiment_scripts import load
 
 
 def test_the_force_density_at_the_pole_converges_at_second_order():
-    check = load_check()
+    check = load("surface_quadrature_check")
     values = {kind: [value for _, value in check.pole_densities(5, 1.2, kind)]
               for kind in ("barycentric", "area-vector")}
     for kind, series in values.items():
