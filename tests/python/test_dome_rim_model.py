@@ -32,3 +32,14 @@ def test_a_ghost_moves_with_a_free_neighbour_and_keeps_the_shell_share():
     for j, share, neighbour in ghosts:
         assert held[j] and not held[neighbour]
         assert 0.0 < share < 1.0
+
+
+def test_the_central_kernels_pole_follows_its_rings_only_with_a_mesh_free_mean():
+    # The octahedron's pole has four neighbours and 2/3 of their area. The area count mixes
+    # M_i and M_j by the areas, so the pole's kernel differs from its rings'; with the mean of
+    # M_i and M_j it does not, and a smooth top drops 1 : 3 from the pole to its second ring.
+    model = load("dome_rim_model")
+    by_area = model.pole_increments(4, "central", True, "area")
+    by_mean = model.pole_increments(4, "central", True, "mean")
+    assert by_area[0] / by_area[1] < 0.2, by_area  # 0.096: the pole sits below its rings
+    assert abs(by_mean[0] / by_mean[1] - 1 / 3) < 0.05, by_mean  # 0.345
