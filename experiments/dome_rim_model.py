@@ -72,10 +72,14 @@ def bulk_weights(X, areas, count="area"):
     return W
 
 
+def face_area_vectors(X, F):
+    return 0.5 * np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+
+
 def rim_ghosts(X, F, held):
     """Per rim vertex j (held, with a face that has a free vertex): its shell share s_j and its
     nearest free neighbour along an edge."""
-    face = 0.5 * np.linalg.norm(np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]), axis=1)
+    face = np.linalg.norm(face_area_vectors(X, F), axis=1)
     on_shell = ~np.all(held[F], axis=1)
     every, shell = np.zeros(len(X)), np.zeros(len(X))
     for k in range(3):
@@ -125,7 +129,7 @@ def solve(level, kernel, split, count="area"):
         n = d / np.linalg.norm(d, axis=1)[:, None]
         blocks = W[a, b][:, None, None] * n[:, :, None] * n[:, None, :]
     else:
-        blocks = W[a, b][:, None, None] * np.ones((1, 1, 1))
+        blocks = W[a, b][:, None, None]
     for p, q, sign in ((ua, ua, 1), (ub, ub, 1), (ua, ub, -1), (ub, ua, -1)):
         both = (p >= 0) & (q >= 0)
         for r in range(dim):
@@ -133,7 +137,7 @@ def solve(level, kernel, split, count="area"):
                 np.add.at(K, (dim * p[both] + r, dim * q[both] + c), sign * blocks[both, r, c])
     # The load q = z along the area vector, each point with its share of its vertex's.
     S = np.zeros_like(X)
-    face_vectors = 0.5 * np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    face_vectors = face_area_vectors(X, F)
     for k in range(3):
         np.add.at(S, F[:, k], face_vectors / 3)
     load = np.zeros(dim * num_free)

@@ -65,13 +65,18 @@ def influence(V, i, horizon):
     return omega, lengths
 
 
+def smooth_field(P):
+    """u = (0, x z, z^2) at the points P (rows)."""
+    return np.stack([0 * P[:, 0], P[:, 0] * P[:, 2], P[:, 2] ** 2], 1)
+
+
 def force_density(V, areas, i, horizon):
     omega, lengths = influence(V, i, horizon)
     partners = np.nonzero(omega > 0)[0]
     count_i = (omega * areas).sum() / areas[i]
     counts = np.array([(influence(V, j, horizon)[0] * areas).sum() / areas[j] for j in partners])
     n = (V[partners] - V[i]) / lengths[partners, None]
-    u = np.stack([0 * V[:, 0], V[:, 0] * V[:, 2], V[:, 2] ** 2], 1)
+    u = smooth_field(V)
     along = np.sum(n * (u[partners] - u[i]), 1)
     w = omega[partners] * (areas[i] + areas[partners]) / ((count_i + counts) * lengths[partners])
     return (w[:, None] * n * along[:, None]).sum(0) / areas[i]
@@ -90,7 +95,7 @@ def continuum_pole_density(horizon, n=500):
     r = np.linalg.norm(Y - pole, axis=1)
     omega = np.clip(1 - r / horizon, 0, None)
     n_ = (Y - pole) / r[:, None]
-    u = np.stack([0 * Y[:, 0], Y[:, 0] * Y[:, 2], Y[:, 2] ** 2], 1) - np.array([0.0, 0.0, 1.0])
+    u = smooth_field(Y) - smooth_field(pole[None, :])
     along = np.sum(n_ * u, 1)
     return ((omega / r * along * dA)[:, None] * n_).sum(0)[2] / (omega * dA).sum()
 
