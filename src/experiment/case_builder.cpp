@@ -273,6 +273,7 @@ class ModelBuilder {
     c_.model.constraints.clear();
     c_.model.motions.clear();
     c_.model.mirror_layers.clear();
+    c_.model.held_edges.clear();
     c_.model.constraint_groups.clear();
     for (const ConstraintSpec& k : spec_.constraints) add_group(k);
     c_.model.paddles.clear();
@@ -375,6 +376,17 @@ class ModelBuilder {
     for (int v : vertices)
       for (char letter : axes) m.constraints.push_back({v, letter - 'x', 0.0, {}, group});
     if (spec.mirror_layer) add_mirror_layer(spec, group, vertices, axes);
+    if (spec.split_edge) add_split_edge(spec, group, vertices, axes);
+  }
+
+  // A support whose edge vertices' free share moves with the free side.
+  void add_split_edge(const ConstraintSpec& spec, int group, const std::vector<int>& vertices,
+                      const std::string& axes) {
+    if (static_cast<int>(axes.size()) != dim_)
+      spec.field.fail("edge", "a split edge holds every axis: leave \"axes\" out");
+    c_.model.held_edges.push_back({group, vertices});
+    const std::string problem = solve::support_terms_problem(c_.model, c_.stepping);
+    if (!problem.empty()) spec.field.fail("edge", problem);
   }
 
   // A clamp's mirror layer: a full clamp on a plane, as deep as the horizon.
@@ -391,7 +403,7 @@ class ModelBuilder {
     const std::string why = model::find_clamp_plane(c_.model.surface.V, vertices, &layer);
     if (!why.empty()) spec.field.fail("layer", "the support has no clamp plane: " + why);
     c_.model.mirror_layers.push_back(layer);
-    const std::string problem = solve::mirror_layer_problem(c_.model, c_.stepping);
+    const std::string problem = solve::support_terms_problem(c_.model, c_.stepping);
     if (!problem.empty()) spec.field.fail("layer", problem);
   }
 

@@ -68,6 +68,7 @@ struct ConstraintSpec {
   SelectionSpec selection;
   std::string axes;              // supports: the held axes, e.g. "xyz"
   bool mirror_layer = false;     // supports: "layer": "mirror" (model::MirrorLayer)
+  bool split_edge = false;       // supports: "edge": "split" (model::HeldEdge)
   Eigen::VectorXd displacement;  // prescribed: one entry per axis (a rotation's translation)
   // prescribed "rotation": {"axis": [x, y, z] (3D), "angle_degrees": a,
   // "centre": [...]}: the group moves rigidly (model::RigidMotion).

@@ -323,11 +323,15 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
     } else {
       spec.axes = read_axes(f);
       spec.mirror_layer = f.choice("layer", "none", {"none", "mirror"}) == "mirror";
+      spec.split_edge = f.choice("edge", "held", {"held", "split"}) == "split";
     }
     if (prescribed && f.has("layer"))
       f.refuse("layer",
                "a mirror layer belongs to a fixed clamp (\"supports\"), not to a "
                "prescribed group");
+    if (prescribed && f.has("edge"))
+      f.refuse("edge", "a split edge belongs to a fixed support (\"supports\"), not to a "
+                       "prescribed group");
     f.finish();
     groups.push_back(spec);
   };
@@ -504,9 +508,10 @@ FiberSpec read_fibers(Fields& root) {
   // the paper's count, so that its figures are reproduced as published.
   const bool central = spec.kinematics == model::FiberKinematics::Central;
   const std::string count = f.choice("connection_count", central ? "area" : "symmetric",
-                                     {"symmetric", "global", "area"});
+                                     {"symmetric", "global", "area", "mean"});
   spec.count = count == "global" ? model::ConnectionCount::Global
                : count == "area" ? model::ConnectionCount::Area
+               : count == "mean" ? model::ConnectionCount::Mean
                                  : model::ConnectionCount::Symmetric;
   const bool fades = central && spec.horizon > 0.0;
   if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) ==
@@ -522,11 +527,11 @@ FiberSpec read_fibers(Fields& root) {
                                        std::to_string(spec.treecode_tolerance));
   } else if (f.has("treecode_tolerance"))
     f.fail("treecode_tolerance", "applies to \"product\": \"treecode\" only");
-  if (spec.treecode_tolerance > 0.0 && spec.count == model::ConnectionCount::Area)
+  if (spec.treecode_tolerance > 0.0 && model::counts_by_area(spec.count))
     f.fail("product",
            "\"treecode\" needs one connection count for every fiber: set "
-           "\"connection_count\": \"global\" (the area count differs from vertex to vertex) "
-           "or \"product\": \"exact\"");
+           "\"connection_count\": \"global\" (the " + count +
+               " count differs from vertex to vertex) or \"product\": \"exact\"");
   if (spec.treecode_tolerance > 0.0 && spec.horizon > 0.0)
     f.fail("product",
            "\"treecode\" approximates the sum over every pair; with a \"horizon\" most pairs "

@@ -15,6 +15,7 @@
 #include "fiberfluid/geom/vtk_writer.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/held_edge.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::experiment {
@@ -200,10 +201,20 @@ json mirror_layers_json(const model::Model& m) {
   return layers;
 }
 
+// The supports whose edge is split: which, and how many edge vertices.
+json split_edges_json(const model::Model& m) {
+  json edges = json::array();
+  for (const model::HeldEdge& edge : m.held_edges)
+    edges.push_back({{"support", m.constraint_groups.at(static_cast<size_t>(edge.group))},
+                     {"edge_vertices", model::held_edge_vertices(m, edge.held).size()}});
+  return edges;
+}
+
 json fibers_json(const Case& c) {
   const FiberReport& f = c.fibers;
   return {{"kinematics", model::kinematics_name(c.model.material.kinematics)},
           {"mirror_layers", mirror_layers_json(c.model)},
+          {"split_edges", split_edges_json(c.model)},
           {"horizon", f.horizon > 0.0 ? json(f.horizon) : json(nullptr)},  // m; null: every pair
           {"pruning", f.pruning ? "auto" : "off"},
           {"convex", f.convex},

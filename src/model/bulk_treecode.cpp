@@ -19,6 +19,7 @@ Eigen::MatrixXd as_3d(const Eigen::MatrixXd& X) {
 }  // namespace
 
 bool BulkTreecode::applicable(const PairFactors& factors) {
+  if (factors.mean_count()) return false;  // its weights are not h (|S_i| + |S_j|) / L
   const std::vector<double> counts = factors.vertex_counts();
   for (double c : counts)
     if (c != counts.front()) return false;
@@ -31,7 +32,7 @@ BulkTreecode::BulkTreecode(const Eigen::MatrixXd& X, const Eigen::VectorXd& area
   if (!applicable(factors))
     throw std::invalid_argument(
         "the treecode product needs one connection count for all fibers (no pruning, or the "
-        "global count)");
+        "global count) and the weights h (|S_i| + |S_j|) / L (not the mean count)");
   const std::vector<double> counts = factors.vertex_counts();
   h_ = counts.empty() ? 0.0 : connection_factor(1.0, counts.front(), counts.front());
   if (const geom::FiberMask* mask = factors.mask())

@@ -24,6 +24,7 @@ const char* to_string(ConnectionCount count) {
   switch (count) {
     case ConnectionCount::Global: return "global";
     case ConnectionCount::Area: return "area";
+    case ConnectionCount::Mean: return "mean";
     case ConnectionCount::Symmetric: break;
   }
   return "symmetric";
@@ -33,9 +34,10 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
     : PairFactors(fibers, count, num_vertices, Influence{}, nullptr) {}
 
 namespace {
-// |S_i| at the reference, for the area count (empty otherwise: not needed).
+// |S_i| at the reference, for the area and mean counts (empty otherwise: not
+// needed).
 Eigen::VectorXd counting_areas(const Model& model) {
-  if (model.connection_count != ConnectionCount::Area) return {};
+  if (!counts_by_area(model.connection_count)) return {};
   return geom::vertex_area_vectors(model.surface.V, model.surface.F).magnitude;
 }
 }  // namespace
@@ -53,14 +55,16 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
   // with a weighing influence, by their summed weights; with the area count,
   // by the area the fibers reach, in units of the vertex's own.
   global_ = n_ - 1;
-  const bool by_area = count_ == ConnectionCount::Area;
+  const bool by_area = counts_by_area(count_);
   if (by_area && areas.size() != n_)
     throw std::invalid_argument("the area connection count needs every vertex's area");
   for (Eigen::Index i = 0; by_area && i < areas.size(); ++i)
     if (!(areas[i] > 0.0) || !std::isfinite(areas[i]))
       throw InputError("vertex " + std::to_string(i) + " has no area vector (|S_" +
                        std::to_string(i) + "| = " + std::to_string(areas[i]) +
-                       "): \"connection_count\": \"area\" weighs each vertex by it");
+                       "): \"connection_count\": \"" + to_string(count_) +
+                     "\" weighs each vertex by it");
+  if (count_ == ConnectionCount::Mean) areas_ = areas;
   if (influence_.weighs()) {
     if (reference == nullptr || reference->rows() != n_)
       throw std::invalid_argument("a weighing influence needs the reference positions");
@@ -121,7 +125,10 @@ double PairFactors::factor(int i, int j) const {
   const bool global = count_ == ConnectionCount::Global || kept_.empty();
   const auto count = [&](int k) { return global ? global_ : kept_[static_cast<size_t>(k)]; };
   const bool joined = fibers_ == nullptr ? i != j : fibers_->kept(i, j);
-  return joined ? connection_factor(weight(i, j), count(i), count(j)) : 0.0;
+  if (!joined) return 0.0;
+  if (mean_count())
+    return mean_connection_factor(weight(i, j), areas_[i], areas_[j], count(i), count(j));
+  return connection_factor(weight(i, j), count(i), count(j));
 }
 
 std::vector<double> PairFactors::vertex_counts() const {
@@ -136,7 +143,11 @@ void PairFactors::row(int i, double* row) const {
     weights(i, row);
     const bool global = count_ == ConnectionCount::Global;
     const auto count = [&](int k) { return global ? global_ : kept_[static_cast<size_t>(k)]; };
-    for (int j = 0; j < n_; ++j) row[j] = connection_factor(row[j], count(i), count(j));
+    if (mean_count())
+      for (int j = 0; j < n_; ++j)
+        row[j] = mean_connection_factor(row[j], areas_[i], areas_[j], count(i), count(j));
+    else
+      for (int j = 0; j < n_; ++j) row[j] = connection_factor(row[j], count(i), count(j));
   }
   row[i] = 0.0;
 }

@@ -20,8 +20,8 @@ class PairFactors {
   PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
               const Influence& influence, const Eigen::MatrixXd* reference,
               const Eigen::VectorXd& areas = {});
-  // With ConnectionCount::Area, `areas` are the reference |S_i| and c_i =
-  // sum_j kept_ij omega(L_ij) |S_j| / |S_i| (model.hpp).
+  // With ConnectionCount::Area or Mean, `areas` are the reference |S_i| and
+  // c_i = sum_j kept_ij omega(L_ij) |S_j| / |S_i| (model.hpp).
   // The factors of a model: its fibers, count and influence at its reference.
   explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.
@@ -32,6 +32,9 @@ class PairFactors {
   // h_ij = kept_ij / (c_i + c_j), c_i per vertex (N-1 with every pair kept,
   // the mean count with the global count, n_i with the symmetric one).
   std::vector<double> vertex_counts() const;
+  // Whether the weights mix the counts by the mean count's formula
+  // (mean_connection_factor; the tiled kernels' counted_bulk_weight(..., true)).
+  bool mean_count() const { return count_ == ConnectionCount::Mean; }
   const geom::FiberMask* mask() const { return fibers_; }  // null: every pair kept
   const Influence& influence() const { return influence_; }
   // The reference positions the influence weighs by (empty unless it weighs).
@@ -49,6 +52,7 @@ class PairFactors {
   Influence influence_;
   Eigen::MatrixXd reference_;  // for a weighing influence
   std::vector<double> kept_;   // n_i (weighed by the influence)
+  Eigen::VectorXd areas_;      // the reference |S_i|, for the mean count
   double global_ = 0.0;        // the count for ConnectionCount::Global or a full body
 };
 

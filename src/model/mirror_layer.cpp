@@ -9,6 +9,7 @@
 
 #include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/held_edge.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
 
 namespace fiberfluid::model {
@@ -126,6 +127,58 @@ class ClampedRegion {
 
 }  // namespace
 
+namespace {
+
+// The bulk weight of a pair (i, j) at a layer fiber's length L (the fiber
+// from s_i to an image of s_j): its influence and counts as a bulk fiber's.
+double layer_pair_weight(const Model& model, const PairFactors& factors,
+                         const std::vector<double>& counts, const Eigen::VectorXd& area0, int i,
+                         int j, double length) {
+  return counted_bulk_weight(model.influence(length), area0[i], area0[j],
+                             counts[static_cast<size_t>(i)], counts[static_cast<size_t>(j)],
+                             length, factors.mean_count());
+}
+
+// A split edge's ghosts (held_edge.hpp) across the layer. An edge vertex j
+// lies on the plane, its image is itself; its ghost at x_k + (s_j - s_k)
+// has the image s_j + s_k - x_k. Each free vertex i near the plane joins the
+// image of j's ghost with s_j of the pair's weight (the layer's bulk fiber
+// to j's image is j itself, held), and each pair of ghosts joins one ghost
+// to the other's image with s_i s_j of it: b = x_i + x_p - offset as the
+// layer's own fibers.
+void add_ghost_images(const Model& model, const MirrorLayer& layer, const HeldEdge& held_edge,
+                      const PairFactors& factors, const Eigen::VectorXd& area0,
+                      const std::vector<int>& near, std::vector<LayerFiber>* fibers) {
+  const Eigen::MatrixXd& V = model.surface.V;
+  const geom::FiberMask* mask = model.fibers.get();
+  const std::vector<double> counts = factors.vertex_counts();
+  const auto full_weight = [&](int i, int j, double length) {
+    return layer_pair_weight(model, factors, counts, area0, i, j, length);
+  };
+  const std::vector<EdgeVertex> edge = held_edge_vertices(model, held_edge.held);
+  for (const EdgeVertex& e : edge) {
+    const int j = e.vertex, kj = e.neighbour;
+    const Eigen::Vector3d sj = padded(V, j), skj = padded(V, kj);
+    for (int i : near) {
+      if (mask != nullptr && !mask->kept(i, j)) continue;
+      const double length = (padded(V, i) - sj).norm();
+      if (length >= layer.depth) continue;
+      fibers->push_back({i, kj, sj + skj, length, e.free_share * full_weight(i, j, length)});
+    }
+    for (const EdgeVertex& g : edge) {  // each pair of ghosts once
+      const int i = g.vertex, ki = g.neighbour;
+      if (i >= j || (mask != nullptr && !mask->kept(i, j))) continue;
+      const Eigen::Vector3d si = padded(V, i), ski = padded(V, ki);
+      const double length = (si - sj).norm();
+      if (length >= layer.depth) continue;
+      fibers->push_back({ki, kj, sj + skj - si + ski, length,
+                         e.free_share * g.free_share * full_weight(i, j, length)});
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLayer& layer,
                                             const PairFactors& factors,
                                             const Eigen::VectorXd& area0) {
@@ -156,11 +209,11 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
       if (length >= layer.depth) continue;
       // Where the fiber from s_i to the image crosses the plane.
       if (!region.holds(padded(V, i) + hi / (hi + hj) * (image - padded(V, i)))) continue;
-      const auto a = static_cast<size_t>(i), b = static_cast<size_t>(j);
-      const double weight = 0.5 * model.influence(length) * (area0[i] + area0[j]) /
-                            ((counts[a] + counts[b]) * length);
+      const double weight = 0.5 * layer_pair_weight(model, factors, counts, area0, i, j, length);
       fibers.push_back({i, j, 2.0 * foot, length, weight});
     }
+  if (const HeldEdge* edge = held_edge_of(model, layer.group))
+    add_ghost_images(model, layer, *edge, factors, area0, near, &fibers);
   return fibers;
 }
 

@@ -153,8 +153,19 @@ enum class ConnectionCount {
   // its fibers reach, so that the response converges as the mesh is refined
   // (the default for central fibers: model.md).
   Area,
+  // The area count's c_i, mixed by the plain mean of the reached areas
+  // M_i = c_i |S_i|: w_ij = 2 kept omega |S_i| |S_j| / ((M_i + M_j) L). The
+  // area count mixes M_i and M_j weighted by the ends' areas, so a vertex
+  // whose neighbours are larger than it (the octahedron's poles) reads its
+  // neighbours' reach and dips below its rings (model.md, "A sphere under
+  // gravity"); the mean does not.
+  Mean,
 };
 const char* to_string(ConnectionCount count);
+// Whether a count weighs the fibers by the areas they reach (Area, Mean).
+inline bool counts_by_area(ConnectionCount count) {
+  return count == ConnectionCount::Area || count == ConnectionCount::Mean;
+}
 
 // How a bulk fiber's weight falls off with its reference length L within the
 // horizon delta: the influence function of peridynamics (Seleson and Parks
@@ -187,6 +198,13 @@ struct MirrorLayer {
   std::vector<int> held;
 };
 
+// A held group whose edge is split (supports[].edge: "split", held_edge.hpp):
+// its edge vertices' free share of area moves with the free side.
+struct HeldEdge {
+  int group = 0;
+  std::vector<int> held;  // the vertices the group holds in every axis
+};
+
 // Everything the equations need: the reference surface (every vertex used by
 // a face), the material, the loads and the constraints.
 struct Model {
@@ -197,6 +215,7 @@ struct Model {
   std::vector<Paddle> paddles;
   std::vector<RigidMotion> motions;        // of prescribed groups (Constraint::motion)
   std::vector<MirrorLayer> mirror_layers;  // of clamped supports (Newton scheme)
+  std::vector<HeldEdge> held_edges;        // of supports whose edge is split (Newton scheme)
   // Names of the support and prescribed groups (one per experiment entry), for
   // reporting the reaction force of each; constraints refer to them by index.
   std::vector<std::string> constraint_groups;

@@ -64,6 +64,7 @@ void for_each_tile_pair(int n, Visit&& visit) {
 // The set's arrays, indexed by position in the set.
 struct SetArrays {
   const double *x0, *x1, *x2, *area, *count;
+  bool mean;  // the mean count's weights (PairFactors::mean_count)
 };
 
 // The multipliers of a tile's rows: m + r * stride (stride 0: one row of ones).
@@ -75,8 +76,8 @@ struct Multipliers {
 // BulkPairs's weight w_ij from the squared distance r2 (the stencil's
 // counted_bulk_weight; DeformedPairs's a is the same at the reference length).
 inline double weight(double m, double area_i, double area_j, double count_i, double count_j,
-                     double r2) {
-  return counted_bulk_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2));
+                     double r2, bool mean) {
+  return counted_bulk_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2), mean);
 }
 
 // (L V) over one tile for three columns: row sums into out at i, the
@@ -96,7 +97,7 @@ void product_tile(const SetArrays& s, const Tile& t, Multipliers mult, const dou
 #pragma omp simd reduction(+ : s0, s1, s2)
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
-      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz);
+      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean);
       const double e0 = w * (ui - v0[j]), e1 = w * (vi - v1[j]), e2 = w * (wi - v2[j]);
       s0 += e0, s1 += e1, s2 += e2;
       o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
@@ -117,7 +118,7 @@ void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult, double* 
 #pragma omp simd reduction(+ : sum)
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
-      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz);
+      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean);
       sum += w;
       out[j] += w;
     }
@@ -142,7 +143,7 @@ FIBERFLUID_VECTOR_CLONES void block_tile(const SetArrays& s, const Tile& t, Mult
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
       column[j] = static_cast<Scalar>(
-          -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz));
+          -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean));
     }
   }
   constexpr int B = 32;
@@ -185,8 +186,9 @@ struct RowArrays {
 // The pair's coefficients from the row arrays at q (stencil: weight, then policy).
 template <class K>
 inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i, double area_j,
-                                         double count_i, double count_j) {
-  const double a = counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q]);
+                                         double count_i, double count_j, bool mean) {
+  const double a =
+      counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q], mean);
   return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q]);
 }
 
@@ -205,7 +207,7 @@ PairColumns columns_of(const std::vector<double> (&x)[3], const std::vector<doub
 // lower triangle of the stored tangent's table).
 template <class K, bool kForces, bool kTable, class Scalar = float>
 FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area, const double* count,
-                                       int i, int j0, int first, int end, const RowArrays& row,
+                                       bool mean, int i, int j0, int first, int end, const RowArrays& row,
                                        const std::array<double*, 3>& out, Scalar* k1 = nullptr,
                                        Scalar* k2 = nullptr) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
@@ -216,7 +218,7 @@ FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
   double f0 = 0.0, f1 = 0.0, f2 = 0.0;
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (int j = first; j < end; ++j) {
-    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], mean);
     if constexpr (kTable) {
       k1[j] = static_cast<Scalar>(c.c1);
       k2[j] = static_cast<Scalar>(c.c2);
@@ -234,7 +236,8 @@ FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
 
 template <class K>
 FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* const w[3],
-                                          const double* area, const double* count, int i, int j0,
+                                          const double* area, const double* count, bool mean,
+                                          int i, int j0,
                                           int first, int end, const RowArrays& row,
                                           const std::array<double*, 3>& out) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
@@ -246,7 +249,7 @@ FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* co
   double p0 = 0.0, p1 = 0.0, p2 = 0.0;
 #pragma omp simd reduction(+ : p0, p1, p2)
   for (int j = first; j < end; ++j) {
-    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j]);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], mean);
     const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
     const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
     const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
@@ -278,6 +281,7 @@ BulkPairs::BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
       position_[static_cast<size_t>(vertex_[k])] = static_cast<int>(k);
   }
   const std::vector<double> counts = factors.vertex_counts();
+  mean_ = factors.mean_count();
   for (auto& column : x_) column.assign(static_cast<size_t>(n_), 0.0);
   area_.resize(static_cast<size_t>(n_));
   count_.resize(static_cast<size_t>(n_));
@@ -368,7 +372,8 @@ double BulkPairs::listed_weight(int r, int c) const {
   if (projection_axis_ >= 0) m *= projection(vi, vj);
   const auto r_ = static_cast<size_t>(r), c_ = static_cast<size_t>(c);
   const double d0 = x_[0][r_] - x_[0][c_], d1 = x_[1][r_] - x_[1][c_], d2 = x_[2][r_] - x_[2][c_];
-  return weight(m, area_[r_], area_[c_], count_[r_], count_[c_], d0 * d0 + d1 * d1 + d2 * d2);
+  return weight(m, area_[r_], area_[c_], count_[r_], count_[c_], d0 * d0 + d1 * d1 + d2 * d2,
+                mean_);
 }
 
 template <class Visit>
@@ -387,7 +392,8 @@ Eigen::VectorXd BulkPairs::row_sums() const {
     for_each_listed([&](int r, int, double w) { sums[r] += w; });
     return sums;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
+                      mean_};
   ThreadAccumulators sums(n_, 1);
   for_each_tile([&](const Tile& t, Multipliers m, int thread) {
     row_sums_tile(s, t, m, sums.column(thread, 0));
@@ -401,7 +407,8 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
     for_each_listed([&](int r, int c, double w) { out.row(r) += w * (V.row(r) - V.row(c)); });
     return out;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
+                      mean_};
   const auto k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
   const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(n_);
@@ -445,7 +452,8 @@ void BulkPairs::fill_off_diagonal_of(double scale, Matrix* K) const {
     for_each_listed([&](int r, int c, double w) { (*K)(r, c) = static_cast<Scalar>(-scale * w); });
     return;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
+                      mean_};
   Scalar* data = K->data();
   const Eigen::Index ld = K->rows();
   // Tiles write disjoint parts of K: no accumulators.
@@ -466,6 +474,7 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
                              FiberKinematics kinematics)
     : n_(static_cast<int>(S.rows())),
       count_(factors.vertex_counts()),
+      mean_(factors.mean_count()),
       area_(area),
       mask_(factors.mask()),
       influence_(factors.influence()),
@@ -541,7 +550,8 @@ Eigen::MatrixXd DeformedPairs::listed_sums(Term&& term) const {
       for (size_t q = 0; q < partners.size(); ++q) {
         const int j = partners[q];
         const PairCoefficients c =
-            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j],
+                                mean_);
         for (int a = 0; a < 3; ++a)
           sum[a] += term(policy, static_cast<size_t>(i), static_cast<size_t>(j), c, a);
       }
@@ -562,7 +572,8 @@ void DeformedPairs::listed_coefficients(std::vector<double>* c1, std::vector<dou
       for (size_t q = 0; q < partners.size(); ++q) {
         const int j = partners[q];
         const PairCoefficients c =
-            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j]);
+            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j],
+                                mean_);
         (*c1)[first + q] = c.c1;
         (*c2)[first + q] = c.c2;
       }
@@ -622,7 +633,7 @@ Eigen::MatrixXd DeformedPairs::forces() const {
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      row_pass<K, true, false>(p, area_.data(), count_.data(), i, j0, first, end, row,
+      row_pass<K, true, false>(p, area_.data(), count_.data(), mean_, i, j0, first, end, row,
                                forces.columns(thread));
     });
   });
@@ -650,7 +661,7 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
     for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      tangent_row<K>(p, w, area_.data(), count_.data(), i, j0, first, end, row,
+      tangent_row<K>(p, w, area_.data(), count_.data(), mean_, i, j0, first, end, row,
                      products.columns(thread));
     });
   });
@@ -711,10 +722,10 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
       Scalar* k1 = c1->col(i).data();
       Scalar* k2 = c2->col(i).data();
       if (forces != nullptr)
-        row_pass<K, true, true>(p, area, count, i, j0, first, end, row, forces->columns(thread),
+        row_pass<K, true, true>(p, area, count, mean_, i, j0, first, end, row, forces->columns(thread),
                                 k1, k2);
       else
-        row_pass<K, false, true>(p, area, count, i, j0, first, end, row, {}, k1, k2);
+        row_pass<K, false, true>(p, area, count, mean_, i, j0, first, end, row, {}, k1, k2);
     });
   });
   // The diagonal after the pass, not before: zeroed first, it would be the

@@ -111,6 +111,7 @@ class BulkPairs {
 
   int n_ = 0;
   std::vector<double> x_[3], area_, count_;
+  bool mean_ = false;          // the mean count's weights (PairFactors::mean_count)
   std::vector<int> vertex_;    // the set's vertices (mask and law lookups)
   std::vector<int> position_;  // a vertex's position in the set, -1 if not in it (sparse)
   const geom::FiberMask* mask_ = nullptr;
@@ -197,6 +198,7 @@ class DeformedPairs {
 
   int n_ = 0;
   std::vector<double> s_[3], x_[3], u_[3], count_;
+  bool mean_ = false;  // the mean count's weights (PairFactors::mean_count)
   const Eigen::VectorXd& area_;
   const geom::FiberMask* mask_;
   Influence influence_;

@@ -31,11 +31,24 @@ inline double connection_factor(double kept, double count_i, double count_j) {
   return kept / (count_i + count_j);
 }
 
+// The mean count's factor (ConnectionCount::Mean): with M_i = c_i |S_i| the
+// area the fibers at i reach, w_ij = 2 kept |S_i| |S_j| / ((M_i + M_j) L),
+// that is h_ij = 2 kept |S_i| |S_j| / ((|S_i| + |S_j|) (M_i + M_j)).
+inline double mean_connection_factor(double kept, double area_i, double area_j, double count_i,
+                                     double count_j) {
+  return 2.0 * kept * area_i * area_j /
+         ((area_i + area_j) * (count_i * area_i + count_j * area_j));
+}
+
 // bulk_weight(connection_factor(kept, c_i, c_j), ...) written with one
-// division instead of two: the form the tiled kernels use.
+// division instead of two: the form the tiled kernels use. With `mean`, the
+// mean count's weight 2 kept |S_i| |S_j| / ((c_i |S_i| + c_j |S_j|) L)
+// (a select, not a branch, so that the loops still vectorise).
 inline double counted_bulk_weight(double kept, double area_i, double area_j, double count_i,
-                                  double count_j, double length) {
-  return kept * (area_i + area_j) / ((count_i + count_j) * length);
+                                  double count_j, double length, bool mean = false) {
+  const double reached = mean ? count_i * area_i + count_j * area_j : count_i + count_j;
+  const double areas = mean ? 2.0 * area_i * area_j : area_i + area_j;
+  return kept * areas / (reached * length);
 }
 
 // Surface fiber weight (paper Eq. 7): (|S_i| + |S_k|) / (2 |s_i - s_k|^2).

@@ -10,6 +10,7 @@
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/geom/fiber_mask.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/held_edge.hpp"
 #include "fiberfluid/model/loads.hpp"
 #include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/model/pair_kernels.hpp"
@@ -40,8 +41,9 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& w) {
   return m;
 }
 
-// dA_f/dx_v for the k-th corner of face f (dim x dim, padded to 3x3). 3D:
-// A_f = (x0 x x1 + x1 x x2 + x2 x x0) / 2, so dA_f/dx_k = [x_{k+2} - x_{k+1}]_x / 2.
+}  // namespace
+
+// 3D: A_f = (x0 x x1 + x1 x x2 + x2 x x0) / 2, so dA_f/dx_k = [x_{k+2} - x_{k+1}]_x / 2.
 // 2D: A_f = (d_y, -d_x), d = x_1 - x_0.
 Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
                                      Eigen::Index f, int k) {
@@ -54,6 +56,8 @@ Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::Matr
   m(1, 0) = -1.0;
   return k == 1 ? m : Eigen::Matrix3d(-m);
 }
+
+namespace {
 
 // The terms c_i S_i(x) (pressure: c = P; hydrostatic load: c = -q) have the
 // geometric tangent c_i dS_i/dx_v = c_i C0 sum over faces f at i and v of
@@ -74,8 +78,10 @@ void add_area_vector_tangent(const TermContext& ctx, const Eigen::MatrixXd& X,
     }
 }
 
-// sum_v dA_f/dx_v w_v for face f (face_area_derivative applied directly: in
-// 3D sum_k (x_{k+2} - x_{k+1}) x w_k / 2, in 2D the rotated w_1 - w_0).
+}  // namespace
+
+// face_area_derivative applied directly: in 3D sum_k (x_{k+2} - x_{k+1}) x
+// w_k / 2, in 2D the rotated w_1 - w_0.
 Eigen::Vector3d face_area_rate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F, Eigen::Index f,
                                const Eigen::MatrixXd& W) {
   Eigen::Vector3d dA = Eigen::Vector3d::Zero();
@@ -90,6 +96,8 @@ Eigen::Vector3d face_area_rate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& 
   }
   return dA;
 }
+
+namespace {
 
 // The same applied to W (#V by dim): row i is c_i dS_i/dx W; #V by 3.
 Eigen::MatrixXd area_vector_product(const TermContext& ctx, const Eigen::MatrixXd& X,
@@ -448,6 +456,8 @@ std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const 
   for (size_t l = 0; l < c.model.loads.size(); ++l) terms.push_back(make_load_term(c, l));
   for (const MirrorLayer& layer : c.model.mirror_layers)
     terms.push_back(make_mirror_layer_term(c, layer));
+  for (const HeldEdge& edge : c.model.held_edges)
+    for (auto& term : make_held_edge_terms(c, edge)) terms.push_back(std::move(term));
   return terms;
 }
 

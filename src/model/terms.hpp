@@ -79,6 +79,16 @@ class TangentSink {
   std::vector<Eigen::Triplet<double>>* entries_ = nullptr;
 };
 
+// dA_f/dx_v for the k-th corner v of face f (dim x dim, padded to 3x3): the
+// face area vector's derivative, for the terms whose forces follow the
+// surface (pressure, hydrostatic load, a split edge's share of pressure).
+Eigen::Matrix3d face_area_derivative(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F,
+                                     Eigen::Index f, int k);
+// sum_v dA_f/dx_v w_v for face f: the face area vector's rate along W (#V
+// by dim), padded to 3.
+Eigen::Vector3d face_area_rate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F, Eigen::Index f,
+                               const Eigen::MatrixXd& W);
+
 class EquilibriumTerm {
  public:
   virtual ~EquilibriumTerm() = default;

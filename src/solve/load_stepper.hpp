@@ -256,9 +256,10 @@ std::string sensitivity_problem(const model::Model& model);
 // the way there).
 std::string warm_start_problem(const model::Model& model, const SteppingOptions& options);
 
-// "" when the model's mirror layers (model::MirrorLayer) can run with these
-// options, else why not: they need the Newton scheme.
-std::string mirror_layer_problem(const model::Model& model, const SteppingOptions& options);
+// "" when the model's support terms (mirror layers, model::MirrorLayer, and
+// split edges, model::HeldEdge) can run with these options, else why not:
+// they need the Newton scheme.
+std::string support_terms_problem(const model::Model& model, const SteppingOptions& options);
 
 // The backend SolverKind::Auto runs: pcg with the treecode, else
 // choose_solver's rule by size (the largest axis block, the distinct factors).

@@ -74,10 +74,15 @@ std::string kinematics_problem(const model::Model& model, const SteppingOptions&
          "incremental scheme's matrix is the paper's vector spring";
 }
 
-std::string mirror_layer_problem(const model::Model& model, const SteppingOptions& options) {
-  if (model.mirror_layers.empty() || options.scheme == Scheme::Newton) return {};
-  return "a support's mirror layer needs the Newton scheme (stepping.scheme \"newton\"): the "
-         "incremental scheme's matrix has no layer fibers";
+std::string support_terms_problem(const model::Model& model, const SteppingOptions& options) {
+  if (options.scheme == Scheme::Newton) return {};
+  if (!model.mirror_layers.empty())
+    return "a support's mirror layer needs the Newton scheme (stepping.scheme \"newton\"): the "
+           "incremental scheme's matrix has no layer fibers";
+  if (!model.held_edges.empty())
+    return "a support's split edge needs the Newton scheme (stepping.scheme \"newton\"): the "
+           "incremental scheme's matrix has no edge fibers";
+  return {};
 }
 
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
@@ -95,7 +100,7 @@ std::string setup_problem(const model::Model& model, const SteppingOptions& opti
   if (!why.empty()) return why;
   why = kinematics_problem(model, options);
   if (!why.empty()) return why;
-  why = mirror_layer_problem(model, options);
+  why = support_terms_problem(model, options);
   if (!why.empty()) return why;
   return model::singular_setup_reason(model);
 }

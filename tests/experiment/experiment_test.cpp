@@ -626,6 +626,54 @@ TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
   expect_config_error(dir, bad, "prescribed[0].layer: a mirror layer belongs to a fixed clamp");
 }
 
+// A support's split edge ("edge": "split", held_edge.hpp) and the mean
+// connection count: read, reported, run, and refused where they cannot act.
+TEST(ExperimentConfig, ASupportsSplitEdgeAndTheMeanCountAreReadAndChecked) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["surface"] = {{"generator", "box"},
+                  {"min", {0, 0, 0}},
+                  {"max", {0.06, 0.02, 0.02}},
+                  {"segments", {6, 2, 2}}};
+  c["supports"] = {{{"label", "clamp"}, {"where", "x <= 0"}, {"layer", "mirror"},
+                    {"edge", "split"}}};
+  c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.025}, {"connection_count", "mean"}};
+  c["stepping"]["scheme"] = "newton";
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const model::Model& m = ex.cases[0].model;
+  ASSERT_EQ(m.held_edges.size(), 1u);
+  EXPECT_EQ(m.held_edges[0].held.size(), 9u);  // the end face's 3 x 3 grid
+  EXPECT_EQ(m.connection_count, model::ConnectionCount::Mean);
+  const ExperimentResult r = run_experiment(ex);
+  ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
+  const nlohmann::json fibers = summary_json(ex, r)["fibers"];
+  ASSERT_EQ(fibers["split_edges"].size(), 1u);
+  EXPECT_EQ(fibers["split_edges"][0]["support"], "clamp");
+  EXPECT_EQ(fibers["split_edges"][0]["edge_vertices"], 8);
+
+  nlohmann::json bad = c;
+  bad["supports"][0]["edge"] = "cut";
+  expect_config_error(dir, bad, "supports[0].edge");
+  bad = c;
+  bad["supports"][0].erase("layer");
+  bad["supports"][0]["axes"] = "xy";
+  expect_config_error(dir, bad, "supports[0].edge: a split edge holds every axis");
+  bad = c;
+  bad["supports"][0].erase("layer");
+  bad["fibers"] = {{"kinematics", "vector"}};
+  bad["stepping"]["scheme"] = "incremental";
+  expect_config_error(dir, bad, "supports[0].edge: a support's split edge needs the Newton scheme");
+  bad = c;
+  bad["prescribed"] = {
+      {{"where", "x >= 0.06"}, {"displacement", {0, 0, 0.001}}, {"edge", "split"}}};
+  expect_config_error(dir, bad, "prescribed[0].edge: a split edge belongs to a fixed support");
+  bad = c;
+  bad["fibers"]["product"] = "treecode";
+  bad["fibers"].erase("horizon");
+  bad["supports"][0].erase("layer");
+  expect_config_error(dir, bad, "fibers.product: \"treecode\" needs one connection count");
+}
+
 // A prescribed group may turn rigidly: "rotation" (axis, angle in degrees,
 // centre) with an optional translation, along its schedule.
 // A cylinder of central fibers pressed between two frictionless paddles and
