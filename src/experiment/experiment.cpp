@@ -65,11 +65,11 @@ std::function<geom::Surface()> read_generator(Fields& f, double* vertices) {
   if (kind == "dome") {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
-    const bool octahedral = f.choice("base", "icosahedron", {"icosahedron", "octahedron"}) ==
-                            "octahedron";
+    const bool octahedral =
+        f.choice("base", "icosahedron", {"icosahedron", "octahedron"}) == "octahedron";
     *vertices = (octahedral ? 4.0 : 10.0) * std::pow(4.0, subdivisions) + 2.0;
-    const geom::DomeBase base = octahedral ? geom::DomeBase::Octahedron
-                                           : geom::DomeBase::Icosahedron;
+    const geom::DomeBase base =
+        octahedral ? geom::DomeBase::Octahedron : geom::DomeBase::Icosahedron;
     return [=] { return geom::dome(semi_axes, subdivisions, base); };
   }
   if (kind == "cylinder") {
@@ -330,8 +330,9 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
                "a mirror layer belongs to a fixed clamp (\"supports\"), not to a "
                "prescribed group");
     if (prescribed && f.has("edge"))
-      f.refuse("edge", "a split edge belongs to a fixed support (\"supports\"), not to a "
-                       "prescribed group");
+      f.refuse("edge",
+               "a split edge belongs to a fixed support (\"supports\"), not to a "
+               "prescribed group");
     f.finish();
     groups.push_back(spec);
   };
@@ -514,8 +515,7 @@ FiberSpec read_fibers(Fields& root) {
                : count == "mean" ? model::ConnectionCount::Mean
                                  : model::ConnectionCount::Symmetric;
   const bool fades = central && spec.horizon > 0.0;
-  if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) ==
-      "conical") {
+  if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) == "conical") {
     if (!(spec.horizon > 0.0))
       f.fail("influence", "a conical influence (1 - L / horizon) needs a \"horizon\"");
     spec.influence = model::Influence::Kind::Conical;
@@ -530,8 +530,8 @@ FiberSpec read_fibers(Fields& root) {
   if (spec.treecode_tolerance > 0.0 && model::counts_by_area(spec.count))
     f.fail("product",
            "\"treecode\" needs one connection count for every fiber: set "
-           "\"connection_count\": \"global\" (the " + count +
-               " count differs from vertex to vertex) or \"product\": \"exact\"");
+           "\"connection_count\": \"global\" (the " +
+               count + " count differs from vertex to vertex) or \"product\": \"exact\"");
   if (spec.treecode_tolerance > 0.0 && spec.horizon > 0.0)
     f.fail("product",
            "\"treecode\" approximates the sum over every pair; with a \"horizon\" most pairs "

@@ -22,10 +22,14 @@ double checked_fiber_length(const Eigen::MatrixXd& X, int i, int j) {
 
 const char* to_string(ConnectionCount count) {
   switch (count) {
-    case ConnectionCount::Global: return "global";
-    case ConnectionCount::Area: return "area";
-    case ConnectionCount::Mean: return "mean";
-    case ConnectionCount::Symmetric: break;
+    case ConnectionCount::Global:
+      return "global";
+    case ConnectionCount::Area:
+      return "area";
+    case ConnectionCount::Mean:
+      return "mean";
+    case ConnectionCount::Symmetric:
+      break;
   }
   return "symmetric";
 }
@@ -63,7 +67,7 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
       throw InputError("vertex " + std::to_string(i) + " has no area vector (|S_" +
                        std::to_string(i) + "| = " + std::to_string(areas[i]) +
                        "): \"connection_count\": \"" + to_string(count_) +
-                     "\" weighs each vertex by it");
+                       "\" weighs each vertex by it");
   if (count_ == ConnectionCount::Mean) areas_ = areas;
   if (influence_.weighs()) {
     if (reference == nullptr || reference->rows() != n_)

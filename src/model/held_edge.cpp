@@ -7,16 +7,11 @@
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/loads.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/model/point_fibers.hpp"
 
 namespace fiberfluid::model {
 
 namespace {
-
-Eigen::Vector3d padded(const Eigen::MatrixXd& M, Eigen::Index row) {
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();
-  v.head(M.cols()) = M.row(row).transpose();
-  return v;
-}
 
 // A_f at x (3D: half the cross product of two edges; 2D: the edge's outward
 // normal times its length), padded to 3.
@@ -25,7 +20,7 @@ Eigen::Vector3d face_area_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXi
     const Eigen::Vector3d a = X.row(F(f, 0)), b = X.row(F(f, 1)), c = X.row(F(f, 2));
     return 0.5 * (b - a).cross(c - a);
   }
-  const Eigen::Vector3d d = padded(X, F(f, 1)) - padded(X, F(f, 0));
+  const Eigen::Vector3d d = padded_row(X, F(f, 1)) - padded_row(X, F(f, 0));
   return {d.y(), -d.x(), 0.0};
 }
 
@@ -101,7 +96,7 @@ std::vector<OffsetFiber> held_edge_fibers(const Model& model, const HeldEdge& ed
   for (const EdgeVertex& e : held_edge_vertices(model, edge.held)) {
     points[static_cast<size_t>(e.vertex)] = {
         {e.vertex, Eigen::Vector3d::Zero(), 1.0 - e.free_share},
-        {e.neighbour, padded(V, e.vertex) - padded(V, e.neighbour), e.free_share}};
+        {e.neighbour, padded_row(V, e.vertex) - padded_row(V, e.neighbour), e.free_share}};
     is_edge[static_cast<size_t>(e.vertex)] = 1;
     edge_vertices.push_back(e.vertex);
   }
@@ -111,126 +106,20 @@ std::vector<OffsetFiber> held_edge_fibers(const Model& model, const HeldEdge& ed
       if (i == j || (is_edge[static_cast<size_t>(i)] && i > j)) continue;  // each pair once
       const double h = factors.factor(i, j);
       if (!(h > 0.0)) continue;
-      const double length = (padded(V, i) - padded(V, j)).norm();
+      const double length = (padded_row(V, i) - padded_row(V, j)).norm();
       const double w = bulk_weight(h, area0[i], area0[j], length);
       fibers.push_back({i, j, Eigen::Vector3d::Zero(), length, -w});
       for (const Point& a : points[static_cast<size_t>(i)])
         for (const Point& b : points[static_cast<size_t>(j)]) {
           if (a.vertex == b.vertex) continue;  // both move with one vertex: no strain
-          fibers.push_back({a.vertex, b.vertex, b.offset - a.offset, length, a.share * b.share * w});
+          fibers.push_back(
+              {a.vertex, b.vertex, b.offset - a.offset, length, a.share * b.share * w});
         }
     }
   return fibers;
 }
 
 namespace {
-
-// The split's fibers, with the bulk fibers' kinematics and law.
-class HeldEdgeFiberTerm final : public EquilibriumTerm {
- public:
-  HeldEdgeFiberTerm(const TermContext& c, const HeldEdge& edge)
-      : c_(c), fibers_(held_edge_fibers(c.model, edge, c.pair_factors, c.area0)) {}
-  const char* name() const override { return "split edge's fibers"; }
-  Role role() const override { return Role::Fibers; }
-
-  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const OffsetFiber& f, const State& st) {
-      using K = decltype(policy);
-      for (int a = 0; a < dim(); ++a) {
-        const double force = m[a] * pair_force<K>(st.coefficients, st.b[a], st.d[a]);
-        R[dof(f.i, a)] += force;
-        R[dof(f.p, a)] -= force;
-      }
-    });
-  }
-
-  void add_tangent(const TermState& s, TangentSink& J) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const OffsetFiber& f, const State& st) {
-      using K = decltype(policy);
-      for (int a = 0; a < dim(); ++a)
-        for (int e = 0; e < dim(); ++e) {
-          const double entry =
-              m[a] * pair_tangent_entry<K>(st.coefficients, a == e, st.b[a], st.d[a], st.b[e]);
-          J.add(dof(f.i, a), dof(f.i, e), entry);
-          J.add(dof(f.i, a), dof(f.p, e), -entry);
-          J.add(dof(f.p, a), dof(f.i, e), -entry);
-          J.add(dof(f.p, a), dof(f.p, e), entry);
-        }
-    });
-  }
-
-  void add_tangent_product(const TermState& s, const Eigen::VectorXd&, const Eigen::MatrixXd& W,
-                           Eigen::VectorXd& out) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const OffsetFiber& f, const State& st) {
-      using K = decltype(policy);
-      const Eigen::Vector3d w = padded(W, f.i) - padded(W, f.p);
-      const double b_dot_w = st.b.dot(w);
-      for (int a = 0; a < dim(); ++a) {
-        const double value =
-            m[a] * pair_tangent<K>(st.coefficients, w[a], b_dot_w, st.b[a], st.d[a]);
-        out[dof(f.i, a)] += value;
-        out[dof(f.p, a)] -= value;
-      }
-    });
-  }
-
-  void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
-                                Eigen::Ref<Eigen::VectorXd> column) const override {
-    if (p.kind == MaterialParameter::Kind::SurfaceTension) return;
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    const FiberLaw& law = c_.model.material.law;
-    for_each_fiber(s, [&](auto policy, const OffsetFiber& f, const State& st) {
-      using K = decltype(policy);
-      for (int a = 0; a < dim(); ++a) {
-        double value = 0.0;
-        if (p.kind == MaterialParameter::Kind::AxisFactor) {  // the force over its factor
-          if (a != p.index) continue;
-          value = pair_force<K>(st.coefficients, st.b[a], st.d[a]);
-        } else {
-          value = m[a] * pair_parameter_force<K>(f.weight, law.modulus_derivative(p.index, st.e),
-                                                 st.r, f.length, st.b[a], st.d[a]);
-        }
-        column[dof(f.i, a)] += value;
-        column[dof(f.p, a)] -= value;
-      }
-    });
-  }
-
- private:
-  struct State {
-    Eigen::Vector3d b, d;  // x_i minus the fiber's far point, and u_i minus its displacement
-    double r = 0.0, e = 0.0;
-    PairCoefficients coefficients{0.0, 0.0};
-  };
-
-  int dim() const { return c_.model.dim(); }
-  Eigen::Index dof(int vertex, int axis) const { return c_.model.dof(vertex, axis); }
-
-  // body(policy, fiber, state) for each fiber at the state s.
-  template <class Body>
-  void for_each_fiber(const TermState& s, Body&& body) const {
-    const FiberLaw& law = c_.model.material.law;
-    with_kinematics(c_.model.material.kinematics, [&](auto policy) {
-      using K = decltype(policy);
-      State st;
-      for (const OffsetFiber& f : fibers_) {
-        st.b = padded(s.X, f.i) - padded(s.X, f.p) - f.offset;
-        st.d = padded(s.U, f.i) - padded(s.U, f.p);
-        st.r = st.b.norm();
-        st.e = fiber_strain(st.r, f.length);
-        st.coefficients =
-            K::coefficients(f.weight, law.modulus(st.e), law.slope(st.e), st.r, f.length);
-        body(policy, f, st);
-      }
-    });
-  }
-
-  const TermContext& c_;
-  std::vector<OffsetFiber> fibers_;
-};
 
 // The ghosts' shares of the fluid: P S^g_j(x) moved from j to k, and
 // S^g_j . (u_k - u_j) in the volume row.
@@ -244,7 +133,7 @@ class HeldEdgeFluidTerm final : public EquilibriumTerm {
   void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
     for (const EdgeVertex& e : edge_) {
       const Eigen::Vector3d S = ghost_area_vector(s.X, e);
-      const Eigen::Vector3d swept = padded(s.U, e.neighbour) - padded(s.U, e.vertex);
+      const Eigen::Vector3d swept = padded_row(s.U, e.neighbour) - padded_row(s.U, e.vertex);
       for (int a = 0; a < dim(); ++a) {
         R[dof(e.neighbour, a)] += s.P * S[a];
         R[dof(e.vertex, a)] -= s.P * S[a];
@@ -257,7 +146,7 @@ class HeldEdgeFluidTerm final : public EquilibriumTerm {
     const Eigen::MatrixXi& F = c_.model.surface.F;
     for (const EdgeVertex& e : edge_) {
       const Eigen::Vector3d S = ghost_area_vector(s.X, e);
-      const Eigen::Vector3d swept = padded(s.U, e.neighbour) - padded(s.U, e.vertex);
+      const Eigen::Vector3d swept = padded_row(s.U, e.neighbour) - padded_row(s.U, e.vertex);
       for (int a = 0; a < dim(); ++a) {
         J.add(dof(e.neighbour, a), pressure(), S[a]);
         J.add(dof(e.vertex, a), pressure(), -S[a]);
@@ -284,7 +173,7 @@ class HeldEdgeFluidTerm final : public EquilibriumTerm {
     const Eigen::MatrixXi& F = c_.model.surface.F;
     for (const EdgeVertex& e : edge_) {
       const Eigen::Vector3d S = ghost_area_vector(s.X, e);
-      const Eigen::Vector3d swept = padded(s.U, e.neighbour) - padded(s.U, e.vertex);
+      const Eigen::Vector3d swept = padded_row(s.U, e.neighbour) - padded_row(s.U, e.vertex);
       Eigen::Vector3d rate = Eigen::Vector3d::Zero();
       for (int f : e.free_faces) rate += c_.C0 * face_area_rate(s.X, F, f, W);
       for (int a = 0; a < dim(); ++a) {
@@ -292,7 +181,8 @@ class HeldEdgeFluidTerm final : public EquilibriumTerm {
         out[dof(e.neighbour, a)] += value;
         out[dof(e.vertex, a)] -= value;
       }
-      out[pressure()] += S.dot(padded(W, e.neighbour) - padded(W, e.vertex)) + swept.dot(rate);
+      out[pressure()] +=
+          S.dot(padded_row(W, e.neighbour) - padded_row(W, e.vertex)) + swept.dot(rate);
     }
   }
 
@@ -347,8 +237,9 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
         for (int corner = 0; corner < F.cols(); ++corner) {
           const int v = F(f, corner);
           // dG/dx_v: the face's turning times j's weight, and A_f times the weight's rate.
-          const Eigen::Matrix3d dG = weight(q, e.vertex, f) * face_area_derivative(s.X, F, f, corner) +
-                                     A * q.gradient.transpose() * weight_rate(q, e.vertex, v);
+          const Eigen::Matrix3d dG =
+              weight(q, e.vertex, f) * face_area_derivative(s.X, F, f, corner) +
+              A * q.gradient.transpose() * weight_rate(q, e.vertex, v);
           for (int a = 0; a < dim(); ++a)
             for (int b = 0; b < dim(); ++b) {
               J.add(dof(e.neighbour, a), dof(v, b), -dG(a, b));
@@ -369,7 +260,7 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
         double weight_change = 0.0;  // sum_v dw_jf/dx_v . w_v
         for (int corner = 0; corner < F.cols(); ++corner) {
           const int v = F(f, corner);
-          weight_change += weight_rate(q, e.vertex, v) * q.gradient.dot(padded(W, v));
+          weight_change += weight_rate(q, e.vertex, v) * q.gradient.dot(padded_row(W, v));
         }
         rate += weight(q, e.vertex, f) * face_area_rate(s.X, F, f, W) +
                 face_area_vector(s.X, F, f) * weight_change;
@@ -418,7 +309,8 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
   // G_j: the load's force on j from its free faces.
   Eigen::Vector3d share(const Eigen::MatrixXd& X, const Field& q, const EdgeVertex& e) const {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int f : e.free_faces) sum += weight(q, e.vertex, f) * face_area_vector(X, c_.model.surface.F, f);
+    for (int f : e.free_faces)
+      sum += weight(q, e.vertex, f) * face_area_vector(X, c_.model.surface.F, f);
     return sum;
   }
   int dim() const { return c_.model.dim(); }
@@ -435,7 +327,12 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
 std::vector<std::unique_ptr<EquilibriumTerm>> make_held_edge_terms(const TermContext& context,
                                                                    const HeldEdge& edge) {
   std::vector<std::unique_ptr<EquilibriumTerm>> terms;
-  terms.push_back(std::make_unique<HeldEdgeFiberTerm>(context, edge));
+  std::vector<PointFiber> fibers;
+  for (const OffsetFiber& f :
+       held_edge_fibers(context.model, edge, context.pair_factors, context.area0))
+    fibers.push_back({f.i, f.p, /*mirrored=*/false, f.offset, f.length, f.weight});
+  terms.push_back(make_point_fiber_term(context, std::move(fibers), "split edge's fibers",
+                                        EquilibriumTerm::Role::Fibers));
   terms.push_back(std::make_unique<HeldEdgeFluidTerm>(context, edge));
   for (size_t l = 0; l < context.model.loads.size(); ++l)
     if (context.model.loads[l].kind == Load::Kind::Hydrostatic)

@@ -55,7 +55,7 @@ struct OffsetFiber {
 // that make it and the free neighbour its ghost moves with.
 struct EdgeVertex {
   int vertex = 0, neighbour = 0;
-  double free_share = 0.0;       // s_j in (0, 1]
+  double free_share = 0.0;      // s_j in (0, 1]
   std::vector<int> free_faces;  // j's faces with a free vertex
 };
 
@@ -72,8 +72,7 @@ const HeldEdge* held_edge_of(const Model& model, int group);
 // points of i and of j (each vertex itself with share 1 - s, its ghost with
 // share s) with the shares' product times w_ij.
 std::vector<OffsetFiber> held_edge_fibers(const Model& model, const HeldEdge& edge,
-                                          const PairFactors& factors,
-                                          const Eigen::VectorXd& area0);
+                                          const PairFactors& factors, const Eigen::VectorXd& area0);
 
 // The terms of one split edge: its fibers (role Fibers: the body's own, so
 // that the part taken from (i, j) lowers j's reaction as it should), the

@@ -11,16 +11,11 @@
 #include "fiberfluid/model/fiber_network.hpp"
 #include "fiberfluid/model/held_edge.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/model/point_fibers.hpp"
 
 namespace fiberfluid::model {
 
 namespace {
-
-Eigen::Vector3d padded(const Eigen::MatrixXd& M, Eigen::Index row) {
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();
-  v.head(M.cols()) = M.row(row).transpose();
-  return v;
-}
 
 std::string metres(double value) {
   std::ostringstream out;
@@ -96,7 +91,7 @@ class ClampedRegion {
       if (same_plane(layer, other, tolerance))
         for (int v : other.held) {
           if (!same_layer(other, layer) && own[static_cast<size_t>(v)]) continue;  // shared: ours
-          points_.push_back(padded(V, v));
+          points_.push_back(padded_row(V, v));
           ours_.push_back(same_layer(other, layer) || own[static_cast<size_t>(v)]);
         }
     // The mesh's resolution on the clamp: its longest edge between two held vertices.
@@ -135,8 +130,8 @@ double layer_pair_weight(const Model& model, const PairFactors& factors,
                          const std::vector<double>& counts, const Eigen::VectorXd& area0, int i,
                          int j, double length) {
   return counted_bulk_weight(model.influence(length), area0[i], area0[j],
-                             counts[static_cast<size_t>(i)], counts[static_cast<size_t>(j)],
-                             length, factors.mean_count());
+                             counts[static_cast<size_t>(i)], counts[static_cast<size_t>(j)], length,
+                             factors.mean_count());
 }
 
 // A split edge's ghosts (held_edge.hpp) across the layer. An edge vertex j
@@ -158,17 +153,17 @@ void add_ghost_images(const Model& model, const MirrorLayer& layer, const HeldEd
   const std::vector<EdgeVertex> edge = held_edge_vertices(model, held_edge.held);
   for (const EdgeVertex& e : edge) {
     const int j = e.vertex, kj = e.neighbour;
-    const Eigen::Vector3d sj = padded(V, j), skj = padded(V, kj);
+    const Eigen::Vector3d sj = padded_row(V, j), skj = padded_row(V, kj);
     for (int i : near) {
       if (mask != nullptr && !mask->kept(i, j)) continue;
-      const double length = (padded(V, i) - sj).norm();
+      const double length = (padded_row(V, i) - sj).norm();
       if (length >= layer.depth) continue;
       fibers->push_back({i, kj, sj + skj, length, e.free_share * full_weight(i, j, length)});
     }
     for (const EdgeVertex& g : edge) {  // each pair of ghosts once
       const int i = g.vertex, ki = g.neighbour;
       if (i >= j || (mask != nullptr && !mask->kept(i, j))) continue;
-      const Eigen::Vector3d si = padded(V, i), ski = padded(V, ki);
+      const Eigen::Vector3d si = padded_row(V, i), ski = padded_row(V, ki);
       const double length = (si - sj).norm();
       if (length >= layer.depth) continue;
       fibers->push_back({ki, kj, sj + skj - si + ski, length,
@@ -189,7 +184,7 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
   std::vector<int> near;
   std::vector<double> height(static_cast<size_t>(n), 0.0);
   for (int v = 0; v < n; ++v) {
-    height[static_cast<size_t>(v)] = (padded(V, v) - layer.point).dot(layer.normal);
+    height[static_cast<size_t>(v)] = (padded_row(V, v) - layer.point).dot(layer.normal);
     if (height[static_cast<size_t>(v)] > 1e-6 * size &&
         height[static_cast<size_t>(v)] < layer.depth)
       near.push_back(v);
@@ -202,13 +197,13 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
     for (int j : near) {
       if (i != j && mask != nullptr && !mask->kept(i, j)) continue;  // pruned or beyond the horizon
       const double hi = height[static_cast<size_t>(i)], hj = height[static_cast<size_t>(j)];
-      const Eigen::Vector3d foot = padded(V, j) - hj * layer.normal;
+      const Eigen::Vector3d foot = padded_row(V, j) - hj * layer.normal;
       // As the term computes the fiber (b = x_i + x_j - 2 q_j): no strain at the reference.
-      const double length = (padded(V, i) + padded(V, j) - 2.0 * foot).norm();
-      const Eigen::Vector3d image = 2.0 * foot - padded(V, j);
+      const double length = (padded_row(V, i) + padded_row(V, j) - 2.0 * foot).norm();
+      const Eigen::Vector3d image = 2.0 * foot - padded_row(V, j);
       if (length >= layer.depth) continue;
       // Where the fiber from s_i to the image crosses the plane.
-      if (!region.holds(padded(V, i) + hi / (hi + hj) * (image - padded(V, i)))) continue;
+      if (!region.holds(padded_row(V, i) + hi / (hi + hj) * (image - padded_row(V, i)))) continue;
       const double weight = 0.5 * layer_pair_weight(model, factors, counts, area0, i, j, length);
       fibers.push_back({i, j, 2.0 * foot, length, weight});
     }
@@ -217,123 +212,14 @@ std::vector<LayerFiber> mirror_layer_fibers(const Model& model, const MirrorLaye
   return fibers;
 }
 
-namespace {
-
-class MirrorLayerTerm final : public EquilibriumTerm {
- public:
-  MirrorLayerTerm(const TermContext& c, const MirrorLayer& layer)
-      : c_(c),
-        group_(layer.group),
-        fibers_(mirror_layer_fibers(c.model, layer, c.pair_factors, c.area0)) {}
-
-  const char* name() const override { return "mirror layer"; }
-  Role role() const override { return Role::Support; }
-  int support_group() const override { return group_; }
-
-  void add_residual(const TermState& s, Eigen::VectorXd& R) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
-      using K = decltype(policy);
-      for (int a = 0; a < dim(); ++a) {
-        const double force = m[a] * pair_force<K>(st.coefficients, st.b[a], st.d[a]);
-        R[dof(f.i, a)] += force;
-        R[dof(f.j, a)] += force;
-      }
-    });
-  }
-
-  void add_tangent(const TermState& s, TangentSink& J) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
-      using K = decltype(policy);
-      // b and d move alike with x_i and x_j: four equal blocks.
-      for (int a = 0; a < dim(); ++a)
-        for (int e = 0; e < dim(); ++e) {
-          const double entry =
-              m[a] * pair_tangent_entry<K>(st.coefficients, a == e, st.b[a], st.d[a], st.b[e]);
-          for (int row : {f.i, f.j})
-            for (int col : {f.i, f.j}) J.add(dof(row, a), dof(col, e), entry);
-        }
-    });
-  }
-
-  void add_tangent_product(const TermState& s, const Eigen::VectorXd& /*v*/,
-                           const Eigen::MatrixXd& W, Eigen::VectorXd& out) const override {
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
-      using K = decltype(policy);
-      const Eigen::Vector3d w = padded(W, f.i) + padded(W, f.j);
-      const double b_dot_w = st.b.dot(w);
-      for (int a = 0; a < dim(); ++a) {
-        const double value =
-            m[a] * pair_tangent<K>(st.coefficients, w[a], b_dot_w, st.b[a], st.d[a]);
-        out[dof(f.i, a)] += value;
-        out[dof(f.j, a)] += value;
-      }
-    });
-  }
-
-  void add_parameter_derivative(const TermState& s, const MaterialParameter& p,
-                                Eigen::Ref<Eigen::VectorXd> column) const override {
-    if (p.kind == MaterialParameter::Kind::SurfaceTension) return;
-    const Eigen::Vector3d m = c_.model.material.axis_factors;
-    const FiberLaw& law = c_.model.material.law;
-    for_each_fiber(s, [&](auto policy, const LayerFiber& f, const State& st) {
-      using K = decltype(policy);
-      for (int a = 0; a < dim(); ++a) {
-        double value = 0.0;
-        if (p.kind == MaterialParameter::Kind::AxisFactor) {  // the force over its factor
-          if (a != p.index) continue;
-          value = pair_force<K>(st.coefficients, st.b[a], st.d[a]);
-        } else {
-          value = m[a] * pair_parameter_force<K>(f.weight, law.modulus_derivative(p.index, st.e),
-                                                 st.r, f.length, st.b[a], st.d[a]);
-        }
-        column[dof(f.i, a)] += value;
-        column[dof(f.j, a)] += value;
-      }
-    });
-  }
-
- private:
-  struct State {
-    Eigen::Vector3d b, d;  // x_i minus the image of j, and u_i minus the image's displacement
-    double r = 0.0, e = 0.0;
-    PairCoefficients coefficients{0.0, 0.0};
-  };
-
-  int dim() const { return c_.model.dim(); }
-  Eigen::Index dof(int vertex, int axis) const { return c_.model.dof(vertex, axis); }
-
-  // body(policy, fiber, state) for each fiber at the state s.
-  template <class Body>
-  void for_each_fiber(const TermState& s, Body&& body) const {
-    const FiberLaw& law = c_.model.material.law;
-    with_kinematics(c_.model.material.kinematics, [&](auto policy) {
-      using K = decltype(policy);
-      State st;
-      for (const LayerFiber& f : fibers_) {
-        st.b = padded(s.X, f.i) + padded(s.X, f.j) - f.twice_foot;
-        st.d = padded(s.U, f.i) + padded(s.U, f.j);
-        st.r = st.b.norm();
-        st.e = fiber_strain(st.r, f.length);
-        st.coefficients =
-            K::coefficients(f.weight, law.modulus(st.e), law.slope(st.e), st.r, f.length);
-        body(policy, f, st);
-      }
-    });
-  }
-
-  const TermContext& c_;
-  int group_;
-  std::vector<LayerFiber> fibers_;
-};
-
-}  // namespace
-
 std::unique_ptr<EquilibriumTerm> make_mirror_layer_term(const TermContext& context,
                                                         const MirrorLayer& layer) {
-  return std::make_unique<MirrorLayerTerm>(context, layer);
+  std::vector<PointFiber> fibers;
+  for (const LayerFiber& f :
+       mirror_layer_fibers(context.model, layer, context.pair_factors, context.area0))
+    fibers.push_back({f.i, f.j, /*mirrored=*/true, f.twice_foot, f.length, f.weight});
+  return make_point_fiber_term(context, std::move(fibers), "mirror layer",
+                               EquilibriumTerm::Role::Support, layer.group);
 }
 
 }  // namespace fiberfluid::model

@@ -187,8 +187,7 @@ struct RowArrays {
 template <class K>
 inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i, double area_j,
                                          double count_i, double count_j, bool mean) {
-  const double a =
-      counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q], mean);
+  const double a = counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q], mean);
   return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q]);
 }
 
@@ -206,8 +205,9 @@ PairColumns columns_of(const std::vector<double> (&x)[3], const std::vector<doub
 // opposite at j); with kTable its coefficients written to k1, k2 at j (the
 // lower triangle of the stored tangent's table).
 template <class K, bool kForces, bool kTable, class Scalar = float>
-FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area, const double* count,
-                                       bool mean, int i, int j0, int first, int end, const RowArrays& row,
+FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
+                                       const double* count, bool mean, int i, int j0, int first,
+                                       int end, const RowArrays& row,
                                        const std::array<double*, 3>& out, Scalar* k1 = nullptr,
                                        Scalar* k2 = nullptr) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
@@ -236,9 +236,8 @@ FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
 
 template <class K>
 FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* const w[3],
-                                          const double* area, const double* count, bool mean,
-                                          int i, int j0,
-                                          int first, int end, const RowArrays& row,
+                                          const double* area, const double* count, bool mean, int i,
+                                          int j0, int first, int end, const RowArrays& row,
                                           const std::array<double*, 3>& out) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
   const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
@@ -392,8 +391,7 @@ Eigen::VectorXd BulkPairs::row_sums() const {
     for_each_listed([&](int r, int, double w) { sums[r] += w; });
     return sums;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
-                      mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
   ThreadAccumulators sums(n_, 1);
   for_each_tile([&](const Tile& t, Multipliers m, int thread) {
     row_sums_tile(s, t, m, sums.column(thread, 0));
@@ -407,8 +405,7 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
     for_each_listed([&](int r, int c, double w) { out.row(r) += w * (V.row(r) - V.row(c)); });
     return out;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
-                      mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
   const auto k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
   const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(n_);
@@ -452,8 +449,7 @@ void BulkPairs::fill_off_diagonal_of(double scale, Matrix* K) const {
     for_each_listed([&](int r, int c, double w) { (*K)(r, c) = static_cast<Scalar>(-scale * w); });
     return;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(),
-                      mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
   Scalar* data = K->data();
   const Eigen::Index ld = K->rows();
   // Tiles write disjoint parts of K: no accumulators.
@@ -549,9 +545,8 @@ Eigen::MatrixXd DeformedPairs::listed_sums(Term&& term) const {
       double sum[3] = {0.0, 0.0, 0.0};
       for (size_t q = 0; q < partners.size(); ++q) {
         const int j = partners[q];
-        const PairCoefficients c =
-            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j],
-                                mean_);
+        const PairCoefficients c = row_coefficients<K>(row, static_cast<int>(q), area[i], area[j],
+                                                       count[i], count[j], mean_);
         for (int a = 0; a < 3; ++a)
           sum[a] += term(policy, static_cast<size_t>(i), static_cast<size_t>(j), c, a);
       }
@@ -571,9 +566,8 @@ void DeformedPairs::listed_coefficients(std::vector<double>* c1, std::vector<dou
       const size_t first = offsets_[static_cast<size_t>(i)];
       for (size_t q = 0; q < partners.size(); ++q) {
         const int j = partners[q];
-        const PairCoefficients c =
-            row_coefficients<K>(row, static_cast<int>(q), area[i], area[j], count[i], count[j],
-                                mean_);
+        const PairCoefficients c = row_coefficients<K>(row, static_cast<int>(q), area[i], area[j],
+                                                       count[i], count[j], mean_);
         (*c1)[first + q] = c.c1;
         (*c2)[first + q] = c.c2;
       }
@@ -722,8 +716,8 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
       Scalar* k1 = c1->col(i).data();
       Scalar* k2 = c2->col(i).data();
       if (forces != nullptr)
-        row_pass<K, true, true>(p, area, count, mean_, i, j0, first, end, row, forces->columns(thread),
-                                k1, k2);
+        row_pass<K, true, true>(p, area, count, mean_, i, j0, first, end, row,
+                                forces->columns(thread), k1, k2);
       else
         row_pass<K, false, true>(p, area, count, mean_, i, j0, first, end, row, {}, k1, k2);
     });
@@ -772,8 +766,8 @@ FIBERFLUID_VECTOR_CLONES void stored_tangent_rows(int i, int n, const float* k1a
   const double xb0 = x0[h], xb1 = x1[h], xb2 = x2[h], db0 = d0[h], db1 = d1[h], db2 = d2[h];
   const double wb0 = w0[h], wb1 = w1[h], wb2 = w2[h];
   double sa0, sa1, sa2;  // the pair (i, i + 1) itself
-  stored_term<K>({k1a[h], k2a[h]}, xa0 - xb0, xa1 - xb1, xa2 - xb2, wa0 - wb0, wa1 - wb1,
-                 wa2 - wb2, da0 - db0, da1 - db1, da2 - db2, sa0, sa1, sa2);
+  stored_term<K>({k1a[h], k2a[h]}, xa0 - xb0, xa1 - xb1, xa2 - xb2, wa0 - wb0, wa1 - wb1, wa2 - wb2,
+                 da0 - db0, da1 - db1, da2 - db2, sa0, sa1, sa2);
   double sb0 = -sa0, sb1 = -sa1, sb2 = -sa2;
 #pragma omp simd reduction(+ : sa0, sa1, sa2, sb0, sb1, sb2)
   for (int j = i + 2; j < n; ++j) {

@@ -36,8 +36,7 @@ inline double connection_factor(double kept, double count_i, double count_j) {
 // that is h_ij = 2 kept |S_i| |S_j| / ((|S_i| + |S_j|) (M_i + M_j)).
 inline double mean_connection_factor(double kept, double area_i, double area_j, double count_i,
                                      double count_j) {
-  return 2.0 * kept * area_i * area_j /
-         ((area_i + area_j) * (count_i * area_i + count_j * area_j));
+  return 2.0 * kept * area_i * area_j / ((area_i + area_j) * (count_i * area_i + count_j * area_j));
 }
 
 // bulk_weight(connection_factor(kept, c_i, c_j), ...) written with one

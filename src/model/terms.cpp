@@ -29,12 +29,6 @@ TermState::TermState(const TermContext& c, const Eigen::VectorXd& x_,
 
 namespace {
 
-Eigen::Vector3d row3(const Eigen::MatrixXd& M, Eigen::Index i) {
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();
-  v.head(M.cols()) = M.row(i).transpose();
-  return v;
-}
-
 Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& w) {
   Eigen::Matrix3d m;
   m << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
@@ -88,10 +82,10 @@ Eigen::Vector3d face_area_rate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& 
   if (X.cols() == 3) {
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d next = X.row(F(f, (k + 1) % 3)), after = X.row(F(f, (k + 2) % 3));
-      dA += 0.5 * (after - next).cross(row3(W, F(f, k)));
+      dA += 0.5 * (after - next).cross(padded_row(W, F(f, k)));
     }
   } else {
-    const Eigen::Vector3d dw = row3(W, F(f, 1)) - row3(W, F(f, 0));
+    const Eigen::Vector3d dw = padded_row(W, F(f, 1)) - padded_row(W, F(f, 0));
     dA = Eigen::Vector3d(dw.y(), -dw.x(), 0.0);
   }
   return dA;
@@ -186,7 +180,7 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
                   [&](auto policy, int i, int k, const PairCoefficients& c,
                       const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
                     using K = decltype(policy);
-                    const Eigen::Vector3d v = row3(W, i) - row3(W, k);
+                    const Eigen::Vector3d v = padded_row(W, i) - padded_row(W, k);
                     const double b_dot_v = b.dot(v);
                     for (int a = 0; a < dim; ++a)
                       out[a * n + i] += pair_tangent<K>(c, v[a], b_dot_v, b[a], d[a]);
@@ -211,7 +205,7 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
                   [&](auto policy, int i, int k, const PairCoefficients& c,
                       const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
                     if (i > k) return;
-                    const double L = (row3(V0, i) - row3(V0, k)).norm();
+                    const double L = (padded_row(V0, i) - padded_row(V0, k)).norm();
                     out.push_back(read_fiber<decltype(policy)>(i, k, c, b, d, L, no_factors));
                   });
     std::sort(out.begin(), out.end(), [](const FiberReading& p, const FiberReading& q) {
@@ -240,8 +234,9 @@ class SurfaceTensionTerm final : public EquilibriumTerm {
         for (Eigen::SparseMatrix<double>::InnerIterator it(c_.surface, col); it; ++it) {
           const int i = static_cast<int>(it.row()), k = static_cast<int>(it.col());
           if (i == k) continue;
-          const Eigen::Vector3d b = row3(s.X, i) - row3(s.X, k), d = row3(s.U, i) - row3(s.U, k);
-          const double L = (row3(V0, i) - row3(V0, k)).norm(), r = b.norm();
+          const Eigen::Vector3d b = padded_row(s.X, i) - padded_row(s.X, k),
+                                d = padded_row(s.U, i) - padded_row(s.U, k);
+          const double L = (padded_row(V0, i) - padded_row(V0, k)).norm(), r = b.norm();
           body(policy, i, k, K::coefficients(-scale * it.value(), 1.0, 0.0, r, L), b, d);
         }
     });
@@ -602,8 +597,10 @@ std::vector<FiberReading> BulkFiberTerm::readings(
     using K = decltype(policy);
     for (size_t p = 0; p < pairs.size(); ++p) {
       const auto [i, j] = pairs[p];
-      out[p] = read_fiber<K>(i, j, {force_coefficient[p], 0.0}, row3(s.X, i) - row3(s.X, j),
-                             row3(s.U, i) - row3(s.U, j), (row3(V0, i) - row3(V0, j)).norm(), m);
+      out[p] =
+          read_fiber<K>(i, j, {force_coefficient[p], 0.0}, padded_row(s.X, i) - padded_row(s.X, j),
+                        padded_row(s.U, i) - padded_row(s.U, j),
+                        (padded_row(V0, i) - padded_row(V0, j)).norm(), m);
     }
   });
   return out;

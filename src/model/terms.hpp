@@ -79,6 +79,13 @@ class TangentSink {
   std::vector<Eigen::Triplet<double>>* entries_ = nullptr;
 };
 
+// Row `row` of M (#V by dim) as a 3-vector, zero-padded in 2D.
+inline Eigen::Vector3d padded_row(const Eigen::MatrixXd& M, Eigen::Index row) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  v.head(M.cols()) = M.row(row).transpose();
+  return v;
+}
+
 // dA_f/dx_v for the k-th corner v of face f (dim x dim, padded to 3x3): the
 // face area vector's derivative, for the terms whose forces follow the
 // surface (pressure, hydrostatic load, a split edge's share of pressure).

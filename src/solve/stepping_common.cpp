@@ -29,8 +29,9 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
     if (const auto fold = geom::find_fold(now, last_face_areas)) {
       const std::string face = "face " + std::to_string(fold->face) + " turned over ";
       if (!fold->crossing)
-        return face + "(its normal reversed against its neighbours'): the load is too large for "
-                      "the material";
+        return face +
+               "(its normal reversed against its neighbours'): the load is too large for "
+               "the material";
       return face + "and the surface passes through itself (faces " +
              std::to_string(fold->crossing->first) + " and " +
              std::to_string(fold->crossing->second) +

@@ -38,10 +38,10 @@ INSTANTIATE_TEST_SUITE_P(
                       "liver_gravity.json", "bunny_gravity.json", "liver_sweep.json",
                       "nonlinear_round_trip.json", "liver_paddles.json", "stress_strain.json",
                       "benchmark_block_mp1.json", "benchmark_block_mp2.json", "benchmark_rod.json",
-                      "benchmark_rod_converged.json",
-                      "liver_fem_reference.json", "bar_bending.json", "cantilever_large.json",
-                      "compression_large.json", "liver_interactive.json",
-                      "cylinder_mesh_study.json", "dome_mesh_study.json"));
+                      "benchmark_rod_converged.json", "liver_fem_reference.json",
+                      "bar_bending.json", "cantilever_large.json", "compression_large.json",
+                      "liver_interactive.json", "cylinder_mesh_study.json",
+                      "dome_mesh_study.json"));
 
 // A minimal valid experiment, edited by each bad-config case.
 nlohmann::json base_config() {
@@ -635,8 +635,8 @@ TEST(ExperimentConfig, ASupportsSplitEdgeAndTheMeanCountAreReadAndChecked) {
                   {"min", {0, 0, 0}},
                   {"max", {0.06, 0.02, 0.02}},
                   {"segments", {6, 2, 2}}};
-  c["supports"] = {{{"label", "clamp"}, {"where", "x <= 0"}, {"layer", "mirror"},
-                    {"edge", "split"}}};
+  c["supports"] = {
+      {{"label", "clamp"}, {"where", "x <= 0"}, {"layer", "mirror"}, {"edge", "split"}}};
   c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.025}, {"connection_count", "mean"}};
   c["stepping"]["scheme"] = "newton";
   const Experiment ex = load_experiment(write_config(dir, c));

@@ -20,8 +20,8 @@ TEST(MeshStudy, RichardsonFindsTheOrderAndTheLimitOfASmoothSequence) {
   // 1/2.25 and on the unequal h = 1, 0.6, 0.35 the order is near 2 and the
   // extrapolation far closer to 2 than the finest value.
   const auto f = [](double h) { return 2.0 + 0.3 * h * h - 0.01 * h * h * h; };
-  for (const auto& h : {std::vector<double>{1.0, 1.0 / 1.5, 1.0 / 2.25},
-                        std::vector<double>{1.0, 0.6, 0.35}}) {
+  for (const auto& h :
+       {std::vector<double>{1.0, 1.0 / 1.5, 1.0 / 2.25}, std::vector<double>{1.0, 0.6, 0.35}}) {
     const RichardsonEstimate e = richardson(f(h[0]), f(h[1]), f(h[2]), h[0], h[1], h[2]);
     EXPECT_TRUE(e.monotone);
     EXPECT_NEAR(e.order, 2.0, 0.1);
@@ -57,7 +57,8 @@ TEST(MeshStudy, RefinesWhatTheFileGivesAndNamesWhatItLacks) {
   EXPECT_DOUBLE_EQ(factor, 2.0);
   // A generator's surface remeshed: the remeshing sets the resolution, so a
   // ratio that is no power of 2 refines it and leaves the subdivisions.
-  json remeshed = {{"surface", {{"generator", "icosphere"}, {"subdivisions", 5}, {"remesh_vertices", 600}}}};
+  json remeshed = {
+      {"surface", {{"generator", "icosphere"}, {"subdivisions", 5}, {"remesh_vertices", 600}}}};
   refined = refined_document(remeshed, StudiedMesh::Surface, 1.25, &resolution, &factor);
   EXPECT_EQ(refined["surface"]["remesh_vertices"], 938);
   EXPECT_EQ(refined["surface"]["subdivisions"], 5);
@@ -89,10 +90,9 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   sphere.erase("expected");
   sphere["surface"]["radius"] = 1.0;
   const auto file = dir.write("sphere.json", sphere.dump());
-  const testing::Outcome outcome =
-      testing::run_cli("study mesh " + file.string() +
-                       " --ratio 2 --figure max_displacement --plot -o " +
-                       (dir.path() / "study").string());
+  const testing::Outcome outcome = testing::run_cli(
+      "study mesh " + file.string() + " --ratio 2 --figure max_displacement --plot -o " +
+      (dir.path() / "study").string());
   ASSERT_EQ(outcome.status, 0) << outcome.output;
   EXPECT_NE(outcome.output.find("level 3: subdivisions 3"), std::string::npos) << outcome.output;
   std::ifstream study_file(dir.path() / "study" / "study.json");
@@ -105,13 +105,13 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "plot.png")) << outcome.output;
   // Run again into the same folder: replaced whole. Into a folder fiberfluid
   // did not write: refused before anything runs, the folder kept.
-  const testing::Outcome again = testing::run_cli(
-      "study mesh " + file.string() + " --ratio 2 --figure max_displacement -o " +
-      (dir.path() / "study").string());
+  const testing::Outcome again =
+      testing::run_cli("study mesh " + file.string() + " --ratio 2 --figure max_displacement -o " +
+                       (dir.path() / "study").string());
   EXPECT_EQ(again.status, 0) << again.output;
   dir.write("notes.txt", "mine");
-  const testing::Outcome foreign = testing::run_cli(
-      "study mesh " + file.string() + " --ratio 2 -o " + dir.path().string());
+  const testing::Outcome foreign =
+      testing::run_cli("study mesh " + file.string() + " --ratio 2 -o " + dir.path().string());
   EXPECT_NE(foreign.status, 0);
   EXPECT_EQ(foreign.output.find("level 1 of 3"), std::string::npos) << foreign.output;
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "notes.txt"));
@@ -200,10 +200,9 @@ TEST(FitMeshCheck, AFitReportsHowFarItsParametersMoveOnACoarserMesh) {
   json fit = json::parse(in);
   fit["fit"]["mesh_check"] = "coarser";
   fit.erase("expected");
-  fit["fit"]["targets"][0]["file"] =
-      (testing::experiment_file("fit_sphere.json").parent_path() /
-       fit["fit"]["targets"][0]["file"].get<std::string>())
-          .string();
+  fit["fit"]["targets"][0]["file"] = (testing::experiment_file("fit_sphere.json").parent_path() /
+                                      fit["fit"]["targets"][0]["file"].get<std::string>())
+                                         .string();
   const auto file = dir.write("fit.json", fit.dump());
   const testing::Outcome outcome =
       testing::run_cli("fit " + file.string() + " -q -o " + (dir.path() / "out").string());

@@ -26,6 +26,8 @@
 namespace fiberfluid::model {
 namespace {
 
+using testing::random_displacements;
+
 std::vector<int> vertices_where(const Model& m,
                                 const std::function<bool(const Eigen::Vector3d&)>& in) {
   std::vector<int> chosen;
@@ -71,13 +73,6 @@ Model clamped_block(const FiberLaw& law, FiberKinematics kinematics, bool layer 
   gravity.integration = Load::Integration::Exact;
   m.loads = {gravity};
   return m;
-}
-
-Eigen::VectorXd random_displacements(const Model& m, unsigned seed, double size) {
-  std::srand(seed);
-  Eigen::VectorXd x = size * Eigen::VectorXd::Random(m.num_unknowns());
-  x[m.pressure_dof()] = 300.0;
-  return x;
 }
 
 TEST(MirrorLayer, TheClampPlaneIsFoundAndAClampWithoutOneIsNamed) {
@@ -217,38 +212,12 @@ TEST(MirrorLayer, TangentAndParameterDerivativesMatchCentralDifferences) {
       const Equilibrium eq(m);
       const Eigen::VectorXd x = random_displacements(m, 3, 0.002);
       const std::vector<double> factors = {0.6};
-      const Eigen::MatrixXd J = eq.tangent(x, factors);
-      const Eigen::MatrixXd fd =
-          testing::finite_difference_tangent(eq, x, factors, /*displacement_step=*/1e-7,
-                                             /*pressure_step=*/1e-2);
-      EXPECT_LT((J - fd).norm() / fd.norm(), 1e-6);
-      const Eigen::VectorXd v = random_displacements(m, 7, 1.0);
-      EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm());
-      EXPECT_TRUE(testing::stored_product_matches(eq.linearize(x, factors).apply(v), J, v));
-      EXPECT_LT((Eigen::MatrixXd(eq.sparse_tangent(x, factors)) - J).norm(), 1e-12 * J.norm());
+      testing::expect_tangent_matches_differences(eq, x, factors, random_displacements(m, 7, 1.0));
       // The layer is in there: without it the tangent differs.
       const Model bare = clamped_block(law, kinematics, false);
+      const Eigen::MatrixXd J = eq.tangent(x, factors);
       EXPECT_GT((Equilibrium(bare).tangent(x, factors) - J).norm(), 1e-3 * J.norm());
-
-      std::vector<std::string> names = law.parameter_names();
-      names.push_back("factor_z");
-      const Eigen::MatrixXd D = eq.parameter_derivatives(x, names);
-      for (size_t k = 0; k < names.size(); ++k) {
-        auto with = [&](double delta) {
-          Model changed = m;
-          if (names[k] == "factor_z")
-            changed.material.axis_factors.z() += delta;
-          else
-            changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
-          return Equilibrium(changed).residual(x, factors);
-        };
-        const double h =
-            1e-5 * std::max(1.0, names[k] == "factor_z" ? 1.3 : std::abs(law.parameter(names[k])));
-        const Eigen::VectorXd difference = (with(h) - with(-h)) / (2.0 * h);
-        EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - difference).norm(),
-                  1e-6 * difference.norm())
-            << names[k];
-      }
+      testing::expect_parameter_derivatives_match_differences(m, x, factors);
     }
 }
 

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -156,6 +158,58 @@ inline double mean_deflection_at(const model::Model& m, const Eigen::MatrixXd& U
   for (int v = 0; v < m.num_vertices(); ++v)
     if (std::abs(m.surface.V(v, 0) - x) < 1e-9) sum += U(v, 2), ++count;
   return sum / count;
+}
+
+// Displacements uniform in [-size, size] (Eigen's Random after srand(seed))
+// and a pressure of 300 Pa.
+inline Eigen::VectorXd random_displacements(const model::Model& m, unsigned seed, double size) {
+  std::srand(seed);
+  Eigen::VectorXd x = size * Eigen::VectorXd::Random(m.num_unknowns());
+  x[m.pressure_dof()] = 300.0;
+  return x;
+}
+
+// The tangent at x against central differences of the residual, and its
+// product, stored-coefficient product and sparse form against it (v: a
+// direction).
+inline void expect_tangent_matches_differences(const model::Equilibrium& eq,
+                                               const Eigen::VectorXd& x,
+                                               const std::vector<double>& factors,
+                                               const Eigen::VectorXd& v) {
+  const Eigen::MatrixXd J = eq.tangent(x, factors);
+  const Eigen::MatrixXd fd = finite_difference_tangent(eq, x, factors, /*displacement_step=*/1e-7,
+                                                       /*pressure_step=*/1e-2);
+  EXPECT_LT((J - fd).norm() / fd.norm(), 1e-6);
+  EXPECT_LT((eq.tangent_product(x, factors, v) - J * v).norm(), 1e-10 * (J * v).norm());
+  EXPECT_TRUE(stored_product_matches(eq.linearize(x, factors).apply(v), J, v));
+  EXPECT_LT((Eigen::MatrixXd(eq.sparse_tangent(x, factors)) - J).norm(), 1e-12 * J.norm());
+}
+
+// dR/dtheta at x for every parameter of the model's law and the z axis
+// factor against central differences of the residual.
+inline void expect_parameter_derivatives_match_differences(const model::Model& m,
+                                                           const Eigen::VectorXd& x,
+                                                           const std::vector<double>& factors) {
+  const model::FiberLaw& law = m.material.law;
+  std::vector<std::string> names = law.parameter_names();
+  names.push_back("factor_z");
+  const Eigen::MatrixXd D = model::Equilibrium(m).parameter_derivatives(x, names);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const bool factor = names[k] == "factor_z";
+    auto with = [&](double delta) {
+      model::Model changed = m;
+      if (factor)
+        changed.material.axis_factors.z() += delta;
+      else
+        changed.material.law.set_parameter(names[k], law.parameter(names[k]) + delta);
+      return model::Equilibrium(changed).residual(x, factors);
+    };
+    const double h = 1e-5 * std::max(1.0, factor ? m.material.axis_factors.z()
+                                                 : std::abs(law.parameter(names[k])));
+    const Eigen::VectorXd difference = (with(h) - with(-h)) / (2.0 * h);
+    EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - difference).norm(), 1e-6 * difference.norm())
+        << names[k];
+  }
 }
 
 }  // namespace fiberfluid::testing
