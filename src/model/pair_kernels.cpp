@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 #include "fiberfluid/geom/fiber_mask.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
@@ -64,7 +65,6 @@ void for_each_tile_pair(int n, Visit&& visit) {
 // The set's arrays, indexed by position in the set.
 struct SetArrays {
   const double *x0, *x1, *x2, *area, *count;
-  bool mean;  // the mean count's weights (PairFactors::mean_count)
 };
 
 // The multipliers of a tile's rows: m + r * stride (stride 0: one row of ones).
@@ -80,11 +80,23 @@ inline double weight(double m, double area_i, double area_j, double count_i, dou
   return counted_bulk_weight(m, area_i, area_j, count_i, count_j, std::sqrt(r2), mean);
 }
 
+// f(std::bool_constant<mean>): which weight the count takes (the mean
+// count's or the others'), fixed at compile time so that the default's
+// loops carry no select.
+template <class F>
+void with_count(bool mean, F&& f) {
+  if (mean)
+    f(std::true_type{});
+  else
+    f(std::false_type{});
+}
+
 // (L V) over one tile for three columns: row sums into out at i, the
 // opposite terms (w_ji (v_j - v_i) = -w_ij (v_i - v_j)) into out at j.
-FIBERFLUID_VECTOR_CLONES
-void product_tile(const SetArrays& s, const Tile& t, Multipliers mult, const double* const v[3],
-                  const std::array<double*, 3>& out) {
+template <bool kMean>
+FIBERFLUID_VECTOR_CLONES void product_tile(const SetArrays& s, const Tile& t, Multipliers mult,
+                                           const double* const v[3],
+                                           const std::array<double*, 3>& out) {
   const double *x0 = s.x0, *x1 = s.x1, *x2 = s.x2, *a = s.area, *c = s.count;
   const double *v0 = v[0], *v1 = v[1], *v2 = v[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
@@ -97,7 +109,7 @@ void product_tile(const SetArrays& s, const Tile& t, Multipliers mult, const dou
 #pragma omp simd reduction(+ : s0, s1, s2)
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
-      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean);
+      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, kMean);
       const double e0 = w * (ui - v0[j]), e1 = w * (vi - v1[j]), e2 = w * (wi - v2[j]);
       s0 += e0, s1 += e1, s2 += e2;
       o0[j] -= e0, o1[j] -= e1, o2[j] -= e2;
@@ -107,8 +119,9 @@ void product_tile(const SetArrays& s, const Tile& t, Multipliers mult, const dou
 }
 
 // Row sums sum_j w_ij over one tile, into out at i and at j.
-FIBERFLUID_VECTOR_CLONES
-void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult, double* out) {
+template <bool kMean>
+FIBERFLUID_VECTOR_CLONES void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult,
+                                            double* out) {
   const double *x0 = s.x0, *x1 = s.x1, *x2 = s.x2, *a = s.area, *c = s.count;
   for (int r = 0; r < t.ni; ++r) {
     const int i = t.i0 + r;
@@ -118,7 +131,7 @@ void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult, double* 
 #pragma omp simd reduction(+ : sum)
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
-      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean);
+      const double w = weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, kMean);
       sum += w;
       out[j] += w;
     }
@@ -130,7 +143,7 @@ void row_sums_tile(const SetArrays& s, const Tile& t, Multipliers mult, double* 
 // columns i of the tile written whole (contiguous), then mirrored into the
 // rows i in 32 x 32 blocks, so that the strided side touches 32 pages at a
 // time (the TLB's reach) instead of one per column of the tile.
-template <class Scalar>
+template <bool kMean, class Scalar>
 FIBERFLUID_VECTOR_CLONES void block_tile(const SetArrays& s, const Tile& t, Multipliers mult,
                                          double scale, Scalar* K, Eigen::Index ld) {
   const double *x0 = s.x0, *x1 = s.x1, *x2 = s.x2, *a = s.area, *c = s.count;
@@ -143,7 +156,7 @@ FIBERFLUID_VECTOR_CLONES void block_tile(const SetArrays& s, const Tile& t, Mult
     for (int j = t.j0 + (t.diagonal ? r + 1 : 0); j < t.j0 + t.nj; ++j) {
       const double dx = xi - x0[j], dy = yi - x1[j], dz = zi - x2[j];
       column[j] = static_cast<Scalar>(
-          -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, s.mean));
+          -scale * weight(m[j - t.j0], ai, a[j], ci, c[j], dx * dx + dy * dy + dz * dz, kMean));
     }
   }
   constexpr int B = 32;
@@ -204,12 +217,11 @@ PairColumns columns_of(const std::vector<double> (&x)[3], const std::vector<doub
 // formed once: with kForces its forces summed into out (the term at i, its
 // opposite at j); with kTable its coefficients written to k1, k2 at j (the
 // lower triangle of the stored tangent's table).
-template <class K, bool kForces, bool kTable, class Scalar = float>
+template <class K, bool kMean, bool kForces, bool kTable, class Scalar = float>
 FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
-                                       const double* count, bool mean, int i, int j0, int first,
-                                       int end, const RowArrays& row,
-                                       const std::array<double*, 3>& out, Scalar* k1 = nullptr,
-                                       Scalar* k2 = nullptr) {
+                                       const double* count, int i, int j0, int first, int end,
+                                       const RowArrays& row, const std::array<double*, 3>& out,
+                                       Scalar* k1 = nullptr, Scalar* k2 = nullptr) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
   const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
   double *o0 = out[0], *o1 = out[1], *o2 = out[2];
@@ -218,7 +230,7 @@ FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
   double f0 = 0.0, f1 = 0.0, f2 = 0.0;
 #pragma omp simd reduction(+ : f0, f1, f2)
   for (int j = first; j < end; ++j) {
-    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], mean);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], kMean);
     if constexpr (kTable) {
       k1[j] = static_cast<Scalar>(c.c1);
       k2[j] = static_cast<Scalar>(c.c2);
@@ -234,10 +246,10 @@ FIBERFLUID_VECTOR_CLONES void row_pass(const PairColumns& p, const double* area,
   if constexpr (kForces) o0[i] += f0, o1[i] += f1, o2[i] += f2;
 }
 
-template <class K>
+template <class K, bool kMean>
 FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* const w[3],
-                                          const double* area, const double* count, bool mean, int i,
-                                          int j0, int first, int end, const RowArrays& row,
+                                          const double* area, const double* count, int i, int j0,
+                                          int first, int end, const RowArrays& row,
                                           const std::array<double*, 3>& out) {
   const double *x0 = p.x[0], *x1 = p.x[1], *x2 = p.x[2];
   const double *u0 = p.u[0], *u1 = p.u[1], *u2 = p.u[2];
@@ -248,7 +260,7 @@ FIBERFLUID_VECTOR_CLONES void tangent_row(const PairColumns& p, const double* co
   double p0 = 0.0, p1 = 0.0, p2 = 0.0;
 #pragma omp simd reduction(+ : p0, p1, p2)
   for (int j = first; j < end; ++j) {
-    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], mean);
+    const PairCoefficients c = row_coefficients<K>(row, j - j0, ai, area[j], ci, count[j], kMean);
     const double b0 = xi0 - x0[j], b1 = xi1 - x1[j], b2 = xi2 - x2[j];
     const double v0 = wi0 - w0[j], v1 = wi1 - w1[j], v2 = wi2 - w2[j];
     const double b_dot_v = b0 * v0 + b1 * v1 + b2 * v2;
@@ -391,10 +403,12 @@ Eigen::VectorXd BulkPairs::row_sums() const {
     for_each_listed([&](int r, int, double w) { sums[r] += w; });
     return sums;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   ThreadAccumulators sums(n_, 1);
-  for_each_tile([&](const Tile& t, Multipliers m, int thread) {
-    row_sums_tile(s, t, m, sums.column(thread, 0));
+  with_count(mean_, [&](auto mean) {
+    for_each_tile([&](const Tile& t, Multipliers m, int thread) {
+      row_sums_tile<mean()>(s, t, m, sums.column(thread, 0));
+    });
   });
   return sums.sum().col(0);
 }
@@ -405,7 +419,7 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
     for_each_listed([&](int r, int c, double w) { out.row(r) += w * (V.row(r) - V.row(c)); });
     return out;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   const auto k = static_cast<int>(V.cols());
   Eigen::MatrixXd out(n_, k);
   const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(n_);
@@ -415,8 +429,10 @@ Eigen::MatrixXd BulkPairs::laplacian_product(const Eigen::MatrixXd& V) const {
     const double* columns[3];
     for (int c = 0; c < 3; ++c) columns[c] = c < width ? V.col(first + c).data() : zeros.data();
     ThreadAccumulators products(n_, 3);
-    for_each_tile([&](const Tile& t, Multipliers m, int thread) {
-      product_tile(s, t, m, columns, products.columns(thread));
+    with_count(mean_, [&](auto mean) {
+      for_each_tile([&](const Tile& t, Multipliers m, int thread) {
+        product_tile<mean()>(s, t, m, columns, products.columns(thread));
+      });
     });
     out.middleCols(first, width) = products.sum().leftCols(width);
   }
@@ -449,11 +465,14 @@ void BulkPairs::fill_off_diagonal_of(double scale, Matrix* K) const {
     for_each_listed([&](int r, int c, double w) { (*K)(r, c) = static_cast<Scalar>(-scale * w); });
     return;
   }
-  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data(), mean_};
+  const SetArrays s{x_[0].data(), x_[1].data(), x_[2].data(), area_.data(), count_.data()};
   Scalar* data = K->data();
   const Eigen::Index ld = K->rows();
   // Tiles write disjoint parts of K: no accumulators.
-  for_each_tile([&](const Tile& t, Multipliers m, int) { block_tile(s, t, m, scale, data, ld); });
+  with_count(mean_, [&](auto mean) {
+    for_each_tile(
+        [&](const Tile& t, Multipliers m, int) { block_tile<mean()>(s, t, m, scale, data, ld); });
+  });
 }
 
 void BulkPairs::fill_off_diagonal(double scale, Eigen::MatrixXd* K) const {
@@ -626,9 +645,11 @@ Eigen::MatrixXd DeformedPairs::forces() const {
   ThreadAccumulators forces(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
-    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      row_pass<K, true, false>(p, area_.data(), count_.data(), mean_, i, j0, first, end, row,
-                               forces.columns(thread));
+    with_count(mean_, [&](auto mean) {
+      for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+        row_pass<K, mean(), true, false>(p, area_.data(), count_.data(), i, j0, first, end, row,
+                                         forces.columns(thread));
+      });
     });
   });
   return forces.sum();
@@ -654,9 +675,11 @@ Eigen::MatrixXd DeformedPairs::tangent_product(const Eigen::MatrixXd& W) const {
   ThreadAccumulators products(n_, 3);
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
-    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      tangent_row<K>(p, w, area_.data(), count_.data(), mean_, i, j0, first, end, row,
-                     products.columns(thread));
+    with_count(mean_, [&](auto mean) {
+      for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+        tangent_row<K, mean()>(p, w, area_.data(), count_.data(), i, j0, first, end, row,
+                               products.columns(thread));
+      });
     });
   });
   return products.sum();
@@ -712,14 +735,16 @@ void DeformedPairs::store_coefficients(Table* c1, Table* c2, ThreadAccumulators*
   const PairColumns p = columns_of(x_, u_);
   with_kinematics(kinematics_, [&](auto policy) {
     using K = decltype(policy);
-    for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
-      Scalar* k1 = c1->col(i).data();
-      Scalar* k2 = c2->col(i).data();
-      if (forces != nullptr)
-        row_pass<K, true, true>(p, area, count, mean_, i, j0, first, end, row,
-                                forces->columns(thread), k1, k2);
-      else
-        row_pass<K, false, true>(p, area, count, mean_, i, j0, first, end, row, {}, k1, k2);
+    with_count(mean_, [&](auto mean) {
+      for_each_row([&](int i, int j0, int first, int end, const RowArrays& row, int thread) {
+        Scalar* k1 = c1->col(i).data();
+        Scalar* k2 = c2->col(i).data();
+        if (forces != nullptr)
+          row_pass<K, mean(), true, true>(p, area, count, i, j0, first, end, row,
+                                          forces->columns(thread), k1, k2);
+        else
+          row_pass<K, mean(), false, true>(p, area, count, i, j0, first, end, row, {}, k1, k2);
+      });
     });
   });
   // The diagonal after the pass, not before: zeroed first, it would be the
