@@ -8,6 +8,8 @@
 
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/held_edge.hpp"
+#include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::model {
@@ -58,6 +60,12 @@ Equilibrium::Equilibrium(const Model& model)
   context_.volume0 = volume0_;
   surface_ = surface_tension_laplacian(model.surface.V, area0_, geom::unique_edges(model.surface));
   terms_ = make_surface_and_load_terms(context_);
+  // The supports' terms: they build on the terms above (terms.hpp), not
+  // the other way round.
+  for (const MirrorLayer& layer : model.mirror_layers)
+    terms_.push_back(make_mirror_layer_term(context_, layer));
+  for (const HeldEdge& edge : model.held_edges)
+    for (auto& term : make_held_edge_terms(context_, edge)) terms_.push_back(std::move(term));
 }
 
 std::vector<std::string> Equilibrium::term_names() const {

@@ -10,9 +10,7 @@
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/geom/fiber_mask.hpp"
 #include "fiberfluid/model/assembly.hpp"
-#include "fiberfluid/model/held_edge.hpp"
 #include "fiberfluid/model/loads.hpp"
-#include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
 
@@ -449,10 +447,6 @@ std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const 
   terms.push_back(std::make_unique<SurfaceTensionTerm>(c));
   terms.push_back(std::make_unique<PressureVolumeTerm>(c));
   for (size_t l = 0; l < c.model.loads.size(); ++l) terms.push_back(make_load_term(c, l));
-  for (const MirrorLayer& layer : c.model.mirror_layers)
-    terms.push_back(make_mirror_layer_term(c, layer));
-  for (const HeldEdge& edge : c.model.held_edges)
-    for (auto& term : make_held_edge_terms(c, edge)) terms.push_back(std::move(term));
   return terms;
 }
 

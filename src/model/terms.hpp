@@ -9,6 +9,10 @@
 //   point load        -lambda F                     (one term per load)
 //   hydrostatic load  -q_i(x) S_i(x)                (one term per load)
 //   mirror layer      fibers to the body's image across a clamp (mirror_layer.hpp)
+//   split edge        a held edge's free share as ghosts (held_edge.hpp)
+//
+// The supports' terms (the last two) are built on this file's (point_fibers.hpp,
+// face_area_derivative) and added by Equilibrium.
 //
 // A new load kind is one new term and its case in make_load_term. Contact
 // with the paddles is not a term: contacts are held unknowns of the stepper's
@@ -176,9 +180,9 @@ class BulkFiberTerm final : public EquilibriumTerm {
   const TermContext& c_;
 };
 
-// The terms other than the bulk fibers, in the order they are summed:
-// surface tension, pressure and volume, one per load of the model, then one
-// per mirror layer.
+// The terms other than the bulk fibers and the supports' (Equilibrium adds
+// the mirror layers' and the split edges' after these), in the order they
+// are summed: surface tension, pressure and volume, one per load of the model.
 // Throws std::invalid_argument for a load of an unknown kind.
 std::vector<std::unique_ptr<EquilibriumTerm>> make_surface_and_load_terms(const TermContext& c);
 
