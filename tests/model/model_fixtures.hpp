@@ -16,6 +16,7 @@
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/solve/load_stepper.hpp"
 
 namespace fiberfluid::testing {
 
@@ -210,6 +211,22 @@ inline void expect_parameter_derivatives_match_differences(const model::Model& m
     EXPECT_LT((D.col(static_cast<Eigen::Index>(k)) - difference).norm(), 1e-6 * difference.norm())
         << names[k];
   }
+}
+
+// The model solved by Newton in `steps` steps; the first support group's
+// reaction balances the applied load (to 1e-8 of it, which is over 0.01 N).
+inline solve::SteppingSummary expect_reaction_balances_load(const model::Model& m, int steps) {
+  solve::SteppingOptions newton;
+  newton.scheme = solve::Scheme::Newton;
+  newton.steps = steps;
+  const solve::SteppingSummary run = solve::solve_load_steps(m, newton);
+  EXPECT_TRUE(run.success) << run.message;
+  if (!run.success) return run;
+  const solve::StepRecord& last = run.steps.back();
+  const Eigen::Vector3d weight = last.applied_force;
+  EXPECT_GT(weight.norm(), 0.01);
+  EXPECT_LT((last.reactions[0] + weight).norm(), 1e-8 * weight.norm());
+  return run;
 }
 
 }  // namespace fiberfluid::testing
