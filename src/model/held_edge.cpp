@@ -273,10 +273,10 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
   }
 
  private:
-  // The pressures at a state: q_i per vertex, their gradient dq/dx (the same
-  // at every vertex), and the exact form's face sums.
+  // The pressures at a state: q_i per vertex with the exact form's weights
+  // (ExactFaceShares), and their gradient dq/dx (the same at every vertex).
   struct Field {
-    Eigen::VectorXd q, face_sum;
+    ExactFaceShares shares;
     Eigen::Vector3d gradient;
   };
   const Load& load() const { return c_.model.loads[load_]; }
@@ -286,25 +286,18 @@ class HeldEdgeLoadTerm final : public EquilibriumTerm {
   }
   Field field(const TermState& s) const {
     const double per_depth = hydrostatic_pressure_per_depth(load(), s.factors[load_]);
-    Field out;
-    out.q = per_depth * hydrostatic_heads(s.X, load().acceleration, level_);
-    out.gradient = per_depth * load().acceleration / load().acceleration.norm();
-    if (exact()) out.face_sum = ExactFaceShares(c_.model.surface.F, out.q).face_sum;
-    return out;
+    return {ExactFaceShares(c_.model.surface.F,
+                            per_depth * hydrostatic_heads(s.X, load().acceleration, level_)),
+            per_depth * load().acceleration / load().acceleration.norm()};
   }
   // j's weight on face f: q_j C0 (vertex form) or w_jf (exact form).
   double weight(const Field& q, int j, int f) const {
-    if (!exact()) return c_.C0 * q.q[j];
-    return per_pressure() * (q.q[j] + q.face_sum[f]);
+    return exact() ? q.shares.w(j, f) : c_.C0 * q.shares.q[j];
   }
   // d(weight)/dq_v for a corner v of the face (times the gradient: d/dx_v).
-  double weight_rate(const Field&, int j, int v) const {
+  double weight_rate(const Field& q, int j, int v) const {
     if (!exact()) return v == j ? c_.C0 : 0.0;
-    return per_pressure() * (v == j ? 2.0 : 1.0);
-  }
-  double per_pressure() const {
-    const double m = static_cast<double>(c_.model.surface.F.cols());
-    return 1.0 / (m * (m + 1.0));
+    return q.shares.per_pressure * (v == j ? 2.0 : 1.0);
   }
   // G_j: the load's force on j from its free faces.
   Eigen::Vector3d share(const Eigen::MatrixXd& X, const Field& q, const EdgeVertex& e) const {
