@@ -25,8 +25,6 @@
 namespace fiberfluid::fit {
 
 // A measured surface tied to the load step it was measured at.
-class EvaluationCache;
-
 struct MeasuredStep {
   Target target;
   int step = 0;  // 1..stepping.steps
@@ -270,42 +268,6 @@ class Calibration {
   FitResult result_at(const Eigen::VectorXd& phi) const;
 
  private:
-  // A result at phi with nothing known yet: the values there, NaN errors,
-  // intervals and costs, sized for the parameters.
-  FitResult result_from(const Eigen::VectorXd& phi) const;
-  // The distances, their statistics, the run and the force misfits of an
-  // evaluation, into result.
-  void describe_at(const Evaluation& at, FitResult& result) const;
-  // The linearised 95% intervals' ends checked on the profile likelihood:
-  // an end where it has risen by less than half the 95% level is moved out
-  // to where it reaches the level, or to the parameter's bound.
-  void check_interval_ends(EvaluationCache& evaluations, const Eigen::VectorXd& phi,
-                           const Eigen::MatrixXd& covariance, double variance,
-                           FitResult& result) const;
-  // The optimum's warm-started evaluation run again along the load path: its
-  // run described (every step's record) and, where the two equilibria
-  // differ, FitResult::warm_start_note says so.
-  void check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
-                        FitResult& result) const;
-  // evaluate() with these stepping options (a warm start in them is used as
-  // given); keep_path_states: a failed run's Evaluation::path_states.
-  Evaluation evaluate_with(const Eigen::VectorXd& phi, bool with_jacobian,
-                           solve::SteppingOptions stepping, bool keep_path_states) const;
-  // A start's run that gives up early (at most kProbeCuts halvings of a step
-  // and kProbeIterations Newton iterations per piece; a success is the full
-  // run's, to the bit), keeping a failed path's states near n/2, n/4, ...
-  Evaluation probe_start(const Eigen::VectorXd& phi, bool with_jacobian,
-                         const Eigen::VectorXd& warm_start = {}) const;
-  // Where the start's probe failed: the softest start with every modulus
-  // and gamma 2, 4, ... 1024 times the start's (within the bounds) whose
-  // probe succeeds, and that factor; nullopt when none does, or none can
-  // help. One whose end the failed probe passed (its state at step n/s) is
-  // solved from there, warm.
-  std::optional<Eigen::VectorXd> stiffer_start(const Eigen::VectorXd& start_phi,
-                                               const Evaluation& failed_probe,
-                                               EvaluationCache& evaluations,
-                                               bool with_sensitivities, double* factor) const;
-
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

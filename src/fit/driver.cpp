@@ -1,0 +1,270 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The fit's driver: the start's probe and a stiffer start where it fails,
+// the optimiser, the run at the optimum (along the path, where it was warm
+// started), and the estimate's ending.
+#include "fiberfluid/fit/driver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/fit/uncertainty.hpp"
+#include "fiberfluid/util/run_control.hpp"
+
+namespace fiberfluid::fit {
+
+FitDriver::FitDriver(const Calibration& calibration, const FitProblem& problem)
+    : calibration_(calibration), problem_(problem) {}
+
+FitResult FitDriver::result_from(const Eigen::VectorXd& phi) const {
+  const FitProblem& m = problem_;
+  const int P = m.map().size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  FitResult result;
+  result.method = m.options().method;
+  result.analytic_jacobian = m.analytic();
+  result.names = m.map().names();
+  result.initial = result.values = m.map().values(phi);
+  result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
+  result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
+  result.initial_cost = result.final_cost = nan;
+  return result;
+}
+
+FitResult FitDriver::result_at(const Eigen::VectorXd& phi) const {
+  FitResult result = result_from(phi);
+  const Evaluation at = calibration_.evaluate(phi, false);
+  result.forward_runs = at.forward_runs;
+  if (!at.ok) {
+    result.status = cancel_requested() ? FitStatus::Interrupted : FitStatus::ForwardRunsFailed;
+    result.message = "the forward run failed: " + at.message;
+    return result;
+  }
+  problem_.describe(at, result);
+  result.initial_cost = result.final_cost;
+  result.status = FitStatus::Converged;
+  result.success = true;
+  return result;
+}
+
+void FitDriver::check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
+                                 FitResult& result) const {
+  const Evaluation path = calibration_.evaluate(phi, false);
+  if (!path.ok) {
+    if (cancel_requested()) return;
+    result.warm_start_note = "the run along the load path at the fitted values failed (" +
+                             path.message +
+                             "): the fit's warm-started equilibrium is not reached from the "
+                             "unloaded body";
+    return;
+  }
+  // Both are equilibria to Newton's tolerance: the same one agrees far below
+  // the distances' scale; another one (a branch) differs at it.
+  const double gap = (path.residuals - warm.residuals).lpNorm<Eigen::Infinity>();
+  const double scale =
+      std::max(warm.residuals.lpNorm<Eigen::Infinity>(), 1e-9 * problem_.body_length());
+  if (gap > 1e-4 * scale) {
+    std::ostringstream note;
+    note << "the run along the load path at the fitted values differs from the warm-started one "
+            "by up to "
+         << gap << " m in a residual (the residuals reach " << scale
+         << " m): another equilibrium; the path's is reported (fit with \"warm_start\": false)";
+    result.warm_start_note = note.str();
+  }
+  problem_.describe(path, result);  // the path's run: every step's record
+}
+
+namespace {
+
+// The fitted parameters that scale the body's stiffness: the law's moduli
+// (Y, Y0, Y_t, Y_c), gamma and the axis factors.
+bool scales_stiffness(const std::string& name) {
+  return (!name.empty() && name[0] == 'Y') || name == "gamma" || name.rfind("factor_", 0) == 0;
+}
+
+// A start probe's limits: a step cut at most twice, a piece given at most 12
+// Newton iterations. A start that needs more is too soft for its load more
+// often than not, and a stiffer start costs less than the failing step's
+// remaining cuts (the layered phantom from Y/5: the probe gives up after
+// 72 s, the full run after 109 s).
+constexpr int kProbeCuts = 2;
+constexpr int kProbeIterations = 12;
+
+}  // namespace
+
+Evaluation FitDriver::probe_start(const Eigen::VectorXd& phi, bool with_jacobian,
+                                  const Eigen::VectorXd& warm_start) const {
+  solve::SteppingOptions stepping = problem_.stepping();
+  stepping.newton.max_step_cuts = std::min(stepping.newton.max_step_cuts, kProbeCuts);
+  stepping.newton.max_iterations = std::min(stepping.newton.max_iterations, kProbeIterations);
+  if (problem_.warm_starts()) stepping.warm_start = warm_start;
+  return problem_.evaluate(phi, with_jacobian, std::move(stepping), true);
+}
+
+// A forward run that fails at the start is most often a material too soft
+// for its load: a face turns over, or the run runs away. With every modulus
+// and gamma times s the equilibrium at the full load is the start's at 1/s
+// of it (the pressure times s): the same body with the load divided by s.
+// So the start is stiffened by 2, 4, ... 1024, within the bounds, and a
+// stiffened start whose end the failed probe passed (its state at step n/s)
+// is solved from there, warm; the others walk their paths (a runaway at a
+// step too large for a soft body need not recur on a stiffer one). A body
+// moved only by prescribed motions and paddles has nothing to stiffen
+// against.
+std::optional<Eigen::VectorXd> FitDriver::stiffer_start(const Eigen::VectorXd& start_phi,
+                                                        const Evaluation& failed_probe,
+                                                        EvaluationCache& evaluations,
+                                                        bool with_sensitivities,
+                                                        double* factor) const {
+  const FitProblem& m = problem_;
+  if (m.model().loads.empty()) return std::nullopt;
+  const std::vector<Parameter>& parameters = m.map().parameters();
+  const Eigen::VectorXd upper = m.map().upper_phi();
+  std::vector<int> stiffness;
+  for (int k = 0; k < m.map().size(); ++k)
+    if (scales_stiffness(parameters[static_cast<size_t>(k)].name)) stiffness.push_back(k);
+  if (stiffness.empty()) return std::nullopt;
+  const Eigen::VectorXd start = m.map().values(start_phi);
+  const int n = m.stepping().steps;
+  for (double s = 2.0; s <= kStiffest && !cancel_requested(); s *= 2.0) {
+    Eigen::VectorXd phi = start_phi;
+    bool moved = false;
+    for (int k : stiffness) {
+      const Parameter& p = parameters[static_cast<size_t>(k)];
+      const double value = s * start[k];
+      const double wanted = p.log_scale ? std::log(value) : value;
+      phi[k] = std::min(wanted, upper[k]);
+      moved |= phi[k] > start_phi[k];
+    }
+    if (!moved) return std::nullopt;  // every stiffness on its upper bound
+    Eigen::VectorXd warm;             // the probe's state at n/s, its pressure times s
+    if (const auto at = failed_probe.path_states.find(static_cast<int>(step_at_share(n, s)));
+        at != failed_probe.path_states.end()) {
+      warm = at->second;
+      warm[warm.size() - 1] *= s;
+    }
+    if (evaluations.add(phi, with_sensitivities, probe_start(phi, with_sensitivities, warm))) {
+      *factor = s;
+      return phi;
+    }
+  }
+  return std::nullopt;
+}
+
+FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
+  const FitProblem& m = problem_;
+  const auto start = std::chrono::steady_clock::now();
+  const int P = m.map().size();
+  // Sized from the start, whatever the ending: a report never reads past them.
+  FitResult result = result_from(start_phi);
+  EvaluationCache evaluations(calibration_);
+  auto finish = [&](FitStatus status, std::string message) {
+    result.status = status;
+    result.success = converged(status);
+    if (!message.empty()) result.message = std::move(message);
+    result.forward_runs = evaluations.forward_runs;
+    result.warm_started_runs = evaluations.warm_started_runs;
+    result.sensitivity_solves = evaluations.sensitivity_solves;
+    result.failed_runs = evaluations.failed_runs;
+    result.failures_by_cause = evaluations.failures_by_cause;
+    result.failed_examples = evaluations.failed_examples;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  // The start, as Levenberg-Marquardt will ask for it (with analytic
+  // sensitivities): a failure here is the user's to fix, not a rejected step.
+  const bool levenberg_marquardt = m.options().method == Method::LevenbergMarquardt;
+  Eigen::VectorXd phi0 = start_phi;
+  const bool with_sensitivities = levenberg_marquardt && m.analytic();
+  // A start too soft for its load fails fast in a probe, and a stiffer start
+  // is looked for; only when none runs is the start run in full.
+  if (evaluations.kept(start_phi, with_sensitivities) == nullptr) {
+    const Evaluation probe = probe_start(start_phi, with_sensitivities);
+    if (evaluations.add(start_phi, with_sensitivities, probe) == nullptr) {
+      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+      double factor = 1.0;
+      const std::optional<Eigen::VectorXd> stiffer =
+          stiffer_start(start_phi, probe, evaluations, with_sensitivities, &factor);
+      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+      if (stiffer) {
+        phi0 = *stiffer;
+        std::ostringstream note;
+        note << "the forward run at the starting parameters failed, in a probe that gives up "
+                "after "
+             << kProbeCuts << " halvings of a step or " << kProbeIterations
+             << " Newton iterations (" << probe.message
+             << "); the fit started from the moduli and gamma times " << factor
+             << ", the softest such start whose run succeeds";
+        result.start_note = note.str();
+      } else if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities);
+                 !given.ok) {
+        if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
+        return finish(FitStatus::StartFailed,
+                      "the forward run at the starting parameters failed: " + given.message +
+                          (m.model().loads.empty()
+                               ? ""
+                               : " (and with the moduli and gamma up to 1024 times the start's, "
+                                 "within their bounds)"));
+      }
+    }
+  }
+  const Evaluation& first = evaluations.at(phi0, with_sensitivities);
+  result.initial_cost = problem_.cost(first.residuals);
+  if (!std::isfinite(result.initial_cost))
+    return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
+
+  const OptimizerOutcome outcome = levenberg_marquardt
+                                       ? fit_levenberg_marquardt(evaluations, m.options(), phi0)
+                                       : fit_nlopt(evaluations, m.options(), phi0);
+  result.message = outcome.message;
+  result.iterations = outcome.iterations;
+  result.values = m.map().values(outcome.phi);
+  if (!result.iterations.empty()) result.final_cost = result.iterations.back().cost;
+
+  // At the optimum (usually kept from the optimiser): the run and the
+  // distances. An interrupted fit takes only what it has already run.
+  const Evaluation* kept = evaluations.kept(outcome.phi, false);
+  if (outcome.status == FitStatus::Interrupted && (kept == nullptr || !kept->ok))
+    return finish(FitStatus::Interrupted, "");
+  const Evaluation best =
+      kept != nullptr ? *kept : evaluations.at(outcome.phi, false);  // a copy: entries move
+  if (!best.ok) {
+    if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+    return finish(FitStatus::ForwardRunsFailed,
+                  "the forward run at the fitted parameters failed: " + best.message);
+  }
+  problem_.describe(best, result);
+  if (best.summary.warm_started) {
+    check_along_path(outcome.phi, best, result);
+    evaluations.forward_runs += 1;
+  }
+  describe_bounds(m.map(), outcome.phi, false, result);
+  if (outcome.status != FitStatus::Converged) return finish(outcome.status, "");
+
+  // Converged: is it an estimate? The covariance needs a full-rank Jacobian.
+  Eigen::MatrixXd covariance;
+  result.covariance_ok = phi_covariance(evaluations, m.options(), outcome.phi, &covariance);
+  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+  if (!result.covariance_ok) {
+    const Evaluation* with_jacobian = evaluations.kept(outcome.phi, true);
+    result.status_detail =
+        with_jacobian != nullptr && with_jacobian->ok
+            ? unidentifiable_because(with_jacobian->jacobian, result.names)
+            : "the Jacobian at the optimum could not be evaluated: " + evaluations.last_failure;
+    return finish(FitStatus::NotIdentifiable, "");
+  }
+  const int dof = m.num_residuals() - P;
+  const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
+  describe_estimates(m.map(), outcome.phi, covariance, variance, result);
+  if (m.options().check_intervals) {
+    const int runs_before = evaluations.forward_runs;
+    check_interval_ends(evaluations, problem_, outcome.phi, covariance, variance, result);
+    result.interval_runs = evaluations.forward_runs - runs_before;
+    if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+  }
+  return finish(result.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
+}
+
+}  // namespace fiberfluid::fit

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The fit's driver (internal to fit/): from a start to an ending, through
+// the start's probe (a stiffer start where the given one fails), the
+// optimiser (Ceres or NLopt), the run at the optimum and its estimate.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/problem.hpp"
+
+namespace fiberfluid::fit {
+
+class EvaluationCache;
+
+class FitDriver {
+ public:
+  // Both must outlive the driver; the calibration evaluates (its cache's
+  // runs), the problem describes.
+  FitDriver(const Calibration& calibration, const FitProblem& problem);
+
+  // Calibration::run_from and Calibration::result_at.
+  FitResult run_from(const Eigen::VectorXd& start_phi) const;
+  FitResult result_at(const Eigen::VectorXd& phi) const;
+
+ private:
+  // A result at phi with nothing known yet: the values there, NaN errors,
+  // intervals and costs, sized for the parameters.
+  FitResult result_from(const Eigen::VectorXd& phi) const;
+  // The optimum's warm-started evaluation run again along the load path: its
+  // run described (every step's record) and, where the two equilibria
+  // differ, FitResult::warm_start_note says so.
+  void check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
+                        FitResult& result) const;
+  // A start's run that gives up early (at most kProbeCuts halvings of a step
+  // and kProbeIterations Newton iterations per piece; a success is the full
+  // run's, to the bit), keeping a failed path's states near n/2, n/4, ...
+  Evaluation probe_start(const Eigen::VectorXd& phi, bool with_jacobian,
+                         const Eigen::VectorXd& warm_start = {}) const;
+  // Where the start's probe failed: the softest start with every modulus
+  // and gamma 2, 4, ... 1024 times the start's (within the bounds) whose
+  // probe succeeds, and that factor; nullopt when none does, or none can
+  // help. One whose end the failed probe passed (its state at step n/s) is
+  // solved from there, warm.
+  std::optional<Eigen::VectorXd> stiffer_start(const Eigen::VectorXd& start_phi,
+                                               const Evaluation& failed_probe,
+                                               EvaluationCache& evaluations,
+                                               bool with_sensitivities, double* factor) const;
+
+  const Calibration& calibration_;
+  const FitProblem& problem_;
+};
+
+}  // namespace fiberfluid::fit
