@@ -21,7 +21,7 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
-#include "fiberfluid/solve/interactive_stepper.hpp"
+#include "fiberfluid/solve/newton/interactive_stepper.hpp"
 #include "fiberfluid/util/omp_wait_policy.hpp"
 
 namespace {

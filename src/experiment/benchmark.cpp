@@ -22,7 +22,7 @@
 #include "fiberfluid/metrics/metrics.hpp"
 #include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/model/assembly.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::experiment {
 namespace {

@@ -15,7 +15,7 @@
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/free_motions.hpp"
 #include "fiberfluid/model/mirror_layer.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/progress.hpp"
 #include "fiberfluid/util/run_control.hpp"

@@ -20,7 +20,7 @@
 #include "fiberfluid/experiment/resources.hpp"
 #include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/model/model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::experiment {
 

@@ -65,11 +65,10 @@ std::function<geom::Surface()> read_generator(Fields& f, double* vertices) {
   if (kind == "dome") {
     const Eigen::Vector3d semi_axes = f.vector("semi_axes", 3);
     const int subdivisions = f.integer("subdivisions", 2, 0, 6);
-    const bool octahedral =
-        f.choice("base", "icosahedron", {"icosahedron", "octahedron"}) == "octahedron";
-    *vertices = (octahedral ? 4.0 : 10.0) * std::pow(4.0, subdivisions) + 2.0;
     const geom::DomeBase base =
-        octahedral ? geom::DomeBase::Octahedron : geom::DomeBase::Icosahedron;
+        f.enumeration("base", geom::DomeBase::Icosahedron, geom::kDomeBaseNames);
+    const bool octahedral = base == geom::DomeBase::Octahedron;
+    *vertices = (octahedral ? 4.0 : 10.0) * std::pow(4.0, subdivisions) + 2.0;
     return [=] { return geom::dome(semi_axes, subdivisions, base); };
   }
   if (kind == "cylinder") {
@@ -140,7 +139,7 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder) {
 }
 
 // ------------------------------------------------------------ selections
-model::Schedule read_schedule(Fields& f, const std::string& fallback) {
+model::Schedule read_schedule(Fields& f, model::Schedule::Kind fallback) {
   model::Schedule schedule;
   if (f.has("schedule") && f.peek("schedule")->is_array()) {  // a table (typed below)
     schedule.kind = model::Schedule::Kind::Table;
@@ -148,10 +147,7 @@ model::Schedule read_schedule(Fields& f, const std::string& fallback) {
     schedule.values.assign(values.data(), values.data() + values.size());
     return schedule;
   }
-  const std::string name = f.choice("schedule", fallback, {"ramp", "final", "up_down"});
-  schedule.kind = name == "ramp"    ? model::Schedule::Kind::Ramp
-                  : name == "final" ? model::Schedule::Kind::Final
-                                    : model::Schedule::Kind::UpDown;
+  schedule.kind = f.enumeration("schedule", fallback, model::kScheduleNames);
   return schedule;
 }
 
@@ -277,16 +273,15 @@ std::vector<LoadSpec> read_loads(Fields& root) {
       load.kind = model::Load::Kind::Hydrostatic;
       spec.vector = per_axis_vector(f, "acceleration");
       load.density = f.positive("density", 1000.0);
-      load.integration = f.choice("integration", "vertex", {"vertex", "exact"}) == "exact"
-                             ? model::Load::Integration::Exact
-                             : model::Load::Integration::Vertex;
+      load.integration =
+          f.enumeration("integration", model::Load::Integration::Vertex, model::kIntegrationNames);
     } else {
       load.kind = model::Load::Kind::Point;
       if (!f.has("vertex")) f.fail("vertex", "missing (required): the vertex the force acts on");
       spec.input_vertex = f.integer("vertex", 0, 0, std::numeric_limits<int>::max());
       spec.vector = per_axis_vector(f, "force");
     }
-    load.schedule = read_schedule(f, "ramp");
+    load.schedule = read_schedule(f, model::Schedule::Kind::Ramp);
     f.finish();
     loads.push_back(spec);
   }
@@ -316,10 +311,10 @@ std::vector<ConstraintSpec> read_constraints(Fields& root) {
       r.finish();
       spec.rotation = rotation;
       if (f.has("displacement")) spec.displacement = per_axis_vector(f, "displacement");
-      spec.schedule = read_schedule(f, "ramp");
+      spec.schedule = read_schedule(f, model::Schedule::Kind::Ramp);
     } else if (prescribed) {
       spec.displacement = per_axis_vector(f, "displacement");
-      spec.schedule = read_schedule(f, "ramp");
+      spec.schedule = read_schedule(f, model::Schedule::Kind::Ramp);
     } else {
       spec.axes = read_axes(f);
       spec.mirror_layer = f.choice("layer", "none", {"none", "mirror"}) == "mirror";
@@ -374,7 +369,7 @@ std::vector<PaddleSpec> read_paddles(Fields& root) {
       if (!(*spec.compression > 0.0 && *spec.compression < 1.0))
         f.fail("compression", "expected a share of the body's extent between 0 and 1");
     }
-    p.schedule = read_schedule(f, "ramp");
+    p.schedule = read_schedule(f, model::Schedule::Kind::Ramp);
     p.sticking = f.choice("contact", "frictionless", {"frictionless", "sticking"}) == "sticking";
     f.finish();
     paddles.push_back(spec);
@@ -388,13 +383,7 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.max_iterations = f.integer("max_iterations", o.max_iterations, 1, 10000);
   o.max_step_cuts = f.integer("max_step_cuts", o.max_step_cuts, 0, 30);
   o.line_search = f.boolean("line_search", o.line_search);
-  const std::string tangent =
-      f.choice("tangent", "auto", {"auto", "dense", "krylov", "sparse", "reused"});
-  o.tangent = tangent == "dense"    ? solve::TangentSolver::Dense
-              : tangent == "krylov" ? solve::TangentSolver::Krylov
-              : tangent == "sparse" ? solve::TangentSolver::Sparse
-              : tangent == "reused" ? solve::TangentSolver::Reused
-                                    : solve::TangentSolver::Auto;
+  o.tangent = f.enumeration("tangent", solve::TangentSolver::Auto, solve::kTangentSolverNames);
   o.krylov_tolerance = f.positive("krylov_tolerance", o.krylov_tolerance);
   o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
   o.krylov_max_iterations = f.integer("krylov_max_iterations", o.krylov_max_iterations, 1, 100000);
@@ -405,33 +394,27 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
 }
 
 solve::SteppingOptions read_stepping(Fields f, solve::SteppingOptions options) {
-  options.scheme = f.choice("scheme", "incremental", {"incremental", "newton"}) == "newton"
-                       ? solve::Scheme::Newton
-                       : solve::Scheme::Incremental;
+  options.scheme = f.enumeration("scheme", solve::Scheme::Incremental, solve::kSchemeNames);
   if (f.has("newton") && options.scheme != solve::Scheme::Newton)
     f.fail("newton", "Newton options need \"scheme\": \"newton\"");
   if (options.scheme == solve::Scheme::Newton)
     options.newton = read_newton(f.object_or_empty("newton"), options.newton);
   options.steps = f.integer("steps", options.steps, 1, 100000);
   if (f.has("control")) {
-    const bool arc = f.choice("control", "load", {"load", "arc_length"}) == "arc_length";
-    if (arc && options.scheme != solve::Scheme::Newton)
-      f.fail("control", "arc-length control needs \"scheme\": \"newton\"");
     options.newton.control =
-        arc ? solve::NewtonOptions::Control::ArcLength : solve::NewtonOptions::Control::Load;
+        f.enumeration("control", solve::NewtonOptions::Control::Load, solve::kControlNames);
+    if (options.newton.control == solve::NewtonOptions::Control::ArcLength &&
+        options.scheme != solve::Scheme::Newton)
+      f.fail("control", "arc-length control needs \"scheme\": \"newton\"");
   }
   options.newton.max_arc_steps =
       f.integer("max_arc_steps", options.newton.max_arc_steps, 1, 100000);
   options.rebuild_matrix = f.boolean("rebuild_matrix", options.rebuild_matrix);
   options.update_load_geometry = f.boolean("update_load_geometry", options.update_load_geometry);
-  const std::string method = f.choice("boundary_method", model::to_string(options.boundary_method),
-                                      {"elimination", "penalty"});
   options.boundary_method =
-      method == "penalty" ? model::BoundaryMethod::Penalty : model::BoundaryMethod::Elimination;
+      f.enumeration("boundary_method", options.boundary_method, model::kBoundaryMethodNames);
   options.penalty = f.positive("penalty", options.penalty);
-  const std::string solver =
-      f.choice("solver", solve::to_string(options.solver), solve::solver_kind_names());
-  options.solver = *solve::solver_kind_from_string(solver);
+  options.solver = f.enumeration("solver", options.solver, solve::kSolverKindNames);
   options.pcg.tolerance = f.positive("tolerance", options.pcg.tolerance);
   options.pcg.max_iterations = f.integer("max_iterations", options.pcg.max_iterations, 1, 1000000);
   options.max_volume_change = f.positive("max_volume_change", options.max_volume_change);
@@ -508,12 +491,10 @@ FiberSpec read_fibers(Fields& root) {
   // within a horizon the fibers fade out conically. The vector spring keeps
   // the paper's count, so that its figures are reproduced as published.
   const bool central = spec.kinematics == model::FiberKinematics::Central;
-  const std::string count = f.choice("connection_count", central ? "area" : "symmetric",
-                                     {"symmetric", "global", "area", "mean"});
-  spec.count = count == "global" ? model::ConnectionCount::Global
-               : count == "area" ? model::ConnectionCount::Area
-               : count == "mean" ? model::ConnectionCount::Mean
-                                 : model::ConnectionCount::Symmetric;
+  spec.count =
+      f.enumeration("connection_count",
+                    central ? model::ConnectionCount::Area : model::ConnectionCount::Symmetric,
+                    model::kConnectionCountNames);
   const bool fades = central && spec.horizon > 0.0;
   if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) == "conical") {
     if (!(spec.horizon > 0.0))
@@ -531,7 +512,8 @@ FiberSpec read_fibers(Fields& root) {
     f.fail("product",
            "\"treecode\" needs one connection count for every fiber: set "
            "\"connection_count\": \"global\" (the " +
-               count + " count differs from vertex to vertex) or \"product\": \"exact\"");
+               std::string(model::to_string(spec.count)) +
+               " count differs from vertex to vertex) or \"product\": \"exact\"");
   if (spec.treecode_tolerance > 0.0 && spec.horizon > 0.0)
     f.fail("product",
            "\"treecode\" approximates the sum over every pair; with a \"horizon\" most pairs "
@@ -633,9 +615,8 @@ FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
   return curve;
 }
 
-FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
-  FitSpec spec;
-  spec.field = f.field();
+// fit.targets: the surfaces and force curves.
+void read_fit_targets(Fields& f, const std::filesystem::path& folder, FitSpec& spec) {
   for (Fields t : f.objects("targets")) {
     if (t.choice("type", "surface", {"surface", "force"}) == "force") {
       spec.force_curves.push_back(read_force_target(t, folder));
@@ -656,6 +637,10 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   }
   if (spec.targets.empty() && spec.force_curves.empty())
     f.fail("targets", "expected at least one target (a surface, or a force curve)");
+}
+
+// fit.parameters: each fitted once.
+void read_fit_parameters(Fields& f, FitSpec& spec) {
   for (Fields p : f.objects("parameters")) {
     FitParameterSpec parameter;
     parameter.field = p.field();
@@ -671,12 +656,10 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     spec.parameters.push_back(parameter);
   }
   if (spec.parameters.empty()) f.fail("parameters", "expected at least one parameter to fit");
-  spec.mesh_check = f.choice("mesh_check", "none", {"none", "coarser", "finer"});
-  if (f.has("start_from")) {
-    spec.start_from = f.string("start_from");
-    if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;
-    f.resolve("start_from", absolute_path(*spec.start_from));
-  }
+}
+
+// The fit's method and options.
+void read_fit_options(Fields& f, FitSpec& spec) {
   // The options' values are checked once, by fit::check_options, for every
   // front end alike (its messages begin with the option's name); here only
   // their types.
@@ -750,6 +733,20 @@ FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
     const std::string option = what.substr(0, what.find(':'));
     named(option == "loss_scale" ? "objective.loss_scale" : option, e);
   }
+}
+
+FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
+  FitSpec spec;
+  spec.field = f.field();
+  read_fit_targets(f, folder, spec);
+  read_fit_parameters(f, spec);
+  spec.mesh_check = f.choice("mesh_check", "none", {"none", "coarser", "finer"});
+  if (f.has("start_from")) {
+    spec.start_from = f.string("start_from");
+    if (spec.start_from->is_relative()) spec.start_from = folder / *spec.start_from;
+    f.resolve("start_from", absolute_path(*spec.start_from));
+  }
+  read_fit_options(f, spec);
   f.finish();
   return spec;
 }
@@ -876,12 +873,7 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
     root.fail("name", "expected " + problem);
   ex.description = root.string("description", "");
-  const std::string kind =
-      root.choice("kind", "simulate", {"simulate", "areas", "benchmark", "calibration"});
-  ex.kind = kind == "areas"         ? Experiment::Kind::Areas
-            : kind == "benchmark"   ? Experiment::Kind::Benchmark
-            : kind == "calibration" ? Experiment::Kind::Calibration
-                                    : Experiment::Kind::Simulate;
+  ex.kind = root.enumeration("kind", Experiment::Kind::Simulate, kExperimentKindNames);
   ex.expected = read_expected(root);
   if (root.has("fit")) {
     if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");

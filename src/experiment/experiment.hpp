@@ -13,6 +13,7 @@
 #include "fiberfluid/experiment/fem_reference.hpp"
 #include "fiberfluid/experiment/fit_spec.hpp"
 #include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -109,6 +110,11 @@ struct Experiment {
     return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
   }
 };
+inline constexpr auto kExperimentKindNames =
+    names_of<Experiment::Kind>({{Experiment::Kind::Simulate, "simulate"},
+                                {Experiment::Kind::Areas, "areas"},
+                                {Experiment::Kind::Benchmark, "benchmark"},
+                                {Experiment::Kind::Calibration, "calibration"}});
 // The fields of an experiment file that belong to the whole experiment
 // (name, variants, fit, ...): a variant cannot change them.
 const std::vector<std::string>& experiment_wide_fields();

@@ -264,8 +264,10 @@ MeshCheck run_mesh_check(const Experiment& at_fit) {
   json& fit_section = document["fit"];
   fit_section["mesh_check"] = "none";
   for (const char* key : {"start_from", "starts", "same_optimum"}) fit_section.erase(key);
-  if (fit_section.value("method", "") == "multistart") fit_section["method"] = "levenberg-marquardt";
-  const bool by_halves = document.contains("surface") && document["surface"].contains("subdivisions");
+  if (fit_section.value("method", "") == "multistart")
+    fit_section["method"] = "levenberg-marquardt";
+  const bool by_halves =
+      document.contains("surface") && document["surface"].contains("subdivisions");
   const double ratio = by_halves ? 2.0 : 1.5;
   const double factor = at_fit.fit->mesh_check == "coarser" ? 1.0 / ratio : ratio;
   MeshCheck check;
@@ -276,9 +278,9 @@ MeshCheck run_mesh_check(const Experiment& at_fit) {
   } catch (const InputError& e) {
     throw InputError("fit.mesh_check: " + std::string(e.what()));
   }
-  const Experiment other = parse_experiment(
-      refined, at_fit.source.parent_path(),
-      at_fit.source.string() + " [mesh check, " + check.resolution + "]");
+  const Experiment other =
+      parse_experiment(refined, at_fit.source.parent_path(),
+                       at_fit.source.string() + " [mesh check, " + check.resolution + "]");
   FitSetup setup = setup_fit(other, {});
   check.fitted = setup.calibration->run();
   return check;
@@ -394,9 +396,10 @@ json multistart_json(const fit::MultistartResult& search, const std::vector<std:
 
 }  // namespace
 
-json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult& r,
-              const ExperimentResult& run, const fit::MultistartResult* search) {
-  const fit::Calibration& c = *setup.calibration;
+namespace {
+
+// fit.json's parameters: each fitted value with its error, interval and bounds.
+json parameters_json(const fit::Calibration& c, const fit::FitResult& r) {
   json parameters = json::array();
   for (size_t k = 0; k < r.names.size(); ++k) {
     const Eigen::Index i = static_cast<Eigen::Index>(k);
@@ -413,9 +416,11 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
                           {"bounds", {number(p.lower), number(p.upper)}},
                           {"log_scale", p.log_scale}});
   }
-  json iterations = json::array();
-  for (const fit::IterationRecord& it : r.iterations)
-    iterations.push_back(iteration_json(it, r.names));
+  return parameters;
+}
+
+// fit.json's targets: each scan, the step it was measured at, its distances.
+json targets_json(const FitSetup& setup, const fit::FitResult& r) {
   json targets = json::array();
   for (size_t t = 0; t < setup.targets.size(); ++t) {
     json target = {{"file", setup.targets[t].target.label},
@@ -425,6 +430,12 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     if (t < r.statistics.size()) target["distance"] = statistics_json(r.statistics[t]);
     targets.push_back(target);
   }
+  return targets;
+}
+
+// fit.json's force curves: what each reads, its weight, its misfit.
+json force_curves_json(const Experiment& ex, const FitSetup& setup, const fit::Calibration& c,
+                       const fit::FitResult& r) {
   json curves = json::array();
   for (size_t k = 0; k < setup.force_curves.size(); ++k) {
     const fit::ForceCurve& f = setup.force_curves[k];
@@ -453,6 +464,19 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     }
     curves.push_back(curve);
   }
+  return curves;
+}
+
+}  // namespace
+
+json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult& r,
+              const ExperimentResult& run, const fit::MultistartResult* search) {
+  const fit::Calibration& c = *setup.calibration;
+  json iterations = json::array();
+  for (const fit::IterationRecord& it : r.iterations)
+    iterations.push_back(iteration_json(it, r.names));
+  const json parameters = parameters_json(c, r), targets = targets_json(setup, r),
+             curves = force_curves_json(ex, setup, c, r);
   json failures = json::object();
   for (const auto& [cause, count] : r.failures_by_cause) failures[cause] = count;
   json examples = json::array();

@@ -13,6 +13,7 @@
 #include "fiberfluid/experiment/case_spec.hpp"
 #include "fiberfluid/experiment/schema.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -151,6 +152,12 @@ class Fields {
     if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
       fail(key, "expected one of " + join(allowed) + ", got " + excerpt(s));
     return s;
+  }
+  // A choice among an enum's names (util/names.hpp), as its value: the names
+  // offered, the default's name and the value read are the one list's.
+  template <class Enum, std::size_t N>
+  Enum enumeration(const std::string& key, Enum fallback, const Names<Enum, N>& names) {
+    return *names.find(choice(key, names.name(fallback), names.all()));
   }
   // A list of `size` numbers (any size when size < 0).
   Eigen::VectorXd vector(const std::string& key, int size) {

@@ -10,7 +10,7 @@
 
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/cost_model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::experiment {
 

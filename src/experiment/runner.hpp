@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/util/work_dealer.hpp"
 
 namespace fiberfluid::experiment {

@@ -27,10 +27,10 @@ Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
 
 Calibration::~Calibration() = default;
 
-const ParameterMap& Calibration::parameters() const { return impl_->problem.map(); }
+const ParameterMap& Calibration::parameters() const { return impl_->problem.parameters(); }
 const FitOptions& Calibration::options() const { return impl_->problem.options(); }
 const model::Model& Calibration::model() const { return impl_->problem.model(); }
-bool Calibration::analytic_jacobian() const { return impl_->problem.analytic(); }
+bool Calibration::analytic_jacobian() const { return impl_->problem.analytic_jacobian(); }
 bool Calibration::warm_starts() const { return impl_->problem.warm_starts(); }
 int Calibration::num_residuals() const { return impl_->problem.num_residuals(); }
 int Calibration::num_counted_vertices() const { return impl_->problem.num_counted_vertices(); }
@@ -43,19 +43,19 @@ double Calibration::cost(const Eigen::VectorXd& r) const { return impl_->problem
 
 Evaluation Calibration::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
                                  const Eigen::VectorXd& warm_start) const {
-  solve::SteppingOptions stepping = impl_->problem.stepping();
-  if (impl_->problem.warm_starts()) stepping.warm_start = warm_start;
-  return impl_->problem.evaluate(phi, with_jacobian, std::move(stepping), false);
+  return impl_->problem.evaluate(phi, with_jacobian, warm_start);
 }
 
-FitResult Calibration::run() const { return run_from(impl_->problem.map().initial_phi()); }
+const FitProblem& Calibration::problem() const { return impl_->problem; }
+
+FitResult Calibration::run() const { return run_from(impl_->problem.parameters().initial_phi()); }
 
 FitResult Calibration::run_from(const Eigen::VectorXd& start_phi) const {
-  return FitDriver(*this, impl_->problem).run_from(start_phi);
+  return FitDriver(impl_->problem).run_from(start_phi);
 }
 
 FitResult Calibration::result_at(const Eigen::VectorXd& phi) const {
-  return FitDriver(*this, impl_->problem).result_at(phi);
+  return FitDriver(impl_->problem).result_at(phi);
 }
 
 }  // namespace fiberfluid::fit

@@ -26,14 +26,14 @@ class SharedEvaluation {
     // Analytic sensitivities cost a few tangent solves next to a whole
     // forward run: take them always, so that an accepted trial point needs
     // no second run when Ceres asks for its Jacobian.
-    with_jacobian = with_jacobian || cache_.calibration().analytic_jacobian();
-    const int P = cache_.calibration().parameters().size();
+    with_jacobian = with_jacobian || cache_.problem().analytic_jacobian();
+    const int P = cache_.problem().parameters().size();
     return cache_.at(Eigen::Map<const Eigen::VectorXd>(phi, P), with_jacobian);
   }
   // False when the point would need forward runs beyond max_evaluations
   // (a kept point needs none).
   bool affordable(const double* phi, bool with_jacobian) const {
-    const Calibration& calibration = cache_.calibration();
+    const FitProblem& calibration = cache_.problem();
     if (cache_.forward_runs < max_runs_) return true;
     with_jacobian = with_jacobian || calibration.analytic_jacobian();
     return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, calibration.parameters().size()),
@@ -90,7 +90,7 @@ struct CeresProblem {
   CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi,
                int max_runs = std::numeric_limits<int>::max())
       : shared(cache, max_runs), loss(make_loss(options)), problem(problem_options()) {
-    const Calibration& calibration = cache.calibration();
+    const FitProblem& calibration = cache.problem();
     const ParameterMap& map = calibration.parameters();
     for (int i = 0; i < calibration.num_residuals(); ++i)
       problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(),
@@ -110,7 +110,7 @@ struct CeresProblem {
 
 class Recorder final : public ceres::IterationCallback {
  public:
-  Recorder(const Calibration& calibration, const FitOptions& options, const Eigen::VectorXd& phi,
+  Recorder(const FitProblem& calibration, const FitOptions& options, const Eigen::VectorXd& phi,
            const SharedEvaluation& shared, OptimizerOutcome& outcome)
       : calibration_(calibration),
         options_(options),
@@ -140,7 +140,7 @@ class Recorder final : public ceres::IterationCallback {
   bool evaluations_spent = false;
 
  private:
-  const Calibration& calibration_;
+  const FitProblem& calibration_;
   const FitOptions& options_;
   const Eigen::VectorXd& phi_;
   const SharedEvaluation& shared_;
@@ -165,7 +165,7 @@ IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
 
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start) {
-  const Calibration& calibration = evaluations.calibration();
+  const FitProblem& calibration = evaluations.problem();
   OptimizerOutcome outcome;
   Eigen::VectorXd phi = start;
   CeresProblem p(evaluations, options, phi, options.max_evaluations);
@@ -228,7 +228,7 @@ bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
   const bool ok = c.Compute(blocks, &p.problem);
   FLAGS_minloglevel = log_level;
   if (!ok) return false;
-  const int P = evaluations.calibration().parameters().size();
+  const int P = evaluations.problem().parameters().size();
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(P, P);
   if (!c.GetCovarianceBlock(phi.data(), phi.data(), C.data())) return false;
   *covariance = C;

@@ -8,24 +8,24 @@
 #include <cmath>
 #include <sstream>
 
+#include "fiberfluid/fit/evaluation_cache.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
 #include "fiberfluid/fit/uncertainty.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 
-FitDriver::FitDriver(const Calibration& calibration, const FitProblem& problem)
-    : calibration_(calibration), problem_(problem) {}
+FitDriver::FitDriver(const FitProblem& problem) : problem_(problem) {}
 
 FitResult FitDriver::result_from(const Eigen::VectorXd& phi) const {
   const FitProblem& m = problem_;
-  const int P = m.map().size();
+  const int P = m.parameters().size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   FitResult result;
   result.method = m.options().method;
-  result.analytic_jacobian = m.analytic();
-  result.names = m.map().names();
-  result.initial = result.values = m.map().values(phi);
+  result.analytic_jacobian = m.analytic_jacobian();
+  result.names = m.parameters().names();
+  result.initial = result.values = m.parameters().values(phi);
   result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
   result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
   result.initial_cost = result.final_cost = nan;
@@ -34,7 +34,7 @@ FitResult FitDriver::result_from(const Eigen::VectorXd& phi) const {
 
 FitResult FitDriver::result_at(const Eigen::VectorXd& phi) const {
   FitResult result = result_from(phi);
-  const Evaluation at = calibration_.evaluate(phi, false);
+  const Evaluation at = problem_.evaluate(phi, false, Eigen::VectorXd());
   result.forward_runs = at.forward_runs;
   if (!at.ok) {
     result.status = cancel_requested() ? FitStatus::Interrupted : FitStatus::ForwardRunsFailed;
@@ -50,7 +50,7 @@ FitResult FitDriver::result_at(const Eigen::VectorXd& phi) const {
 
 void FitDriver::check_along_path(const Eigen::VectorXd& phi, const Evaluation& warm,
                                  FitResult& result) const {
-  const Evaluation path = calibration_.evaluate(phi, false);
+  const Evaluation path = problem_.evaluate(phi, false, Eigen::VectorXd());
   if (!path.ok) {
     if (cancel_requested()) return;
     result.warm_start_note = "the run along the load path at the fitted values failed (" +
@@ -119,13 +119,13 @@ std::optional<Eigen::VectorXd> FitDriver::stiffer_start(const Eigen::VectorXd& s
                                                         double* factor) const {
   const FitProblem& m = problem_;
   if (m.model().loads.empty()) return std::nullopt;
-  const std::vector<Parameter>& parameters = m.map().parameters();
-  const Eigen::VectorXd upper = m.map().upper_phi();
+  const std::vector<Parameter>& parameters = m.parameters().parameters();
+  const Eigen::VectorXd upper = m.parameters().upper_phi();
   std::vector<int> stiffness;
-  for (int k = 0; k < m.map().size(); ++k)
+  for (int k = 0; k < m.parameters().size(); ++k)
     if (scales_stiffness(parameters[static_cast<size_t>(k)].name)) stiffness.push_back(k);
   if (stiffness.empty()) return std::nullopt;
-  const Eigen::VectorXd start = m.map().values(start_phi);
+  const Eigen::VectorXd start = m.parameters().values(start_phi);
   const int n = m.stepping().steps;
   for (double s = 2.0; s <= kStiffest && !cancel_requested(); s *= 2.0) {
     Eigen::VectorXd phi = start_phi;
@@ -152,13 +152,55 @@ std::optional<Eigen::VectorXd> FitDriver::stiffer_start(const Eigen::VectorXd& s
   return std::nullopt;
 }
 
+// A start too soft for its load fails fast in a probe, and a stiffer start
+// is looked for; only when none runs is the start run in full.
+std::optional<Eigen::VectorXd> FitDriver::starting_point(
+    const Eigen::VectorXd& start_phi, bool with_sensitivities, EvaluationCache& evaluations,
+    FitResult& result, std::pair<FitStatus, std::string>* ending) const {
+  const auto stop = [&](FitStatus status, std::string message) {
+    *ending = {status, std::move(message)};
+    return std::optional<Eigen::VectorXd>();
+  };
+  if (evaluations.kept(start_phi, with_sensitivities) == nullptr) {
+    const Evaluation probe = probe_start(start_phi, with_sensitivities);
+    if (evaluations.add(start_phi, with_sensitivities, probe) == nullptr) {
+      if (cancel_requested()) return stop(FitStatus::Interrupted, "interrupted at the start");
+      double factor = 1.0;
+      const std::optional<Eigen::VectorXd> stiffer =
+          stiffer_start(start_phi, probe, evaluations, with_sensitivities, &factor);
+      if (cancel_requested()) return stop(FitStatus::Interrupted, "interrupted at the start");
+      if (stiffer) {
+        std::ostringstream note;
+        note << "the forward run at the starting parameters failed, in a probe that gives up "
+                "after "
+             << kProbeCuts << " halvings of a step or " << kProbeIterations
+             << " Newton iterations (" << probe.message
+             << "); the fit started from the moduli and gamma times " << factor
+             << ", the softest such start whose run succeeds";
+        result.start_note = note.str();
+        return stiffer;
+      } else if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities);
+                 !given.ok) {
+        if (cancel_requested()) return stop(FitStatus::Interrupted, "interrupted at the start");
+        return stop(FitStatus::StartFailed,
+                    "the forward run at the starting parameters failed: " + given.message +
+                        (problem_.model().loads.empty()
+                             ? ""
+                             : " (and with the moduli and gamma up to 1024 times the start's, "
+                               "within their bounds)"));
+      }
+    }
+  }
+  return start_phi;
+}
+
 FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   const FitProblem& m = problem_;
   const auto start = std::chrono::steady_clock::now();
-  const int P = m.map().size();
+  const int P = m.parameters().size();
   // Sized from the start, whatever the ending: a report never reads past them.
   FitResult result = result_from(start_phi);
-  EvaluationCache evaluations(calibration_);
+  EvaluationCache evaluations(problem_);
   auto finish = [&](FitStatus status, std::string message) {
     result.status = status;
     result.success = converged(status);
@@ -176,51 +218,22 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   // The start, as Levenberg-Marquardt will ask for it (with analytic
   // sensitivities): a failure here is the user's to fix, not a rejected step.
   const bool levenberg_marquardt = m.options().method == Method::LevenbergMarquardt;
-  Eigen::VectorXd phi0 = start_phi;
-  const bool with_sensitivities = levenberg_marquardt && m.analytic();
-  // A start too soft for its load fails fast in a probe, and a stiffer start
-  // is looked for; only when none runs is the start run in full.
-  if (evaluations.kept(start_phi, with_sensitivities) == nullptr) {
-    const Evaluation probe = probe_start(start_phi, with_sensitivities);
-    if (evaluations.add(start_phi, with_sensitivities, probe) == nullptr) {
-      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-      double factor = 1.0;
-      const std::optional<Eigen::VectorXd> stiffer =
-          stiffer_start(start_phi, probe, evaluations, with_sensitivities, &factor);
-      if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-      if (stiffer) {
-        phi0 = *stiffer;
-        std::ostringstream note;
-        note << "the forward run at the starting parameters failed, in a probe that gives up "
-                "after "
-             << kProbeCuts << " halvings of a step or " << kProbeIterations
-             << " Newton iterations (" << probe.message
-             << "); the fit started from the moduli and gamma times " << factor
-             << ", the softest such start whose run succeeds";
-        result.start_note = note.str();
-      } else if (const Evaluation& given = evaluations.at(start_phi, with_sensitivities);
-                 !given.ok) {
-        if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
-        return finish(FitStatus::StartFailed,
-                      "the forward run at the starting parameters failed: " + given.message +
-                          (m.model().loads.empty()
-                               ? ""
-                               : " (and with the moduli and gamma up to 1024 times the start's, "
-                                 "within their bounds)"));
-      }
-    }
-  }
-  const Evaluation& first = evaluations.at(phi0, with_sensitivities);
+  const bool with_sensitivities = levenberg_marquardt && m.analytic_jacobian();
+  std::pair<FitStatus, std::string> ending;
+  const std::optional<Eigen::VectorXd> phi0 =
+      starting_point(start_phi, with_sensitivities, evaluations, result, &ending);
+  if (!phi0) return finish(ending.first, ending.second);
+  const Evaluation& first = evaluations.at(*phi0, with_sensitivities);
   result.initial_cost = problem_.cost(first.residuals);
   if (!std::isfinite(result.initial_cost))
     return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
   const OptimizerOutcome outcome = levenberg_marquardt
-                                       ? fit_levenberg_marquardt(evaluations, m.options(), phi0)
-                                       : fit_nlopt(evaluations, m.options(), phi0);
+                                       ? fit_levenberg_marquardt(evaluations, m.options(), *phi0)
+                                       : fit_nlopt(evaluations, m.options(), *phi0);
   result.message = outcome.message;
   result.iterations = outcome.iterations;
-  result.values = m.map().values(outcome.phi);
+  result.values = m.parameters().values(outcome.phi);
   if (!result.iterations.empty()) result.final_cost = result.iterations.back().cost;
 
   // At the optimum (usually kept from the optimiser): the run and the
@@ -240,7 +253,7 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
     check_along_path(outcome.phi, best, result);
     evaluations.forward_runs += 1;
   }
-  describe_bounds(m.map(), outcome.phi, false, result);
+  describe_bounds(m.parameters(), outcome.phi, false, result);
   if (outcome.status != FitStatus::Converged) return finish(outcome.status, "");
 
   // Converged: is it an estimate? The covariance needs a full-rank Jacobian.
@@ -257,7 +270,7 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   }
   const int dof = m.num_residuals() - P;
   const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
-  describe_estimates(m.map(), outcome.phi, covariance, variance, result);
+  describe_estimates(m.parameters(), outcome.phi, covariance, variance, result);
   if (m.options().check_intervals) {
     const int runs_before = evaluations.forward_runs;
     check_interval_ends(evaluations, problem_, outcome.phi, covariance, variance, result);

@@ -6,8 +6,10 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <string>
+#include <utility>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/problem.hpp"
 
 namespace fiberfluid::fit {
@@ -16,9 +18,8 @@ class EvaluationCache;
 
 class FitDriver {
  public:
-  // Both must outlive the driver; the calibration evaluates (its cache's
-  // runs), the problem describes.
-  FitDriver(const Calibration& calibration, const FitProblem& problem);
+  // The problem must outlive the driver.
+  explicit FitDriver(const FitProblem& problem);
 
   // Calibration::run_from and Calibration::result_at.
   FitResult run_from(const Eigen::VectorXd& start_phi) const;
@@ -48,7 +49,15 @@ class FitDriver {
                                                EvaluationCache& evaluations,
                                                bool with_sensitivities, double* factor) const;
 
-  const Calibration& calibration_;
+  // Where the fit starts (evaluated and kept): start_phi when its run
+  // succeeds, else the softest stiffer start whose probe runs
+  // (FitResult::start_note says so); nullopt, with how the fit ends, when it
+  // cannot start (interrupted, or no start runs).
+  std::optional<Eigen::VectorXd> starting_point(const Eigen::VectorXd& start_phi,
+                                                bool with_sensitivities,
+                                                EvaluationCache& evaluations, FitResult& result,
+                                                std::pair<FitStatus, std::string>* ending) const;
+
   const FitProblem& problem_;
 };
 

@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
+#include "fiberfluid/fit/problem.hpp"
 
 namespace fiberfluid::fit {
 
@@ -18,8 +19,8 @@ namespace fiberfluid::fit {
 // point asked for twice (the start, the optimum) costs one run. Counts runs.
 class EvaluationCache {
  public:
-  explicit EvaluationCache(const Calibration& calibration) : calibration_(calibration) {}
-  const Calibration& calibration() const { return calibration_; }
+  explicit EvaluationCache(const FitProblem& problem) : problem_(problem) {}
+  const FitProblem& problem() const { return problem_; }
   // The evaluation at phi, with the Jacobian when asked (a kept one without
   // it is evaluated again). The reference stays valid until the next call.
   const Evaluation& at(const Eigen::VectorXd& phi, bool with_jacobian);
@@ -48,7 +49,7 @@ class EvaluationCache {
     bool has_jacobian = false;
     Evaluation evaluation;
   };
-  const Calibration& calibration_;
+  const FitProblem& problem_;
   std::deque<Entry> kept_;  // newest first
   Evaluation interrupted_;  // the last evaluation an interrupt cut short (not kept)
   Evaluation unkept_;       // the last evaluation add() did not keep

@@ -20,9 +20,9 @@ constexpr double kFailedCost = 1e30;
 
 struct Objective {
   Objective(EvaluationCache& e, const FitOptions& o, OptimizerOutcome& out)
-      : evaluations(e), calibration(e.calibration()), options(o), outcome(out) {}
+      : evaluations(e), calibration(e.problem()), options(o), outcome(out) {}
   EvaluationCache& evaluations;
-  const Calibration& calibration;
+  const FitProblem& calibration;
   const FitOptions& options;
   OptimizerOutcome& outcome;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
@@ -90,7 +90,7 @@ std::string describe(nlopt_result r) {
 }
 
 // One NLopt run of `algorithm` from phi (updated to the best point).
-nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
+nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& calibration,
                       const FitOptions& options, Objective& objective, Eigen::VectorXd& phi,
                       int max_evaluations) {
   const ParameterMap& map = calibration.parameters();
@@ -130,7 +130,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const Calibration& calibration,
 
 OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
                            const Eigen::VectorXd& start) {
-  const Calibration& calibration = evaluations.calibration();
+  const FitProblem& calibration = evaluations.problem();
   OptimizerOutcome outcome;
   const ParameterMap& map = calibration.parameters();
   Eigen::VectorXd phi = start;

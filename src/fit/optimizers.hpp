@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
 #include "fiberfluid/fit/evaluation_cache.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 
 namespace fiberfluid::fit {
 

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fiberfluid/fit/residuals/blocks.hpp"
+#include "fiberfluid/solve/newton/newton.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fit {
@@ -120,9 +121,29 @@ const solve::StepRecord& record_of(const solve::SteppingSummary& summary, int k)
 }  // namespace
 
 Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
+                                const Eigen::VectorXd& warm_start) const {
+  solve::SteppingOptions stepping = stepping_;
+  if (warm_starts_) stepping.warm_start = warm_start;
+  return evaluate(phi, with_jacobian, std::move(stepping), false);
+}
+
+solve::SteppingSummary FitProblem::run_forward(const model::Model& model,
+                                               const solve::SteppingOptions& options,
+                                               std::map<int, StepState>& at,
+                                               std::map<int, Eigen::VectorXd>* path_states) const {
+  return solve::solve_load_steps(
+      model, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+        if (path_states && near_a_halving(r.step, options.steps)) (*path_states)[r.step] = x;
+        if (!std::binary_search(state_steps_.begin(), state_steps_.end(), r.step)) return;
+        StepState& state = at[r.step];
+        state.x = x;
+        for (const auto& block : blocks_) state.observed.push_back(block->observe(model, r));
+      });
+}
+
+Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
                                 solve::SteppingOptions stepping, bool keep_path_states) const {
   const ParameterMap& map = map_;
-  const int P = map.size();
   const size_t nb = blocks_.size();
   Evaluation e;
   const Eigen::VectorXd values = map.values(phi);
@@ -138,24 +159,8 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
   const bool sensitivities_wanted = with_jacobian && !map.material_names().empty();
   if (sensitivities_wanted && analytic_)
     stepping.sensitivities = {map.material_names(), state_steps_};
-  // Per step read: the state, and each block's readings of its record.
-  struct StepState {
-    Eigen::VectorXd x;
-    std::vector<std::vector<double>> observed;  // per block
-  };
   std::map<int, StepState> states;
-  auto forward = [&](const model::Model& model, const solve::SteppingOptions& options,
-                     std::map<int, StepState>& at) {
-    return solve::solve_load_steps(
-        model, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
-          if (keep_path_states && near_a_halving(r.step, options.steps)) e.path_states[r.step] = x;
-          if (!std::binary_search(state_steps_.begin(), state_steps_.end(), r.step)) return;
-          StepState& state = at[r.step];
-          state.x = x;
-          for (const auto& block : blocks_) state.observed.push_back(block->observe(model, r));
-        });
-  };
-  e.summary = forward(changed, stepping, states);
+  e.summary = run_forward(changed, stepping, states, keep_path_states ? &e.path_states : nullptr);
   e.forward_runs = 1;
   e.warm_started_runs = e.summary.warm_started ? 1 : 0;
   if (!e.summary.success) {
@@ -180,56 +185,67 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
         readings[b][step].sensitivities = blocks_[b]->observed_sensitivities(changed, record, nm);
     }
   } else if (sensitivities_wanted) {
-    for (int step : state_steps_) {
-      run.sensitivities[step].resize(states.at(step).x.size(), nm);
-      for (size_t b = 0; b < nb; ++b)
-        readings[b][step].sensitivities.resize(
-            static_cast<Eigen::Index>(states.at(step).observed[b].size()), nm);
-    }
-    for (int j = 0; j < nm; ++j) {
-      const int k = map.material_indices()[static_cast<size_t>(j)];
-      const double h = options_.difference_step * std::max(1.0, std::abs(phi[k]));
-      std::map<int, StepState> plus, minus;
-      for (double sign : {1.0, -1.0}) {
-        Eigen::VectorXd shifted = phi;
-        shifted[k] += sign * h;
-        model::Model moved = model_;
-        moved.material = map.material(model_.material, map.values(shifted));
-        solve::SteppingOptions shifted_stepping = stepping_;
-        if (warm_starts_) shifted_stepping.warm_start = e.summary.unknowns;  // phi's, next door
-        const solve::SteppingSummary s = forward(moved, shifted_stepping, sign > 0 ? plus : minus);
-        ++e.forward_runs;
-        e.warm_started_runs += s.warm_started ? 1 : 0;
-        if (!s.success) {
-          e.message = "a finite-difference run failed: " + s.message;
-          return e;
-        }
-      }
-      for (int step : state_steps_) {  // du/dtheta, as the stepper gives it
-        const double denominator = 2.0 * h * run.dvalue[k];
-        run.sensitivities[step].col(j) = (plus.at(step).x - minus.at(step).x) / denominator;
-        for (size_t b = 0; b < nb; ++b) {
-          Eigen::MatrixXd& d = readings[b][step].sensitivities;
-          for (Eigen::Index i = 0; i < d.rows(); ++i)
-            d(i, j) = (plus.at(step).observed[b][static_cast<size_t>(i)] -
-                       minus.at(step).observed[b][static_cast<size_t>(i)]) /
-                      denominator;
-        }
-      }
-    }
+    e.message = central_differences(phi, states, run, readings,
+                                    keep_path_states ? &e.path_states : nullptr, e);
+    if (!e.message.empty()) return e;
   }
   e.residuals.resize(residuals_);
-  if (with_jacobian) e.jacobian = Eigen::MatrixXd::Zero(residuals_, P);
-  const ForwardRun& at = run;
+  if (with_jacobian) e.jacobian = Eigen::MatrixXd::Zero(residuals_, map.size());
   Eigen::Index row = 0;
   for (size_t b = 0; b < nb; ++b) {
-    e.message = blocks_[b]->evaluate(at, readings[b], row, e);
+    e.message = blocks_[b]->evaluate(run, readings[b], row, e);
     if (!e.message.empty()) return e;
     row += blocks_[b]->rows();
   }
   e.ok = e.residuals.allFinite() && (!with_jacobian || e.jacobian.allFinite());
   if (!e.ok) e.message = "non-finite distances or forces";
   return e;
+}
+
+std::string FitProblem::central_differences(const Eigen::VectorXd& phi,
+                                            const std::map<int, StepState>& states, ForwardRun& run,
+                                            std::vector<std::map<int, StepReadings>>& readings,
+                                            std::map<int, Eigen::VectorXd>* path_states,
+                                            Evaluation& e) const {
+  const ParameterMap& map = map_;
+  const size_t nb = blocks_.size();
+  const int nm = static_cast<int>(map.material_names().size());
+  for (int step : state_steps_) {
+    run.sensitivities[step].resize(states.at(step).x.size(), nm);
+    for (size_t b = 0; b < nb; ++b)
+      readings[b][step].sensitivities.resize(
+          static_cast<Eigen::Index>(states.at(step).observed[b].size()), nm);
+  }
+  for (int j = 0; j < nm; ++j) {
+    const int k = map.material_indices()[static_cast<size_t>(j)];
+    const double h = options_.difference_step * std::max(1.0, std::abs(phi[k]));
+    std::map<int, StepState> plus, minus;
+    for (double sign : {1.0, -1.0}) {
+      Eigen::VectorXd shifted = phi;
+      shifted[k] += sign * h;
+      model::Model moved = model_;
+      moved.material = map.material(model_.material, map.values(shifted));
+      solve::SteppingOptions shifted_stepping = stepping_;
+      if (warm_starts_) shifted_stepping.warm_start = e.summary.unknowns;  // phi's, next door
+      const solve::SteppingSummary s =
+          run_forward(moved, shifted_stepping, sign > 0 ? plus : minus, path_states);
+      ++e.forward_runs;
+      e.warm_started_runs += s.warm_started ? 1 : 0;
+      if (!s.success) return "a finite-difference run failed: " + s.message;
+    }
+    for (int step : state_steps_) {  // du/dtheta, as the stepper gives it
+      const double denominator = 2.0 * h * run.dvalue[k];
+      run.sensitivities[step].col(j) = (plus.at(step).x - minus.at(step).x) / denominator;
+      for (size_t b = 0; b < nb; ++b) {
+        Eigen::MatrixXd& d = readings[b][step].sensitivities;
+        for (Eigen::Index i = 0; i < d.rows(); ++i)
+          d(i, j) = (plus.at(step).observed[b][static_cast<size_t>(i)] -
+                     minus.at(step).observed[b][static_cast<size_t>(i)]) /
+                    denominator;
+      }
+    }
+  }
+  return "";
 }
 
 void FitProblem::describe(const Evaluation& best, FitResult& result) const {

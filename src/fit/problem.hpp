@@ -9,10 +9,12 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/residuals/residual_block.hpp"
 
 namespace fiberfluid::fit {
@@ -47,9 +49,9 @@ class FitProblem {
 
   const model::Model& model() const { return model_; }
   const solve::SteppingOptions& stepping() const { return stepping_; }
-  const ParameterMap& map() const { return map_; }
+  const ParameterMap& parameters() const { return map_; }
   const FitOptions& options() const { return options_; }
-  bool analytic() const { return analytic_; }
+  bool analytic_jacobian() const { return analytic_; }
   bool warm_starts() const { return warm_starts_; }
   int num_residuals() const { return residuals_; }
   int num_counted_vertices() const { return static_cast<int>(counted_.size()); }
@@ -57,6 +59,10 @@ class FitProblem {
   const std::vector<ForceCurve>& force_curves() const { return curves_; }
   double force_weight(size_t curve) const { return curve_weights_.at(curve); }
 
+  // Calibration::evaluate: the residuals at phi, the final state solved from
+  // `warm_start` where the problem takes warm starts.
+  Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
+                      const Eigen::VectorXd& warm_start) const;
   // The residuals (with_jacobian: and their Jacobian) at phi, run with these
   // stepping options (a warm start in them is used as given);
   // keep_path_states: a failed run's Evaluation::path_states (near_a_halving).
@@ -68,6 +74,27 @@ class FitProblem {
   void describe(const Evaluation& at, FitResult& result) const;
 
  private:
+  // Per step read: the state, and each block's readings of its record.
+  struct StepState {
+    Eigen::VectorXd x;
+    std::vector<std::vector<double>> observed;  // per block
+  };
+  // A run of `model` along the path, its states at the steps read into `at`
+  // (and, with path_states, its states near n/2, n/4, ...).
+  solve::SteppingSummary run_forward(const model::Model& model,
+                                     const solve::SteppingOptions& options,
+                                     std::map<int, StepState>& at,
+                                     std::map<int, Eigen::VectorXd>* path_states) const;
+  // du/dtheta and the blocks' readings' derivatives by central differences
+  // of whole runs in phi (two per material parameter), into run and
+  // readings; the runs counted in e (and, as a probe's, their path states
+  // kept: a failed one's are where a stiffer start may begin). "" or why a
+  // run failed.
+  std::string central_differences(const Eigen::VectorXd& phi,
+                                  const std::map<int, StepState>& states, ForwardRun& run,
+                                  std::vector<std::map<int, StepReadings>>& readings,
+                                  std::map<int, Eigen::VectorXd>* path_states, Evaluation& e) const;
+
   model::Model model_;
   solve::SteppingOptions stepping_;
   std::vector<ForceCurve> curves_;

@@ -99,12 +99,12 @@ std::string unidentifiable_because(const Eigen::MatrixXd& J,
 void check_interval_ends(EvaluationCache& evaluations, const FitProblem& m,
                          const Eigen::VectorXd& phi, const Eigen::MatrixXd& covariance,
                          double variance, FitResult& result) {
-  const int P = m.map().size();
-  const Eigen::VectorXd lower = m.map().lower_phi(), upper = m.map().upper_phi();
+  const int P = m.parameters().size();
+  const Eigen::VectorXd lower = m.parameters().lower_phi(), upper = m.parameters().upper_phi();
   const double level = 0.5 * 3.841458820694124 * variance;
   constexpr double kSmallest = 1e-4;  // a half-width in phi below which rounding rules the rise
   constexpr int kDoublings = 10, kRefinements = 3, kRefits = 3, kRunsPerParameter = 8;
-  const bool refit = m.analytic() && P > 1;  // else the others stay at the optimum
+  const bool refit = m.analytic_jacobian() && P > 1;  // else the others stay at the optimum
   // How far one move may take each other parameter: a log-scaled one by
   // max_step_factor (as a Levenberg-Marquardt step), a linear one by its
   // linearised 95% half-width (nothing for one on its bound). A parameter
@@ -113,7 +113,7 @@ void check_interval_ends(EvaluationCache& evaluations, const FitProblem& m,
   Eigen::VectorXd reach(P);
   for (int j = 0; j < P; ++j)
     reach[j] = on_bound(phi[j], lower[j], upper[j]) ? 0.0
-               : m.map().parameters()[static_cast<size_t>(j)].log_scale
+               : m.parameters().parameters()[static_cast<size_t>(j)].log_scale
                    ? std::log(m.options().max_step_factor)
                    : 1.96 * std::sqrt(std::max(0.0, variance * covariance(j, j)));
   // The checks' forward runs, at most kRunsPerParameter per parameter: past
@@ -124,7 +124,7 @@ void check_interval_ends(EvaluationCache& evaluations, const FitProblem& m,
   result.interval_notes.assign(static_cast<size_t>(P), "");
   for (int k = 0; k < P && !cancel_requested(); ++k) {
     const int runs_before = evaluations.forward_runs;
-    const Parameter& parameter = m.map().parameters()[static_cast<size_t>(k)];
+    const Parameter& parameter = m.parameters().parameters()[static_cast<size_t>(k)];
     const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
     if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
     const Eigen::VectorXd path = covariance.col(k) / covariance(k, k);  // the linearised profile

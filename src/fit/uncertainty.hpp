@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/parameters.hpp"
 #include "fiberfluid/fit/problem.hpp"
 

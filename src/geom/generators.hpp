@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include "fiberfluid/geom/surface.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::geom {
 
@@ -33,6 +34,8 @@ Surface cube(double edge = 1.0);
 // a loop of edges at every subdivision, so its rim is the ellipse itself, a
 // crease the mesh follows exactly (what a resolution study needs: model.md).
 enum class DomeBase { Icosahedron, Octahedron };
+inline constexpr auto kDomeBaseNames = names_of<DomeBase>(
+    {{DomeBase::Icosahedron, "icosahedron"}, {DomeBase::Octahedron, "octahedron"}});
 Surface dome(const Eigen::Vector3d& semi_axes, int subdivisions,
              DomeBase base = DomeBase::Icosahedron);
 

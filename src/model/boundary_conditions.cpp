@@ -14,10 +14,6 @@
 
 namespace fiberfluid::model {
 
-const char* to_string(BoundaryMethod method) {
-  return method == BoundaryMethod::Penalty ? "penalty" : "elimination";
-}
-
 HalfSpace parse_half_space(const std::string& text, int dim) {
   static const std::regex form(
       R"(^\s*([xyz])\s*(>=|<=|>|<)\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*$)");

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::model {
 
@@ -13,7 +14,9 @@ enum class BoundaryMethod {
   Elimination,  // fixed unknowns removed from the system (default)
   Penalty,      // the paper's: the diagonal entry replaced by a large number
 };
-const char* to_string(BoundaryMethod method);
+inline constexpr auto kBoundaryMethodNames = names_of<BoundaryMethod>(
+    {{BoundaryMethod::Elimination, "elimination"}, {BoundaryMethod::Penalty, "penalty"}});
+inline const char* to_string(BoundaryMethod method) { return kBoundaryMethodNames.name(method); }
 
 // ---------------------------------------------------------------- selection
 // A half-space written as "z >= 0.8", "x < 0", "y<=1.5".

@@ -20,20 +20,6 @@ double checked_fiber_length(const Eigen::MatrixXd& X, int i, int j) {
   return length;
 }
 
-const char* to_string(ConnectionCount count) {
-  switch (count) {
-    case ConnectionCount::Global:
-      return "global";
-    case ConnectionCount::Area:
-      return "area";
-    case ConnectionCount::Mean:
-      return "mean";
-    case ConnectionCount::Symmetric:
-      break;
-  }
-  return "symmetric";
-}
-
 PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices)
     : PairFactors(fibers, count, num_vertices, Influence{}, nullptr) {}
 

@@ -11,6 +11,7 @@
 #include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/model/fiber_law.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::model {
 
@@ -78,6 +79,11 @@ struct Schedule {
 
   double factor(int step, int steps) const;
 };
+// The schedules named in an experiment file (a table is given as a list).
+inline constexpr auto kScheduleNames =
+    names_of<Schedule::Kind>({{Schedule::Kind::Ramp, "ramp"},
+                              {Schedule::Kind::Final, "final"},
+                              {Schedule::Kind::UpDown, "up_down"}});
 
 struct Load {
   enum class Kind {
@@ -98,6 +104,8 @@ struct Load {
   Integration integration = Integration::Vertex;
   Schedule schedule;
 };
+inline constexpr auto kIntegrationNames = names_of<Load::Integration>(
+    {{Load::Integration::Vertex, "vertex"}, {Load::Integration::Exact, "exact"}});
 
 // One degree of freedom held at a displacement (0 for a support).
 struct Constraint {
@@ -161,7 +169,12 @@ enum class ConnectionCount {
   // gravity"); the mean does not.
   Mean,
 };
-const char* to_string(ConnectionCount count);
+inline constexpr auto kConnectionCountNames =
+    names_of<ConnectionCount>({{ConnectionCount::Symmetric, "symmetric"},
+                               {ConnectionCount::Global, "global"},
+                               {ConnectionCount::Area, "area"},
+                               {ConnectionCount::Mean, "mean"}});
+inline const char* to_string(ConnectionCount count) { return kConnectionCountNames.name(count); }
 // Whether a count weighs the fibers by the areas they reach (Area, Mean).
 inline bool counts_by_area(ConnectionCount count) {
   return count == ConnectionCount::Area || count == ConnectionCount::Mean;

@@ -16,7 +16,7 @@
 //
 // A new load kind is one new term and its case in make_load_term. Contact
 // with the paddles is not a term: contacts are held unknowns of the stepper's
-// active set (newton_stepper.cpp), and their reactions are the residual's rows.
+// active set (solve/newton/contact_set.hpp), and their reactions are the residual's rows.
 #pragma once
 
 #include <Eigen/Core>

@@ -22,7 +22,7 @@
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
-#include "fiberfluid/solve/interactive_stepper.hpp"
+#include "fiberfluid/solve/newton/interactive_stepper.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/run_control.hpp"
 

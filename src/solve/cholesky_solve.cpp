@@ -125,11 +125,16 @@ template <class Scalar>
 void dispatch(int n, const Scalar* L, Scalar* X, int nrhs, int ldx) {
   if (n <= 0) return;
   switch (nrhs) {
-    case 0: return;
-    case 1: return solve<Scalar, 1>(n, L, X, ldx);
-    case 2: return solve<Scalar, 2>(n, L, X, ldx);
-    case 3: return solve<Scalar, 3>(n, L, X, ldx);
-    default: throw std::invalid_argument("cholesky_solve_in_place: at most 3 right-hand sides");
+    case 0:
+      return;
+    case 1:
+      return solve<Scalar, 1>(n, L, X, ldx);
+    case 2:
+      return solve<Scalar, 2>(n, L, X, ldx);
+    case 3:
+      return solve<Scalar, 3>(n, L, X, ldx);
+    default:
+      throw std::invalid_argument("cholesky_solve_in_place: at most 3 right-hand sides");
   }
 }
 

@@ -3,60 +3,15 @@
 
 #include <sstream>
 
-#include "fiberfluid/solve/backends.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::solve {
 
-const char* to_string(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::Auto:
-      return "auto";
-    case SolverKind::DenseLU:
-      return "dense-lu";
-    case SolverKind::BlockCholesky:
-      return "block-cholesky";
-    case SolverKind::Cholmod:
-      return "cholmod";
-    case SolverKind::PCG:
-      return "pcg";
-  }
-  return "?";
-}
-
-namespace {
-constexpr SolverKind kEverySolver[] = {SolverKind::Auto, SolverKind::DenseLU,
-                                       SolverKind::BlockCholesky, SolverKind::Cholmod,
-                                       SolverKind::PCG};
-}  // namespace
-
 std::optional<SolverKind> solver_kind_from_string(const std::string& name) {
-  for (SolverKind kind : kEverySolver)
-    if (name == to_string(kind)) return kind;
-  return std::nullopt;
+  return kSolverKindNames.find(name);
 }
 
-std::vector<std::string> solver_kind_names() {
-  std::vector<std::string> names;
-  for (SolverKind kind : kEverySolver) names.push_back(to_string(kind));
-  return names;
-}
-
-std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const PcgOptions& pcg) {
-  switch (kind) {
-    case SolverKind::DenseLU:
-      return make_dense_lu_solver();
-    case SolverKind::BlockCholesky:
-      return make_block_cholesky_solver();
-    case SolverKind::Cholmod:
-      return make_cholmod_solver();
-    case SolverKind::PCG:
-      return make_pcg_solver(pcg);
-    case SolverKind::Auto:
-      break;
-  }
-  return nullptr;
-}
+std::vector<std::string> solver_kind_names() { return kSolverKindNames.all(); }
 
 SolverKind choose_solver(double largest_block, int factors, double budget_bytes) {
   const double n = largest_block;

@@ -9,6 +9,7 @@
 
 #include "fiberfluid/model/bordered_system.hpp"
 #include "fiberfluid/solve/status.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::solve {
 
@@ -21,7 +22,13 @@ enum class SolverKind {
   Cholmod,        // Schur complement on P, sparse Cholesky per axis block (SuiteSparse)
   PCG,            // Schur complement on P, matrix-free preconditioned conjugate gradients
 };
-const char* to_string(SolverKind kind);
+inline constexpr auto kSolverKindNames =
+    names_of<SolverKind>({{SolverKind::Auto, "auto"},
+                          {SolverKind::DenseLU, "dense-lu"},
+                          {SolverKind::BlockCholesky, "block-cholesky"},
+                          {SolverKind::Cholmod, "cholmod"},
+                          {SolverKind::PCG, "pcg"}});
+inline const char* to_string(SolverKind kind) { return kSolverKindNames.name(kind); }
 std::optional<SolverKind> solver_kind_from_string(const std::string& name);
 // Every name solver_kind_from_string reads, for the readers' lists and messages.
 std::vector<std::string> solver_kind_names();

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// What both steppers share: the checks before a run and after every step,
-// the options' validation and names, and the summary's report. Its own file
-// so that newton_stepper.cpp does not call into load_stepper.cpp (which
-// hands the Newton scheme to it).
+// What both schemes share: the checks before a run and after every step,
+// the options' validation, and the summary's report.
 #include "fiberfluid/solve/stepping_common.hpp"
 
 #include <algorithm>
@@ -135,24 +133,6 @@ bool NewtonOptions::IsValid(std::string* why) const {
       max_contact_rounds < 1)
     return *why = "newton iteration limits must be at least 1 (max_step_cuts at least 0)", false;
   return true;
-}
-
-const char* to_string(Scheme scheme) { return scheme == Scheme::Newton ? "newton" : "incremental"; }
-
-const char* to_string(TangentSolver solver) {
-  switch (solver) {
-    case TangentSolver::Auto:
-      return "auto";
-    case TangentSolver::Dense:
-      return "dense";
-    case TangentSolver::Krylov:
-      return "krylov";
-    case TangentSolver::Sparse:
-      return "sparse";
-    case TangentSolver::Reused:
-      return "reused";
-  }
-  return "?";
 }
 
 TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,

@@ -13,7 +13,7 @@
 #include "fiberfluid/model/dof_map.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::solve {
 

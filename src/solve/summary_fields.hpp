@@ -6,7 +6,7 @@
 // to StepRecord or SteppingSummary (other than a live object: the factored
 // system, the final tangent, which stay where they were made) goes here too.
 
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::model {
 template <class A>

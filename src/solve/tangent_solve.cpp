@@ -282,8 +282,8 @@ Status TangentSolve::solve(const Eigen::VectorXd& b, double tolerance, Eigen::Ve
     if (just_factored_ && !rounded) break;
     if (just_factored_) single_factor_ = false;
     if (kind_ == TangentSolver::Reused) preconditioner_dofs_ = dofs_;
-    Status status = kind_ == TangentSolver::Reused ? factor_tangent_preconditioner()
-                                                   : factor_preconditioner();
+    Status status =
+        kind_ == TangentSolver::Reused ? factor_tangent_preconditioner() : factor_preconditioner();
     if (status.ok) status = update_capacitance();
     if (!status.ok) return status;
     result = run_gmres();

@@ -12,7 +12,7 @@
 #include "fiberfluid/model/fiber_system.hpp"
 #include "fiberfluid/solve/dense_lu.hpp"
 #include "fiberfluid/solve/linear_solver.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/solve/sparse_lu.hpp"
 #include "fiberfluid/solve/status.hpp"
 

@@ -11,7 +11,7 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/assembly.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::bridge {
 namespace {

@@ -395,6 +395,45 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   EXPECT_EQ(ex.cases[0].stepping.newton.max_step_cuts, 3);
 }
 
+// Every name a reader offers for an enum reads as the value it names (an
+// enum read through a chain of comparisons once turned a name the chain
+// lacked into its default): each name through the file, compared with the
+// value the enum's one list gives it.
+TEST(ExperimentConfig, EveryNamedChoiceReadsAsTheValueItNames) {
+  ScratchDir dir;
+  for (const auto& entry : solve::kTangentSolverNames.entries()) {
+    nlohmann::json c = base_config();
+    c["stepping"] = {{"scheme", "newton"}, {"newton", {{"tangent", entry.name}}}};
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.newton.tangent, entry.value)
+        << entry.name;
+  }
+  for (const auto& entry : solve::kSolverKindNames.entries()) {
+    nlohmann::json c = base_config();
+    c["stepping"]["solver"] = entry.name;
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.solver, entry.value)
+        << entry.name;
+  }
+  for (const auto& entry : model::kBoundaryMethodNames.entries()) {
+    nlohmann::json c = base_config();
+    c["stepping"]["boundary_method"] = entry.name;
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.boundary_method,
+              entry.value)
+        << entry.name;
+  }
+  for (const auto& entry : model::kConnectionCountNames.entries()) {
+    nlohmann::json c = base_config();
+    c["fibers"] = {{"connection_count", entry.name}};
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.connection_count, entry.value)
+        << entry.name;
+  }
+  for (const auto& entry : solve::kSchemeNames.entries()) {
+    nlohmann::json c = base_config();
+    c["stepping"]["scheme"] = entry.name;
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.scheme, entry.value)
+        << entry.name;
+  }
+}
+
 TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   ScratchDir dir;
   nlohmann::json c = base_config();

@@ -8,7 +8,9 @@
 #include "fit/fit_fixtures.hpp"
 #include "model/model_fixtures.hpp"
 
+#include "fiberfluid/fit/evaluation_cache.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/fit/problem.hpp"
 
 #include <ceres/rotation.h>
 
@@ -117,10 +119,11 @@ TEST(Calibration, AStiffenedStartIsSolvedFromTheFailedStartsPath) {
   for (const char* name : {"Y0", "gamma"})
     stiff.material.set_parameter(name, 2.0 * m.material.parameter(name));
   Eigen::VectorXd half;
-  ASSERT_TRUE(solve::solve_load_steps(m, newton(n), [&](const solve::StepRecord& r,
-                                                        const Eigen::VectorXd& x) {
-                if (r.step == n / 2) half = x;
-              }).success);
+  ASSERT_TRUE(solve::solve_load_steps(m, newton(n),
+                                      [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+                                        if (r.step == n / 2) half = x;
+                                      })
+                  .success);
   const solve::SteppingSummary doubled = solve::solve_load_steps(stiff, newton(n));
   ASSERT_TRUE(doubled.success) << doubled.message;
   half[half.size() - 1] *= 2.0;
@@ -266,8 +269,8 @@ TEST(Calibration, TrialPointsAreSolvedFromTheNearestPointsState) {
   EXPECT_FALSE(b.summary.warm_started);
 
   // Targets that read an earlier step too: the path every time.
-  EXPECT_FALSE(Calibration(m, newton(4), synthetic_targets(m, newton(4), {2, 4}), parameters)
-                   .warm_starts());
+  EXPECT_FALSE(
+      Calibration(m, newton(4), synthetic_targets(m, newton(4), {2, 4}), parameters).warm_starts());
 }
 
 // A parameter the data barely see: a sphere pressed by a paddle, its force
@@ -316,7 +319,7 @@ TEST(Calibration, EvaluationsAreKeptAndCounted) {
   const model::Model m = hanging_sphere();
   const Calibration c(m, newton(2), synthetic_targets(m, newton(2), {2}),
                       {parameter("Y0", 2000.0), parameter("gamma", 200.0)});
-  EvaluationCache cache(c);
+  EvaluationCache cache(c.problem());
   const Eigen::VectorXd phi = c.parameters().initial_phi();
   const double cost = c.cost(cache.at(phi, false).residuals);
   EXPECT_EQ(cache.forward_runs, 1);

@@ -9,7 +9,7 @@
 #include "fiberfluid/fit/parameters.hpp"
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::testing {
 

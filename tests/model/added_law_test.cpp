@@ -11,7 +11,7 @@
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/solve/tangent_solve.hpp"
 #include "model/model_fixtures.hpp"
 

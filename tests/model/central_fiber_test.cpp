@@ -17,7 +17,7 @@
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::model {

@@ -20,7 +20,7 @@
 #include "fiberfluid/model/mirror_layer.hpp"
 #include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::model {

@@ -20,7 +20,7 @@
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/fiber_network.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::model {

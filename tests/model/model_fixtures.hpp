@@ -16,7 +16,7 @@
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::testing {
 

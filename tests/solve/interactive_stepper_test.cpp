@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "fiberfluid/model/boundary_conditions.hpp"
-#include "fiberfluid/solve/interactive_stepper.hpp"
+#include "fiberfluid/solve/newton/interactive_stepper.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "model/model_fixtures.hpp"
 

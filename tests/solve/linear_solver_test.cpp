@@ -14,7 +14,7 @@
 #include "fiberfluid/model/loads.hpp"
 #include "fiberfluid/model/reference/dense_assembly.hpp"
 #include "fiberfluid/solve/backends.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 #include "model/model_fixtures.hpp"
 #include "test_support.hpp"
 

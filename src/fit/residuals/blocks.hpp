@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/force_curve.hpp"
 #include "fiberfluid/fit/residuals/residual_block.hpp"
 #include "fiberfluid/fit/target.hpp"

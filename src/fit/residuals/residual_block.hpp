@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/parameters.hpp"
 #include "fiberfluid/model/model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::fit {
 

@@ -13,6 +13,7 @@
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/solve/linear_solver.hpp"
+#include "fiberfluid/util/names.hpp"
 
 namespace fiberfluid::solve {
 
@@ -25,7 +26,9 @@ enum class Scheme {
   // rigid paddles in contact as an active set.
   Newton,
 };
-const char* to_string(Scheme scheme);
+inline constexpr auto kSchemeNames =
+    names_of<Scheme>({{Scheme::Incremental, "incremental"}, {Scheme::Newton, "newton"}});
+inline const char* to_string(Scheme scheme) { return kSchemeNames.name(scheme); }
 
 // How each Newton step's linear system with the tangent is solved.
 enum class TangentSolver {
@@ -39,7 +42,13 @@ enum class TangentSolver {
            // (dense; sparse for a horizon's lists), reused across iterations and steps
            // while GMRES needs few iterations
 };
-const char* to_string(TangentSolver solver);
+inline constexpr auto kTangentSolverNames =
+    names_of<TangentSolver>({{TangentSolver::Auto, "auto"},
+                             {TangentSolver::Dense, "dense"},
+                             {TangentSolver::Krylov, "krylov"},
+                             {TangentSolver::Sparse, "sparse"},
+                             {TangentSolver::Reused, "reused"}});
+inline const char* to_string(TangentSolver solver) { return kTangentSolverNames.name(solver); }
 // What `requested` means for a Newton run with `reduced_unknowns` (the
 // unknowns left after the supports): Auto is dense up to 600 then Krylov
 // for the vector spring. Central fibers, whose tangent the secant
@@ -82,6 +91,8 @@ struct NewtonOptions {
 
   bool IsValid(std::string* why) const;
 };
+inline constexpr auto kControlNames = names_of<NewtonOptions::Control>(
+    {{NewtonOptions::Control::Load, "load"}, {NewtonOptions::Control::ArcLength, "arc_length"}});
 
 struct SteppingOptions {
   Scheme scheme = Scheme::Incremental;
@@ -244,18 +255,6 @@ std::string treecode_problem(const model::Model& model, const SteppingOptions& o
 // scheme (the incremental scheme's matrix is the vector spring's).
 std::string kinematics_problem(const model::Model& model, const SteppingOptions& options);
 
-// "" when the Newton stepper's analytic sensitivities (du/dtheta and the
-// forces' derivatives) are exact for this model, else why not: a sticking
-// paddle holds each vertex where it first touched, and that place moves with
-// the parameters, which the sensitivities take as fixed.
-std::string sensitivity_problem(const model::Model& model);
-
-// "" when SteppingOptions::warm_start can be used for this model, else why
-// not: the Newton scheme by load control, a start of the model's size with
-// finite values, and no sticking paddle (where a vertex sticks depends on
-// the way there).
-std::string warm_start_problem(const model::Model& model, const SteppingOptions& options);
-
 // "" when the model's support terms (mirror layers, model::MirrorLayer, and
 // split edges, model::HeldEdge) can run with these options, else why not:
 // they need the Newton scheme.
@@ -266,8 +265,9 @@ std::string support_terms_problem(const model::Model& model, const SteppingOptio
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,
                             double budget_bytes);
 
-// The Newton scheme (what solve_load_steps runs for Scheme::Newton).
-SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
-                                   const StepObserver& observer = {});
+// The paper's scheme (what solve_load_steps runs for Scheme::Incremental).
+// The Newton scheme's own entry point and checks: solve/newton/newton.hpp.
+SteppingSummary solve_incremental_steps(const model::Model& model, const SteppingOptions& options,
+                                        const StepObserver& observer = {});
 
 }  // namespace fiberfluid::solve

@@ -7,21 +7,10 @@
 #include <vector>
 
 #include "fiberfluid/model/model.hpp"
-#include "fiberfluid/solve/load_stepper.hpp"
+#include "fiberfluid/solve/newton/newton.hpp"
+#include "fiberfluid/solve/stepping.hpp"
 
 namespace fiberfluid::solve {
-
-// Where the loads, the supports and the paddles stand at one point of a load
-// path: what a Newton step solves equilibrium at.
-struct LoadPoint {
-  std::vector<double> factors;  // per Model::loads: 0 unloaded, 1 the full load
-  Eigen::VectorXd held_values;  // dim N: the supports' prescribed displacements, zero where free
-  std::vector<double> planes;   // per Model::paddles: the plane's coordinate (m)
-};
-
-// The model's own load path at t (t = k after step k of `steps`, linear in
-// between): its loads' and supports' schedules, its paddles' travel.
-LoadPoint scheduled_point(const model::Model& model, double t, int steps);
 
 // One Newton step at a time, each to a load point the caller chooses as it
 // goes: a paddle moved by a hand or a haptic device, a load turned up. Each

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fiberfluid/solve/load_stepper.hpp"
+// The paper's incremental scheme (model.md section 6): A(x_{k-1}) dx_k =
+// B(x_{k-1}, f_k) - B(x_{k-1}, f_{k-1}), a forward-Euler walk along the load path.
+#include "fiberfluid/solve/stepping.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -78,9 +80,8 @@ class Reactions {
 
 }  // namespace
 
-SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
-                                 const StepObserver& observer) {
-  if (options.scheme == Scheme::Newton) return solve_newton_steps(model, options, observer);
+SteppingSummary solve_incremental_steps(const model::Model& model, const SteppingOptions& options,
+                                        const StepObserver& observer) {
   const Clock::time_point start = Clock::now();
   SteppingSummary summary = empty_summary(model, Scheme::Incremental);
   auto fail = [&](const std::string& why) { return failed(summary, why, start); };

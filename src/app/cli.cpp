@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fiberfluid/app/cli.hpp"
+
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+
+#include "fiberfluid/util/progress.hpp"
+#include "fiberfluid/util/run_control.hpp"
+
+namespace fiberfluid::app {
+
+// The first Ctrl-C asks the run to stop at its next check (a load step, a
+// pruning row, a solver iteration) and clean up; a second one ends the
+// process at once (the handler is reset after the first).
+void stop_on_interrupt() {
+  struct sigaction action {};
+  action.sa_handler = [](int) { fiberfluid::request_cancel(); };
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG, reported
+  // with the file's name, instead of the signal ending the process.
+  signal(SIGXFSZ, SIG_IGN);
+}
+
+// Throws Interrupted after a phase that returned early because of Ctrl-C,
+// before its partial results are written anywhere.
+void stop_if_interrupted(const std::string& phase) { fiberfluid::throw_if_cancelled(phase); }
+
+// progress of long phases such as pruning unless quiet; the sink stays set.
+// Estimates of long runs are printed before they start (as notes).
+experiment::Experiment load_showing_progress(const std::string& path, bool quiet,
+                                             ProgressPrinter& printer) {
+  if (!quiet) {
+    fiberfluid::set_progress_sink([&printer](const std::string& label, const char* phase,
+                                             double done,
+                                             double total) { printer(label, phase, done, total); });
+    fiberfluid::set_note_sink([&printer](const std::string& label, const std::string& text) {
+      printer.close();
+      std::cerr << "note: " << (label.empty() ? "" : "[" + label + "] ") << text << "\n";
+    });
+  }
+  experiment::Experiment ex = experiment::load_experiment(path);
+  printer.close();
+  fiberfluid::set_note_sink({});
+  for (const auto& w : ex.warnings) std::cerr << "warning: " << w << "\n";
+  return ex;
+}
+
+// Single quotes for a shell, with any quote inside closed and escaped.
+std::string shell_quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The plot script: installed beside the program (share/fiberfluid/plot.py),
+// or the source tree's when run from the build.
+std::filesystem::path plot_script() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const std::filesystem::path installed =
+        self.parent_path().parent_path() / "share" / "fiberfluid" / "plot.py";
+    if (std::filesystem::exists(installed)) return installed;
+  }
+  return FIBERFLUID_PLOT_SCRIPT;
+}
+
+// --plot: DIR/plot.png from DIR/summary.json, drawn by the plot script with
+// the first python3 that has matplotlib (the one on PATH, else Debian's). A
+// plot that cannot be drawn is a warning: the results are written already.
+void draw_plot(const std::filesystem::path& folder, const std::string& input) {
+  const std::filesystem::path script = plot_script();
+  if (!std::filesystem::exists(script)) {
+    std::cerr << "warning: no plot: the plot script " << script.string() << " is missing\n";
+    return;
+  }
+  for (const char* python : {"python3", "/usr/bin/python3"}) {
+    if (std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0)
+      continue;
+    const std::filesystem::path png = folder / "plot.png";
+    const std::string command = std::string(python) + " " + shell_quoted(script.string()) + " " +
+                                shell_quoted((folder / input).string()) + " " +
+                                shell_quoted(png.string());
+    if (std::system(command.c_str()) == 0 && std::filesystem::exists(png))
+      std::cout << "  plot: " << png.string() << "\n";
+    else
+      std::cerr << "warning: no plot: " << command << " failed\n";
+    return;
+  }
+  std::cerr << "warning: no plot: no python3 with matplotlib (Debian: apt-get install "
+               "python3-matplotlib)\n";
+}
+
+bool every_rank_fails = false;
+
+// Runs `step` on every rank and ends in agreement: when it throws on one
+// rank, it throws on all (the others an AnotherRankFailed), so no rank goes on
+// to wait for work that will never be dealt.
+void on_every_rank(const fiberfluid::parallel::Ranks& ranks, const std::function<void()>& step) {
+  try {
+    step();
+  } catch (...) {
+    ranks.all_ok(false);
+    every_rank_fails = true;
+    throw;
+  }
+  if (!ranks.all_ok(true)) {
+    every_rank_fails = true;
+    throw AnotherRankFailed();
+  }
+}
+
+// Fault injection for the tests of a failure on one rank alone
+// (tests/mpi/mpi_test.sh): FIBERFLUID_FAIL_RANK=r makes rank r throw once its
+// run is set up, outside any work item, while the others wait for it.
+void fail_if_injected(const fiberfluid::parallel::Ranks& ranks) {
+  const char* rank = std::getenv("FIBERFLUID_FAIL_RANK");
+  if (rank != nullptr && std::atoi(rank) == ranks.rank() && ranks.size() > 1)
+    throw std::runtime_error("a failure injected by FIBERFLUID_FAIL_RANK");
+}
+
+// A digest of what a rank will run: the resolved experiment and every
+// case's surface, bit for bit (FNV-1a, 64 bits).
+std::string experiment_digest(const experiment::Experiment& ex) {
+  std::uint64_t hash = 14695981039346656037ull;
+  const auto add = [&hash](const void* data, size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t k = 0; k < size; ++k) hash = (hash ^ bytes[k]) * 1099511628211ull;
+  };
+  const auto add_experiment = [&](const experiment::Experiment& e) {
+    const std::string resolved = e.resolved.dump();
+    add(resolved.data(), resolved.size());
+    for (const experiment::Case& c : e.cases) {
+      add(c.model.surface.V.data(), sizeof(double) * static_cast<size_t>(c.model.surface.V.size()));
+      add(c.model.surface.F.data(), sizeof(int) * static_cast<size_t>(c.model.surface.F.size()));
+    }
+  };
+  add_experiment(ex);
+  for (const experiment::Experiment& specimen : ex.specimens) add_experiment(specimen);
+  return std::to_string(hash);
+}
+
+// Every rank must run what rank 0 runs: started with other files (mpirun's
+// "A : B" form), a rank computed B's variants under A's record, or waited
+// for ever when B had fewer (issue 43). Refused on every rank, naming them.
+void require_one_experiment(const fiberfluid::parallel::Ranks& ranks,
+                            const experiment::Experiment& ex, const std::string& path) {
+  const std::vector<int> differing = ranks.differing_from_root(experiment_digest(ex));
+  if (differing.empty()) return;
+  std::string which;
+  for (int r : differing) which += (which.empty() ? "" : ", ") + std::to_string(r);
+  every_rank_fails = true;
+  throw fiberfluid::InputError(
+      "MPI rank(s) " + which + " read another experiment or surface than rank 0 (" + path +
+      "): every rank must run the same experiment file, with the same mesh");
+}
+
+}  // namespace fiberfluid::app

@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fiberfluid/solve/newton/step_finisher.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/solve/stepping_common.hpp"
+
+namespace fiberfluid::solve {
+namespace {
+
+bool partition_holds(const model::DofPartition& partition, int dof) {
+  return std::binary_search(partition.constrained.begin(), partition.constrained.end(), dof);
+}
+
+}  // namespace
+
+StepFinisher::StepFinisher(const model::Model& model, const SteppingOptions& options,
+                           NewtonSolver& solver, const model::DofPartition& partition,
+                           SteppingSummary& summary)
+    : model_(model),
+      options_(options),
+      solver_(solver),
+      partition_(partition),
+      summary_(summary),
+      reference_volume_(solver.equilibrium().reference_volume()),
+      last_face_areas_(geom::face_area_vectors(model.surface.V, model.surface.F)),
+      groups_(std::max<size_t>(1, model.constraint_groups.size())) {}
+
+void StepFinisher::compare_with(const Eigen::VectorXd& x) {
+  last_face_areas_ = geom::face_area_vectors(model::positions(model_, x), model_.surface.F);
+}
+
+std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
+                                 StepRecord& record) {
+  const int nv = model_.num_vertices(), dim = model_.dim(), k = record.step;
+  const Eigen::MatrixXd X = model::positions(model_, x);
+  const double volume = geom::enclosed_volume(X, model_.surface.F);
+  std::string why =
+      runaway_reason(model_, options_, x, X, volume, reference_volume_, last_face_areas_);
+  if (!why.empty()) return "step " + std::to_string(k) + ": runaway: " + why;
+
+  // Forces on the body: supports per group, paddles, and the loads.
+  const Eigen::VectorXd& R = solver_.last_residual();
+  const Eigen::VectorXd F = solver_.equilibrium().external_forces(x, at.factors);
+  record.reactions.assign(groups_, Eigen::Vector3d::Zero());
+  summary_.reaction_forces = Eigen::MatrixXd::Zero(nv, dim);
+  for (size_t c = 0; c < partition_.constrained.size(); ++c) {
+    const int d = partition_.constrained[c];
+    const model::Constraint& constraint =
+        model_.constraints[static_cast<size_t>(partition_.constraint_of[c])];
+    record.reactions[static_cast<size_t>(constraint.group) % groups_][d / nv] += R[d];
+    summary_.reaction_forces(d % nv, d / nv) = R[d];
+  }
+  // A clamp's mirror layer holds the body through its fibers, not its rows.
+  const std::vector<Eigen::Vector3d> layers = solver_.equilibrium().support_forces(x);
+  for (size_t g = 0; g < layers.size(); ++g) record.reactions[g % groups_] += layers[g];
+  record.paddles.resize(model_.paddles.size());
+  for (size_t p = 0; p < model_.paddles.size(); ++p) {
+    record.paddles[p].plane = at.planes[p];
+    record.paddles[p].travel = at.planes[p] - model_.paddles[p].position;
+  }
+  const model::DofMap held = solver_.held_map();
+  for (int v = 0; v < nv; ++v) {
+    const int p = solver_.contact_paddle()[static_cast<size_t>(v)];
+    if (p < 0) continue;
+    StepRecord::PaddleState& state = record.paddles[static_cast<size_t>(p)];
+    ++state.contacts;
+    for (int a = 0; a < dim; ++a)
+      if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v)) {
+        state.force[a] += R[a * nv + v];
+        summary_.reaction_forces(v, a) = R[a * nv + v];
+      }
+  }
+  for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
+  for (int v = 0; v < nv; ++v) {
+    bool any = false;
+    for (int a = 0; a < dim; ++a) any = any || held.held(a * nv + v);
+    if (!any) continue;
+    StepRecord::HeldForce force;
+    force.vertex = v;
+    force.paddle = solver_.contact_paddle()[static_cast<size_t>(v)];
+    force.force.head(dim) = summary_.reaction_forces.row(v).transpose();
+    record.held_forces.push_back(force);
+  }
+  record.load_factors = at.factors;
+  record.pressure = x[model_.pressure_dof()];
+  record.volume = volume;
+  record.volume_drift = (volume - reference_volume_) / reference_volume_;
+  record.max_displacement = (X - model_.surface.V).rowwise().norm().maxCoeff();
+  record.residual = record.residual_norms.empty() ? 0.0 : record.residual_norms.back();
+  const std::vector<int>& wanted = options_.sensitivities.steps;
+  if (!options_.sensitivities.parameters.empty() &&
+      std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
+    Eigen::MatrixXd residual_change;
+    why = solver_.sensitivities(at, x, options_.sensitivities.parameters, &record.sensitivities,
+                                &residual_change);
+    if (!why.empty()) return "step " + std::to_string(k) + ": sensitivities: " + why;
+    force_sensitivities(residual_change, record);
+  }
+  return {};
+}
+
+size_t StepFinisher::group_of(size_t c) const {
+  const int constraint = partition_.constraint_of[c];
+  return static_cast<size_t>(model_.constraints[static_cast<size_t>(constraint)].group) % groups_;
+}
+
+void StepFinisher::force_sensitivities(const Eigen::MatrixXd& residual_change,
+                                       StepRecord& record) const {
+  const int nv = model_.num_vertices(), dim = model_.dim();
+  const Eigen::Index P = residual_change.cols();
+  record.reaction_sensitivities.assign(groups_, Eigen::MatrixXd::Zero(3, P));
+  for (size_t c = 0; c < partition_.constrained.size(); ++c) {
+    const int d = partition_.constrained[c];
+    const size_t g = group_of(c);
+    record.reaction_sensitivities[g].row(d / nv) += residual_change.row(d);
+  }
+  for (const model::MirrorLayer& layer : model_.mirror_layers)
+    record.reaction_sensitivities[static_cast<size_t>(layer.group) % groups_].setConstant(
+        std::numeric_limits<double>::quiet_NaN());
+  for (StepRecord::PaddleState& state : record.paddles)
+    state.force_sensitivities = Eigen::MatrixXd::Zero(3, P);
+  const model::DofMap held = solver_.held_map();
+  for (int v = 0; v < nv; ++v) {
+    const int p = solver_.contact_paddle()[static_cast<size_t>(v)];
+    if (p < 0) continue;
+    for (int a = 0; a < dim; ++a)
+      if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v))
+        record.paddles[static_cast<size_t>(p)].force_sensitivities.row(a) +=
+            residual_change.row(a * nv + v);
+  }
+}
+
+}  // namespace fiberfluid::solve
