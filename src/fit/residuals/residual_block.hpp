@@ -3,8 +3,9 @@
 // the residual vector, the load steps it reads, and its residuals and their
 // Jacobian from a forward run's states and sensitivities. FitProblem stacks
 // the blocks in order, runs the model once per point and hands each block
-// what it reads. A new kind of target is one block (a class here, its
-// factory in blocks.hpp) and its line in FitProblem's constructor.
+// what it reads. A new kind of target is one block (its class declared in
+// blocks.hpp, defined in a file of its own here) and its line in
+// FitProblem's constructor.
 #pragma once
 
 #include <Eigen/Core>
