@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/fit_workflow.hpp"
+#include "fiberfluid/experiment/fitting.hpp"
 #include "fiberfluid/experiment/output_folder.hpp"
 #include "fiberfluid/experiment/outputs.hpp"
 #include "fiberfluid/experiment/runner.hpp"
@@ -412,6 +414,54 @@ class Interactive {
   ff::solve::InteractiveStepper stepper_;
 };
 
+// fiberfluid.fit_file: an experiment file's fit (or calibration over
+// specimens) through the same workflow as `fiberfluid fit`, its folder
+// written as the command writes it; returns how it ended and the folder's
+// fit.json (calibration.json) as a dict.
+py::dict fit_file(const std::filesystem::path& path, const std::string& output) {
+  namespace xp = ff::experiment;
+  const xp::Experiment ex = xp::load_experiment(path);
+  if (ex.kind != xp::Experiment::Kind::Calibration && !ex.fit)
+    throw ff::InputError(path.string() + ": no \"fit\" section (and not a calibration)");
+  const std::filesystem::path folder = xp::output_folder(output, ex.name);
+  ff::fit::FitStatus status = ff::fit::FitStatus::StartFailed;
+  std::filesystem::path written;
+  std::vector<std::string> warnings;
+  bool runs_succeeded = true;
+  std::string failure;
+  {
+    py::gil_scoped_release release;
+    if (ex.kind == xp::Experiment::Kind::Calibration) {
+      const xp::JointSetup setup = xp::setup_joint(ex);
+      const xp::CalibrationOutcome done = xp::run_calibration(ex, setup, folder, {}, {});
+      status = done.fitted.status;
+      written = done.folder;
+      warnings = done.warnings;
+      failure = done.result.failure;
+    } else {
+      const xp::FitSetup setup = xp::setup_fit(ex);
+      const xp::FitOutcome done = xp::run_fit(ex, setup, folder);
+      status = done.fitted.status;
+      written = done.folder;
+      warnings = done.warnings;
+      runs_succeeded = done.interrupted() || done.result.runs_succeeded();
+      failure = done.result.failure;
+    }
+  }
+  py::dict out;
+  out["status"] = ff::fit::to_string(status);
+  out["success"] = ff::fit::converged(status) && runs_succeeded;
+  out["exit_status"] = runs_succeeded ? xp::fit_exit_status(status) : 2;
+  out["failure"] = failure;
+  out["folder"] = written;
+  out["warnings"] = warnings;
+  const std::filesystem::path report =
+      written / (ex.kind == xp::Experiment::Kind::Calibration ? "calibration.json" : "fit.json");
+  std::ifstream in(report);
+  out["report"] = in ? to_python(nlohmann::json::parse(in)) : py::object(py::none());
+  return out;
+}
+
 PYBIND11_MODULE(fiberfluid, m) {
   m.doc() =
       "fiberfluid: the fibers-and-fluid soft-tissue model (Sardinha et al. 2016). "
@@ -535,6 +585,12 @@ PYBIND11_MODULE(fiberfluid, m) {
            "as `point` gives it.")
       .def_property_readonly("steps_taken", &Interactive::steps_taken);
 
+  m.def("fit_file", &fit_file, py::arg("path"), py::arg("output") = std::string(),
+        "Fits an experiment file's \"fit\" section (or calibrates a \"kind\": \"calibration\" "
+        "over its specimens) as `fiberfluid fit` does, writing its folder (default "
+        "out/<name>; DIR.failed or DIR.interrupted for a fit that did not converge). Returns a "
+        "dict: status, success, exit_status (the command's), failure, folder, warnings, and "
+        "report (the folder's fit.json or calibration.json).");
   m.def(
       "fit", &fit_experiment, py::arg("experiment"), py::arg("targets"), py::arg("parameters"),
       py::arg("method") = "levenberg-marquardt", py::arg("jacobian") = "analytic",

@@ -243,3 +243,26 @@ def test_an_interactive_press_follows_the_schedule_and_returns():
         live.step(paddles=[0.0])
     with pytest.raises(ValueError, match="no variant named"):
         fiberfluid.Interactive(ex, "nonsense")
+
+
+def test_a_file_fit_runs_the_commands_workflow(tmp_path):
+    """fit_file is `fiberfluid fit`: the same workflow, folder, fit.json and ending."""
+    out = fiberfluid.fit_file(os.path.join(EXPERIMENTS, "fit_synthetic_liver.json"),
+                              str(tmp_path / "fit"))
+    assert out["status"] == "converged" and out["success"] and out["exit_status"] == 0
+    assert out["folder"] == tmp_path / "fit"  # a pathlib.Path
+    values = {p["name"]: p["value"] for p in out["report"]["parameters"]}
+    # The values `fiberfluid fit experiments/fit_synthetic_liver.json` prints (truth 20 kPa, 3, 200).
+    assert values["Y0"] == pytest.approx(20593.9737, rel=1e-8)
+    assert values["beta"] == pytest.approx(3.034514146, rel=1e-8)
+    assert values["gamma"] == pytest.approx(199.3943915, rel=1e-8)
+    for name in ("fit_iterations.csv", "fit_distances.csv", "summary.json", "steps.csv"):
+        assert (tmp_path / "fit" / name).exists(), name
+    # A fit the scan cannot separate ends not_identifiable in DIR.failed, exit 2, as the command.
+    shape = fiberfluid.fit_file(os.path.join(EXPERIMENTS, "fit_paddles_liver_shape.json"),
+                                str(tmp_path / "shape"))
+    assert shape["status"] == "not_identifiable" and not shape["success"]
+    assert shape["exit_status"] == 2 and shape["folder"] == tmp_path / "shape.failed"
+    assert "not_identifiable" in shape["failure"]
+    with pytest.raises(ValueError, match='no "fit" section'):
+        fiberfluid.fit_file(os.path.join(EXPERIMENTS, "sphere.json"), str(tmp_path / "sphere"))
