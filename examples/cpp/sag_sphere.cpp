@@ -3,7 +3,7 @@
 // experiment built in code rather than read from a file, swept over Y, and
 // the cap's reaction read back. Prints one line per variant.
 #include <fiberfluid/experiment/experiment.hpp>
-#include <fiberfluid/experiment/runner.hpp>
+#include <fiberfluid/experiment/run/runner.hpp>
 #include <fiberfluid/geom/area_vectors.hpp>
 
 #include <cstdio>

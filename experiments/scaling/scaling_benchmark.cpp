@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/util/omp_wait_policy.hpp"
 #include "gemm_peak.hpp"
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "fiberfluid/experiment/write/file_names.hpp"
 #include "fiberfluid/util/progress.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
@@ -82,7 +83,7 @@ void draw_plot(const std::filesystem::path& folder, const std::string& input) {
   for (const char* python : {"python3", "/usr/bin/python3"}) {
     if (std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0)
       continue;
-    const std::filesystem::path png = folder / "plot.png";
+    const std::filesystem::path png = folder / experiment::output_files::kPlot;
     const std::string command = std::string(python) + " " + shell_quoted(script.string()) + " " +
                                 shell_quoted((folder / input).string()) + " " +
                                 shell_quoted(png.string());

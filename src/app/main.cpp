@@ -9,11 +9,11 @@
 #include <sstream>
 
 #include "fiberfluid/app/cli.hpp"
-#include "fiberfluid/experiment/build_info.hpp"
-#include "fiberfluid/experiment/compare.hpp"
-#include "fiberfluid/experiment/mesh_study.hpp"
-#include "fiberfluid/experiment/output_folder.hpp"
-#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/experiment/read/schema.hpp"
+#include "fiberfluid/experiment/run/compare.hpp"
+#include "fiberfluid/experiment/run/mesh_study.hpp"
+#include "fiberfluid/experiment/write/build_info.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/util/omp_wait_policy.hpp"

@@ -6,11 +6,12 @@
 #include <optional>
 
 #include "fiberfluid/app/cli.hpp"
-#include "fiberfluid/experiment/fit_workflow.hpp"
-#include "fiberfluid/experiment/fitting.hpp"
-#include "fiberfluid/experiment/output_folder.hpp"
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/fit_setup.hpp"
+#include "fiberfluid/experiment/run/fit_workflow.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/benchmark_files.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/util/progress.hpp"
 #include "fiberfluid/util/run_control.hpp"
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "fiberfluid/fem/free_unknowns.hpp"
 #include "fiberfluid/solve/sparse_cholesky.hpp"
@@ -126,6 +127,67 @@ double mechanical_energy(const Dynamics& d, const Eigen::VectorXd& u, const Eige
   return 0.5 * v.dot(d.M * v) + 0.5 * u.dot(d.K * u);
 }
 
+namespace {
+
+// The external force at time t (zero when the scene has none).
+Eigen::VectorXd force_at(const Dynamics& d, double t) {
+  return d.force ? d.force(t) : Eigen::VectorXd(Eigen::VectorXd::Zero(d.K.rows()));
+}
+
+// The held unknowns' values at time t, in d.held's order.
+Eigen::VectorXd held_values_at(const Dynamics& d, double t) {
+  return d.held_values
+             ? d.held_values(t)
+             : Eigen::VectorXd(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size())));
+}
+
+// The trajectory so far, stopped at t for `why`.
+Trajectory stopped(Trajectory out, Integrator integrator, double t, const std::string& why) {
+  std::ostringstream message;
+  message << to_string(integrator) << " at t = " << t << " s: " << why;
+  out.ok = false;
+  out.message = message.str();
+  return out;
+}
+
+// The quasi-static sequence: K_ff u_f = f_f - K_fh u_h at each step, the
+// velocity the difference of two steps.
+Trajectory integrate_quasi_static(const Dynamics& d, const FreeUnknowns& split, double h, int steps,
+                                  const IntegrationOptions& options, Trajectory out) {
+  const int n = static_cast<int>(d.K.rows());
+  Eigen::VectorXd u = out.u.back();
+  auto fail = [&](double t, const std::string& why) {
+    return stopped(out, Integrator::QuasiStatic, t, why);
+  };
+  auto force = [&](double t) { return force_at(d, t); };
+  auto held_at = [&](double t) { return held_values_at(d, t); };
+  const std::string no_convergence =
+      "Gauss-Seidel did not converge in " + std::to_string(options.max_sweeps) + " sweeps";
+  FreeSolve stiffness_solve(d.K, split, false, options);
+  if (!stiffness_solve.ok())
+    return fail(0.0, "the stiffness is singular on the free unknowns (too few supports?)");
+  Eigen::VectorXd free_u;
+  for (int s = 1; s <= steps; ++s) {
+    const double t = s * h;
+    if (cancel_requested()) return fail(t, "interrupted");
+    const Eigen::VectorXd previous = u, target = held_at(t);
+    Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
+    for (size_t k = 0; k < d.held.size(); ++k)
+      fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
+    if (!stiffness_solve.solve(split.restrict(force(t) - d.K * fixed), &free_u))
+      return fail(t, no_convergence);
+    u = fixed;
+    split.scatter(free_u, u);
+    out.times.push_back(t);
+    out.u.push_back(u);
+    out.v.push_back((u - previous) / h);
+  }
+  out.sweeps = stiffness_solve.sweeps();
+  return out;
+}
+
+}  // namespace
+
 Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int steps,
                      const IntegrationOptions& options) {
   const int n = static_cast<int>(d.K.rows());
@@ -137,23 +199,9 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
       return out;
     }
   const FreeUnknowns split(n, d.held);
-  auto force = [&](double t) {
-    return d.force ? d.force(t) : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
-  };
-  auto held_at = [&](double t) {
-    Eigen::VectorXd values =
-        d.held_values
-            ? d.held_values(t)
-            : Eigen::VectorXd(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size())));
-    return values;
-  };
-  auto fail = [&](double t, const std::string& why) {
-    std::ostringstream message;
-    message << to_string(integrator) << " at t = " << t << " s: " << why;
-    out.ok = false;
-    out.message = message.str();
-    return out;
-  };
+  auto force = [&](double t) { return force_at(d, t); };
+  auto held_at = [&](double t) { return held_values_at(d, t); };
+  auto fail = [&](double t, const std::string& why) { return stopped(out, integrator, t, why); };
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n);
   out.times.push_back(0.0);
   out.u.push_back(u);
@@ -161,30 +209,8 @@ Trajectory integrate(const Dynamics& d, Integrator integrator, double h, int ste
 
   const std::string no_convergence =
       "Gauss-Seidel did not converge in " + std::to_string(options.max_sweeps) + " sweeps";
-  if (integrator == Integrator::QuasiStatic) {  // K_ff u_f = f_f - K_fh u_h
-    FreeSolve stiffness_solve(d.K, split, false, options);
-    if (!stiffness_solve.ok())
-      return fail(0.0, "the stiffness is singular on the free unknowns (too few supports?)");
-    Eigen::VectorXd free_u;
-    for (int s = 1; s <= steps; ++s) {
-      const double t = s * h;
-      if (cancel_requested()) return fail(t, "interrupted");
-      const Eigen::VectorXd previous = u, target = held_at(t);
-      Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
-      for (size_t k = 0; k < d.held.size(); ++k)
-        fixed[d.held[k]] = target[static_cast<Eigen::Index>(k)];
-      if (!stiffness_solve.solve(split.restrict(force(t) - d.K * fixed), &free_u))
-        return fail(t, no_convergence);
-      u = fixed;
-      split.scatter(free_u, u);
-      out.times.push_back(t);
-      out.u.push_back(u);
-      out.v.push_back((u - previous) / h);
-    }
-    out.sweeps = stiffness_solve.sweeps();
-    return out;
-  }
-
+  if (integrator == Integrator::QuasiStatic)
+    return integrate_quasi_static(d, split, h, steps, options, std::move(out));
   const bool lumped =
       integrator == Integrator::ExplicitLumped || integrator == Integrator::ImplicitLumped;
   const bool implicit =

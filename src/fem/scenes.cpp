@@ -2,7 +2,10 @@
 #include "fiberfluid/fem/scenes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <stdexcept>
 
 #include "fiberfluid/fem/mesh_tools.hpp"
 #include "fiberfluid/util/error.hpp"
@@ -88,6 +91,66 @@ Scene bending_rod(const RodOptions& o) {
     return t >= 0.0 ? weight : Eigen::VectorXd(Eigen::VectorXd::Zero(weight.size()));
   };
   return s;
+}
+
+// The FEM's static state under the full load.
+Eigen::VectorXd static_state(const Scene& scene) {
+  const Dynamics& d = scene.dynamics;
+  Constraints held;
+  const double late = 1e9;
+  const Eigen::VectorXd values =
+      d.held_values ? d.held_values(late)
+                    : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.held.size()));
+  for (size_t k = 0; k < d.held.size(); ++k)
+    held.hold(d.held[k], values[static_cast<Eigen::Index>(k)]);
+  Eigen::VectorXd u;
+  const Eigen::VectorXd f = d.force ? d.force(late) : Eigen::VectorXd::Zero(d.K.rows());
+  const solve::Status status = solve_static(d.K, f, held, &u);
+  if (!status.ok) throw InputError("benchmark: the static problem is singular: " + status.message);
+  return u;
+}
+
+Eigen::MatrixXd boundary_rows(const Boundary& b, const Eigen::MatrixXd& node_rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(b.nodes.size()), node_rows.cols());
+  for (size_t v = 0; v < b.nodes.size(); ++v)
+    out.row(static_cast<Eigen::Index>(v)) = node_rows.row(b.nodes[v]);
+  return out;
+}
+
+namespace {
+
+// Each row of `points` (nodes of a coarser grid over the same box) as a node
+// of `grid`, whose lattice spacing per axis is `spacing`.
+std::vector<int> grid_nodes_at(const Eigen::MatrixXd& grid, const Eigen::MatrixXd& points,
+                               const Eigen::Vector3d& spacing) {
+  const auto key = [&](const Eigen::MatrixXd& rows, Eigen::Index v) {
+    std::array<long, 3> k{};
+    for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::lround(rows(v, a) / spacing[a]);
+    return k;
+  };
+  std::map<std::array<long, 3>, int> index;
+  for (Eigen::Index v = 0; v < grid.rows(); ++v) index[key(grid, v)] = static_cast<int>(v);
+  std::vector<int> out(static_cast<size_t>(points.rows()));
+  for (Eigen::Index v = 0; v < points.rows(); ++v) {
+    const auto it = index.find(key(points, v));
+    if (it == index.end() || (grid.row(it->second) - points.row(v)).norm() > 1e-9 * spacing.norm())
+      throw std::logic_error("a node of the rod is not a node of its refined grid");
+    out[static_cast<size_t>(v)] = it->second;
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::MatrixXd rod_statics_at(const RodOptions& options, const Eigen::MatrixXd& nodes) {
+  const Scene fine = bending_rod(options);
+  const Eigen::MatrixXd u = displacement_rows(static_state(fine), 3);
+  const Eigen::Vector3d box = fine.mesh.nodes.colwise().maxCoeff().transpose();  // from 0
+  const Eigen::Vector3d spacing = box.cwiseQuotient(options.cells.cast<double>());
+  const std::vector<int> at = grid_nodes_at(fine.mesh.nodes, nodes, spacing);
+  Eigen::MatrixXd out(nodes.rows(), 3);
+  for (Eigen::Index v = 0; v < nodes.rows(); ++v) out.row(v) = u.row(at[static_cast<size_t>(v)]);
+  return out;
 }
 
 }  // namespace fiberfluid::fem

@@ -19,6 +19,7 @@
 
 #include "fiberfluid/fem/dynamics.hpp"
 #include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/fem/mesh_tools.hpp"
 
 namespace fiberfluid::fem {
 
@@ -67,5 +68,18 @@ struct RodOptions {
   bool simplices = false;  // tetrahedra instead of hexahedra
 };
 Scene bending_rod(const RodOptions& options);
+
+// The scene's static state under the full load (the late-time limit of its
+// dynamics). Throws InputError when the held nodes leave it singular.
+Eigen::VectorXd static_state(const Scene& scene);
+
+// The rows of a per-node matrix (#nodes x k) at the boundary's nodes, in its
+// vertex order.
+Eigen::MatrixXd boundary_rows(const Boundary& b, const Eigen::MatrixXd& node_rows);
+
+// The rod's static displacement on the grid of `options` (a refinement of a
+// coarser rod over the same box) at `nodes`, nodes of the coarser grid
+// (#nodes x 3): the refined grid keeps them.
+Eigen::MatrixXd rod_statics_at(const RodOptions& options, const Eigen::MatrixXd& nodes);
 
 }  // namespace fiberfluid::fem

@@ -13,17 +13,19 @@ namespace fiberfluid::fit {
 struct Calibration::Impl {
   FitProblem problem;
   Impl(model::Model model, solve::SteppingOptions stepping, std::vector<MeasuredStep> targets,
-       std::vector<Parameter> parameters, FitOptions options, std::vector<ForceCurve> curves)
+       std::vector<Parameter> parameters, FitOptions options, std::vector<ForceCurve> curves,
+       std::vector<BlockMaker> more_blocks)
       : problem(std::move(model), std::move(stepping), std::move(targets), std::move(parameters),
-                std::move(options), std::move(curves)) {}
+                std::move(options), std::move(curves), std::move(more_blocks)) {}
 };
 
 Calibration::Calibration(model::Model model, solve::SteppingOptions stepping,
                          std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
-                         FitOptions options, std::vector<ForceCurve> force_curves)
+                         FitOptions options, std::vector<ForceCurve> force_curves,
+                         std::vector<BlockMaker> more_blocks)
     : impl_(std::make_unique<Impl>(std::move(model), std::move(stepping), std::move(targets),
                                    std::move(parameters), std::move(options),
-                                   std::move(force_curves))) {}
+                                   std::move(force_curves), std::move(more_blocks))) {}
 
 Calibration::~Calibration() = default;
 

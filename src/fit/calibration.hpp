@@ -15,6 +15,7 @@
 #include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/fit/force_curve.hpp"
 #include "fiberfluid/fit/parameters.hpp"
+#include "fiberfluid/fit/residuals/residual_block.hpp"
 #include "fiberfluid/fit/target.hpp"
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/stepping.hpp"
@@ -28,13 +29,15 @@ class Calibration {
   // The model's material holds the values of the parameters that are not
   // fitted; the parameters' starts replace the fitted ones. The residuals
   // are the surfaces' distances (m), then the force curves' weighted misfits
-  // (m; either kind of target may be absent, not both). Throws InputError
+  // (m), then the rows of the blocks `more_blocks` make (targets of other
+  // kinds, residual_block.hpp); any kind may be absent, not all. Throws InputError
   // (naming the parameter or the target) for a bad parameter, a target step
   // outside the run, a counted vertex that does not exist, a target that
   // does not overlap the body, or a force curve beyond the run's travel.
   Calibration(model::Model model, solve::SteppingOptions stepping,
               std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
-              FitOptions options = {}, std::vector<ForceCurve> force_curves = {});
+              FitOptions options = {}, std::vector<ForceCurve> force_curves = {},
+              std::vector<BlockMaker> more_blocks = {});
   ~Calibration();
 
   const ParameterMap& parameters() const;

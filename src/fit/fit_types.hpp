@@ -176,6 +176,13 @@ struct ForceMisfit {
   double share(double value) const { return scale > 0.0 ? value / scale : 0.0; }
 };
 
+// What a target of a registered kind (ResidualBlock::describe) reports at the
+// fitted values: its kind, its label and its figures by name.
+struct TargetReport {
+  std::string kind, label;
+  std::map<std::string, double> figures;
+};
+
 struct FitResult {
   FitStatus status = FitStatus::StartFailed;
   bool success = false;  // Converged or ConvergedAtBounds: the optimiser converged
@@ -230,7 +237,8 @@ struct FitResult {
   std::vector<Eigen::VectorXd> vertex_distances;
   std::vector<DistanceStatistics> statistics;
   DistanceStatistics overall;
-  std::vector<ForceMisfit> force_misfits;  // per force curve, at the fitted values
+  std::vector<ForceMisfit> force_misfits;   // per force curve, at the fitted values
+  std::vector<TargetReport> other_targets;  // per target of another kind, in order
 };
 
 }  // namespace fiberfluid::fit

@@ -26,7 +26,8 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> ForwardRun::vertex_sensitivity(const Ei
 
 FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
                        std::vector<MeasuredStep> targets, std::vector<Parameter> parameters,
-                       FitOptions options, std::vector<ForceCurve> force_curves)
+                       FitOptions options, std::vector<ForceCurve> force_curves,
+                       std::vector<BlockMaker> more_blocks)
     : model_(std::move(model)),
       stepping_(std::move(stepping)),
       curves_(std::move(force_curves)),
@@ -34,8 +35,8 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
       options_(std::move(options)) {
   check_options(options_);
   if (model_.dim() != 3) throw InputError("calibration fits 3D surfaces; this model is 2D");
-  if (targets.empty() && curves_.empty())
-    throw InputError("nothing to fit to: no target surface and no force curve");
+  if (targets.empty() && curves_.empty() && more_blocks.empty())
+    throw InputError("nothing to fit to: no target surface, force curve or other target");
   const int n = model_.num_vertices();
   if (options_.counted_vertices.empty()) {
     for (int i = 0; i < n; ++i) counted_.push_back(i);
@@ -61,6 +62,8 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
     curve_weights_.push_back(block->weight());
     blocks_.push_back(std::move(block));
   }
+  for (const BlockMaker& make : more_blocks)
+    blocks_.push_back(make(BlockContext{model_, stepping_.steps, length_}));
   for (const auto& block : blocks_) {
     residuals_ += block->rows();
     for (int k : block->steps()) state_steps_.push_back(k);
@@ -255,6 +258,7 @@ void FitProblem::describe(const Evaluation& best, FitResult& result) const {
   result.vertex_distances.clear();  // described afresh (a warm start's check describes twice)
   result.statistics.clear();
   result.force_misfits.clear();
+  result.other_targets.clear();
   Eigen::Index row = 0;
   for (const auto& block : blocks_) {
     block->describe(best, row, result);

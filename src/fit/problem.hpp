@@ -41,7 +41,7 @@ class FitProblem {
   // Throws InputError as Calibration's constructor says.
   FitProblem(model::Model model, solve::SteppingOptions stepping, std::vector<MeasuredStep> targets,
              std::vector<Parameter> parameters, FitOptions options,
-             std::vector<ForceCurve> force_curves);
+             std::vector<ForceCurve> force_curves, std::vector<BlockMaker> more_blocks = {});
   ~FitProblem();
   // The blocks refer to the problem's members: it stays where it was made.
   FitProblem(const FitProblem&) = delete;

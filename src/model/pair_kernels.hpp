@@ -23,7 +23,7 @@
 namespace fiberfluid::model {
 
 namespace detail {
-class ThreadAccumulators;  // pair_kernels.cpp
+class ThreadAccumulators;  // pair_tiles.hpp
 }
 
 // How many times the pair loops of this thread have gone over every fiber

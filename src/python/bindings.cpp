@@ -14,12 +14,12 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/fit_workflow.hpp"
-#include "fiberfluid/experiment/fitting.hpp"
-#include "fiberfluid/experiment/output_folder.hpp"
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
-#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/experiment/read/schema.hpp"
+#include "fiberfluid/experiment/run/fit_setup.hpp"
+#include "fiberfluid/experiment/run/fit_workflow.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/fit/calibration.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"

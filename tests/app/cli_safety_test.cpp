@@ -9,7 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_support.hpp"
-#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/experiment/write/file_names.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid {

@@ -14,8 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_support.hpp"
-#include "fiberfluid/experiment/build_info.hpp"
-#include "fiberfluid/experiment/schema.hpp"
+#include "fiberfluid/experiment/read/schema.hpp"
+#include "fiberfluid/experiment/write/build_info.hpp"
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "test_support.hpp"

@@ -2,7 +2,7 @@
 // Benchmark experiments: their fields, their runs and their files. The
 // paper's findings themselves are the expected figures of
 // experiments/benchmark_*.json (run by ExperimentFile) and fem_test.cpp.
-#include "fiberfluid/experiment/benchmark.hpp"
+#include "fiberfluid/experiment/run/benchmark.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,9 @@
 #include <sstream>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/benchmark_files.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/metrics/metrics.hpp"
 #include "fiberfluid/util/error.hpp"

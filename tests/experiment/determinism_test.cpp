@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
 #include "test_support.hpp"
 
 namespace fiberfluid::experiment {

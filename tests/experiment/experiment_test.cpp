@@ -8,8 +8,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/case_builder.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/csv_tables.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
+#include "fiberfluid/experiment/write/summary_json.hpp"
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
@@ -416,8 +419,7 @@ TEST(ExperimentConfig, EveryNamedChoiceReadsAsTheValueItNames) {
   for (const auto& entry : model::kBoundaryMethodNames.entries()) {
     nlohmann::json c = base_config();
     c["stepping"]["boundary_method"] = entry.name;
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.boundary_method,
-              entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.boundary_method, entry.value)
         << entry.name;
   }
   for (const auto& entry : model::kConnectionCountNames.entries()) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The FEM reference of a simulation: the same supports and loads on
 // tetrahedra, checked against exact solutions.
-#include "fiberfluid/experiment/fem_reference.hpp"
+#include "fiberfluid/experiment/run/fem_reference.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/fit/target.hpp"
 #include "fiberfluid/metrics/metrics.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -202,7 +202,6 @@ TEST(FemReference, TheCommittedCantileverTargetAgreesWithTheCoarserReference) {
   // the clamp and less towards the tip than the solid (docs/model.md).
   EXPECT_NEAR(fiber_turn, fem_turn, 4.5);
 }
-
 
 }  // namespace
 }  // namespace fiberfluid::experiment

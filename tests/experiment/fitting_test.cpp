@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fiberfluid/experiment/fitting.hpp"
+#include "fiberfluid/experiment/run/fit_setup.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,8 @@
 #include <functional>
 #include <map>
 
-#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/write/fit_files.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
@@ -581,6 +582,107 @@ TEST(CalibrationConfig, BadCalibrationsAreNamed) {
   const JointSetup setup = setup_joint(ex);
   EXPECT_EQ(setup.joint->names(),
             (std::vector<std::string>{"Y0", "beta", "synthetic.gamma", "second.gamma"}));
+}
+
+// A target of a registered kind (experiment/targets/): tracked markers'
+// displacements. The sphere of fit_sphere.json, lighter (density 200, the
+// pull 60 N ramped) on the Newton scheme (an analytic Jacobian), run at
+// Y = gamma = 3000; two markers' displacements
+// at the last step, read from that run, give back both parameters from a
+// start a factor 2 and 3 away, and fit.json reports each marker's misfit.
+nlohmann::json marker_sphere(double Y, double gamma) {
+  nlohmann::json d = sphere_fit_document();
+  d.erase("expected");
+  d.erase("fit");
+  d["material"] = {{"Y", Y}, {"gamma", gamma}};
+  d["stepping"] = {{"steps", 5}, {"scheme", "newton"}};
+  d["loads"][0]["density"] = 200;
+  d["loads"][1]["force"] = {-60, -60, -60};
+  d["loads"][1]["schedule"] = "ramp";
+  return d;
+}
+
+TEST(MarkerTarget, TwoMarkersGiveBackYAndGammaAndReportTheirMisfits) {
+  const std::filesystem::path folder = testing::experiment_file("").parent_path();
+  const Experiment truth = parse_experiment(marker_sphere(3000.0, 3000.0), folder, "truth");
+  const ExperimentResult run = run_experiment(truth);
+  ASSERT_TRUE(run.runs_succeeded());
+  const Case& c = truth.cases.front();
+  const Eigen::MatrixXd U =
+      input_positions(c, run.runs.front().summary.unknowns) - c.input_surface.V;
+  nlohmann::json d = marker_sphere(1500.0, 9000.0);
+  nlohmann::json targets = nlohmann::json::array();
+  for (int vertex : {0, 20}) {  // the pulled vertex, and one elsewhere
+    const Eigen::Vector3d u = U.row(vertex).transpose() * 1e3;  // in mm
+    nlohmann::json marker = {{"type", "marker"},
+                             {"label", "marker " + std::to_string(vertex)},
+                             {"units", "mm"},
+                             {"displacement", {u.x(), u.y(), u.z()}}};
+    if (vertex == 0) {
+      marker["vertex"] = vertex;
+    } else {  // by its rest position: the nearest vertex is the one there
+      const Eigen::Vector3d at = c.input_surface.V.row(vertex).transpose() * 1e3;
+      marker["at"] = {at.x(), at.y(), at.z()};
+    }
+    targets.push_back(marker);
+  }
+  d["fit"] = {{"targets", targets},
+              {"parameters",
+               {{{"name", "Y"}, {"lower", 10}, {"upper", 1e6}},
+                {{"name", "gamma"}, {"lower", 10}, {"upper", 1e6}}}}};
+  const Experiment ex = parse_experiment(d, folder, "markers");
+  const FitSetup setup = setup_fit(ex);
+  EXPECT_EQ(setup.calibration->num_residuals(), 6);
+  EXPECT_TRUE(setup.calibration->analytic_jacobian());
+  const fit::FitResult fitted = setup.calibration->run();
+  ASSERT_TRUE(fitted.success) << fitted.message;
+  EXPECT_NEAR(fitted.values[0], 3000.0, 3e-3);
+  EXPECT_NEAR(fitted.values[1], 3000.0, 3e-3);
+  ASSERT_EQ(fitted.other_targets.size(), 2u);
+  EXPECT_EQ(fitted.other_targets[1].label, "marker 20");
+  EXPECT_EQ(fitted.other_targets[1].figures.at("vertex"), 20.0);
+  EXPECT_LT(fitted.other_targets[0].figures.at("misfit"), 1e-9);
+  EXPECT_NEAR(fitted.other_targets[0].figures.at("simulated_x"), U(0, 0), 1e-9);
+
+  // The analytic Jacobian is the central differences' (issue 30's check).
+  const Eigen::VectorXd phi = setup.calibration->parameters().initial_phi();
+  const fit::Evaluation analytic = setup.calibration->evaluate(phi, true);
+  d["fit"]["jacobian"] = "finite-differences";
+  const FitSetup differenced = setup_fit(parse_experiment(d, folder, "markers"));
+  const fit::Evaluation central = differenced.calibration->evaluate(phi, true);
+  ASSERT_TRUE(analytic.ok && central.ok);
+  EXPECT_LT((analytic.jacobian - central.jacobian).norm(), 1e-5 * central.jacobian.norm());
+
+  testing::ScratchDir dir;
+  const Experiment at_fit = with_fitted_material(ex, *setup.calibration, fitted);
+  write_fit_files(dir.path(), at_fit, setup, fitted, run_experiment(at_fit));
+  std::ifstream in(dir.path() / "fit.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  ASSERT_EQ(report["other_targets"].size(), 2u);
+  EXPECT_EQ(report["other_targets"][0]["type"], "marker");
+  EXPECT_EQ(report["counts"]["other_targets"], 2);
+  EXPECT_EQ(report["counts"]["residuals"], 6);
+}
+
+TEST(MarkerTarget, BadMarkersAreRefusedNamingTheirField) {
+  nlohmann::json d = marker_sphere(3000.0, 3000.0);
+  const nlohmann::json parameters = {{{"name", "Y"}, {"lower", 10}, {"upper", 1e6}}};
+  auto with_marker = [&](nlohmann::json marker) {
+    marker["type"] = "marker";
+    if (!marker.contains("displacement")) marker["displacement"] = {0.0, 0.0, -0.1};
+    d["fit"] = {{"targets", {marker}}, {"parameters", parameters}};
+    return d;
+  };
+  expect_fit_error(with_marker({{"vertex", 100000}}),
+                   "fit.targets[0].vertex: input vertex 100000 is not a vertex of the body");
+  expect_fit_error(with_marker({{"vertex", 0}, {"at", {0, 0, 1}}}),
+                   "fit.targets[0].vertex: expected the marker's \"vertex\"");
+  expect_fit_error(with_marker(nlohmann::json::object()), "fit.targets[0].vertex");
+  expect_fit_error(with_marker({{"vertex", 0}, {"step", 6}}),
+                   "fit.targets[0].step: step 6 of a run of 5 load steps");
+  expect_fit_error(with_marker({{"vertex", 0}, {"displacement", {0.0, 1.0}}}),
+                   "fit.targets[0].displacement");
+  expect_fit_error(with_marker({{"vertex", 0}, {"colour", "red"}}), "colour");
 }
 
 }  // namespace

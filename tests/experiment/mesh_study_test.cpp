@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fiberfluid/experiment/mesh_study.hpp"
+#include "fiberfluid/experiment/run/mesh_study.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // file never leave the output root, only fiberfluid's own folders are
 // replaced, concurrent writers never mix or lose a result, and an exception
 // in a worker reaches the caller.
-#include "fiberfluid/experiment/output_folder.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/run_control.hpp"

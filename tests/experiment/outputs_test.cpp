@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Sweeps, reactions, CSV tables and output folders, through the library.
-#include "fiberfluid/experiment/outputs.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
 

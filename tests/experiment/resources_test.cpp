@@ -9,8 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/outputs.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/case_builder.hpp"
+#include "fiberfluid/experiment/run/resources.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/solve/gmres.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/progress.hpp"

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A run's outcome as bytes (what an MPI rank sends back), and the ranks of a
 // one-process run. The runs over several ranks are tests/mpi's.
-#include "fiberfluid/experiment/run_archive.hpp"
+#include "fiberfluid/experiment/run/run_archive.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,11 +6,11 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "fiberfluid/experiment/compare.hpp"
 #include "fiberfluid/experiment/experiment.hpp"
-#include "fiberfluid/experiment/fitting.hpp"
-#include "fiberfluid/experiment/output_folder.hpp"
-#include "fiberfluid/experiment/runner.hpp"
+#include "fiberfluid/experiment/run/compare.hpp"
+#include "fiberfluid/experiment/run/fit_setup.hpp"
+#include "fiberfluid/experiment/run/runner.hpp"
+#include "fiberfluid/experiment/write/output_folder.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"

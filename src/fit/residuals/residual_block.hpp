@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One kind of measurement a fit is held to (internal to fit/): its rows of
-// the residual vector, the load steps it reads, and its residuals and their
-// Jacobian from a forward run's states and sensitivities. FitProblem stacks
-// the blocks in order, runs the model once per point and hands each block
-// what it reads. A new kind of target is one block (its class declared in
-// blocks.hpp, defined in a file of its own here) and its line in
-// FitProblem's constructor.
+// One kind of measurement a fit is held to: its rows of the residual
+// vector, the load steps it reads, and its residuals and their Jacobian from
+// a forward run's states and sensitivities. FitProblem stacks the blocks in
+// order, runs the model once per point and hands each block what it reads.
+// The scans' and force curves' blocks are fit/'s own (blocks.hpp); a block of
+// another kind comes in through a BlockMaker (Calibration's more_blocks): an
+// experiment's target kinds are one file each in experiment/targets/.
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,5 +80,18 @@ class ResidualBlock {
   // `row` on): FitResult::vertex_distances and statistics, force_misfits.
   virtual void describe(const Evaluation& e, Eigen::Index row, FitResult& result) const = 0;
 };
+
+// What a block is made on: the problem's model (its mesh, supports and
+// loads), its load steps and the body's length (the distances' shares'
+// reference).
+struct BlockContext {
+  const model::Model& model;
+  int steps = 0;
+  double length = 0.0;
+};
+// Makes a block of another kind when the problem is set up (after the fit's
+// own blocks, in order). Throws InputError naming its target for one that
+// cannot be fitted.
+using BlockMaker = std::function<std::unique_ptr<ResidualBlock>(const BlockContext&)>;
 
 }  // namespace fiberfluid::fit

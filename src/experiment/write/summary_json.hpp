@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "fiberfluid/experiment/run/results.hpp"
+#include "fiberfluid/experiment/spec/experiment.hpp"
+
+namespace fiberfluid::experiment {
+
+// The summary.json document: the experiment, its units, per run the stepping
+// options and per step load factors, pressure, volume, largest displacement,
+// reactions and wall time, then the final figures and the checks of the
+// expected ones.
+nlohmann::json summary_json(const Experiment& experiment, const ExperimentResult& result);
+
+}  // namespace fiberfluid::experiment
