@@ -31,7 +31,7 @@ int main() {
       std::fprintf(stderr, "%s: %s\n", result.runs[r].variant.c_str(), summary.message.c_str());
       return 1;
     }
-    const auto& surface = ex.cases[r].model.surface;
+    const auto& surface = ex.simulation().cases[r].model.surface;
     std::printf("%s: largest displacement %.6g m, cap reaction z %.6g N, volume %.6g m^3\n",
                 result.runs[r].variant.c_str(),
                 result.figures.at(result.runs[r].variant + ".max_displacement"),

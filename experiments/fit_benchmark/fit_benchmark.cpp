@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
 
   const auto load_start = std::chrono::steady_clock::now();
   const ff::experiment::Experiment ex = ff::experiment::load_experiment(experiment);
-  const ff::experiment::Case& c = ex.cases.front();
+  const ff::experiment::Case& c = ex.simulation().cases.front();
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   std::printf(

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   const fiberfluid::experiment::Experiment ex = fiberfluid::experiment::parse_experiment(
       config, std::filesystem::path(FIBERFLUID_INTERACTIVE_EXPERIMENT).parent_path(),
       FIBERFLUID_INTERACTIVE_EXPERIMENT);
-  const fiberfluid::experiment::Case& c = ex.cases.front();
+  const fiberfluid::experiment::Case& c = ex.simulation().cases.front();
   const fiberfluid::model::Model& model = c.model;
   const double build_seconds = seconds_between(build_start, Clock::now());
 

@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   config["expected"] = nlohmann::json::array();
   const fiberfluid::experiment::Experiment ex =
       fiberfluid::experiment::parse_experiment(config, ".", FIBERFLUID_SPHERE_EXPERIMENT);
-  fiberfluid::model::Model model = ex.cases.front().model;
+  fiberfluid::model::Model model = ex.simulation().cases.front().model;
   if (law == "exponential")
     model.material.law = fiberfluid::model::FiberLaw::exponential(3000.0, 4.0);
   const int n = model.num_vertices();

@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
   double slowest_step = 0.0;
   for (const auto& step : s.steps) slowest_step = std::max(slowest_step, step.seconds);
   nlohmann::json line = {
-      {"vertices", ex.cases.front().model.num_vertices()},
+      {"vertices", ex.simulation().cases.front().model.num_vertices()},
       {"solver", solver},
       {"success", s.success},
       {"message", s.message},

@@ -12,9 +12,6 @@
 
 namespace fiberfluid::app {
 
-// The first Ctrl-C asks the run to stop at its next check (a load step, a
-// pruning row, a solver iteration) and clean up; a second one ends the
-// process at once (the handler is reset after the first).
 void stop_on_interrupt() {
   struct sigaction action {};
   action.sa_handler = [](int) { fiberfluid::request_cancel(); };
@@ -27,12 +24,8 @@ void stop_on_interrupt() {
   signal(SIGXFSZ, SIG_IGN);
 }
 
-// Throws Interrupted after a phase that returned early because of Ctrl-C,
-// before its partial results are written anywhere.
 void stop_if_interrupted(const std::string& phase) { fiberfluid::throw_if_cancelled(phase); }
 
-// progress of long phases such as pruning unless quiet; the sink stays set.
-// Estimates of long runs are printed before they start (as notes).
 experiment::Experiment load_showing_progress(const std::string& path, bool quiet,
                                              ProgressPrinter& printer) {
   if (!quiet) {
@@ -71,9 +64,7 @@ std::filesystem::path plot_script() {
   return FIBERFLUID_PLOT_SCRIPT;
 }
 
-// --plot: DIR/plot.png from DIR/summary.json, drawn by the plot script with
-// the first python3 that has matplotlib (the one on PATH, else Debian's). A
-// plot that cannot be drawn is a warning: the results are written already.
+// The python3 on PATH first, else Debian's.
 void draw_plot(const std::filesystem::path& folder, const std::string& input) {
   const std::filesystem::path script = plot_script();
   if (!std::filesystem::exists(script)) {
@@ -99,9 +90,6 @@ void draw_plot(const std::filesystem::path& folder, const std::string& input) {
 
 bool every_rank_fails = false;
 
-// Runs `step` on every rank and ends in agreement: when it throws on one
-// rank, it throws on all (the others an AnotherRankFailed), so no rank goes on
-// to wait for work that will never be dealt.
 void on_every_rank(const fiberfluid::parallel::Ranks& ranks, const std::function<void()>& step) {
   try {
     step();
@@ -116,9 +104,6 @@ void on_every_rank(const fiberfluid::parallel::Ranks& ranks, const std::function
   }
 }
 
-// Fault injection for the tests of a failure on one rank alone
-// (tests/mpi/mpi_test.sh): FIBERFLUID_FAIL_RANK=r makes rank r throw once its
-// run is set up, outside any work item, while the others wait for it.
 void fail_if_injected(const fiberfluid::parallel::Ranks& ranks) {
   const char* rank = std::getenv("FIBERFLUID_FAIL_RANK");
   if (rank != nullptr && std::atoi(rank) == ranks.rank() && ranks.size() > 1)
@@ -136,13 +121,16 @@ std::string experiment_digest(const experiment::Experiment& ex) {
   const auto add_experiment = [&](const experiment::Experiment& e) {
     const std::string resolved = e.resolved.dump();
     add(resolved.data(), resolved.size());
-    for (const experiment::Case& c : e.cases) {
+    if (e.kind() != experiment::Experiment::Kind::Simulate) return;
+    for (const experiment::Case& c : e.simulation().cases) {
       add(c.model.surface.V.data(), sizeof(double) * static_cast<size_t>(c.model.surface.V.size()));
       add(c.model.surface.F.data(), sizeof(int) * static_cast<size_t>(c.model.surface.F.size()));
     }
   };
   add_experiment(ex);
-  for (const experiment::Experiment& specimen : ex.specimens) add_experiment(specimen);
+  if (ex.kind() == experiment::Experiment::Kind::Calibration)
+    for (const experiment::Experiment& specimen : ex.calibration().specimens)
+      add_experiment(specimen);
   return std::to_string(hash);
 }
 

@@ -6,8 +6,8 @@
 #include <optional>
 
 #include "fiberfluid/app/cli.hpp"
+#include "fiberfluid/experiment/fit_workflow.hpp"
 #include "fiberfluid/experiment/run/fit_setup.hpp"
-#include "fiberfluid/experiment/run/fit_workflow.hpp"
 #include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/experiment/write/fit_files.hpp"
 #include "fiberfluid/experiment/write/output_folder.hpp"
@@ -130,14 +130,14 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
     return kOk;
   }
   std::cout << "calibrating " << joint.names().size() << " parameters ("
-            << ex.calibration->shared.size() << " shared) to " << joint.num_residuals()
+            << ex.calibration().spec.shared.size() << " shared) to " << joint.num_residuals()
             << " residuals of " << joint.specimen_names().size() << " specimens over "
             << ranks.size() << " rank(s)\n";
   for (size_t s = 0; s < setup.specimens.size(); ++s)
     std::cout << "  specimen " << joint.specimen_names()[s] << ": "
-              << ex.specimens[s].source.string() << ", " << setup.specimens[s].targets.size()
-              << " target(s), " << setup.specimens[s].calibration->num_residuals()
-              << " residuals\n";
+              << ex.calibration().specimens[s].source.string() << ", "
+              << setup.specimens[s].targets.size() << " target(s), "
+              << setup.specimens[s].calibration->num_residuals() << " residuals\n";
   const experiment::CalibrationOutcome outcome =
       experiment::run_calibration(ex, setup, folder, ranks.dealer(), broadcast);
   const fit::JointFitResult& fitted = outcome.fitted;
@@ -206,7 +206,7 @@ void print_mesh_check(const fiberfluid::fit::FitResult& fitted,
 void print_fit_plan(const experiment::Experiment& ex, const experiment::FitSetup& setup,
                     int ranks) {
   namespace fit = fiberfluid::fit;
-  const bool multistart = ex.fit->multistart.has_value();
+  const bool multistart = ex.fit()->multistart.has_value();
   for (const auto& t : setup.targets)
     std::cout << "target " << t.target.label << " (step " << t.step << "): " << t.target.description
               << "\n";
@@ -231,11 +231,11 @@ void print_fit_plan(const experiment::Experiment& ex, const experiment::FitSetup
     std::cout << ")" << (force_rows > 0 ? " and " : "");
   }
   if (force_rows > 0) std::cout << force_rows << " force misfits";
-  std::cout << " (" << fit::to_string(ex.fit->options.method) << ", "
+  std::cout << " (" << fit::to_string(ex.fit()->options.method) << ", "
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian"
                                                        : "finite differences");
   if (multistart)
-    std::cout << ", from each of " << ex.fit->multistart->starts << " starts over " << ranks
+    std::cout << ", from each of " << ex.fit()->multistart->starts << " starts over " << ranks
               << " rank(s)";
   std::cout << ")\n";
 }
@@ -268,26 +268,26 @@ int fit_command(const std::string& path, const RunFlags& flags,
   on_every_rank(ranks, [&] {
     fiberfluid::set_progress_sink({});  // the fit's many runs: one line per iteration instead
     if (ranks.root()) folder = experiment::output_folder(flags.output, loaded->name);
-    if (loaded->kind == experiment::Experiment::Kind::Calibration) {
+    if (loaded->kind() == experiment::Experiment::Kind::Calibration) {
       joint = experiment::setup_joint(*loaded, [&](const fit::IterationRecord& r) {
         if (!flags.quiet) print_iteration(r, joint.joint->names());
       });
       return;
     }
-    if (loaded->fit)
-      for (const auto& p : loaded->fit->parameters) names.push_back(p.request.name);
-    multistart = loaded->fit && loaded->fit->multistart;
+    if (loaded->fit())
+      for (const auto& p : loaded->fit()->parameters) names.push_back(p.request.name);
+    multistart = loaded->fit() && loaded->fit()->multistart;
     // A multi-start search prints a line per start instead of per iteration.
     setup = experiment::setup_fit(*loaded, [&](const fit::IterationRecord& r) {
       if (!flags.quiet && !multistart) print_iteration(r, names);
     });
   });
   const experiment::Experiment& ex = *loaded;
-  if (ex.kind == experiment::Experiment::Kind::Calibration)
+  if (ex.kind() == experiment::Experiment::Kind::Calibration)
     return calibrate_specimens(ex, joint, folder, flags, ranks);
   const fiberfluid::WorkDealer dealer = ranks.dealer();
   if (!ranks.root()) {  // the ranks' share of the starts; a single fit is rank 0's alone
-    if (multistart) fit::serve_multistart(*setup.calibration, *ex.fit->multistart, dealer);
+    if (multistart) fit::serve_multistart(*setup.calibration, *ex.fit()->multistart, dealer);
     stop_if_interrupted("the fit");
     return kOk;
   }

@@ -6,8 +6,8 @@
 #include <optional>
 
 #include "fiberfluid/app/cli.hpp"
+#include "fiberfluid/experiment/fit_workflow.hpp"
 #include "fiberfluid/experiment/run/fit_setup.hpp"
-#include "fiberfluid/experiment/run/fit_workflow.hpp"
 #include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/experiment/write/benchmark_files.hpp"
 #include "fiberfluid/experiment/write/output_folder.hpp"
@@ -44,7 +44,7 @@ int run_command(const std::string& path, const RunFlags& flags,
     stop_if_interrupted("the run");
     return kOk;
   }
-  if (ex.fit)
+  if (ex.fit())
     std::cerr << "note: " << path << " has a \"fit\" section: `run` simulates at the starting "
               << "values; `fiberfluid fit` calibrates\n";
   if (ranks.size() > 1 && flags.jobs > 1)
@@ -66,8 +66,8 @@ int run_command(const std::string& path, const RunFlags& flags,
   for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
   std::cout << ex.name << ": results in " << writer.folder().string() << "\n";
-  if (ex.kind == experiment::Experiment::Kind::Simulate) {
-    const experiment::FiberReport& f = ex.cases.front().fibers;
+  if (ex.kind() == experiment::Experiment::Kind::Simulate) {
+    const experiment::FiberReport& f = ex.simulation().cases.front().fibers;
     std::cout << "  fibers: " << f.kept << " kept of " << f.pairs << " ("
               << (!f.pruning ? "pruning off"
                   : f.convex ? "convex"
@@ -95,7 +95,7 @@ int run_command(const std::string& path, const RunFlags& flags,
       if (!run.summary.success) std::cerr << "error: " << run.summary.message << "\n";
     return kSolverFailed;
   }
-  if (flags.plot && ex.kind == experiment::Experiment::Kind::Simulate) draw_plot(writer.folder());
+  if (flags.plot && ex.kind() == experiment::Experiment::Kind::Simulate) draw_plot(writer.folder());
   if (flags.check_expected && !result.checks_passed()) {
     std::cerr << "error: some expected figures were not met (see above)\n";
     return kChecksFailed;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "fiberfluid/fem/mesh_tools.hpp"
-#include "fiberfluid/fit/target.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/target.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -60,12 +60,12 @@ PosedFem pose_fem(const model::Model& m, int steps, const fem::TetMeshOptions& m
       static_cast<size_t>(m.num_vertices()));  // axis -> its constraint
   for (const model::Constraint& k : m.constraints)
     vertex_held[static_cast<size_t>(k.vertex)][k.axis] = &k;
-  const fit::TargetDistance surface(fit::make_target("the surface", V, m.surface.F));
+  const geom::TargetDistance surface(geom::make_target("the surface", V, m.surface.F));
   // (node, axis) -> the constraints it interpolates, with their weights.
   std::map<std::pair<int, int>, std::vector<std::pair<const model::Constraint*, double>>> held;
   std::vector<bool> vertex_reached(static_cast<size_t>(m.num_vertices()), false);
   for (int node : boundary.nodes) {
-    const fit::TargetDistance::Closest closest =
+    const geom::TargetDistance::Closest closest =
         surface.closest(Eigen::Vector3d(mesh.nodes.row(node)));
     const Eigen::Vector3i corners = m.surface.F.row(closest.primitive);
     const Eigen::Vector3d weights = geom::barycentric_coordinates(
@@ -157,12 +157,12 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
     fem::HyperelasticOptions options;
     options.mixed = true;
     fem::HyperelasticSolution solution;
-    const solve::Status status =
+    const linalg::Status status =
         fem::solve_small_strain(posed.mesh, solid, last, options, &solution);
     if (!status.ok) fail(status.message);
     u = solution.u;
   } else {
-    const solve::Status status =
+    const linalg::Status status =
         fem::solve_static(fem::stiffness_matrix(posed.mesh, material), last.forces, last.held, &u);
     if (!status.ok) fail(status.message);
   }
@@ -174,15 +174,15 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
 
 FemOfModel solve_hyperelastic_fem_of_model(const model::Model& m, int steps,
                                            const fem::HyperelasticMaterial& material,
-                                           const fem::TetMeshOptions& mesh_options,
-                                           int order, fem::HyperelasticOptions options) {
+                                           const fem::TetMeshOptions& mesh_options, int order,
+                                           fem::HyperelasticOptions options) {
   const PosedFem posed = pose_fem(m, steps, mesh_options, order);
   options.steps = steps;
   options.mixed = order == 2;
   FemOfModel out;
   const auto solve_start = std::chrono::steady_clock::now();
   fem::HyperelasticSolution solution;
-  const solve::Status status =
+  const linalg::Status status =
       fem::solve_hyperelastic(posed.mesh, material, posed.state, options, &solution);
   if (!status.ok) fail(status.message);
   out.solve_seconds = seconds_since(solve_start);

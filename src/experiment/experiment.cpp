@@ -22,49 +22,75 @@ void require_built(const Experiment& experiment) {
                            "parse_experiment, load_experiment)");
 }
 
-void build_experiment(Experiment& ex, const geom::Surface* surface) {
-  ex.cases.clear();
-  ex.area_surfaces.clear();
-  ex.specimens.clear();
-  if (ex.calibration)  // each specimen's file, read and built; its errors name it
-    for (const SpecimenSpec& s : ex.calibration->specimens) {
-      // A specimen is a simulation, never a calibration (which could list itself).
-      static thread_local bool inside_calibration = false;
-      if (inside_calibration)
-        throw InputError(s.file.string() +
-                         ": a specimen of a calibration is a simulation with "
-                         "a \"fit\" section, not a calibration");
-      inside_calibration = true;
-      Experiment specimen;
-      try {
-        specimen = load_experiment(s.file);
-      } catch (...) {
-        inside_calibration = false;
-        throw;
-      }
+namespace {
+
+// Each specimen's file, read and built; its errors name it.
+void build_calibration(CalibrationStudy& study, std::vector<std::string>& warnings) {
+  study.specimens.clear();
+  for (const SpecimenSpec& s : study.spec.specimens) {
+    // A specimen is a simulation, never a calibration (which could list itself).
+    static thread_local bool inside_calibration = false;
+    if (inside_calibration)
+      throw InputError(s.file.string() +
+                       ": a specimen of a calibration is a simulation with "
+                       "a \"fit\" section, not a calibration");
+    inside_calibration = true;
+    Experiment specimen;
+    try {
+      specimen = load_experiment(s.file);
+    } catch (...) {
       inside_calibration = false;
-      if (!specimen.fit)
-        s.field.fail("experiment", s.file.string() +
-                                       " has no \"fit\" section: a specimen "
-                                       "brings its targets and parameters");
-      for (const std::string& w : specimen.warnings) ex.warnings.push_back(s.name + ": " + w);
-      ex.specimens.push_back(std::move(specimen));
+      throw;
     }
-  for (const NamedSurfaceSpec& named : ex.area_specs)
-    ex.area_surfaces.push_back({named.name, build_surface(named.surface, &ex.warnings)});
-  for (const CaseSpec& spec : ex.specs) {
-    const auto same = std::find_if(ex.specs.begin(), ex.specs.end(), [&](const CaseSpec& s) {
+    inside_calibration = false;
+    if (!specimen.fit())
+      s.field.fail("experiment", s.file.string() +
+                                     " has no \"fit\" section: a specimen "
+                                     "brings its targets and parameters");
+    for (const std::string& w : specimen.warnings) warnings.push_back(s.name + ": " + w);
+    study.specimens.push_back(std::move(specimen));
+  }
+}
+
+// Every case, a sweep's variants on one surface pruned once.
+void build_simulation(Simulation& sim, const geom::Surface* surface,
+                      std::vector<std::string>& warnings) {
+  sim.cases.clear();
+  for (const CaseSpec& spec : sim.specs) {
+    const auto same = std::find_if(sim.specs.begin(), sim.specs.end(), [&](const CaseSpec& s) {
       return s.surface_key == spec.surface_key;
     });
-    const size_t earlier = static_cast<size_t>(same - ex.specs.begin());
-    if (earlier < ex.cases.size())
-      ex.cases.push_back(build_case(spec, ex.cases[earlier]));
+    const size_t earlier = static_cast<size_t>(same - sim.specs.begin());
+    if (earlier < sim.cases.size())
+      sim.cases.push_back(build_case(spec, sim.cases[earlier]));
     else if (surface != nullptr)
-      ex.cases.push_back(build_case(spec, *surface, &ex.warnings));
+      sim.cases.push_back(build_case(spec, *surface, &warnings));
     else
-      ex.cases.push_back(build_case(spec, &ex.warnings));
-    for (const std::string& note : ex.cases.back().notes)
-      ex.warnings.push_back(spec.variant.empty() ? note : spec.variant + ": " + note);
+      sim.cases.push_back(build_case(spec, &warnings));
+    for (const std::string& note : sim.cases.back().notes)
+      warnings.push_back(spec.variant.empty() ? note : spec.variant + ": " + note);
+  }
+}
+
+}  // namespace
+
+void build_experiment(Experiment& ex, const geom::Surface* surface) {
+  switch (ex.kind()) {
+    case Experiment::Kind::Simulate:
+      build_simulation(ex.simulation(), surface, ex.warnings);
+      break;
+    case Experiment::Kind::Areas: {
+      AreaStudy& areas = ex.areas();
+      areas.surfaces.clear();
+      for (const NamedSurfaceSpec& named : areas.specs)
+        areas.surfaces.push_back({named.name, build_surface(named.surface, &ex.warnings)});
+      break;
+    }
+    case Experiment::Kind::Calibration:
+      build_calibration(ex.calibration(), ex.warnings);
+      break;
+    case Experiment::Kind::Benchmark:
+      break;  // its scene is built when it runs
   }
 }
 

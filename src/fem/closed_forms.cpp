@@ -25,8 +25,7 @@ bool on_radius(const Mesh& mesh, int v, double radius, Centre centre = Centre::A
 
 // On the tube's end z = 0 or z = length.
 bool on_end(const Mesh& mesh, int v, double length) {
-  return mesh.nodes(v, 2) <= kOnSurface * length ||
-         mesh.nodes(v, 2) >= (1.0 - kOnSurface) * length;
+  return mesh.nodes(v, 2) <= kOnSurface * length || mesh.nodes(v, 2) >= (1.0 - kOnSurface) * length;
 }
 
 // What an inflation measures: the inner surface's outward reactions summed
@@ -76,7 +75,7 @@ HyperelasticSolution solve_prescribed(const Mesh& mesh, const HyperelasticMateri
     return state;
   };
   HyperelasticSolution solution;
-  const solve::Status status = solve_hyperelastic(mesh, material, path, options, &solution);
+  const linalg::Status status = solve_hyperelastic(mesh, material, path, options, &solution);
   if (!status.ok) throw InputError(problem + ": " + status.message);
   return solution;
 }
@@ -96,7 +95,8 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
   const Mesh mesh = tube_mesh(tube);
   const double A = tube.inner_radius, B = tube.outer_radius, L = tube.length;
   const HeldAxes held = [&](int v) -> Eigen::Vector3i {
-    return on_end(mesh, v, L) || on_radius(mesh, v, A) ? Eigen::Vector3i::Ones() : Eigen::Vector3i::Zero();
+    return on_end(mesh, v, L) || on_radius(mesh, v, A) ? Eigen::Vector3i::Ones()
+                                                       : Eigen::Vector3i::Zero();
   };
   const Prescribed torsion = [&](const Eigen::Vector3d& X, double s) -> Eigen::Vector3d {
     return Eigen::AngleAxisd(s * twist * X.z(), Eigen::Vector3d::UnitZ()) * X - X;
@@ -114,9 +114,9 @@ ClosedFormRun tube_torsion(const TubeMeshSpec& tube, const HyperelasticMaterial&
   }
   const double mu = material.shear_modulus(), b4a4 = std::pow(B, 4) - std::pow(A, 4);
   ClosedFormRun run = run_of(mesh, solution);
-  run.figures = {{"torque", torque, M_PI / 2.0 * mu * twist * b4a4},
-                 {"axial_force", axial,
-                  -M_PI / 4.0 * mu * twist * twist * std::pow(B * B - A * A, 2)}};
+  run.figures = {
+      {"torque", torque, M_PI / 2.0 * mu * twist * b4a4},
+      {"axial_force", axial, -M_PI / 4.0 * mu * twist * twist * std::pow(B * B - A * A, 2)}};
   return run;
 }
 

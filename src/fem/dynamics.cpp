@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "fiberfluid/fem/free_unknowns.hpp"
-#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/linalg/sparse_cholesky.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fem {
@@ -86,7 +86,7 @@ class FreeSolve {
   IntegrationOptions options_;
   Eigen::VectorXd diagonal_, last_;
   Eigen::SparseMatrix<double, Eigen::RowMajor> by_rows_;
-  solve::SparseCholesky cholesky_;
+  linalg::SparseCholesky cholesky_;
   bool ok_ = false;
   long long sweeps_ = 0;
 };

@@ -7,7 +7,7 @@
 
 #include "fiberfluid/fem/free_unknowns.hpp"
 #include "fiberfluid/fem/tetrahedra.hpp"
-#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/linalg/sparse_cholesky.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
@@ -217,7 +217,8 @@ Eigen::MatrixXd elasticity_matrix(const Material& m, int dim) {
 
 Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material& m) {
   const ElementKind kind = element_kind(corners);
-  if (kind == ElementKind::QuadraticTetrahedron) return quadratic_tetrahedron_matrix(corners, m, true);
+  if (kind == ElementKind::QuadraticTetrahedron)
+    return quadratic_tetrahedron_matrix(corners, m, true);
   const bool simplex = kind == ElementKind::Simplex;
   const int dim = static_cast<int>(corners.cols());
   const Eigen::MatrixXd D = elasticity_matrix(m, dim);
@@ -241,7 +242,8 @@ Eigen::MatrixXd element_stiffness(const Eigen::MatrixXd& corners, const Material
 
 Eigen::MatrixXd element_mass(const Eigen::MatrixXd& corners, const Material& m) {
   const ElementKind kind = element_kind(corners);
-  if (kind == ElementKind::QuadraticTetrahedron) return quadratic_tetrahedron_matrix(corners, m, false);
+  if (kind == ElementKind::QuadraticTetrahedron)
+    return quadratic_tetrahedron_matrix(corners, m, false);
   const bool simplex = kind == ElementKind::Simplex;
   const int dim = static_cast<int>(corners.cols()), n = static_cast<int>(corners.rows());
   Eigen::MatrixXd scalar = Eigen::MatrixXd::Zero(n, n);
@@ -283,24 +285,24 @@ Eigen::VectorXd body_forces(const Mesh& mesh, const Material& m, const Eigen::Ve
   return mass_matrix(mesh, m) * per_unit;
 }
 
-solve::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
-                           const Constraints& held, Eigen::VectorXd* u) {
+linalg::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
+                            const Constraints& held, Eigen::VectorXd* u) {
   const int n = static_cast<int>(K.rows());
   Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
   for (size_t c = 0; c < held.dofs.size(); ++c) {
     const int d = held.dofs[c];
-    if (d < 0 || d >= n) return solve::Status::failure("fem: a held unknown is out of range");
+    if (d < 0 || d >= n) return linalg::Status::failure("fem: a held unknown is out of range");
     fixed[d] = held.values[c];
   }
   // K_ff u_f = f_f - K_fh u_h.
   const FreeUnknowns split(n, held.dofs);
   const Eigen::SparseMatrix<double> Kff = split.free_block(K);
   const Eigen::VectorXd rhs = split.restrict(f - K * fixed);
-  solve::SparseCholesky cholesky;
+  linalg::SparseCholesky cholesky;
   cholesky.analyze_pattern(Kff);
-  const solve::Status status = cholesky.factorize(Kff);
+  const linalg::Status status = cholesky.factorize(Kff);
   if (!status.ok)
-    return solve::Status::failure(
+    return linalg::Status::failure(
         "fem: the stiffness is singular on the free unknowns (too few "
         "supports?): " +
         status.message);

@@ -13,7 +13,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "fiberfluid/solve/status.hpp"
+#include "fiberfluid/linalg/status.hpp"
 
 namespace fiberfluid::fem {
 
@@ -78,7 +78,7 @@ struct Constraints {
 // K u = f with the held unknowns eliminated (CHOLMOD). `u` has every
 // unknown; the status fails when K restricted to the free unknowns is not
 // positive definite (too few supports).
-solve::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
-                           const Constraints& held, Eigen::VectorXd* u);
+linalg::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
+                            const Constraints& held, Eigen::VectorXd* u);
 
 }  // namespace fiberfluid::fem

@@ -10,7 +10,7 @@
 
 #include "fiberfluid/fem/free_unknowns.hpp"
 #include "fiberfluid/fem/tetrahedra.hpp"
-#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/linalg/sparse_cholesky.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::fem {
@@ -133,8 +133,8 @@ Eigen::Matrix<double, 9, 9> tangent_at_fixed_pressure(const HyperelasticMaterial
     dF(l % 3, l / 3) = 1.0;
     const double trace_G_dF = contract(G, dF);  // d ln J
     const Eigen::Matrix3d dG = -G * dF.transpose() * G;
-    Eigen::Matrix3d dP = p * ((s.theta.curvature * J + s.theta.slope) * J * trace_G_dF * G +
-                              s.theta.slope * J * dG);
+    Eigen::Matrix3d dP =
+        p * ((s.theta.curvature * J + s.theta.slope) * J * trace_G_dF * G + s.theta.slope * J * dG);
     if (m.kind == Hyperelastic::NeoHookean) {
       dP += mu * (dF - dG);
     } else {
@@ -180,8 +180,9 @@ Discretization discretize(const Mesh& mesh, const HyperelasticMaterial& m, bool 
   check_tetrahedra(mesh);
   const bool quadratic = is_quadratic_tetrahedron(static_cast<int>(mesh.elements.cols()));
   if (mixed && !quadratic)
-    throw InputError("fem: the mixed form needs quadratic tetrahedra (linear ones with a linear "
-                     "pressure are not stable)");
+    throw InputError(
+        "fem: the mixed form needs quadratic tetrahedra (linear ones with a linear "
+        "pressure are not stable)");
   Discretization d{mesh, m, {}, pressure_field(mesh, mixed)};
   const TetrahedronRule rule = tetrahedron_rule(quadratic ? 2 : 1);
   d.rest.resize(static_cast<size_t>(mesh.elements.rows()));
@@ -289,7 +290,8 @@ Eigen::SparseMatrix<double> tangent_of(const Discretization& d, const Eigen::Vec
   std::vector<Eigen::Triplet<double>> entries;
   for (int e = 0; e < d.mesh.elements.rows(); ++e) {
     const ElementResponse r = respond(d, e, x, true);
-    if (entries.empty()) entries.reserve(d.mesh.elements.rows() * r.unknowns.size() * r.unknowns.size());
+    if (entries.empty())
+      entries.reserve(d.mesh.elements.rows() * r.unknowns.size() * r.unknowns.size());
     for (size_t a = 0; a < r.unknowns.size(); ++a)
       for (size_t b = 0; b < r.unknowns.size(); ++b)
         entries.emplace_back(r.unknowns[a], r.unknowns[b],
@@ -312,9 +314,9 @@ double energy_of(const Discretization& d, const Eigen::VectorXd& x) {
 // mixed form's pressure block is smaller than its displacement block by
 // about (h / D)^2 mu / k (1e-20 for a stiff body on millimetre elements),
 // which costs the unscaled LU three digits of the answer.
-solve::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b,
-                            Eigen::VectorXd* x) {
-  solve::SparseCholesky cholesky;
+linalg::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b,
+                             Eigen::VectorXd* x) {
+  linalg::SparseCholesky cholesky;
   cholesky.analyze_pattern(K);
   if (cholesky.factorize(K).ok) {
     *x = cholesky.solve(b);
@@ -329,7 +331,7 @@ solve::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::V
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
   lu.compute(scaled);
   if (lu.info() != Eigen::Success)
-    return solve::Status::failure("the tangent stiffness is singular (too few supports?)");
+    return linalg::Status::failure("the tangent stiffness is singular (too few supports?)");
   *x = scale.asDiagonal() * lu.solve(scale.asDiagonal() * b);
   return {};
 }
@@ -395,7 +397,7 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
       return out.str();
     }
     Eigen::VectorXd dx_free;
-    const solve::Status status =
+    const linalg::Status status =
         solve_tangent(split.free_block(tangent_of(d, x)), -split.restrict(R), &dx_free);
     if (!status.ok) return status.message;
     Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
@@ -519,11 +521,11 @@ double total_strain_energy(const Mesh& mesh, const HyperelasticMaterial& m,
   return energy_of(discretize(mesh, m, false), u);
 }
 
-solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
-                                 const LoadPath& path, const HyperelasticOptions& options,
-                                 HyperelasticSolution* solution) {
+linalg::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
+                                  const LoadPath& path, const HyperelasticOptions& options,
+                                  HyperelasticSolution* solution) {
   check_tetrahedra(mesh);
-  if (options.steps < 1) return solve::Status::failure("fem: steps must be at least 1");
+  if (options.steps < 1) return linalg::Status::failure("fem: steps must be at least 1");
   const Discretization d = discretize(mesh, m, options.mixed);
   const int n = mesh.num_dofs();
   *solution = HyperelasticSolution{};
@@ -532,7 +534,7 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
   done.forces.setZero();
   for (double& value : done.held.values) value = 0.0;
   for (int k : done.held.dofs)
-    if (k < 0 || k >= n) return solve::Status::failure("fem: a held unknown is out of range");
+    if (k < 0 || k >= n) return linalg::Status::failure("fem: a held unknown is out of range");
   const FreeUnknowns split(d.unknowns(), done.held.dofs);
   Eigen::VectorXd internal = forces_of(d, x, nullptr);  // at x, the last equilibrium
   const auto keep = [&] {
@@ -545,8 +547,8 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
   for (int step = 1; step <= options.steps; ++step) {
     const LoadState target = path(step);
     if (target.held.dofs != done.held.dofs || target.forces.size() != n)
-      return solve::Status::failure("fem: step " + std::to_string(step) +
-                                    ": the held unknowns or the force vector changed");
+      return linalg::Status::failure("fem: step " + std::to_string(step) +
+                                     ": the held unknowns or the force vector changed");
     // Advance from `done` to `target` in pieces, halving a piece that fails.
     double reached = 0.0, piece = 1.0;
     int cuts = 0;
@@ -562,8 +564,8 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
         continue;
       }
       if (cuts == options.max_step_cuts)
-        return solve::Status::failure("fem: step " + std::to_string(step) + ": " + why +
-                                      "; the step was halved " + std::to_string(cuts) + " times");
+        return linalg::Status::failure("fem: step " + std::to_string(step) + ": " + why +
+                                       "; the step was halved " + std::to_string(cuts) + " times");
       ++cuts;
       ++solution->step_cuts;
       piece *= 0.5;
@@ -574,24 +576,25 @@ solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m
   return {};
 }
 
-solve::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
-                                 const LoadState& state, const HyperelasticOptions& options,
-                                 HyperelasticSolution* solution) {
+linalg::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
+                                  const LoadState& state, const HyperelasticOptions& options,
+                                  HyperelasticSolution* solution) {
   const Discretization d = discretize(mesh, m, options.mixed);
   const int n = mesh.num_dofs();
   for (int k : state.held.dofs)
-    if (k < 0 || k >= n) return solve::Status::failure("fem: a held unknown is out of range");
-  if (state.forces.size() != n) return solve::Status::failure("fem: one force per unknown needed");
+    if (k < 0 || k >= n) return linalg::Status::failure("fem: a held unknown is out of range");
+  if (state.forces.size() != n) return linalg::Status::failure("fem: one force per unknown needed");
   const FreeUnknowns split(d.unknowns(), state.held.dofs);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(d.unknowns()), held = x;
-  for (size_t k = 0; k < state.held.dofs.size(); ++k) held[state.held.dofs[k]] = state.held.values[k];
+  for (size_t k = 0; k < state.held.dofs.size(); ++k)
+    held[state.held.dofs[k]] = state.held.values[k];
   const Eigen::SparseMatrix<double> K = tangent_of(d, x);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(d.unknowns());
   f.head(n) = state.forces;
   Eigen::VectorXd free;
-  const solve::Status status =
+  const linalg::Status status =
       solve_tangent(split.free_block(K), split.restrict(f - K * held), &free);
-  if (!status.ok) return solve::Status::failure("fem: " + status.message);
+  if (!status.ok) return linalg::Status::failure("fem: " + status.message);
   x = held;
   split.scatter(free, x);
   *solution = HyperelasticSolution{};

@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "fiberfluid/fem/fem.hpp"
-#include "fiberfluid/solve/status.hpp"
+#include "fiberfluid/linalg/status.hpp"
 
 namespace fiberfluid::fem {
 
@@ -103,16 +103,16 @@ struct HyperelasticSolution {
 // max_step_cuts times. The status names the step and why it failed;
 // `solution` then holds the last converged state. Each tangent is factored
 // by CHOLMOD, or by a sparse LU where it is not positive definite.
-solve::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
-                                 const LoadPath& path, const HyperelasticOptions& options,
-                                 HyperelasticSolution* solution);
+linalg::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& m,
+                                  const LoadPath& path, const HyperelasticOptions& options,
+                                  HyperelasticSolution* solution);
 
 // Small strain: one solve of the tangent at rest under `state` (its forces
 // and held values), which is linear elasticity with E and nu (in the mixed
 // form when options.mixed). Fills solution->u, pressure, forces and a
 // one-entry path.
-solve::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
-                                 const LoadState& state, const HyperelasticOptions& options,
-                                 HyperelasticSolution* solution);
+linalg::Status solve_small_strain(const Mesh& mesh, const HyperelasticMaterial& m,
+                                  const LoadState& state, const HyperelasticOptions& options,
+                                  HyperelasticSolution* solution);
 
 }  // namespace fiberfluid::fem

@@ -105,7 +105,7 @@ Eigen::VectorXd static_state(const Scene& scene) {
     held.hold(d.held[k], values[static_cast<Eigen::Index>(k)]);
   Eigen::VectorXd u;
   const Eigen::VectorXd f = d.force ? d.force(late) : Eigen::VectorXd::Zero(d.K.rows());
-  const solve::Status status = solve_static(d.K, f, held, &u);
+  const linalg::Status status = solve_static(d.K, f, held, &u);
   if (!status.ok) throw InputError("benchmark: the static problem is singular: " + status.message);
   return u;
 }

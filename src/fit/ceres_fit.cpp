@@ -33,10 +33,10 @@ class SharedEvaluation {
   // False when the point would need forward runs beyond max_evaluations
   // (a kept point needs none).
   bool affordable(const double* phi, bool with_jacobian) const {
-    const FitProblem& calibration = cache_.problem();
+    const FitProblem& fit_problem = cache_.problem();
     if (cache_.forward_runs < max_runs_) return true;
-    with_jacobian = with_jacobian || calibration.analytic_jacobian();
-    return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, calibration.parameters().size()),
+    with_jacobian = with_jacobian || fit_problem.analytic_jacobian();
+    return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, fit_problem.parameters().size()),
                        with_jacobian) != nullptr;
   }
   const EvaluationCache& cache() const { return cache_; }
@@ -90,9 +90,9 @@ struct CeresProblem {
   CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi,
                int max_runs = std::numeric_limits<int>::max())
       : shared(cache, max_runs), loss(make_loss(options)), problem(problem_options()) {
-    const FitProblem& calibration = cache.problem();
-    const ParameterMap& map = calibration.parameters();
-    for (int i = 0; i < calibration.num_residuals(); ++i)
+    const FitProblem& fit_problem = cache.problem();
+    const ParameterMap& map = fit_problem.parameters();
+    for (int i = 0; i < fit_problem.num_residuals(); ++i)
       problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(),
                                phi.data());
     const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
@@ -110,9 +110,9 @@ struct CeresProblem {
 
 class Recorder final : public ceres::IterationCallback {
  public:
-  Recorder(const FitProblem& calibration, const FitOptions& options, const Eigen::VectorXd& phi,
+  Recorder(const FitProblem& fit_problem, const FitOptions& options, const Eigen::VectorXd& phi,
            const SharedEvaluation& shared, OptimizerOutcome& outcome)
-      : calibration_(calibration),
+      : fit_problem_(fit_problem),
         options_(options),
         phi_(phi),
         shared_(shared),
@@ -127,7 +127,7 @@ class Recorder final : public ceres::IterationCallback {
     const int failed = shared_.cache().failed_runs;
     if (failed > failures_seen_) r.trial_failure = shared_.cache().last_failure;
     failures_seen_ = failed;
-    r.values = calibration_.parameters().values(phi_);  // update_state_every_iteration
+    r.values = fit_problem_.parameters().values(phi_);  // update_state_every_iteration
     r.forward_runs = shared_.cache().forward_runs;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     outcome_.iterations.push_back(r);
@@ -140,7 +140,7 @@ class Recorder final : public ceres::IterationCallback {
   bool evaluations_spent = false;
 
  private:
-  const FitProblem& calibration_;
+  const FitProblem& fit_problem_;
   const FitOptions& options_;
   const Eigen::VectorXd& phi_;
   const SharedEvaluation& shared_;
@@ -165,11 +165,11 @@ IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
 
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start) {
-  const FitProblem& calibration = evaluations.problem();
+  const FitProblem& fit_problem = evaluations.problem();
   OptimizerOutcome outcome;
   Eigen::VectorXd phi = start;
   CeresProblem p(evaluations, options, phi, options.max_evaluations);
-  Recorder recorder(calibration, options, phi, p.shared, outcome);
+  Recorder recorder(fit_problem, options, phi, p.shared, outcome);
   LmSteps steps;
   steps.max_iterations = options.max_iterations;
   steps.function_tolerance = options.function_tolerance;
@@ -177,8 +177,8 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   steps.initial_trust_region_radius = options.initial_trust_region_radius;
   steps.max_step_factor = options.max_step_factor;
   const ceres::Solver::Summary summary = solve_in_moving_box(
-      p.problem, phi.data(), calibration.parameters().parameters(),
-      calibration.parameters().lower_phi(), calibration.parameters().upper_phi(), steps, &recorder);
+      p.problem, phi.data(), fit_problem.parameters().parameters(),
+      fit_problem.parameters().lower_phi(), fit_problem.parameters().upper_phi(), steps, &recorder);
   outcome.phi = phi;  // the best point: Ceres keeps it in phi, also when stopped
   outcome.message = "levenberg-marquardt: " + summary.message;
   switch (summary.termination_type) {

@@ -20,9 +20,9 @@ constexpr double kFailedCost = 1e30;
 
 struct Objective {
   Objective(EvaluationCache& e, const FitOptions& o, OptimizerOutcome& out)
-      : evaluations(e), calibration(e.problem()), options(o), outcome(out) {}
+      : evaluations(e), fit_problem(e.problem()), options(o), outcome(out) {}
   EvaluationCache& evaluations;
-  const FitProblem& calibration;
+  const FitProblem& fit_problem;
   const FitOptions& options;
   OptimizerOutcome& outcome;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
@@ -32,12 +32,12 @@ struct Objective {
   nlopt_opt running = nullptr;  // the optimiser calling, stopped on a requested interruption
 
   double operator()(const double* x) {
-    const int P = calibration.parameters().size();
+    const int P = fit_problem.parameters().size();
     const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(x, P);
     const Evaluation& e = evaluations.at(phi, false);
     ++calls;
-    const double cost = e.ok && std::isfinite(calibration.cost(e.residuals))
-                            ? calibration.cost(e.residuals)
+    const double cost = e.ok && std::isfinite(fit_problem.cost(e.residuals))
+                            ? fit_problem.cost(e.residuals)
                             : kFailedCost;
     if (cancel_requested() && running) nlopt_force_stop(running);
     if (cost < best) {
@@ -46,7 +46,7 @@ struct Objective {
       IterationRecord r;
       r.iteration = calls;
       r.cost = r.trial_cost = cost;
-      r.values = calibration.parameters().values(phi);
+      r.values = fit_problem.parameters().values(phi);
       r.forward_runs = evaluations.forward_runs;
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       outcome.iterations.push_back(r);
@@ -90,10 +90,10 @@ std::string describe(nlopt_result r) {
 }
 
 // One NLopt run of `algorithm` from phi (updated to the best point).
-nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& calibration,
+nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
                       const FitOptions& options, Objective& objective, Eigen::VectorXd& phi,
                       int max_evaluations) {
-  const ParameterMap& map = calibration.parameters();
+  const ParameterMap& map = fit_problem.parameters();
   const int P = map.size();
   nlopt_opt opt = nlopt_create(algorithm, static_cast<unsigned>(P));
   const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
@@ -111,7 +111,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& calibration,
     const Parameter& p = map.parameters()[static_cast<size_t>(k)];
     step[k] = p.log_scale                            ? 0.3
               : p.name.rfind("rotation_", 0) == 0    ? 0.05
-              : p.name.rfind("translation_", 0) == 0 ? 0.05 * calibration.body_length()
+              : p.name.rfind("translation_", 0) == 0 ? 0.05 * fit_problem.body_length()
                                                      : 0.1 * std::max(std::abs(phi[k]), 1e-3);
     if (std::isfinite(lower[k]) && std::isfinite(upper[k]))
       step[k] = std::min(step[k], 0.25 * (upper[k] - lower[k]));
@@ -130,15 +130,15 @@ nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& calibration,
 
 OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
                            const Eigen::VectorXd& start) {
-  const FitProblem& calibration = evaluations.problem();
+  const FitProblem& fit_problem = evaluations.problem();
   OptimizerOutcome outcome;
-  const ParameterMap& map = calibration.parameters();
+  const ParameterMap& map = fit_problem.parameters();
   Eigen::VectorXd phi = start;
   Objective objective(evaluations, options, outcome);
   nlopt_result result;
   if (options.method == Method::Bobyqa) {
     result =
-        minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi, options.max_evaluations);
+        minimise(NLOPT_LN_BOBYQA, fit_problem, options, objective, phi, options.max_evaluations);
   } else {
     const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
     for (int k = 0; k < map.size(); ++k)
@@ -147,10 +147,10 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& optio
                          "\": a global search (" + to_string(options.method) +
                          ") needs finite lower and upper bounds");
     const int global = options.max_evaluations / 2;
-    minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, calibration,
+    minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, fit_problem,
              options, objective, phi, global);
     result = cancel_requested() ? NLOPT_FORCED_STOP
-                                : minimise(NLOPT_LN_BOBYQA, calibration, options, objective, phi,
+                                : minimise(NLOPT_LN_BOBYQA, fit_problem, options, objective, phi,
                                            options.max_evaluations - objective.calls);
   }
   outcome.phi = phi;

@@ -36,7 +36,8 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
   check_options(options_);
   if (model_.dim() != 3) throw InputError("calibration fits 3D surfaces; this model is 2D");
   if (targets.empty() && curves_.empty() && more_blocks.empty())
-    throw InputError("nothing to fit to: no target surface, force curve or other target");
+    throw InputError(
+        "nothing to fit to: no target surface and no force curve (nor another target)");
   const int n = model_.num_vertices();
   if (options_.counted_vertices.empty()) {
     for (int i = 0; i < n; ++i) counted_.push_back(i);
@@ -182,8 +183,8 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
   if (sensitivities_wanted && analytic_) {
     for (int step : state_steps_) {
       const solve::StepRecord& record = record_of(e.summary, step);
-      run.sensitivities[step] = record.sensitivities;
-      e.sensitivity_solves += static_cast<int>(record.sensitivities.cols());
+      run.sensitivities[step] = record.sensitivities.state;
+      e.sensitivity_solves += static_cast<int>(record.sensitivities.state.cols());
       for (size_t b = 0; b < nb; ++b)
         readings[b][step].sensitivities = blocks_[b]->observed_sensitivities(changed, record, nm);
     }

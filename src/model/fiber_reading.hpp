@@ -1,15 +1,29 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-// A fiber's reading (strain, tension, force) from its force coefficients:
-// what the surface-tension term (terms.cpp) and the bulk-fiber term
-// (bulk_fiber_term.cpp) report for a fiber. Internal to those two files.
+// A fiber's reading (strain, tension, force), and how it is made from the
+// fiber's force coefficients: what the surface-tension term (terms.cpp) and
+// the bulk-fiber term (bulk_fiber_term.cpp) report for a fiber.
 
 #include <Eigen/Core>
 
 #include "fiberfluid/model/pair_stencil.hpp"
-#include "fiberfluid/model/terms.hpp"
 
-namespace fiberfluid::model::detail {
+namespace fiberfluid::model {
+
+// One fiber at a state, for reports (a fibers .vtu, a face's surface
+// tension): its ends i < j, its strain e = r / L - 1, the force it exerts on
+// its end i (axis factors applied; on j the opposite) and that force's
+// component along the fiber towards j, its tension (positive when it pulls
+// its ends together). A vector spring's force also has a part across the
+// fiber, so |force| can exceed |tension|; a central fiber's cannot.
+struct FiberReading {
+  int i = 0, j = 0;
+  double strain = 0.0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  double tension = 0.0;
+};
+
+namespace detail {
 
 // A fiber's reading from its force coefficients (pair_stencil.hpp): the
 // residual's part on i is m (c1 g), the force the fiber exerts on i its
@@ -29,4 +43,5 @@ inline FiberReading read_fiber(int i, int j, const PairCoefficients& c, const Ei
   return out;
 }
 
-}  // namespace fiberfluid::model::detail
+}  // namespace detail
+}  // namespace fiberfluid::model

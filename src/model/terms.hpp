@@ -26,22 +26,10 @@
 #include <vector>
 
 #include "fiberfluid/model/fiber_network.hpp"
+#include "fiberfluid/model/fiber_reading.hpp"
 #include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
-
-// One fiber at a state, for reports (a fibers .vtu, a face's surface
-// tension): its ends i < j, its strain e = r / L - 1, the force it exerts on
-// its end i (axis factors applied; on j the opposite) and that force's
-// component along the fiber towards j, its tension (positive when it pulls
-// its ends together). A vector spring's force also has a part across the
-// fiber, so |force| can exceed |tension|; a central fiber's cannot.
-struct FiberReading {
-  int i = 0, j = 0;
-  double strain = 0.0;
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  double tension = 0.0;
-};
 
 // What the terms read of the reference configuration (Equilibrium owns it).
 struct TermContext {

@@ -14,9 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "fiberfluid/experiment/experiment.hpp"
+#include "fiberfluid/experiment/fit_workflow.hpp"
 #include "fiberfluid/experiment/read/schema.hpp"
 #include "fiberfluid/experiment/run/fit_setup.hpp"
-#include "fiberfluid/experiment/run/fit_workflow.hpp"
 #include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/experiment/write/output_folder.hpp"
 #include "fiberfluid/experiment/write/outputs.hpp"
@@ -32,6 +32,13 @@ namespace py = pybind11;
 namespace ff = fiberfluid;
 
 namespace {
+
+// A simulation's cases; none for the other kinds (an area study, a benchmark,
+// a calibration over specimens have no run of their own to show).
+const std::vector<ff::experiment::Case>& cases_of(const ff::experiment::Experiment& ex) {
+  static const std::vector<ff::experiment::Case> none;
+  return ex.kind() == ff::experiment::Experiment::Kind::Simulate ? ex.simulation().cases : none;
+}
 
 // A plain dict (or list) to JSON, through Python's own json module.
 nlohmann::json to_json(const py::object& document) {
@@ -91,7 +98,7 @@ py::dict steps_dict(const ff::experiment::Case& c, const ff::solve::SteppingSumm
 // One run's results: the deformed surface in input order, the steps, the figures.
 py::dict run_dict(const ff::experiment::Experiment& ex,
                   const ff::experiment::ExperimentResult& result, size_t r) {
-  const ff::experiment::Case& c = ex.cases[r];
+  const ff::experiment::Case& c = ex.simulation().cases[r];
   const ff::experiment::RunResult& run = result.runs[r];
   py::dict out;
   out["variant"] = run.variant;
@@ -209,8 +216,8 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
                         const py::list& parameters, const std::string& method,
                         const std::string& jacobian, bool symmetric, const std::string& loss,
                         double loss_scale, int max_iterations) {
-  if (ex.cases.size() != 1) throw ff::InputError("fit: the experiment must be one simulation");
-  const ff::experiment::Case& c = ex.cases.front();
+  if (cases_of(ex).size() != 1) throw ff::InputError("fit: the experiment must be one simulation");
+  const ff::experiment::Case& c = ex.simulation().cases.front();
   std::vector<ff::fit::MeasuredStep> measured;
   std::vector<ff::fit::ForceCurve> curves;
   for (size_t k = 0; k < targets.size(); ++k) {
@@ -376,9 +383,9 @@ class Interactive {
  private:
   static const ff::experiment::Case& pick(const ff::experiment::Experiment& ex,
                                           const std::string& variant) {
-    if (ex.cases.empty()) throw ff::InputError(ex.name + ": the experiment has no run");
-    if (variant.empty()) return ex.cases.front();
-    for (const ff::experiment::Case& c : ex.cases)
+    if (cases_of(ex).empty()) throw ff::InputError(ex.name + ": the experiment has no run");
+    if (variant.empty()) return cases_of(ex).front();
+    for (const ff::experiment::Case& c : cases_of(ex))
       if (c.variant == variant) return c;
     throw ff::InputError(ex.name + ": no variant named \"" + variant + "\"");
   }
@@ -421,7 +428,7 @@ class Interactive {
 py::dict fit_file(const std::filesystem::path& path, const std::string& output) {
   namespace xp = ff::experiment;
   const xp::Experiment ex = xp::load_experiment(path);
-  if (ex.kind != xp::Experiment::Kind::Calibration && !ex.fit)
+  if (ex.kind() != xp::Experiment::Kind::Calibration && !ex.fit())
     throw ff::InputError(path.string() + ": no \"fit\" section (and not a calibration)");
   const std::filesystem::path folder = xp::output_folder(output, ex.name);
   ff::fit::FitStatus status = ff::fit::FitStatus::StartFailed;
@@ -431,7 +438,7 @@ py::dict fit_file(const std::filesystem::path& path, const std::string& output) 
   std::string failure;
   {
     py::gil_scoped_release release;
-    if (ex.kind == xp::Experiment::Kind::Calibration) {
+    if (ex.kind() == xp::Experiment::Kind::Calibration) {
       const xp::JointSetup setup = xp::setup_joint(ex);
       const xp::CalibrationOutcome done = xp::run_calibration(ex, setup, folder, {}, {});
       status = done.fitted.status;
@@ -456,7 +463,7 @@ py::dict fit_file(const std::filesystem::path& path, const std::string& output) 
   out["folder"] = written;
   out["warnings"] = warnings;
   const std::filesystem::path report =
-      written / (ex.kind == xp::Experiment::Kind::Calibration ? "calibration.json" : "fit.json");
+      written / (ex.kind() == xp::Experiment::Kind::Calibration ? "calibration.json" : "fit.json");
   std::ifstream in(report);
   out["report"] = in ? to_python(nlohmann::json::parse(in)) : py::object(py::none());
   return out;
@@ -541,16 +548,17 @@ PYBIND11_MODULE(fiberfluid, m) {
       .def_property_readonly("variants",
                              [](const ff::experiment::Experiment& ex) {
                                std::vector<std::string> names;
-                               for (const ff::experiment::Case& c : ex.cases)
+                               for (const ff::experiment::Case& c : cases_of(ex))
                                  names.push_back(c.variant);
                                return names;
                              })
       .def_property_readonly("warnings",
                              [](const ff::experiment::Experiment& ex) { return ex.warnings; })
-      .def_property_readonly("num_vertices",
-                             [](const ff::experiment::Experiment& ex) {
-                               return ex.cases.empty() ? 0 : ex.cases.front().model.num_vertices();
-                             })
+      .def_property_readonly(
+          "num_vertices",
+          [](const ff::experiment::Experiment& ex) {
+            return cases_of(ex).empty() ? 0 : cases_of(ex).front().model.num_vertices();
+          })
       .def("run", &run, py::arg("jobs") = 0, py::arg("output") = std::string(),
            "Runs every variant (`jobs` at once; 0: one per core). With `output`, writes the "
            "result folder as `fiberfluid run -o` does. Returns a dict with success, runs (each "

@@ -7,12 +7,6 @@
 
 namespace fiberfluid::solve {
 
-std::optional<SolverKind> solver_kind_from_string(const std::string& name) {
-  return kSolverKindNames.find(name);
-}
-
-std::vector<std::string> solver_kind_names() { return kSolverKindNames.all(); }
-
 SolverKind choose_solver(double largest_block, int factors, double budget_bytes) {
   const double n = largest_block;
   if (n <= 600) return SolverKind::DenseLU;  // the paper's method, well within a second

@@ -29,9 +29,6 @@ inline constexpr auto kSolverKindNames =
                           {SolverKind::Cholmod, "cholmod"},
                           {SolverKind::PCG, "pcg"}});
 inline const char* to_string(SolverKind kind) { return kSolverKindNames.name(kind); }
-std::optional<SolverKind> solver_kind_from_string(const std::string& name);
-// Every name solver_kind_from_string reads, for the readers' lists and messages.
-std::vector<std::string> solver_kind_names();
 
 struct PcgOptions {
   double tolerance = 1e-10;   // stop at |r| <= tolerance |b| (relative residual)

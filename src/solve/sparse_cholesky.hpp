@@ -1,32 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
+// CHOLMOD's sparse Cholesky lives on the linear-algebra floor
+// (linalg/sparse_cholesky.hpp), which the FEM shares.
 
-#include <Eigen/SparseCore>
-#include <memory>
-
-#include "fiberfluid/solve/status.hpp"
+#include "fiberfluid/linalg/sparse_cholesky.hpp"
 
 namespace fiberfluid::solve {
-
-// Sparse Cholesky of a symmetric positive definite matrix by SuiteSparse's
-// CHOLMOD (supernodal, fill-reducing ordering). CHOLMOD's headers stay in
-// the .cpp.
-class SparseCholesky {
- public:
-  SparseCholesky();
-  ~SparseCholesky();
-  SparseCholesky(SparseCholesky&&) noexcept;
-  SparseCholesky& operator=(SparseCholesky&&) noexcept;
-
-  // Symbolic analysis of the pattern, reused while the pattern is the same.
-  void analyze_pattern(const Eigen::SparseMatrix<double>& A);
-  // Fails when the matrix is not positive definite.
-  Status factorize(const Eigen::SparseMatrix<double>& A);
-  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
-
+using linalg::SparseCholesky;
 }  // namespace fiberfluid::solve

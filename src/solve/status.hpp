@@ -1,17 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
+// The solvers' status is the linear-algebra floor's (linalg/status.hpp),
+// which the FEM shares.
 
-#include <string>
-#include <utility>
+#include "fiberfluid/linalg/status.hpp"
 
 namespace fiberfluid::solve {
-
-// The outcome of a numerical step that can fail on valid input (a matrix
-// that is not positive definite, no convergence): a status and a message.
-struct Status {
-  bool ok = true;
-  std::string message;
-  static Status failure(std::string why) { return {false, std::move(why)}; }
-};
-
+using linalg::Status;
 }  // namespace fiberfluid::solve

@@ -136,6 +136,18 @@ struct SteppingOptions {
 // A field added to StepRecord or SteppingSummary (other than a live object)
 // goes into solve/summary_fields.hpp's lists too: it is how a run made on
 // another MPI rank comes back.
+// The derivatives of a step's state and forces by the parameters that
+// SteppingOptions::sensitivities names (Newton only), one column per
+// parameter: what a fit's Jacobian is made of.
+struct StepSensitivities {
+  Eigen::MatrixXd state;  // du/dtheta, full layout (zero at held unknowns)
+  // Per paddle (Model::paddles): d force / d theta, 3 x parameters.
+  std::vector<Eigen::MatrixXd> paddle_forces;
+  // Per support group: d reaction / d theta (3 x parameters; NaN for a group
+  // with a mirror layer, whose fibers' share is not differentiated).
+  std::vector<Eigen::MatrixXd> reactions;
+};
+
 struct StepRecord {
   int step = 0;                      // 1..n
   std::vector<double> load_factors;  // one per load, after this step
@@ -179,18 +191,11 @@ struct StepRecord {
     double travel = 0.0;                              // how far it has moved
     Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the body
     int contacts = 0;                                 // vertices held on it
-    // At the steps SteppingOptions::sensitivities lists: d force / d theta,
-    // 3 x parameters.
-    Eigen::MatrixXd force_sensitivities;
   };
   std::vector<PaddleState> paddles;  // one per Model::paddles
-  // At the steps SteppingOptions::sensitivities lists: du/dtheta, full
-  // layout (zero at held unknowns), one column per parameter.
-  Eigen::MatrixXd sensitivities;
-  // Newton, at the sensitivities' steps: per support group, d reaction /
-  // d theta (3 x parameters; NaN for a group with a mirror layer, whose
-  // fibers' share is not differentiated).
-  std::vector<Eigen::MatrixXd> reaction_sensitivities;
+  // What a fit asks of the step (SteppingOptions::sensitivities): empty
+  // except at the steps it lists.
+  StepSensitivities sensitivities;
 };
 
 struct SteppingSummary {

@@ -22,14 +22,19 @@ void fields(A& a, StepRecord::HeldForce& h) {
 }
 template <class A>
 void fields(A& a, StepRecord::PaddleState& p) {
-  a(p.plane, p.travel, p.force, p.contacts, p.force_sensitivities);
+  a(p.plane, p.travel, p.force, p.contacts);
+}
+template <class A>
+void fields(A& a, StepSensitivities& s) {
+  a(s.state, s.paddle_forces, s.reactions);
 }
 template <class A>
 void fields(A& a, StepRecord& r) {
   a(r.step, r.load_factors, r.pressure, r.volume, r.max_displacement, r.residual, r.seconds,
     r.reactions, r.applied_force, r.held_forces, r.newton_iterations, r.residual_norms,
-    r.line_search_halvings, r.krylov_iterations, r.pair_passes, r.step_cuts, r.pieces, r.volume_drift,
-    r.contact_rounds, r.contacts_added, r.contacts_released, r.paddles, r.sensitivities, r.reaction_sensitivities);
+    r.line_search_halvings, r.krylov_iterations, r.pair_passes, r.step_cuts, r.pieces,
+    r.volume_drift, r.contact_rounds, r.contacts_added, r.contacts_released, r.paddles,
+    r.sensitivities);
 }
 template <class A>
 void fields(A& a, SolverStatistics& s) {
@@ -38,8 +43,8 @@ void fields(A& a, SolverStatistics& s) {
 template <class A>
 void fields(A& a, SteppingSummary& s) {
   a(s.success, s.message, s.steps, s.unknowns, s.reaction_forces, s.scheme, s.solver, s.tangent,
-    s.newton_iterations, s.warm_started, s.limit_load_factor, s.krylov_iterations, s.solver_statistics,
-    s.factorizations, s.single_precision_factorizations, s.assemble_seconds, s.factorize_seconds,
-    s.solve_seconds, s.total_seconds);
+    s.newton_iterations, s.warm_started, s.limit_load_factor, s.krylov_iterations,
+    s.solver_statistics, s.factorizations, s.single_precision_factorizations, s.assemble_seconds,
+    s.factorize_seconds, s.solve_seconds, s.total_seconds);
 }
 }  // namespace fiberfluid::solve

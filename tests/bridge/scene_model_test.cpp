@@ -74,7 +74,7 @@ TEST(SceneModel, TheRodRunsAsTheSameExperimentFileRuns) {
       {"stepping", {{"steps", steps}}}};
   experiment::Experiment ex = experiment::read_experiment(doc, ".", "the rod's document");
   experiment::build_experiment(ex, &boundary.surface);
-  const experiment::Case& c = ex.cases.front();
+  const experiment::Case& c = ex.simulation().cases.front();
 
   solve::SteppingOptions stepping;
   stepping.steps = steps;

@@ -113,7 +113,7 @@ nlohmann::json small_rod() {
 TEST(Benchmark, TheRodsStaticShapeConvergesOnRefinedGrids) {
   nlohmann::json d = small_rod();
   d["static_reference"] = {{"levels", 3}, {"ratio", 2}};
-  const BenchmarkResult r = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult r = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(r.ok) << r.message;
   const auto& f = r.figures;
   std::vector<double> largest;
@@ -144,9 +144,9 @@ TEST(Benchmark, TheRodsStaticShapeConvergesOnRefinedGrids) {
 TEST(Benchmark, TheRodsFiberModelIsFittedToTheConvergedShape) {
   nlohmann::json d = small_rod();
   d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"kinematics", "central"}, {"horizon", 0.3}};
-  const BenchmarkResult own = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult own = run_benchmark(parse(d).benchmark());
   d["static_reference"] = {{"levels", 2}};
-  const BenchmarkResult converged = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult converged = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(own.ok && converged.ok && own.fiber && converged.fiber);
   EXPECT_EQ(own.fiber->target, "this mesh");
   EXPECT_EQ(converged.fiber->target, "cells x 4");
@@ -164,9 +164,9 @@ TEST(Benchmark, TheRodsFiberModelIsFittedToTheConvergedShape) {
 TEST(Benchmark, TheRodsCentralFibersBendWhereTheVectorSpringCannot) {
   nlohmann::json d = small_rod();
   d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"scheme", "newton"}};
-  const BenchmarkResult vector = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult vector = run_benchmark(parse(d).benchmark());
   d["fiber_model"] = {{"fit", true}, {"steps", 2}, {"kinematics", "central"}, {"horizon", 0.3}};
-  const BenchmarkResult central = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult central = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(vector.ok && central.ok && vector.fiber && central.fiber) << central.message;
   ASSERT_TRUE(central.series.back().ok) << central.series.back().message;
   EXPECT_LT(central.figures.at("fiber-model.static_E_n"),
@@ -186,8 +186,8 @@ TEST(Benchmark, TheRodsCentralFibersBendWhereTheVectorSpringCannot) {
 // at the same steps, and the figures read off the series.
 TEST(Benchmark, SeriesFollowTheReferenceStepByStep) {
   const Experiment ex = parse(small_block());
-  ASSERT_EQ(ex.kind, Experiment::Kind::Benchmark);
-  const BenchmarkResult r = run_benchmark(*ex.benchmark);
+  ASSERT_EQ(ex.kind(), Experiment::Kind::Benchmark);
+  const BenchmarkResult r = run_benchmark(ex.benchmark());
   ASSERT_TRUE(r.ok) << r.message;
   ASSERT_EQ(r.series.size(), 2u);
   for (const MetricSeries& s : r.series) {
@@ -211,9 +211,9 @@ TEST(Benchmark, SeriesFollowTheReferenceStepByStep) {
 // it cost; triangles give the quadrilaterals' answer up to discretisation.
 TEST(Benchmark, GaussSeidelAndTrianglesAgreeWithTheDefaults) {
   nlohmann::json d = small_block();
-  const BenchmarkResult direct = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult direct = run_benchmark(parse(d).benchmark());
   d["linear_solver"] = {{"method", "gauss-seidel"}, {"tolerance", 1e-12}};
-  const BenchmarkResult swept = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult swept = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(direct.ok && swept.ok);
   EXPECT_GT(swept.reference_sweeps, 90);
   EXPECT_EQ(direct.reference_sweeps, 0);
@@ -224,7 +224,7 @@ TEST(Benchmark, GaussSeidelAndTrianglesAgreeWithTheDefaults) {
         << figure;
   d.erase("linear_solver");
   d["mesh"]["elements"] = "triangle";
-  const BenchmarkResult triangles = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult triangles = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(triangles.ok);
   EXPECT_EQ(triangles.scene.mesh.elements.cols(), 3);
   const double a = direct.figures.at("quasi-static.E_n.at_1s"),
@@ -238,7 +238,7 @@ TEST(Benchmark, GaussSeidelAndTrianglesAgreeWithTheDefaults) {
 TEST(Benchmark, TheFiberModelRunsOnTheScenesBoundary) {
   nlohmann::json d = small_block();
   d["fiber_model"] = {{"Y", 200}, {"gamma", 5}};
-  const BenchmarkResult r = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult r = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(r.ok);
   const MetricSeries& fiber = r.series.back();
   ASSERT_EQ(fiber.label, "fiber-model");
@@ -270,7 +270,7 @@ TEST(Benchmark, TheFittedFiberModelIsTheClosest) {
   d["mesh"]["cells"] = {8, 8};  // on 4 x 4 cells gamma does not change the static shape
   d["solvers"] = {"quasi-static"};
   d["fiber_model"] = {{"fit", true}};
-  const BenchmarkResult fitted = run_benchmark(*parse(d).benchmark);
+  const BenchmarkResult fitted = run_benchmark(parse(d).benchmark());
   ASSERT_TRUE(fitted.ok && fitted.fiber);
   const double gamma = fitted.fiber->gamma, best = fitted.figures.at("fiber-model.static_E_n");
   const double Y = fitted.fiber->Y;
@@ -278,7 +278,7 @@ TEST(Benchmark, TheFittedFiberModelIsTheClosest) {
   ASSERT_GT(gamma, 0.0);
   for (double other : {0.0, 0.7 * gamma, 1.4 * gamma}) {
     d["fiber_model"] = {{"Y", fitted.fiber->Y}, {"gamma", other}};
-    const BenchmarkResult r = run_benchmark(*parse(d).benchmark);
+    const BenchmarkResult r = run_benchmark(parse(d).benchmark());
     EXPECT_GT(r.figures.at("fiber-model.static_E_n"), best) << "gamma " << other;
   }
 }

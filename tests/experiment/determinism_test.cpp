@@ -28,7 +28,7 @@ Outcome run_with(const char* experiment, int threads) {
   const ExperimentResult result = run_experiment(ex, {}, options);
   omp_set_num_threads(before);
   EXPECT_TRUE(result.runs_succeeded()) << experiment;
-  return {result.runs.front().summary.unknowns, ex.cases.front().fibers.kept};
+  return {result.runs.front().summary.unknowns, ex.simulation().cases.front().fibers.kept};
 }
 
 class Determinism : public ::testing::TestWithParam<const char*> {};

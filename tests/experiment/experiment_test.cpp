@@ -78,8 +78,8 @@ void expect_config_error(const ScratchDir& dir, const nlohmann::json& config,
 TEST(ExperimentConfig, BaseConfigIsValid) {
   ScratchDir dir;
   const Experiment ex = load_experiment(write_config(dir, base_config()));
-  ASSERT_EQ(ex.cases.size(), 1u);
-  const Case& c = ex.cases[0];
+  ASSERT_EQ(ex.simulation().cases.size(), 1u);
+  const Case& c = ex.simulation().cases[0];
   EXPECT_EQ(c.model.num_vertices(), 42);
   EXPECT_FALSE(ex.sweeps());
   EXPECT_EQ(c.stepping.steps, 2);
@@ -211,7 +211,7 @@ TEST(ExperimentConfig, CentralFibersDefaultToTheAreaCountAndAConicalInfluence) {
     nlohmann::json c = base_config();
     c["fibers"] = fibers;
     c["stepping"] = {{"scheme", "newton"}, {"steps", 1}};
-    return parse_experiment(c, ".", "doc").cases.at(0).model;
+    return parse_experiment(c, ".", "doc").simulation().cases.at(0).model;
   };
   model::Model m = model_of({{"kinematics", "central"}, {"horizon", 1.5}});
   EXPECT_EQ(m.connection_count, model::ConnectionCount::Area);
@@ -258,10 +258,10 @@ TEST(ACaseIsBuiltFromItsOwnSpecAlone, AReusedCaseEqualsOneBuiltAfreshFieldByFiel
   c["supports"][0]["layer"] = "mirror";
   c["variants"] = {{{"name", "a"}}, {{"name", "b"}}, {{"name", "c"}, {"material", {{"Y", 5e5}}}}};
   const Experiment ex = parse_experiment(c, ".", "doc");
-  ASSERT_EQ(ex.cases.size(), 3u);
+  ASSERT_EQ(ex.simulation().cases.size(), 3u);
   for (size_t k = 1; k < 3; ++k) {
-    const Case& reused = ex.cases[k];
-    const Case fresh = build_case(ex.specs[k]);
+    const Case& reused = ex.simulation().cases[k];
+    const Case fresh = build_case(ex.simulation().specs[k]);
     const model::Model &r = reused.model, &f = fresh.model;
     EXPECT_EQ(reused.variant, fresh.variant);
     EXPECT_EQ(reused.patch, fresh.patch);
@@ -350,9 +350,9 @@ TEST(ExperimentConfig, ASurfaceIsRemeshedToTheCountAsked) {
   c["surface"]["subdivisions"] = 3;
   c["surface"]["remesh_vertices"] = 300;  // from the icosphere's 642
   const Experiment ex = load_experiment(write_config(dir, c));
-  const int n = ex.cases[0].model.num_vertices();
+  const int n = ex.simulation().cases[0].model.num_vertices();
   EXPECT_NEAR(n, 300, 6);
-  EXPECT_EQ(ex.cases[0].input_surface.num_vertices(), n);
+  EXPECT_EQ(ex.simulation().cases[0].input_surface.num_vertices(), n);
   bool told = false;
   for (const std::string& w : ex.warnings)
     told = told || w.find("surface.remesh_vertices: remeshed from 642 to " + std::to_string(n) +
@@ -382,7 +382,7 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
                    {"scheme", "newton"},
                    {"newton", {{"tangent", "krylov"}, {"max_step_cuts", 3}}}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  const model::Model& m = ex.cases[0].model;
+  const model::Model& m = ex.simulation().cases[0].model;
   EXPECT_EQ(m.material.law.name(), "exponential");
   EXPECT_EQ(m.material.law.parameter("beta"), 4.0);
   EXPECT_EQ(m.material.axis_factors.z(), 0.5);
@@ -393,9 +393,9 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   const double bottom = m.surface.V.col(2).minCoeff(), top = m.surface.V.col(2).maxCoeff();
   EXPECT_EQ(m.paddles[0].position, bottom);                       // touching by default
   EXPECT_NEAR(m.paddles[0].travel, 0.2 * (top - bottom), 1e-15);  // upwards, into the body
-  EXPECT_EQ(ex.cases[0].stepping.scheme, solve::Scheme::Newton);
-  EXPECT_EQ(ex.cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
-  EXPECT_EQ(ex.cases[0].stepping.newton.max_step_cuts, 3);
+  EXPECT_EQ(ex.simulation().cases[0].stepping.scheme, solve::Scheme::Newton);
+  EXPECT_EQ(ex.simulation().cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
+  EXPECT_EQ(ex.simulation().cases[0].stepping.newton.max_step_cuts, 3);
 }
 
 // Every name a reader offers for an enum reads as the value it names (an
@@ -407,31 +407,36 @@ TEST(ExperimentConfig, EveryNamedChoiceReadsAsTheValueItNames) {
   for (const auto& entry : solve::kTangentSolverNames.entries()) {
     nlohmann::json c = base_config();
     c["stepping"] = {{"scheme", "newton"}, {"newton", {{"tangent", entry.name}}}};
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.newton.tangent, entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].stepping.newton.tangent,
+              entry.value)
         << entry.name;
   }
   for (const auto& entry : solve::kSolverKindNames.entries()) {
     nlohmann::json c = base_config();
     c["stepping"]["solver"] = entry.name;
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.solver, entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].stepping.solver,
+              entry.value)
         << entry.name;
   }
   for (const auto& entry : model::kBoundaryMethodNames.entries()) {
     nlohmann::json c = base_config();
     c["stepping"]["boundary_method"] = entry.name;
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.boundary_method, entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].stepping.boundary_method,
+              entry.value)
         << entry.name;
   }
   for (const auto& entry : model::kConnectionCountNames.entries()) {
     nlohmann::json c = base_config();
     c["fibers"] = {{"connection_count", entry.name}};
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.connection_count, entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].model.connection_count,
+              entry.value)
         << entry.name;
   }
   for (const auto& entry : solve::kSchemeNames.entries()) {
     nlohmann::json c = base_config();
     c["stepping"]["scheme"] = entry.name;
-    EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].stepping.scheme, entry.value)
+    EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].stepping.scheme,
+              entry.value)
         << entry.name;
   }
 }
@@ -500,7 +505,7 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
   c["surface"]["subdivisions"] = 4;  // 2,562 vertices: proxies in play
   c["fibers"] = {{"product", "treecode"}, {"treecode_tolerance", 1e-6}};
   const Experiment approximate = load_experiment(write_config(dir, c));
-  EXPECT_EQ(approximate.cases[0].model.treecode_tolerance, 1e-6);
+  EXPECT_EQ(approximate.simulation().cases[0].model.treecode_tolerance, 1e-6);
   c.erase("fibers");
   c["stepping"]["solver"] = "pcg";
   const Experiment exact = load_experiment(write_config(dir, c));
@@ -518,8 +523,9 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
   c["variants"] = {{{"name", "soft"}, {"material", {{"Y", 50000}}}},
                    {{"name", "stiff"}, {"material", {{"Y", 200000}}}}};
   const Experiment sweep = load_experiment(write_config(dir, c));
-  ASSERT_EQ(sweep.cases.size(), 2u);
-  for (const Case& variant : sweep.cases) EXPECT_EQ(variant.model.treecode_tolerance, 1e-4);
+  ASSERT_EQ(sweep.simulation().cases.size(), 2u);
+  for (const Case& variant : sweep.simulation().cases)
+    EXPECT_EQ(variant.model.treecode_tolerance, 1e-4);
   c.erase("variants");
 
   c = base_config();
@@ -543,8 +549,8 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
   c["fibers"] = {{"product", "treecode"}};
   expect_config_error(dir, c, "fibers.product: \"treecode\" needs one connection count");
   c["fibers"]["connection_count"] = "global";
-  EXPECT_GT(load_experiment(write_config(dir, c)).cases[0].fibers.pairs,
-            load_experiment(write_config(dir, c)).cases[0].fibers.kept);
+  EXPECT_GT(load_experiment(write_config(dir, c)).simulation().cases[0].fibers.pairs,
+            load_experiment(write_config(dir, c)).simulation().cases[0].fibers.kept);
 }
 
 // fibers.kinematics: the paper's vector spring by default, central fibers
@@ -552,7 +558,7 @@ TEST(ExperimentConfig, TreecodeProductIsReadCheckedAndAgreesWithTheExactRun) {
 TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.material.kinematics,
+  EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].model.material.kinematics,
             model::FiberKinematics::VectorSpring);
   c["fibers"] = {{"kinematics", "central"}};
   expect_config_error(dir, c,
@@ -560,7 +566,7 @@ TEST(ExperimentConfig, FiberKinematicsIsReadAndChecked) {
                       "scheme");
   c["stepping"]["scheme"] = "newton";
   const Experiment ex = load_experiment(write_config(dir, c));
-  EXPECT_EQ(ex.cases[0].model.material.kinematics, model::FiberKinematics::Central);
+  EXPECT_EQ(ex.simulation().cases[0].model.material.kinematics, model::FiberKinematics::Central);
   const ExperimentResult r = run_experiment(ex);
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
   EXPECT_GT(r.figures.at("max_displacement"), 0.0);
@@ -612,7 +618,7 @@ TEST(ExperimentConfig, AMissingGammaIsAWarningNamingItsDefault) {
   EXPECT_NE(ex.warnings[0].find("material.gamma: not given, so 0 (no surface tension"),
             std::string::npos)
       << ex.warnings[0];
-  EXPECT_EQ(ex.cases[0].model.material.surface_tension, 0.0);
+  EXPECT_EQ(ex.simulation().cases[0].model.material.surface_tension, 0.0);
 }
 
 // supports[].layer: "mirror" gives a clamp on a plane the fibers that reach
@@ -629,7 +635,7 @@ TEST(ExperimentConfig, AClampsMirrorLayerIsReadAndChecked) {
   c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.025}};
   c["stepping"]["scheme"] = "newton";
   const Experiment ex = load_experiment(write_config(dir, c));
-  const model::Model& m = ex.cases[0].model;
+  const model::Model& m = ex.simulation().cases[0].model;
   ASSERT_EQ(m.mirror_layers.size(), 1u);
   EXPECT_LT((m.mirror_layers[0].normal - Eigen::Vector3d::UnitX()).norm(), 1e-12);
   EXPECT_EQ(m.mirror_layers[0].depth, 0.025);
@@ -681,7 +687,7 @@ TEST(ExperimentConfig, ASupportsSplitEdgeAndTheMeanCountAreReadAndChecked) {
   c["fibers"] = {{"kinematics", "central"}, {"horizon", 0.025}, {"connection_count", "mean"}};
   c["stepping"]["scheme"] = "newton";
   const Experiment ex = load_experiment(write_config(dir, c));
-  const model::Model& m = ex.cases[0].model;
+  const model::Model& m = ex.simulation().cases[0].model;
   ASSERT_EQ(m.held_edges.size(), 1u);
   EXPECT_EQ(m.held_edges[0].held.size(), 9u);  // the end face's 3 x 3 grid
   EXPECT_EQ(m.connection_count, model::ConnectionCount::Mean);
@@ -743,7 +749,7 @@ TEST(ExperimentConfig, AFreeRotationIsHeldByAGaugeOrRefused) {
             std::string::npos)
       << ex.warnings[0];
   EXPECT_NE(ex.warnings[0].find("as a gauge"), std::string::npos) << ex.warnings[0];
-  const model::Model& m = ex.cases[0].model;
+  const model::Model& m = ex.simulation().cases[0].model;
   ASSERT_EQ(m.constraint_groups.back(), "gauge");
   const ExperimentResult r = run_experiment(ex);
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
@@ -805,7 +811,7 @@ TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
        {"rotation", {{"axis", {0, 1, 0}}, {"angle_degrees", 30}, {"centre", {0, 0, -1}}}},
        {"displacement", {0.1, 0, 0}}}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  const model::Model& m = ex.cases[0].model;
+  const model::Model& m = ex.simulation().cases[0].model;
   ASSERT_EQ(m.motions.size(), 1u);
   EXPECT_NEAR(m.motions[0].angle, M_PI / 6.0, 1e-15);
   EXPECT_EQ(m.motions[0].translation, Eigen::Vector3d(0.1, 0.0, 0.0));
@@ -834,10 +840,10 @@ TEST(ExperimentConfig, APrescribedRotationIsReadAndChecked) {
 TEST(ExperimentConfig, TheHydrostaticLoadsIntegrationIsRead) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.loads[0].integration,
+  EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].model.loads[0].integration,
             model::Load::Integration::Vertex);
   c["loads"][0]["integration"] = "exact";
-  EXPECT_EQ(load_experiment(write_config(dir, c)).cases[0].model.loads[0].integration,
+  EXPECT_EQ(load_experiment(write_config(dir, c)).simulation().cases[0].model.loads[0].integration,
             model::Load::Integration::Exact);
   c["loads"][0]["integration"] = "consistent";
   expect_config_error(dir, c, "loads[0].integration: expected one of");
@@ -850,8 +856,8 @@ TEST(ExperimentConfig, TorusGeneratorIsReadAndChecked) {
       {"generator", "torus"}, {"major_radius", 2.0}, {"minor_radius", 0.5}, {"segments", {24, 12}}};
   c["supports"][0] = {{"where", "z >= 0.4"}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  EXPECT_EQ(ex.cases[0].model.num_vertices(), 24 * 12);
-  EXPECT_FALSE(ex.cases[0].fibers.convex);
+  EXPECT_EQ(ex.simulation().cases[0].model.num_vertices(), 24 * 12);
+  EXPECT_FALSE(ex.simulation().cases[0].fibers.convex);
   c["surface"]["minor_radius"] = 2.5;
   expect_config_error(dir, c, "surface.minor_radius: must be below major_radius");
   c["surface"]["minor_radius"] = 0.5;
@@ -868,8 +874,9 @@ TEST(ExperimentConfig, AHorizonsKeptFibersAreWrittenFromItsLists) {
   c["surface"]["subdivisions"] = 3;  // 642 vertices
   c["fibers"] = {{"horizon", 0.2}, {"write", "kept"}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  ASSERT_TRUE(ex.cases[0].model.fibers && ex.cases[0].model.fibers->sparse());
-  const long long kept = ex.cases[0].fibers.kept;
+  ASSERT_TRUE(ex.simulation().cases[0].model.fibers &&
+              ex.simulation().cases[0].model.fibers->sparse());
+  const long long kept = ex.simulation().cases[0].fibers.kept;
   EXPECT_GT(kept, 642);
   OutputWriter writer(ex, dir.path() / "out");
   writer.begin();
@@ -889,7 +896,8 @@ TEST(ExperimentConfig, AHorizonsKeptFibersAreWrittenFromItsLists) {
 TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   ScratchDir dir;
   nlohmann::json c = base_config();
-  EXPECT_TRUE(load_experiment(write_config(dir, c)).cases[0].fibers.convex);  // an icosphere
+  EXPECT_TRUE(
+      load_experiment(write_config(dir, c)).simulation().cases[0].fibers.convex);  // an icosphere
 
   // The paper's 2D L: three pairs see each other across the re-entrant corner.
   c["surface"] = {{"generator", "polygon"},
@@ -898,7 +906,7 @@ TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
   c["loads"][0]["acceleration"] = {0, -9.81};
   c["fibers"] = {{"write", "pruned"}, {"connection_count", "global"}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  const Case& l_case = ex.cases[0];
+  const Case& l_case = ex.simulation().cases[0];
   EXPECT_FALSE(l_case.fibers.convex);
   EXPECT_EQ(l_case.fibers.pairs, 15);
   EXPECT_EQ(l_case.fibers.kept, 12);
@@ -921,8 +929,8 @@ TEST(ExperimentConfig, FibersArePrunedForConcaveBodiesAndWrittenOnRequest) {
 
   c["fibers"] = {{"pruning", "off"}};
   const Experiment unpruned = load_experiment(write_config(dir, c));
-  EXPECT_FALSE(unpruned.cases[0].model.fibers);
-  EXPECT_EQ(unpruned.cases[0].fibers.kept, 15);
+  EXPECT_FALSE(unpruned.simulation().cases[0].model.fibers);
+  EXPECT_EQ(unpruned.simulation().cases[0].fibers.kept, 15);
 
   c["fibers"] = {{"pruning", "sometimes"}};
   expect_config_error(dir, c, "fibers.pruning: expected one of auto, off");
@@ -951,7 +959,7 @@ TEST(ExperimentConfig, VertexIndicesAreInputIndicesAndOutputsKeepTheInputOrder) 
   c["loads"][0]["acceleration"] = {0, -9.81, 0};
   c["output"] = {{"vtk", true}, {"every", 1}};
   const Experiment ex = load_experiment(write_config(dir, c));
-  const Case& liver = ex.cases[0];
+  const Case& liver = ex.simulation().cases[0];
   EXPECT_EQ(liver.input_surface.num_vertices(), 181);
   EXPECT_EQ(liver.model.num_vertices(), 139);
 
@@ -997,9 +1005,9 @@ TEST(ExperimentPhases, ReadingOpensNoFileAndBuildingNamesTheField) {
   nlohmann::json c = base_config();
   c["surface"] = {{"file", "no_such_mesh.obj"}};
   Experiment ex = read_experiment(c, "/nonexistent_folder", "doc");
-  ASSERT_EQ(ex.specs.size(), 1u);
-  EXPECT_TRUE(ex.cases.empty());
-  EXPECT_EQ(ex.specs[0].surface.file,
+  ASSERT_EQ(ex.simulation().specs.size(), 1u);
+  EXPECT_TRUE(ex.simulation().cases.empty());
+  EXPECT_EQ(ex.simulation().specs[0].surface.file,
             std::filesystem::path("/nonexistent_folder/no_such_mesh.obj"));
   try {
     build_experiment(ex);
@@ -1039,9 +1047,9 @@ TEST(ExperimentPhases, AProgramGivesTheSurface) {
   Experiment ex = read_experiment(without_surface, ".", "doc");
   const geom::Surface sphere = geom::icosphere(1, 1.0);
   build_experiment(ex, &sphere);
-  ASSERT_EQ(ex.cases.size(), 1u);
-  const model::Model& a = from_generator.cases[0].model;
-  const model::Model& b = ex.cases[0].model;
+  ASSERT_EQ(ex.simulation().cases.size(), 1u);
+  const model::Model& a = from_generator.simulation().cases[0].model;
+  const model::Model& b = ex.simulation().cases[0].model;
   EXPECT_EQ(b.surface.V, a.surface.V);
   ASSERT_EQ(b.constraints.size(), a.constraints.size());
   for (size_t k = 0; k < a.constraints.size(); ++k)
@@ -1056,8 +1064,8 @@ TEST(ExperimentPhases, AProgramGivesTheSurface) {
   for (int i = 0; i < dented.num_vertices(); ++i)
     if (dented.V(i, 0) > 0.9) dented.V(i, 0) -= 0.5;  // push a cap inward
   build_experiment(on_cube, &dented);
-  EXPECT_FALSE(on_cube.cases[0].fibers.convex);
-  EXPECT_LT(on_cube.cases[0].fibers.kept, on_cube.cases[0].fibers.pairs);
+  EXPECT_FALSE(on_cube.simulation().cases[0].fibers.convex);
+  EXPECT_LT(on_cube.simulation().cases[0].fibers.kept, on_cube.simulation().cases[0].fibers.pairs);
 
   // Neither the document nor the program gives a surface, or both do.
   Experiment nothing = read_experiment(without_surface, ".", "doc");

@@ -190,7 +190,7 @@ TEST(FemReference, TheCommittedCantileverTargetAgreesWithTheCoarserReference) {
   }
   EXPECT_LT(largest, 2.5e-3) << "regenerate data/targets/cantilever_large_fem_p2.obj (SOURCES.md)";
   EXPECT_LT(sum / static_cast<double>(fresh.V.rows()), 0.5e-3);
-  const model::Model& fibers = ex.cases[0].model;
+  const model::Model& fibers = ex.simulation().cases[0].model;
   const double length = 0.18;
   const double fem_turn = end_face_rotation(fem.rest_boundary, fem.deformed_boundary.V, length);
   const double fiber_turn = end_face_rotation(

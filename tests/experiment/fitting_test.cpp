@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 
+#include "fiberfluid/experiment/read/schema.hpp"
 #include "fiberfluid/experiment/write/fit_files.hpp"
 #include "fiberfluid/experiment/write/outputs.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
@@ -146,7 +147,7 @@ TEST(EveryDocumentedOptionIsHonoured, EachOptionWithEachMethodIsTakenOrRefused) 
       if (taken) {
         const Experiment ex =
             parse_experiment(d, testing::experiment_file("").parent_path(), "doc");
-        const fit::FitOptions& o = ex.fit->options;
+        const fit::FitOptions& o = ex.fit()->options;
         const std::string key = option.key;
         if (key == "max_iterations") {
           EXPECT_EQ(o.max_iterations, 7);
@@ -164,7 +165,7 @@ TEST(EveryDocumentedOptionIsHonoured, EachOptionWithEachMethodIsTakenOrRefused) 
           EXPECT_EQ(o.difference_step, 1e-4);
         }
         if (key == "starts") {
-          EXPECT_EQ(ex.fit->multistart->starts, 3);
+          EXPECT_EQ(ex.fit()->multistart->starts, 3);
         }
       } else {
         expect_fit_error(d, std::string("fit.") + option.key + ": only with");
@@ -212,8 +213,8 @@ TEST(ACaseIsBuiltFromItsOwnSpecAlone, AFitsResolvedExperimentIsItsRunAtTheFitted
     const Experiment at_fit = with_fitted_material(ex, *setup.calibration, r);
     const Experiment again =
         parse_experiment(at_fit.resolved, testing::experiment_file("").parent_path(), "resolved");
-    const model::Material &fitted = at_fit.cases.front().model.material,
-                          &read = again.cases.front().model.material;
+    const model::Material &fitted = at_fit.simulation().cases.front().model.material,
+                          &read = again.simulation().cases.front().model.material;
     for (const std::string& name : fitted.parameter_names())
       EXPECT_EQ(read.parameter(name), fitted.parameter(name)) << file << ": " << name;
     for (size_t k = 0; k < r.names.size(); ++k)  // the fitted values, not the starts
@@ -577,7 +578,7 @@ TEST(CalibrationConfig, BadCalibrationsAreNamed) {
 
   const Experiment ex = parse_experiment(document("fit_fine_liver.json"),
                                          testing::experiment_file("").parent_path(), "doc");
-  ASSERT_EQ(ex.specimens.size(), 2u);
+  ASSERT_EQ(ex.calibration().specimens.size(), 2u);
   EXPECT_THROW(run_experiment(ex), InputError);
   const JointSetup setup = setup_joint(ex);
   EXPECT_EQ(setup.joint->names(),
@@ -607,7 +608,7 @@ TEST(MarkerTarget, TwoMarkersGiveBackYAndGammaAndReportTheirMisfits) {
   const Experiment truth = parse_experiment(marker_sphere(3000.0, 3000.0), folder, "truth");
   const ExperimentResult run = run_experiment(truth);
   ASSERT_TRUE(run.runs_succeeded());
-  const Case& c = truth.cases.front();
+  const Case& c = truth.simulation().cases.front();
   const Eigen::MatrixXd U =
       input_positions(c, run.runs.front().summary.unknowns) - c.input_surface.V;
   nlohmann::json d = marker_sphere(1500.0, 9000.0);
@@ -683,6 +684,12 @@ TEST(MarkerTarget, BadMarkersAreRefusedNamingTheirField) {
   expect_fit_error(with_marker({{"vertex", 0}, {"displacement", {0.0, 1.0}}}),
                    "fit.targets[0].displacement");
   expect_fit_error(with_marker({{"vertex", 0}, {"colour", "red"}}), "colour");
+  // The schema, recorded from the reader, shows every field of the kind.
+  const nlohmann::json fields =
+      experiment_schema()["properties"]["fit"]["properties"]["targets"]["items"]["properties"];
+  for (const char* field : {"vertex", "at", "displacement", "units", "step", "weight", "label"})
+    EXPECT_TRUE(fields.contains(field)) << field;
+  EXPECT_NE(fields["type"].dump().find("marker"), std::string::npos) << fields["type"];
 }
 
 }  // namespace

@@ -69,18 +69,19 @@ TEST(Sweep, EachVariantIsTheBaseWithItsMergePatch) {
     {"name": "no_tension", "material": {"gamma": null}}
   ])");
   const Experiment ex = parse(c);
-  ASSERT_EQ(ex.cases.size(), 3u);
+  ASSERT_EQ(ex.simulation().cases.size(), 3u);
   EXPECT_TRUE(ex.sweeps());
-  EXPECT_EQ(ex.cases[0].model.material.young_modulus().x(), 10000.0);
-  EXPECT_EQ(ex.cases[0].model.material.surface_tension, 1.0);  // kept from the base
-  EXPECT_EQ(ex.cases[0].stepping.steps, 3);
-  EXPECT_EQ(ex.cases[1].model.loads.size(), 1u);  // a list is replaced whole
-  EXPECT_EQ(ex.cases[1].model.loads[0].kind, model::Load::Kind::Point);
-  EXPECT_EQ(ex.cases[1].model.constraint_groups, std::vector<std::string>{"bottom"});
-  EXPECT_EQ(ex.cases[1].stepping.steps, 5);
-  EXPECT_EQ(ex.cases[1].model.material.young_modulus().x(), 20000.0);
-  EXPECT_EQ(ex.cases[2].model.material.surface_tension, 0.0);  // null removes the field
-  EXPECT_EQ(ex.cases[1].patch["stepping"]["steps"], 5);
+  EXPECT_EQ(ex.simulation().cases[0].model.material.young_modulus().x(), 10000.0);
+  EXPECT_EQ(ex.simulation().cases[0].model.material.surface_tension, 1.0);  // kept from the base
+  EXPECT_EQ(ex.simulation().cases[0].stepping.steps, 3);
+  EXPECT_EQ(ex.simulation().cases[1].model.loads.size(), 1u);  // a list is replaced whole
+  EXPECT_EQ(ex.simulation().cases[1].model.loads[0].kind, model::Load::Kind::Point);
+  EXPECT_EQ(ex.simulation().cases[1].model.constraint_groups, std::vector<std::string>{"bottom"});
+  EXPECT_EQ(ex.simulation().cases[1].stepping.steps, 5);
+  EXPECT_EQ(ex.simulation().cases[1].model.material.young_modulus().x(), 20000.0);
+  EXPECT_EQ(ex.simulation().cases[2].model.material.surface_tension,
+            0.0);  // null removes the field
+  EXPECT_EQ(ex.simulation().cases[1].patch["stepping"]["steps"], 5);
 }
 
 TEST(Sweep, BadVariantsAreNamed) {

@@ -65,7 +65,7 @@ const ResourcePart* part(const ResourceEstimate& e, const std::string& name) {
   return nullptr;
 }
 
-Case built(const json& doc) { return build_case(read(doc).specs[0]); }
+Case built(const json& doc) { return build_case(read(doc).simulation().specs[0]); }
 
 TEST_F(ResourceGuards, TheEstimateCountsTheBackendsDenseBlocks) {
   const Case c = built(sphere(3, "block-cholesky"));  // 642 vertices, 61 held (z >= 0.04)
@@ -116,7 +116,7 @@ TEST_F(ResourceGuards, AutoTakesPcgWhenTheDenseBlocksWouldNotFitTheBudget) {
   const ExperimentResult r = run_experiment(ex);
   ASSERT_TRUE(r.runs_succeeded()) << r.runs[0].summary.message;
   EXPECT_EQ(r.runs[0].summary.solver, solve::SolverKind::PCG);
-  EXPECT_EQ(ex.cases[0].estimate.solver, "pcg");
+  EXPECT_EQ(ex.simulation().cases[0].estimate.solver, "pcg");
 }
 
 // A horizon's fibers are found before the estimate, which then counts its

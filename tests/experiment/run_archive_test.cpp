@@ -33,16 +33,16 @@ RunOutcome paddle_run() {
   RunOutcome outcome;
   outcome.run.variant = "pressed";
   outcome.run.rank = 3;
-  outcome.run.summary =
-      solve::solve_load_steps(ex.cases.front().model, ex.cases.front().stepping,
-                              [&](const solve::StepRecord&, const Eigen::VectorXd& x) {
-                                outcome.step_unknowns.push_back(x);
-                              });
+  outcome.run.summary = solve::solve_load_steps(
+      ex.simulation().cases.front().model, ex.simulation().cases.front().stepping,
+      [&](const solve::StepRecord&, const Eigen::VectorXd& x) {
+        outcome.step_unknowns.push_back(x);
+      });
   solve::StepRecord& last = outcome.run.summary.steps.back();
-  last.sensitivities = Eigen::MatrixXd::Random(outcome.run.summary.unknowns.size(), 2);
-  last.reaction_sensitivities = {Eigen::MatrixXd::Random(3, 2)};
-  last.reaction_sensitivities.front()(1, 1) = std::numeric_limits<double>::quiet_NaN();
-  last.paddles.front().force_sensitivities = Eigen::MatrixXd::Random(3, 2);
+  last.sensitivities.state = Eigen::MatrixXd::Random(outcome.run.summary.unknowns.size(), 2);
+  last.sensitivities.reactions = {Eigen::MatrixXd::Random(3, 2)};
+  last.sensitivities.reactions.front()(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  last.sensitivities.paddle_forces = {Eigen::MatrixXd::Random(3, 2)};
   outcome.run.system_matrix = Eigen::MatrixXd::Random(4, 4);
   return outcome;
 }
@@ -92,11 +92,11 @@ TEST(RunArchive, AnOutcomeArrivesBitForBit) {
     EXPECT_EQ(b.reactions, a.reactions);
   }
   EXPECT_GT(s.steps.back().paddles[0].contacts, 0);
-  EXPECT_TRUE(same_bits(g.steps.back().sensitivities, s.steps.back().sensitivities));
-  EXPECT_TRUE(same_bits(g.steps.back().reaction_sensitivities.at(0),
-                        s.steps.back().reaction_sensitivities.at(0)));
-  EXPECT_TRUE(same_bits(g.steps.back().paddles[0].force_sensitivities,
-                        s.steps.back().paddles[0].force_sensitivities));
+  EXPECT_TRUE(same_bits(g.steps.back().sensitivities.state, s.steps.back().sensitivities.state));
+  EXPECT_TRUE(same_bits(g.steps.back().sensitivities.reactions.at(0),
+                        s.steps.back().sensitivities.reactions.at(0)));
+  EXPECT_TRUE(same_bits(g.steps.back().sensitivities.paddle_forces.at(0),
+                        s.steps.back().sensitivities.paddle_forces.at(0)));
 }
 
 // A message cut short, with bytes to spare, or with a length beyond its end

@@ -61,8 +61,8 @@ TEST(Fem, PassesThePatchTest) {
         }
         ASSERT_LT(static_cast<int>(held.dofs.size()), mesh.num_dofs());  // inner nodes exist
         Eigen::VectorXd u;
-        const solve::Status s = solve_static(stiffness_matrix(mesh, m),
-                                             Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u);
+        const linalg::Status s = solve_static(stiffness_matrix(mesh, m),
+                                              Eigen::VectorXd::Zero(mesh.num_dofs()), held, &u);
         ASSERT_TRUE(s.ok) << s.message;
         EXPECT_LT((u - exact).cwiseAbs().maxCoeff(), 1e-14) << dim << "D, simplices " << simplices;
         // A rigid motion costs no energy: K annihilates it.
@@ -166,7 +166,7 @@ double cantilever_tip(int refinement, double* theory) {
     }
   }
   Eigen::VectorXd u;
-  const solve::Status s = solve_static(stiffness_matrix(mesh, m), f, held, &u);
+  const linalg::Status s = solve_static(stiffness_matrix(mesh, m), f, held, &u);
   EXPECT_TRUE(s.ok) << s.message;
   double tip = 0.0;
   int count = 0;
@@ -199,8 +199,8 @@ TEST(Fem, CantileverConvergesToBeamTheory) {
 TEST(Fem, TooFewSupportsIsAStatus) {
   const Mesh mesh = structured_grid(Eigen::Vector2d(1, 1), Eigen::Vector2i(2, 2));
   Eigen::VectorXd u;
-  const solve::Status s = solve_static(stiffness_matrix(mesh, Material{}),
-                                       Eigen::VectorXd::Ones(mesh.num_dofs()), Constraints{}, &u);
+  const linalg::Status s = solve_static(stiffness_matrix(mesh, Material{}),
+                                        Eigen::VectorXd::Ones(mesh.num_dofs()), Constraints{}, &u);
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("too few supports"), std::string::npos) << s.message;
 }

@@ -103,8 +103,8 @@ TEST(Hyperelastic, ForcesAndTangentMatchFiniteDifferences) {
     for (Hyperelastic kind : kKinds) {
       HyperelasticMaterial m = material(kind);
       m.poisson = 0.49;  // a bulk modulus far above the shear modulus
-      const std::string what = to_string(kind) + ", " + std::to_string(mesh.elements.cols()) +
-                               " nodes per element";
+      const std::string what =
+          to_string(kind) + ", " + std::to_string(mesh.elements.cols()) + " nodes per element";
       const Eigen::VectorXd f = internal_forces(mesh, m, u);
       const Eigen::MatrixXd K = Eigen::MatrixXd(tangent_stiffness(mesh, m, u));
       const double h = 1e-6;
@@ -197,7 +197,7 @@ TEST(Hyperelastic, UniaxialStretchToTwiceTheLengthMatchesTheClosedForm) {
       const std::string label = std::string(element.name) + ", " + to_string(kind);
       const HyperelasticMaterial m = material(kind);
       HyperelasticSolution solution;
-      const solve::Status status =
+      const linalg::Status status =
           solve_hyperelastic(mesh, m, path, options_of(element, 10), &solution);
       ASSERT_TRUE(status.ok) << label << ": " << status.message;
       ASSERT_EQ(solution.path.size(), 10u);
@@ -245,8 +245,7 @@ TEST(Hyperelastic, SimpleShearGivesShearStressMuGamma) {
       const std::string label = std::string(element.name) + ", " + to_string(kind);
       const HyperelasticMaterial m = material(kind);
       HyperelasticSolution solution;
-      ASSERT_TRUE(solve_hyperelastic(mesh, m, path, options_of(element, 4), &solution).ok)
-          << label;
+      ASSERT_TRUE(solve_hyperelastic(mesh, m, path, options_of(element, 4), &solution).ok) << label;
       for (int v = 0; v < mesh.num_nodes(); ++v)
         EXPECT_NEAR(solution.u[3 * v], gamma * mesh.nodes(v, 1), 1e-9) << label;
       double shear = 0.0, normal = 0.0;
@@ -274,7 +273,7 @@ TEST(Hyperelastic, AnUnsolvableStepIsAStatusNamingIt) {
   options.steps = 2;
   options.max_step_cuts = 1;
   HyperelasticSolution solution;
-  const solve::Status status =
+  const linalg::Status status =
       solve_hyperelastic(mesh, material(Hyperelastic::NeoHookean), path, options, &solution);
   ASSERT_FALSE(status.ok);
   EXPECT_EQ(status.message.rfind("fem: step 1: ", 0), 0u) << status.message;

@@ -89,7 +89,8 @@ void read_experiment(const uint8_t* data, size_t size) {
     const experiment::Experiment ex =
         experiment::read_experiment(*document, kExperiments, "fuzz.json");
     check_output_name(ex.name);
-    for (const experiment::CaseSpec& spec : ex.specs) {
+    if (ex.kind() != experiment::Experiment::Kind::Simulate) return;
+    for (const experiment::CaseSpec& spec : ex.simulation().specs) {
       if (!spec.variant.empty()) check_output_name(spec.variant);
       std::string why;
       require(spec.stepping.IsValid(&why), "parsed stepping options are valid");
@@ -117,16 +118,17 @@ void build_and_run(const uint8_t* data, size_t size) {
   const SmallBudgets budgets;  // the estimate refuses longer cases before pruning
   try {
     experiment::Experiment ex = experiment::read_experiment(*document, kExperiments, "fuzz.json");
-    if (ex.kind != experiment::Experiment::Kind::Simulate || ex.specs.size() > 4) return;
+    if (ex.kind() != experiment::Experiment::Kind::Simulate || ex.simulation().specs.size() > 4)
+      return;
     // Nor for long mesh checks: a generated surface larger than any the
     // estimate would let run (an icosphere subdivided 7 times has 163,842
     // vertices, and CGAL's self-intersection test takes 19 s of the 25 s
     // timeout under ASan) is not built.
-    for (const experiment::CaseSpec& spec : ex.specs)
+    for (const experiment::CaseSpec& spec : ex.simulation().specs)
       if (spec.surface.generate && spec.surface.generate().num_vertices() > kMostGeneratedVertices)
         return;
     experiment::build_experiment(ex);
-    ex.fem_reference.reset();  // tetrahedral meshing: seconds per input
+    ex.simulation().fem_reference.reset();  // tetrahedral meshing: seconds per input
     experiment::RunOptions options;
     options.jobs = 1;
     const experiment::ExperimentResult result = experiment::run_experiment(ex, {}, options);
@@ -155,8 +157,8 @@ void set_up_fit(const uint8_t* data, size_t size) {
   try {
     experiment::Experiment ex = experiment::read_experiment(*document, kExperiments, "fuzz.json");
     check_output_name(ex.name);
-    if (!ex.fit) return;
-    fit::check_options(ex.fit->options);  // read_fit checked them: they pass again
+    if (!ex.fit()) return;
+    fit::check_options(ex.fit()->options);  // read_fit checked them: they pass again
     experiment::build_experiment(ex);
     const experiment::FitSetup setup = experiment::setup_fit(ex);
     const fit::Calibration& c = *setup.calibration;

@@ -131,12 +131,12 @@ TEST(AddedLaw, ExperimentFilesNameItByItsTypeAndCheckItsParameters) {
     "stepping": {"steps": 2, "scheme": "newton"}
   })");
   const experiment::Experiment ex = experiment::parse_experiment(document, ".", "cubic.json");
-  const model::FiberLaw& law = ex.cases[0].model.material.law;
+  const model::FiberLaw& law = ex.simulation().cases[0].model.material.law;
   EXPECT_EQ(law.name(), "cubic_test_law");
   EXPECT_EQ(law.parameter("c"), 12.0);
   EXPECT_DOUBLE_EQ(law.modulus(0.1), 2500.0 * 1.12);
   // Its parameters are the material's, so a fit can name them.
-  EXPECT_TRUE(ex.cases[0].model.material.has_parameter("c"));
+  EXPECT_TRUE(ex.simulation().cases[0].model.material.has_parameter("c"));
 
   nlohmann::json missing = document;
   missing["material"]["law"].erase("c");

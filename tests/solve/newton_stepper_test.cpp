@@ -265,12 +265,12 @@ TEST(Newton, SensitivitiesAtChosenStepsMatchFiniteDifferences) {
     o.sensitivities = {names, {2, 3}};
     const SteppingSummary s = solve_load_steps(m, o);
     ASSERT_TRUE(s.success) << s.message;
-    EXPECT_EQ(s.steps[0].sensitivities.size(), 0);
+    EXPECT_EQ(s.steps[0].sensitivities.state.size(), 0);
     for (size_t p = 0; p < names.size(); ++p)
       for (int step : {2, 3}) {
         const Eigen::VectorXd& expected = fd[p][static_cast<size_t>(step - 2)];
-        const Eigen::VectorXd du =
-            s.steps[static_cast<size_t>(step - 1)].sensitivities.col(static_cast<Eigen::Index>(p));
+        const Eigen::VectorXd du = s.steps[static_cast<size_t>(step - 1)].sensitivities.state.col(
+            static_cast<Eigen::Index>(p));
         EXPECT_LT((du - expected).norm(), 1e-6 * expected.norm())
             << names[p] << " step " << step << " " << to_string(kind);
       }
@@ -439,10 +439,8 @@ TEST(Newton, AWarmStartSolvesThePathsEndFromANearbyState) {
     SteppingOptions warm = path;
     warm.warm_start = near.unknowns;
     std::vector<int> observed;
-    const SteppingSummary s =
-        solve_load_steps(m, warm, [&](const StepRecord& r, const Eigen::VectorXd&) {
-          observed.push_back(r.step);
-        });
+    const SteppingSummary s = solve_load_steps(
+        m, warm, [&](const StepRecord& r, const Eigen::VectorXd&) { observed.push_back(r.step); });
     ASSERT_TRUE(s.success) << s.message;
     EXPECT_TRUE(s.warm_started) << "pressed " << pressed;
     EXPECT_EQ(observed, std::vector<int>{5});
@@ -512,7 +510,7 @@ TEST(Newton, ForceSensitivitiesMatchFiniteDifferences) {
     const SteppingSummary s = solve_load_steps(m, o);
     ASSERT_TRUE(s.success) << s.message;
     const StepRecord& last = s.steps.back();
-    ASSERT_EQ(last.reaction_sensitivities.size(), 1u);
+    ASSERT_EQ(last.sensitivities.reactions.size(), 1u);
     for (size_t p = 0; p < names.size(); ++p) {
       const double h = names[p] == "beta" ? 1e-4 : 0.1;
       const auto plus = final_forces(names[p], h), minus = final_forces(names[p], -h);
@@ -520,10 +518,10 @@ TEST(Newton, ForceSensitivitiesMatchFiniteDifferences) {
       const Eigen::Vector3d support = (plus.second - minus.second) / (2.0 * h);
       const auto column = static_cast<Eigen::Index>(p);
       EXPECT_GT(paddle.norm(), 0.0) << names[p];
-      EXPECT_LT((last.paddles[0].force_sensitivities.col(column) - paddle).norm(),
+      EXPECT_LT((last.sensitivities.paddle_forces[0].col(column) - paddle).norm(),
                 1e-5 * paddle.norm())
           << names[p] << " sticking " << sticking;
-      EXPECT_LT((last.reaction_sensitivities[0].col(column) - support).norm(),
+      EXPECT_LT((last.sensitivities.reactions[0].col(column) - support).norm(),
                 1e-5 * support.norm())
           << names[p] << " sticking " << sticking;
     }

@@ -74,12 +74,26 @@ void check_variant_name(const Fields& f, const std::string& name,
 // with the variant's JSON merge patch (RFC 7386) applied.
 void read_simulation(Fields& root, const nlohmann::json& document,
                      const std::filesystem::path& folder, Experiment& ex) {
+  Simulation& simulation = ex.content.emplace<Simulation>();
+  if (root.has("fit")) {
+    if (root.has("variants"))
+      root.fail("fit",
+                "a fit calibrates one simulation: remove \"variants\" (fit several loads "
+                "with several targets, each tied to its step)");
+    simulation.fit = read_fit(root.object("fit"), folder);
+  }
+  if (root.has("fem_reference")) {
+    if (root.has("variants"))
+      root.fail("fem_reference", "a FEM reference solves one simulation: remove \"variants\"");
+    Fields f = root.object("fem_reference");
+    simulation.fem_reference = read_fem_reference(f);
+  }
   json base = document;
   for (const char* field : kExperimentFields) base.erase(field);
   if (!root.has("variants")) {
     json resolved;
     Fields f(base, "", root.file(), &resolved);
-    ex.specs.push_back(read_case(f, folder, &ex.warnings));
+    simulation.specs.push_back(read_case(f, folder, &ex.warnings));
     ex.resolved.update(resolved);
   } else {
     const json& variants = root.raw("variants");
@@ -89,7 +103,7 @@ void read_simulation(Fields& root, const nlohmann::json& document,
     for (size_t k = 0; k < variants.size(); ++k) {
       Fields v(variants[k], "variants[" + std::to_string(k) + "]", root.file());
       const std::string name = v.string("name");
-      check_variant_name(v, name, ex.specs);
+      check_variant_name(v, name, simulation.specs);
       json patch = variants[k];
       patch.erase("name");
       for (const char* field : kExperimentFields)
@@ -102,17 +116,18 @@ void read_simulation(Fields& root, const nlohmann::json& document,
       CaseSpec c = read_case(f, folder, &ex.warnings);
       c.variant = name;
       c.patch = patch;
-      ex.specs.push_back(std::move(c));
+      simulation.specs.push_back(std::move(c));
       resolved_variants.push_back(std::move(resolved));
     }
     // Each variant resolved whole: merged onto an empty base, it is its case.
     ex.resolved["variants"] = std::move(resolved_variants);
   }
   Fields output = root.object_or_empty("output");
-  ex.output.vtk = output.boolean("vtk", true);
-  ex.output.obj = output.boolean("obj", true);
-  ex.output.every = output.integer("every", 1, 1, 1000000);
-  ex.output.vtk_format = output.choice("vtk_format", "auto", {"auto", "ascii", "compressed"});
+  simulation.output.vtk = output.boolean("vtk", true);
+  simulation.output.obj = output.boolean("obj", true);
+  simulation.output.every = output.integer("every", 1, 1, 1000000);
+  simulation.output.vtk_format =
+      output.choice("vtk_format", "auto", {"auto", "ascii", "compressed"});
   output.finish();
 }
 
@@ -145,14 +160,15 @@ CalibrationSpec read_calibration(Fields& root, const std::filesystem::path& fold
 }
 
 void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& ex) {
+  AreaStudy& areas = ex.content.emplace<AreaStudy>();
   for (Fields f : root.objects("surfaces")) {
     NamedSurfaceSpec named;
     named.name = f.string("name");
     named.surface = read_surface_spec(f, folder);
     f.finish();
-    ex.area_specs.push_back(named);
+    areas.specs.push_back(named);
   }
-  if (ex.area_specs.empty()) root.fail("surfaces", "expected at least one surface");
+  if (areas.specs.empty()) root.fail("surfaces", "expected at least one surface");
 }
 
 // Every expected figure names a figure the experiment will have (a fit's
@@ -177,35 +193,29 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
     root.fail("name", "expected " + problem);
   ex.description = root.string("description", "");
-  ex.kind = root.enumeration("kind", Experiment::Kind::Simulate, kExperimentKindNames);
+  const Experiment::Kind kind =
+      root.enumeration("kind", Experiment::Kind::Simulate, kExperimentKindNames);
   ex.expected = read_expected(root);
-  if (root.has("fit")) {
-    if (ex.kind != Experiment::Kind::Simulate) root.fail("fit", "only a simulation can be fitted");
-    if (root.has("variants"))
-      root.fail("fit",
-                "a fit calibrates one simulation: remove \"variants\" (fit several loads "
-                "with several targets, each tied to its step)");
-    ex.fit = read_fit(root.object("fit"), folder);
-  }
-  if (root.has("fem_reference")) {
-    if (ex.kind != Experiment::Kind::Simulate)
-      root.fail("fem_reference", "only a simulation has a FEM reference");
-    if (root.has("variants"))
-      root.fail("fem_reference", "a FEM reference solves one simulation: remove \"variants\"");
-    Fields f = root.object("fem_reference");
-    ex.fem_reference = read_fem_reference(f);
-  }
-  if (ex.kind == Experiment::Kind::Simulate) {
-    read_simulation(root, document, folder, ex);  // each case checks its own fields
-  } else if (ex.kind == Experiment::Kind::Benchmark) {
-    ex.benchmark = read_benchmark(root);
-    root.finish();
-  } else if (ex.kind == Experiment::Kind::Calibration) {
-    ex.calibration = read_calibration(root, folder);
-    root.finish();
-  } else {
-    read_areas(root, folder, ex);
-    root.finish();
+  if (kind != Experiment::Kind::Simulate && root.has("fit"))
+    root.fail("fit", "only a simulation can be fitted");
+  if (kind != Experiment::Kind::Simulate && root.has("fem_reference"))
+    root.fail("fem_reference", "only a simulation has a FEM reference");
+  switch (kind) {
+    case Experiment::Kind::Simulate:
+      read_simulation(root, document, folder, ex);  // each case checks its own fields
+      break;
+    case Experiment::Kind::Benchmark:
+      ex.content = read_benchmark(root);
+      root.finish();
+      break;
+    case Experiment::Kind::Calibration:
+      ex.content = CalibrationStudy{read_calibration(root, folder), {}};
+      root.finish();
+      break;
+    case Experiment::Kind::Areas:
+      read_areas(root, folder, ex);
+      root.finish();
+      break;
   }
   check_expected_names(root, ex);
   return ex;

@@ -69,8 +69,9 @@ Comparison compare_surfaces(const geom::Surface& reference, const geom::Surface&
   if (c.dim == 3) {
     if (!approximation.V.allFinite())
       throw InputError(approximation_label + ": a vertex coordinate is not finite");
-    const fit::TargetDistance distance(fit::make_target(reference_label, reference.V, reference.F));
-    const std::vector<fit::TargetDistance::Closest> closest = distance.closest(approximation.V);
+    const geom::TargetDistance distance(
+        geom::make_target(reference_label, reference.V, reference.F));
+    const std::vector<geom::TargetDistance::Closest> closest = distance.closest(approximation.V);
     Eigen::VectorXd d(static_cast<Eigen::Index>(closest.size()));
     for (size_t i = 0; i < closest.size(); ++i)
       d[static_cast<Eigen::Index>(i)] = closest[i].distance;

@@ -67,9 +67,9 @@ FemReferenceResult solve_fem_reference(const Case& c, const RunResult& run,
   if (run.summary.success) {  // the fiber model's final surface against the FEM's
     geom::Surface fiber = m.surface;
     fiber.V = V + model::displacements(m, run.summary.unknowns);
-    const fit::TargetDistance distance(
-        fit::make_target("the FEM reference", out.deformed_boundary.V, out.deformed_boundary.F));
-    const std::vector<fit::TargetDistance::Closest> closest = distance.closest(fiber.V);
+    const geom::TargetDistance distance(
+        geom::make_target("the FEM reference", out.deformed_boundary.V, out.deformed_boundary.F));
+    const std::vector<geom::TargetDistance::Closest> closest = distance.closest(fiber.V);
     Eigen::VectorXd d(static_cast<Eigen::Index>(closest.size()));
     for (size_t k = 0; k < closest.size(); ++k)
       d[static_cast<Eigen::Index>(k)] = closest[k].distance;

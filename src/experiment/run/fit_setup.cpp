@@ -117,11 +117,12 @@ bool fit_result_kept(fit::FitStatus status) { return fit::converged(status); }
 
 FitSetup setup_fit(const Experiment& ex,
                    std::function<void(const fit::IterationRecord&)> progress) {
-  if (!ex.fit) throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");
-  if (ex.cases.size() != 1)
+  if (!ex.fit())
+    throw InputError(ex.source.string() + ": no \"fit\" section: nothing to calibrate");
+  if (ex.simulation().cases.size() != 1)
     throw InputError(ex.source.string() + ": a fit calibrates one simulation");
-  const FitSpec& spec = *ex.fit;
-  const Case& c = ex.cases.front();
+  const FitSpec& spec = *ex.fit();
+  const Case& c = ex.simulation().cases.front();
   FitSetup setup;
   for (const FitTargetSpec& t : spec.targets) {
     fit::Target target;
@@ -211,7 +212,7 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
 }
 
 MeshCheck run_mesh_check(const Experiment& at_fit) {
-  if (!at_fit.fit || at_fit.fit->mesh_check == "none")
+  if (!at_fit.fit() || at_fit.fit()->mesh_check == "none")
     throw std::logic_error("run_mesh_check: the fit asks for no mesh check");
   // The fit as resolved, at the fitted material: Levenberg-Marquardt from
   // there (a multi-start search has found its optimum), nothing checked.
@@ -225,7 +226,7 @@ MeshCheck run_mesh_check(const Experiment& at_fit) {
   const bool by_halves =
       document.contains("surface") && document["surface"].contains("subdivisions");
   const double ratio = by_halves ? 2.0 : 1.5;
-  const double factor = at_fit.fit->mesh_check == "coarser" ? 1.0 / ratio : ratio;
+  const double factor = at_fit.fit()->mesh_check == "coarser" ? 1.0 / ratio : ratio;
   MeshCheck check;
   double actual = 0.0;
   json refined;
@@ -287,13 +288,14 @@ Experiment with_fitted_material(const Experiment& experiment, const fit::Calibra
                                 const fit::FitResult& result) {
   Experiment fitted = experiment;
   const fit::ParameterMap& map = calibration.parameters();
-  model::Material& material = fitted.cases.front().model.material;
+  model::Material& material = fitted.simulation().cases.front().model.material;
   material = map.material(material, result.values);
   // The folder's run is at the fitted values: so is its
   // experiment.resolved.json, which repeats that run (it said the start's:
   // issue 43, the run and its record built from different specs).
   if (fitted.resolved.is_object() && fitted.resolved.contains("material"))
-    write_material_values(material, fitted.cases.front().model.dim(), fitted.resolved["material"]);
+    write_material_values(material, fitted.simulation().cases.front().model.dim(),
+                          fitted.resolved["material"]);
   return fitted;
 }
 
@@ -309,15 +311,15 @@ namespace fiberfluid::experiment {
 
 JointSetup setup_joint(const Experiment& ex,
                        std::function<void(const fit::IterationRecord&)> progress) {
-  if (ex.kind != Experiment::Kind::Calibration || !ex.calibration)
+  if (ex.kind() != Experiment::Kind::Calibration)
     throw InputError(ex.source.string() + ": not a calibration over specimens");
   require_built(ex);
-  const CalibrationSpec& spec = *ex.calibration;
+  const CalibrationSpec& spec = ex.calibration().spec;
   JointSetup setup;
   std::vector<const fit::Calibration*> calibrations;
   std::vector<std::string> names;
-  for (size_t s = 0; s < ex.specimens.size(); ++s) {
-    setup.specimens.push_back(setup_fit(ex.specimens[s]));
+  for (size_t s = 0; s < ex.calibration().specimens.size(); ++s) {
+    setup.specimens.push_back(setup_fit(ex.calibration().specimens[s]));
     calibrations.push_back(setup.specimens.back().calibration.get());
     names.push_back(spec.specimens[s].name);
   }
@@ -341,8 +343,8 @@ std::map<std::string, double> joint_figures(const Experiment& ex, const fit::Joi
   std::map<std::string, double> figures = {{"fit.cost", r.final_cost}};
   for (size_t k = 0; k < r.names.size(); ++k)
     figures["fit." + r.names[k]] = r.values[static_cast<Eigen::Index>(k)];
-  for (size_t s = 0; s < r.specimens.size() && s < ex.calibration->specimens.size(); ++s) {
-    const std::string prefix = "fit." + ex.calibration->specimens[s].name + ".";
+  for (size_t s = 0; s < r.specimens.size() && s < ex.calibration().spec.specimens.size(); ++s) {
+    const std::string prefix = "fit." + ex.calibration().spec.specimens[s].name + ".";
     const fit::DistanceStatistics& d = r.specimens[s].overall;
     figures[prefix + "distance_mean"] = d.mean;
     figures[prefix + "distance_rms"] = d.rms;

@@ -196,7 +196,6 @@ ResourceEstimate estimate_resources(const model::Model& model, const solve::Step
   const solve::TangentSolver tangent_kind = solve::choose_tangent(
       o.newton.tangent, blocks.newton_unknowns, model.material.kinematics, sparse_fibers);
   const bool dense_tangent = newton && tangent_kind == solve::TangentSolver::Dense;
-  const bool sparse_tangent = newton && tangent_kind == solve::TangentSolver::Sparse;
   // The reused tangent LU costs what the dense one does a factorisation; it
   // is then counted as Krylov's preconditioner, refactored about once in four
   // steps (issue 42: 9 and 12 for the compressed cylinder's 40 steps, 1 for the

@@ -39,7 +39,7 @@ std::optional<std::pair<int, int>> vertex_axis(const std::string& rest, int dim)
 }
 
 void add_area_figures(const Experiment& ex, ExperimentResult& result) {
-  for (const NamedSurface& s : ex.area_surfaces) {
+  for (const NamedSurface& s : ex.areas().surfaces) {
     const geom::VertexAreaVectors areas = geom::vertex_area_vectors(s.surface.V, s.surface.F);
     result.figures[s.name + ".vertices"] = s.surface.num_vertices();
     result.figures[s.name + ".faces"] = s.surface.num_faces();
@@ -86,8 +86,8 @@ FigureCheck check_figure(const Experiment& ex, const ExperimentResult& result,
   if (it != result.figures.end())
     value = it->second;
   else if (r >= 0)
-    value =
-        run_figure(ex.cases[static_cast<size_t>(r)], result.runs[static_cast<size_t>(r)], figure);
+    value = run_figure(ex.simulation().cases[static_cast<size_t>(r)],
+                       result.runs[static_cast<size_t>(r)], figure);
   if (!value) return check;
   check.found = true;
   check.actual = *value;
@@ -214,19 +214,20 @@ bool checks_system_matrix(const Experiment& ex) {
 
 // Runs case r here, reporting its steps to `observer`.
 RunResult run_case(const Experiment& ex, size_t r, const solve::StepObserver& observer) {
-  const ProgressLabel label(ex.cases[r].variant);
+  const ProgressLabel label(ex.simulation().cases[r].variant);
   RunResult run;
-  run.variant = ex.cases[r].variant;
-  run.summary = solve::solve_load_steps(ex.cases[r].model, ex.cases[r].stepping, observer);
+  run.variant = ex.simulation().cases[r].variant;
+  run.summary = solve::solve_load_steps(ex.simulation().cases[r].model,
+                                        ex.simulation().cases[r].stepping, observer);
   if (run.summary.system && checks_system_matrix(ex))
     run.system_matrix = run.summary.system->dense_matrix();
   return run;
 }
 
 void report_variants(const Experiment& ex, size_t finished) {
-  if (ex.cases.size() > 1)
+  if (ex.simulation().cases.size() > 1)
     report_progress("variants", static_cast<double>(finished),
-                    static_cast<double>(ex.cases.size()));
+                    static_cast<double>(ex.simulation().cases.size()));
 }
 
 // The cases in this process, `options.jobs` at a time.
@@ -234,15 +235,17 @@ void run_local_cases(const Experiment& ex, const RunObserver& observer, const Ru
                      ExperimentResult& result) {
   std::atomic<size_t> finished{0};
   report_variants(ex, 0);
-  for_each_case(ex.cases.size(), effective_jobs(options, ex.cases.size()), [&](size_t r) {
-    solve::StepObserver step_observer;
-    if (observer)
-      step_observer = [&observer, r](const solve::StepRecord& record, const Eigen::VectorXd& x) {
-        observer(r, record, x);
-      };
-    result.runs[r] = run_case(ex, r, step_observer);
-    report_variants(ex, ++finished);
-  });
+  for_each_case(ex.simulation().cases.size(), effective_jobs(options, ex.simulation().cases.size()),
+                [&](size_t r) {
+                  solve::StepObserver step_observer;
+                  if (observer)
+                    step_observer = [&observer, r](const solve::StepRecord& record,
+                                                   const Eigen::VectorXd& x) {
+                      observer(r, record, x);
+                    };
+                  result.runs[r] = run_case(ex, r, step_observer);
+                  report_variants(ex, ++finished);
+                });
 }
 
 // Case r wherever it is dealt, packed with its unknowns after each step. A
@@ -256,7 +259,7 @@ std::string run_case_packed(const Experiment& ex, size_t r) {
     });
   } catch (const std::exception& e) {
     outcome = RunOutcome{};
-    outcome.run.variant = ex.cases[r].variant;
+    outcome.run.variant = ex.simulation().cases[r].variant;
     outcome.run.summary.message = e.what();
   }
   return pack_run_outcome(outcome);
@@ -269,7 +272,7 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Wo
   std::atomic<size_t> finished{0};
   report_variants(ex, 0);
   dealer(
-      ex.cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
+      ex.simulation().cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
       [&](size_t r, int rank, std::string&& bytes) {
         RunOutcome outcome = unpack_run_outcome(bytes);
         const std::vector<solve::StepRecord>& steps = outcome.run.summary.steps;
@@ -289,54 +292,54 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Wo
 
 void serve_cases(const Experiment& ex, const WorkDealer& dealer) {
   require_built(ex);
-  if (ex.kind != Experiment::Kind::Simulate) return;  // rank 0 says why, or runs it alone
+  if (ex.kind() != Experiment::Kind::Simulate) return;  // rank 0 says why, or runs it alone
   dealer(
-      ex.cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
+      ex.simulation().cases.size(), [&ex](size_t r) { return run_case_packed(ex, r); },
       [](size_t, int, std::string&&) {});
 }
 
 ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observer,
                                 const RunOptions& options) {
   require_built(ex);
-  if (ex.kind == Experiment::Kind::Calibration)
+  if (ex.kind() == Experiment::Kind::Calibration)
     throw InputError(ex.source.string() +
                      ": a calibration over specimens runs with `fiberfluid "
                      "fit` (its specimens run with `fiberfluid run`)");
   ExperimentResult result;
-  if (ex.kind == Experiment::Kind::Areas) {
+  if (ex.kind() == Experiment::Kind::Areas) {
     add_area_figures(ex, result);
-  } else if (ex.kind == Experiment::Kind::Benchmark) {
+  } else if (ex.kind() == Experiment::Kind::Benchmark) {
     auto benchmark =
-        std::make_shared<BenchmarkResult>(run_benchmark(*ex.benchmark, [](int done, int total) {
+        std::make_shared<BenchmarkResult>(run_benchmark(ex.benchmark(), [](int done, int total) {
           report_progress("benchmark runs", done, total);
         }));
     result.figures = benchmark->figures;
     if (!benchmark->ok) result.failure = benchmark->message;
     result.benchmark = benchmark;
   } else {
-    result.runs.resize(ex.cases.size());
+    result.runs.resize(ex.simulation().cases.size());
     if (options.dealer)
       run_dealt_cases(ex, observer, options.dealer, result);
     else
       run_local_cases(ex, observer, options, result);
-    if (ex.fem_reference && !ex.cases.empty()) {
+    if (ex.fem_reference() && !ex.simulation().cases.empty()) {
       report_progress("FEM reference", 0.0, 1.0);
-      auto reference = std::make_shared<FemReferenceResult>(
-          solve_fem_reference(ex.cases.front(), result.runs.front(), *ex.fem_reference));
+      auto reference = std::make_shared<FemReferenceResult>(solve_fem_reference(
+          ex.simulation().cases.front(), result.runs.front(), *ex.fem_reference()));
       report_progress("FEM reference", 1.0, 1.0);
       for (const auto& [name, value] : reference->figures) result.figures[name] = value;
       result.fem_reference = reference;
     }
-    const FiberReport& fibers = ex.cases.front().fibers;
+    const FiberReport& fibers = ex.simulation().cases.front().fibers;
     result.figures["fibers.in_all"] = static_cast<double>(fibers.pairs);
     result.figures["fibers.kept"] = static_cast<double>(fibers.kept);
     result.figures["fibers.pruned"] = static_cast<double>(fibers.pairs - fibers.kept);
-    for (size_t r = 0; r < ex.cases.size(); ++r) {
+    for (size_t r = 0; r < ex.simulation().cases.size(); ++r) {
       const RunResult& run = result.runs[r];
       const std::string prefix = run.variant.empty() ? "" : run.variant + ".";
       if (run.summary.success)
-        for (const std::string& name : run_figure_names(ex.cases[r].model))
-          if (const std::optional<double> value = run_figure(ex.cases[r], run, name))
+        for (const std::string& name : run_figure_names(ex.simulation().cases[r].model))
+          if (const std::optional<double> value = run_figure(ex.simulation().cases[r], run, name))
             result.figures[prefix + name] = *value;
     }
   }

@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "fiberfluid/experiment/spec/benchmark_spec.hpp"
@@ -68,10 +70,40 @@ struct CalibrationSpec {
   int max_iterations = 50;
 };
 
-// A parsed and validated experiment file.
+struct Experiment;
+
+// "kind": "simulate" (the default): one case, or one per variant of a sweep.
+struct Simulation {
+  std::vector<CaseSpec> specs;  // as parsed (read_experiment): one, or one per variant
+  std::vector<Case> cases;      // as built (build_experiment), in the same order
+  OutputOptions output;
+  std::optional<FitSpec> fit;  // the "fit" section: what `fiberfluid fit` calibrates
+  // "fem_reference": the simulation solved by FEM on tetrahedra too, its
+  // deformed boundary written (fem_reference.obj) as a target.
+  std::optional<FemReferenceSpec> fem_reference;
+
+  bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
+};
+
+// "kind": "areas": named surfaces measured (the paper's Table 1).
+struct AreaStudy {
+  std::vector<NamedSurfaceSpec> specs;  // as parsed
+  std::vector<NamedSurface> surfaces;   // as built
+};
+
+// "kind": "calibration": the specimens and what they share, as parsed; and
+// the specimens' experiments, as loaded (build_experiment).
+struct CalibrationStudy {
+  CalibrationSpec spec;
+  std::vector<Experiment> specimens;
+};
+
+// A parsed and validated experiment file: what every kind has, and the
+// kind's own part (a simulation, an area study, a benchmark, a calibration
+// over specimens), of which it has exactly one.
 struct Experiment {
+  // The alternatives of `content`, in its order.
   enum class Kind { Simulate, Areas, Benchmark, Calibration };
-  Kind kind = Kind::Simulate;
   std::string name;
   std::string description;
   std::filesystem::path source;  // the JSON file ("" for a document built in a program)
@@ -81,44 +113,71 @@ struct Experiment {
   // gives the same experiment).
   nlohmann::json document, resolved;
 
-  // As parsed (read_experiment), and as built (build_experiment):
-  std::vector<CaseSpec> specs;  // Simulate: one, or one per variant
-  std::vector<Case> cases;
-  OutputOptions output;
-
-  // Areas:
-  std::vector<NamedSurfaceSpec> area_specs;
-  std::vector<NamedSurface> area_surfaces;
-
-  std::optional<BenchmarkSpec> benchmark;  // Benchmark: the scene, solvers and comparisons
-
-  // Calibration: the specimens and what they share, as parsed; and the
-  // specimens' experiments, as loaded (build_experiment).
-  std::optional<CalibrationSpec> calibration;
-  std::vector<Experiment> specimens;
-
-  std::optional<FitSpec> fit;
-  // "fem_reference": also solve the simulation by linear FEM on tetrahedra
-  // and write its deformed boundary (fem_reference.obj) as a target.
-  std::optional<FemReferenceSpec>
-      fem_reference;  // the "fit" section: what `fiberfluid fit` calibrates
+  std::variant<Simulation, AreaStudy, BenchmarkSpec, CalibrationStudy> content;
 
   std::vector<ExpectedFigure> expected;
   std::vector<std::string> warnings;  // e.g. from the mesh reader
 
-  bool sweeps() const { return !specs.empty() && !specs.front().variant.empty(); }
-  // Whether build_experiment has made what running needs (read_experiment leaves it unbuilt).
-  bool built() const {
-    if (kind == Kind::Calibration)
-      return calibration && specimens.size() == calibration->specimens.size();
-    return kind != Kind::Simulate || (!cases.empty() && cases.size() == specs.size());
+  Kind kind() const { return static_cast<Kind>(content.index()); }
+  // The kind's part. Asking another kind's is a program's mistake
+  // (std::logic_error naming both): the file's "kind" chose it.
+  Simulation& simulation() { return part<Simulation>("a simulation"); }
+  const Simulation& simulation() const { return part<Simulation>("a simulation"); }
+  AreaStudy& areas() { return part<AreaStudy>("an area study"); }
+  const AreaStudy& areas() const { return part<AreaStudy>("an area study"); }
+  const BenchmarkSpec& benchmark() const { return part<BenchmarkSpec>("a benchmark"); }
+  CalibrationStudy& calibration() { return part<CalibrationStudy>("a calibration"); }
+  const CalibrationStudy& calibration() const { return part<CalibrationStudy>("a calibration"); }
+  // A simulation's "fit" and "fem_reference" sections; null when it has none
+  // or is of another kind.
+  const FitSpec* fit() const {
+    const Simulation* s = std::get_if<Simulation>(&content);
+    return s && s->fit ? &*s->fit : nullptr;
   }
+  const FemReferenceSpec* fem_reference() const {
+    const Simulation* s = std::get_if<Simulation>(&content);
+    return s && s->fem_reference ? &*s->fem_reference : nullptr;
+  }
+
+  // A simulation with variants.
+  bool sweeps() const {
+    const Simulation* s = std::get_if<Simulation>(&content);
+    return s && s->sweeps();
+  }
+  // Whether build_experiment has made what running needs (read_experiment leaves it unbuilt).
+  bool built() const;
+
+ private:
+  template <class Part>
+  Part& part(const char* what) {
+    return const_cast<Part&>(static_cast<const Experiment&>(*this).part<Part>(what));
+  }
+  template <class Part>
+  const Part& part(const char* what) const;
 };
+
 inline constexpr auto kExperimentKindNames =
     names_of<Experiment::Kind>({{Experiment::Kind::Simulate, "simulate"},
                                 {Experiment::Kind::Areas, "areas"},
                                 {Experiment::Kind::Benchmark, "benchmark"},
                                 {Experiment::Kind::Calibration, "calibration"}});
+
+template <class Part>
+const Part& Experiment::part(const char* what) const {
+  if (const Part* p = std::get_if<Part>(&content)) return *p;
+  throw std::logic_error("experiment " + name + " is not " + what);
+}
+
+inline bool Experiment::built() const {
+  switch (kind()) {
+    case Kind::Calibration:
+      return calibration().specimens.size() == calibration().spec.specimens.size();
+    case Kind::Simulate:
+      return !simulation().cases.empty() && simulation().cases.size() == simulation().specs.size();
+    default:
+      return true;
+  }
+}
 
 // Throws std::logic_error unless the experiment is built: a program that ran
 // read_experiment without build_experiment is told so instead of crashing.

@@ -95,13 +95,13 @@ std::vector<std::string> run_figure_names(const model::Model& model) {
 
 std::vector<std::string> calibration_figures(const Experiment& ex) {
   std::vector<std::string> names = {"fit.cost"};
-  if (!ex.calibration) return names;
-  for (const std::string& shared : ex.calibration->shared) names.push_back("fit." + shared);
-  for (size_t s = 0; s < ex.specimens.size(); ++s) {
-    const std::string prefix = "fit." + ex.calibration->specimens[s].name + ".";
-    for (const FitParameterSpec& p : ex.specimens[s].fit->parameters)
-      if (std::find(ex.calibration->shared.begin(), ex.calibration->shared.end(), p.request.name) ==
-          ex.calibration->shared.end())
+  if (ex.kind() != Experiment::Kind::Calibration) return names;
+  for (const std::string& shared : ex.calibration().spec.shared) names.push_back("fit." + shared);
+  for (size_t s = 0; s < ex.calibration().specimens.size(); ++s) {
+    const std::string prefix = "fit." + ex.calibration().spec.specimens[s].name + ".";
+    for (const FitParameterSpec& p : ex.calibration().specimens[s].fit()->parameters)
+      if (std::find(ex.calibration().spec.shared.begin(), ex.calibration().spec.shared.end(),
+                    p.request.name) == ex.calibration().spec.shared.end())
         names.push_back(prefix + p.request.name);
     for (const char* f :
          {"distance_mean", "distance_rms", "distance_sd", "distance_largest", "distance_sd_share"})
@@ -111,10 +111,10 @@ std::vector<std::string> calibration_figures(const Experiment& ex) {
 }
 
 std::string figure_problem(const Experiment& ex, const std::string& figure, bool fit_figures) {
-  const bool fitted = ex.fit || ex.kind == Experiment::Kind::Calibration;
+  const bool fitted = ex.fit() || ex.kind() == Experiment::Kind::Calibration;
   if (!fit_figures && fitted && figure.rfind("fit.", 0) == 0) return {};
   std::vector<std::string> valid;
-  switch (ex.kind) {
+  switch (ex.kind()) {
     case Experiment::Kind::Calibration:
       for (const std::string& f : calibration_figures(ex)) {
         if (figure == f) return {};
@@ -124,7 +124,7 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
     case Experiment::Kind::Benchmark:
       return {};
     case Experiment::Kind::Areas:
-      for (const NamedSurfaceSpec& s : ex.area_specs)
+      for (const NamedSurfaceSpec& s : ex.areas().specs)
         for (const std::string& f : kAreaFigures) {
           if (figure == s.name + "." + f) return {};
           valid.push_back(s.name + "." + f);
@@ -135,23 +135,23 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
         if (figure == f) return {};
         valid.push_back(f);
       }
-      if (ex.fem_reference)
+      if (ex.fem_reference())
         for (const std::string& f : kFemFigures) {
           if (figure == "fem_reference." + f) return {};
           valid.push_back("fem_reference." + f);
         }
-      if (ex.fit) {
+      if (ex.fit()) {
         std::vector<std::string> fitted = kFitFigures;
-        for (const FitParameterSpec& p : ex.fit->parameters) fitted.push_back(p.request.name);
-        if (!ex.fit->force_curves.empty())
+        for (const FitParameterSpec& p : ex.fit()->parameters) fitted.push_back(p.request.name);
+        if (!ex.fit()->force_curves.empty())
           fitted.insert(fitted.end(), {"force_rms", "force_largest", "force_rms_share"});
-        if (ex.fit->multistart) fitted.insert(fitted.end(), {"optima", "best_optimum_starts"});
+        if (ex.fit()->multistart) fitted.insert(fitted.end(), {"optima", "best_optimum_starts"});
         for (const std::string& f : fitted) {
           if (figure == "fit." + f) return {};
           valid.push_back("fit." + f);
         }
       }
-      for (const CaseSpec& spec : ex.specs) {
+      for (const CaseSpec& spec : ex.simulation().specs) {
         const std::string prefix = spec.variant.empty() ? "" : spec.variant + ".";
         if (figure.rfind(prefix, 0) == 0 && is_run_figure(spec, figure.substr(prefix.size())))
           return {};

@@ -99,19 +99,20 @@ int marker_vertex(const MarkerSpec& spec, const Case& c, const FieldName& field)
 FitKindTargetSpec read_marker_target(Fields& t, const std::filesystem::path&) {
   MarkerSpec m;
   const FieldName field = t.field();
-  if (t.has("vertex") == t.has("at"))
-    t.fail("vertex",
-           "expected the marker's \"vertex\" (an input vertex index) or its rest "
-           "position \"at\": one of them");
-  double scale = 1.0;
+  // The fields every marker has first, so that the schema's explorer reads
+  // them all (it follows the reader until its first refusal).
   const std::string units = t.choice("units", "m", {"m", "cm", "mm", "um"});
-  scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
-  if (t.has("vertex")) m.input_vertex = t.integer("vertex", 0, 0, std::numeric_limits<int>::max());
-  if (t.has("at")) m.at = Eigen::Vector3d(t.vector("at", 3) * scale);
+  const double scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
   m.displacement = t.vector("displacement", 3) * scale;
   m.step = t.integer("step", 0, 1, 100000);
   m.weight = t.positive("weight", 1.0);
   m.label = t.string("label", "marker");
+  if (t.has("vertex") == t.has("at"))
+    t.fail("vertex",
+           "expected the marker's \"vertex\" (an input vertex index) or its rest "
+           "position \"at\": one of them");
+  if (t.has("vertex")) m.input_vertex = t.integer("vertex", 0, 0, std::numeric_limits<int>::max());
+  if (t.has("at")) m.at = Eigen::Vector3d(t.vector("at", 3) * scale);
   t.finish();
   FitKindTargetSpec spec;
   spec.field = field;

@@ -184,7 +184,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
   t.header("steps");
   for (const char* h : headers) t.header(h);
   // Reactions at the end, per group of the first case (variants may differ).
-  const model::Model& first = ex.cases.front().model;
+  const model::Model& first = ex.simulation().cases.front().model;
   const size_t groups = first.constraint_groups.size();
   for (size_t g = 0; g < groups; ++g)
     for (int a = 0; a < first.dim(); ++a)
@@ -212,7 +212,8 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
       else
         t.text("");
     }
-    const bool same_groups = ex.cases[r].model.constraint_groups == first.constraint_groups;
+    const bool same_groups =
+        ex.simulation().cases[r].model.constraint_groups == first.constraint_groups;
     for (size_t g = 0; g < groups; ++g)
       for (int a = 0; a < first.dim(); ++a) {
         if (s.success && same_groups && !s.steps.empty())
@@ -231,7 +232,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
     t.number(s.total_seconds);
     t.number(run.rank);
     t.text(s.message);
-    t.text(ex.cases[r].patch.is_null() ? "" : ex.cases[r].patch.dump());
+    t.text(ex.simulation().cases[r].patch.is_null() ? "" : ex.simulation().cases[r].patch.dump());
     t.end_row();
   }
   return t.str();

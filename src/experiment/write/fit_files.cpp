@@ -163,7 +163,7 @@ json force_curves_json(const Experiment& ex, const FitSetup& setup, const fit::C
   for (size_t k = 0; k < setup.force_curves.size(); ++k) {
     const fit::ForceCurve& f = setup.force_curves[k];
     const bool paddle = f.source == fit::ForceCurve::Source::Paddle;
-    const model::Model& model = ex.cases.front().model;
+    const model::Model& model = ex.simulation().cases.front().model;
     json curve = {
         {"file", f.label},
         {paddle ? "paddle" : "support",
@@ -228,8 +228,8 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
       {"jacobian", r.analytic_jacobian ? "analytic: Newton sensitivities, one tangent solve per "
                                          "material parameter"
                                        : "finite differences of whole forward runs (central)"},
-      {"loss", fit::to_string(ex.fit->options.loss)},
-      {"symmetric", ex.fit->options.symmetric},
+      {"loss", fit::to_string(ex.fit()->options.loss)},
+      {"symmetric", ex.fit()->options.symmetric},
       {"parameters", parameters},
       {"covariance", r.covariance_ok ? "ceres covariance at the optimum, scaled by the "
                                        "residual variance"
@@ -251,7 +251,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
         {"targets", setup.targets.size()},
         {"target_points", target_points},
         {"forward_distances", counted * static_cast<int>(setup.targets.size())},
-        {"symmetric_distances", ex.fit->options.symmetric ? target_points : 0},
+        {"symmetric_distances", ex.fit()->options.symmetric ? target_points : 0},
         {"force_curves", setup.force_curves.size()},
         {"force_rows", force_rows},
         {"residuals", c.num_residuals()},
@@ -330,7 +330,7 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
     geom::write_text_file(folder / fit_files::kForceCurve.name(k), rows.str());
   }
 
-  const Case& c = ex.cases.front();
+  const Case& c = ex.simulation().cases.front();
   std::ostringstream distances;
   distances.precision(12);
   distances << "vertex,target,step,distance_m\n";
@@ -372,8 +372,8 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   }
   json specimens = json::array();
   for (size_t s = 0; s < setup.specimens.size(); ++s) {
-    json specimen = {{"name", ex.calibration->specimens[s].name},
-                     {"experiment", ex.specimens[s].source.string()},
+    json specimen = {{"name", ex.calibration().spec.specimens[s].name},
+                     {"experiment", ex.calibration().specimens[s].source.string()},
                      {"body_length", setup.specimens[s].calibration->body_length()},
                      {"residuals", setup.specimens[s].calibration->num_residuals()}};
     if (s < r.specimens.size() && !r.specimens[s].statistics.empty()) {
@@ -397,7 +397,7 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
       {"success", r.success},
       {"message", r.message},
       {"method", "levenberg-marquardt over every specimen's distances (analytic Jacobian blocks)"},
-      {"shared", ex.calibration->shared},
+      {"shared", ex.calibration().spec.shared},
       {"parameters", parameters},
       {"intervals_are",
        "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
@@ -426,10 +426,10 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   // Each specimen's fit files at the joint optimum, in a folder of its own.
   for (size_t s = 0; s < r.specimens.size() && s < setup.specimens.size(); ++s) {
     if (r.specimens[s].statistics.empty()) continue;  // no run there
-    const std::filesystem::path own = folder / ex.calibration->specimens[s].name;
+    const std::filesystem::path own = folder / ex.calibration().spec.specimens[s].name;
     std::filesystem::create_directories(own);
-    const Experiment at_fit =
-        with_fitted_material(ex.specimens[s], *setup.specimens[s].calibration, r.specimens[s]);
+    const Experiment at_fit = with_fitted_material(ex.calibration().specimens[s],
+                                                   *setup.specimens[s].calibration, r.specimens[s]);
     write_fit_files(own, at_fit, setup.specimens[s], r.specimens[s], ExperimentResult{});
   }
 }

@@ -42,7 +42,7 @@ void OutputWriter::abandon() noexcept {
 }
 
 fs::path OutputWriter::run_folder(size_t run) const {
-  const std::string& variant = experiment_.cases[run].variant;
+  const std::string& variant = experiment_.simulation().cases[run].variant;
   return variant.empty() ? staging_ : staging_ / variant;
 }
 
@@ -51,16 +51,16 @@ void OutputWriter::begin() {
   geom::write_text_file(staging_ / kIncompleteMark,
                         "fiberfluid is writing this folder, or was stopped while it did: "
                         "these are not the results of a complete run.\n");
-  if (experiment_.kind != Experiment::Kind::Simulate) return;
-  series_.assign(experiment_.cases.size(), {});
+  if (experiment_.kind() != Experiment::Kind::Simulate) return;
+  series_.assign(experiment_.simulation().cases.size(), {});
   equilibria_.clear();
-  equilibria_.resize(experiment_.cases.size());  // made when a run first writes
+  equilibria_.resize(experiment_.simulation().cases.size());  // made when a run first writes
   write_fibers();
-  for (size_t r = 0; r < experiment_.cases.size(); ++r) {
+  for (size_t r = 0; r < experiment_.simulation().cases.size(); ++r) {
     fs::create_directories(run_folder(r));
-    if (!experiment_.output.vtk) continue;
+    if (!experiment_.simulation().output.vtk) continue;
     fs::create_directories(run_folder(r) / kVtk);
-    const model::Model& m = experiment_.cases[r].model;
+    const model::Model& m = experiment_.simulation().cases[r].model;
     write_state(r, 0, Eigen::VectorXd::Zero(m.num_unknowns()),
                 std::vector<double>(m.loads.size(), 0.0));
   }
@@ -125,7 +125,7 @@ Eigen::VectorXd face_surface_tension(const geom::Surface& s,
 }  // namespace
 
 void OutputWriter::write_fibers() const {
-  const Case& c = experiment_.cases.front();
+  const Case& c = experiment_.simulation().cases.front();
   if (c.fibers.write == "none") return;
   const std::vector<std::pair<int, int>> lines = written_fibers(c);
   const Eigen::MatrixXd& S = c.model.surface.V;
@@ -134,7 +134,7 @@ void OutputWriter::write_fibers() const {
     rest[static_cast<Eigen::Index>(k)] = (S.row(lines[k].first) - S.row(lines[k].second)).norm();
   geom::VtuContent content;
   content.cells = {{"rest_length", rest}};
-  content.encoding = vtk_encoding(experiment_.output.vtk_format, lines.size());
+  content.encoding = vtk_encoding(experiment_.simulation().output.vtk_format, lines.size());
   geom::write_lines_vtu(staging_ / kFibers, S, lines, content);
 }
 
@@ -142,7 +142,8 @@ void OutputWriter::write_fibers() const {
 // its own): a sweep whose runs write no .vtu builds none.
 const model::Equilibrium& OutputWriter::equilibrium(size_t run) const {
   std::unique_ptr<const model::Equilibrium>& slot = equilibria_[run];
-  if (!slot) slot = std::make_unique<const model::Equilibrium>(experiment_.cases[run].model);
+  if (!slot)
+    slot = std::make_unique<const model::Equilibrium>(experiment_.simulation().cases[run].model);
   return *slot;
 }
 
@@ -150,7 +151,7 @@ const model::Equilibrium& OutputWriter::equilibrium(size_t run) const {
 // with its strain, its tension and the size of its force (the equilibrium
 // equations' fiber forces, model.md section 7).
 void OutputWriter::write_final_fibers(size_t run, const Eigen::VectorXd& unknowns) const {
-  const Case& c = experiment_.cases[run];
+  const Case& c = experiment_.simulation().cases[run];
   const std::vector<std::pair<int, int>> lines = written_fibers(c);
   const std::vector<model::FiberReading> readings =
       equilibrium(run).bulk_fiber_readings(unknowns, lines);
@@ -164,7 +165,7 @@ void OutputWriter::write_final_fibers(size_t run, const Eigen::VectorXd& unknown
   }
   geom::VtuContent content;
   content.cells = {{"strain", strain}, {"tension", tension}, {"force", force}};
-  content.encoding = vtk_encoding(experiment_.output.vtk_format, lines.size());
+  content.encoding = vtk_encoding(experiment_.simulation().output.vtk_format, lines.size());
   geom::write_lines_vtu(run_folder(run) / kFibersFinal, model::positions(c.model, unknowns), lines,
                         content);
 }
@@ -178,7 +179,7 @@ void OutputWriter::write_final_fibers(size_t run, const Eigen::VectorXd& unknown
 void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unknowns,
                                const std::vector<double>& load_factors,
                                const std::vector<solve::StepRecord::HeldForce>& held_forces) {
-  const Case& c = experiment_.cases[run];
+  const Case& c = experiment_.simulation().cases[run];
   const model::Model& m = c.model;
   geom::Surface deformed = c.input_surface;
   deformed.V = input_positions(c, unknowns);
@@ -213,7 +214,8 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
   content.field = {{"step", {static_cast<double>(step)}},
                    {"load_factors", load_factors},
                    {"pressure", {unknowns[m.pressure_dof()]}}};
-  content.encoding = vtk_encoding(experiment_.output.vtk_format, static_cast<size_t>(n));
+  content.encoding =
+      vtk_encoding(experiment_.simulation().output.vtk_format, static_cast<size_t>(n));
   char name[32];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
   geom::write_vtu(run_folder(run) / kVtk / name, deformed, content);
@@ -222,8 +224,9 @@ void OutputWriter::write_state(size_t run, int step, const Eigen::VectorXd& unkn
 
 void OutputWriter::on_step(size_t run, const solve::StepRecord& record,
                            const Eigen::VectorXd& unknowns) {
-  const bool last = record.step == experiment_.cases[run].stepping.steps;
-  if (experiment_.output.vtk && (last || record.step % experiment_.output.every == 0))
+  const bool last = record.step == experiment_.simulation().cases[run].stepping.steps;
+  if (experiment_.simulation().output.vtk &&
+      (last || record.step % experiment_.simulation().output.every == 0))
     write_state(run, record.step, unknowns, record.load_factors, record.held_forces);
 }
 
@@ -248,15 +251,15 @@ void OutputWriter::write_fem_path(const FemReferenceResult& f) {
 
 void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& more) {
   for (size_t r = 0; r < result.runs.size(); ++r) {
-    const Case& c = experiment_.cases[r];
+    const Case& c = experiment_.simulation().cases[r];
     const RunResult& run = result.runs[r];
-    if (experiment_.output.vtk) geom::write_pvd(run_folder(r) / kSeries, series_[r]);
+    if (experiment_.simulation().output.vtk) geom::write_pvd(run_folder(r) / kSeries, series_[r]);
     geom::write_text_file(run_folder(r) / kSteps, steps_csv(c, run));
     geom::write_text_file(run_folder(r) / kLoadDisplacement, load_displacement_csv(c, run));
     if (!run.summary.success) continue;
     geom::write_text_file(run_folder(r) / kVertices, vertices_csv(c, run));
     if (c.fibers.write != "none") write_final_fibers(r, run.summary.unknowns);
-    if (experiment_.output.obj) {
+    if (experiment_.simulation().output.obj) {
       geom::Surface deformed = c.input_surface;
       deformed.V = input_positions(c, run.summary.unknowns);
       geom::write_obj(run_folder(r) / kFinal, deformed);
@@ -274,7 +277,7 @@ void OutputWriter::finish(const ExperimentResult& result, const FolderFiller& mo
     if (f.path.size() > 1) write_fem_path(f);
   }
   if (result.benchmark) {
-    write_benchmark_files(staging_, *experiment_.benchmark, *result.benchmark);
+    write_benchmark_files(staging_, experiment_.benchmark(), *result.benchmark);
   }
   geom::write_text_file(staging_ / kSummary, summary_json(experiment_, result).dump(2) + "\n");
   write_experiment_files();
@@ -299,11 +302,11 @@ void OutputWriter::write_experiment_files() const {
   if (experiment_.document.is_null()) return;  // built without a document
   geom::write_text_file(staging_ / kExperiment, experiment_.document.dump(2) + "\n");
   nlohmann::json resolved = experiment_.resolved;
-  const bool given_surface = experiment_.kind == Experiment::Kind::Simulate &&
-                             !experiment_.cases.empty() && !resolved.contains("surface") &&
-                             !resolved.contains("variants");
+  const bool given_surface = experiment_.kind() == Experiment::Kind::Simulate &&
+                             !experiment_.simulation().cases.empty() &&
+                             !resolved.contains("surface") && !resolved.contains("variants");
   if (given_surface) {
-    geom::write_obj(staging_ / kInputSurface, experiment_.cases.front().input_surface);
+    geom::write_obj(staging_ / kInputSurface, experiment_.simulation().cases.front().input_surface);
     resolved["surface"] = {{"file", kInputSurface}};
   }
   geom::write_text_file(staging_ / kResolved, resolved.dump(2) + "\n");

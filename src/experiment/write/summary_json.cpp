@@ -230,10 +230,7 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
   json build = json::object();
   for (const auto& [name, value] : build_info()) build[name] = value;
   doc["build"] = build;
-  doc["kind"] = ex.kind == Experiment::Kind::Areas         ? "areas"
-                : ex.kind == Experiment::Kind::Benchmark   ? "benchmark"
-                : ex.kind == Experiment::Kind::Calibration ? "calibration"
-                                                           : "simulate";
+  doc["kind"] = kExperimentKindNames.name(ex.kind());
   if (!result.failure.empty()) doc["failure"] = result.failure;
   doc["units"] = {{"length", "m"},
                   {"displacement", "m"},
@@ -244,8 +241,8 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
                   {"gamma", "N/m"},
                   {"time", "s"}};
   doc["success"] = result.runs_succeeded();
-  if (ex.kind == Experiment::Kind::Simulate) {
-    const Case& first = ex.cases.front();
+  if (ex.kind() == Experiment::Kind::Simulate) {
+    const Case& first = ex.simulation().cases.front();
     doc["surface"] = {{"dimension", first.input_surface.dim},
                       {"vertices", first.input_surface.num_vertices()},
                       {"used_vertices", first.model.num_vertices()},
@@ -253,7 +250,7 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
     doc["fibers"] = fibers_json(first);
     json runs = json::array();
     for (size_t r = 0; r < result.runs.size(); ++r)
-      runs.push_back(run_json(ex.cases[r], result, result.runs[r]));
+      runs.push_back(run_json(ex.simulation().cases[r], result, result.runs[r]));
     doc["runs"] = runs;
   }
   doc["figures"] = result.figures;

@@ -110,8 +110,8 @@ Eigen::MatrixXd ForceCurveMisfits::observed_sensitivities(const model::Model& mo
                                                           int material_parameters) const {
   const size_t i = static_cast<size_t>(curve_.index);
   const Eigen::MatrixXd& d = curve_.source == ForceCurve::Source::Paddle
-                                 ? record.paddles[i].force_sensitivities
-                                 : record.reaction_sensitivities[i];
+                                 ? record.sensitivities.paddle_forces[i]
+                                 : record.sensitivities.reactions[i];
   Eigen::MatrixXd row(1, material_parameters);
   for (int j = 0; j < material_parameters; ++j) {
     Eigen::Vector3d column = d.col(j);

@@ -38,12 +38,22 @@ LoadPoint scheduled_point(const model::Model& m, double t, int steps) {
   return at;
 }
 
-std::string sensitivity_problem(const Model& model) {
+namespace {
+
+// The first paddle that sticks (holds each vertex where it touched), or null.
+const model::Paddle* sticking_paddle(const Model& model) {
   for (const model::Paddle& paddle : model.paddles)
-    if (paddle.sticking)
-      return "paddle " + paddle.label +
-             " sticks: it holds each vertex where it touched, a place that moves with the "
-             "parameters (fit with finite differences)";
+    if (paddle.sticking) return &paddle;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string sensitivity_problem(const Model& model) {
+  if (const model::Paddle* paddle = sticking_paddle(model))
+    return "paddle " + paddle->label +
+           " sticks: it holds each vertex where it touched, a place that moves with the "
+           "parameters (fit with finite differences)";
   return {};
 }
 
@@ -57,11 +67,10 @@ std::string warm_start_problem(const Model& model, const SteppingOptions& option
     return "expected " + std::to_string(expected) + " unknowns (displacements and pressure), got " +
            std::to_string(options.warm_start.size());
   if (!options.warm_start.allFinite()) return "the start has non-finite values";
-  for (const model::Paddle& paddle : model.paddles)
-    if (paddle.sticking)
-      return "paddle " + paddle.label +
-             " sticks: where a vertex sticks depends on the way there, so the end of the path "
-             "cannot be solved from elsewhere";
+  if (const model::Paddle* paddle = sticking_paddle(model))
+    return "paddle " + paddle->label +
+           " sticks: where a vertex sticks depends on the way there, so the end of the path "
+           "cannot be solved from elsewhere";
   return {};
 }
 

@@ -96,8 +96,8 @@ std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
   if (!options_.sensitivities.parameters.empty() &&
       std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
     Eigen::MatrixXd residual_change;
-    why = solver_.sensitivities(at, x, options_.sensitivities.parameters, &record.sensitivities,
-                                &residual_change);
+    why = solver_.sensitivities(at, x, options_.sensitivities.parameters,
+                                &record.sensitivities.state, &residual_change);
     if (!why.empty()) return "step " + std::to_string(k) + ": sensitivities: " + why;
     force_sensitivities(residual_change, record);
   }
@@ -113,25 +113,25 @@ void StepFinisher::force_sensitivities(const Eigen::MatrixXd& residual_change,
                                        StepRecord& record) const {
   const int nv = model_.num_vertices(), dim = model_.dim();
   const Eigen::Index P = residual_change.cols();
-  record.reaction_sensitivities.assign(groups_, Eigen::MatrixXd::Zero(3, P));
+  std::vector<Eigen::MatrixXd>& reactions = record.sensitivities.reactions;
+  reactions.assign(groups_, Eigen::MatrixXd::Zero(3, P));
   for (size_t c = 0; c < partition_.constrained.size(); ++c) {
     const int d = partition_.constrained[c];
     const size_t g = group_of(c);
-    record.reaction_sensitivities[g].row(d / nv) += residual_change.row(d);
+    reactions[g].row(d / nv) += residual_change.row(d);
   }
   for (const model::MirrorLayer& layer : model_.mirror_layers)
-    record.reaction_sensitivities[static_cast<size_t>(layer.group) % groups_].setConstant(
+    reactions[static_cast<size_t>(layer.group) % groups_].setConstant(
         std::numeric_limits<double>::quiet_NaN());
-  for (StepRecord::PaddleState& state : record.paddles)
-    state.force_sensitivities = Eigen::MatrixXd::Zero(3, P);
+  std::vector<Eigen::MatrixXd>& paddle_forces = record.sensitivities.paddle_forces;
+  paddle_forces.assign(record.paddles.size(), Eigen::MatrixXd::Zero(3, P));
   const model::DofMap held = solver_.held_map();
   for (int v = 0; v < nv; ++v) {
     const int p = solver_.contact_paddle()[static_cast<size_t>(v)];
     if (p < 0) continue;
     for (int a = 0; a < dim; ++a)
       if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v))
-        record.paddles[static_cast<size_t>(p)].force_sensitivities.row(a) +=
-            residual_change.row(a * nv + v);
+        paddle_forces[static_cast<size_t>(p)].row(a) += residual_change.row(a * nv + v);
   }
 }
 

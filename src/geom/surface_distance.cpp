@@ -13,10 +13,10 @@
 #include <boost/iterator/counting_iterator.hpp>
 #include <optional>
 
-#include "fiberfluid/fit/target.hpp"
+#include "fiberfluid/geom/target.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
-namespace fiberfluid::fit {
+namespace fiberfluid::geom {
 namespace {
 
 using Kernel = CGAL::Simple_cartesian<double>;
@@ -110,4 +110,4 @@ std::vector<TargetDistance::Closest> TargetDistance::closest(const Eigen::Matrix
   return out;
 }
 
-}  // namespace fiberfluid::fit
+}  // namespace fiberfluid::geom

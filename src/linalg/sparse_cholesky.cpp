@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fiberfluid/solve/sparse_cholesky.hpp"
+#include "fiberfluid/linalg/sparse_cholesky.hpp"
 
 #include <Eigen/CholmodSupport>
 
-namespace fiberfluid::solve {
+namespace fiberfluid::linalg {
 
 struct SparseCholesky::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
@@ -38,4 +38,4 @@ Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
   return impl_->llt.solve(b);
 }
 
-}  // namespace fiberfluid::solve
+}  // namespace fiberfluid::linalg

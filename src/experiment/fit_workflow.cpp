@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "fiberfluid/experiment/run/fit_workflow.hpp"
+#include "fiberfluid/experiment/fit_workflow.hpp"
 
 #include "fiberfluid/experiment/write/fit_files.hpp"
 #include "fiberfluid/experiment/write/outputs.hpp"
@@ -22,8 +22,8 @@ FitOutcome run_fit(const Experiment& ex, const FitSetup& setup, const std::files
                    const WorkDealer& dealer, const FitHooks& hooks) {
   const fit::Calibration& calibration = *setup.calibration;
   FitOutcome out;
-  if (ex.fit->multistart) {
-    out.search = fit::run_multistart(calibration, *ex.fit->multistart, dealer, hooks.on_start);
+  if (ex.fit()->multistart) {
+    out.search = fit::run_multistart(calibration, *ex.fit()->multistart, dealer, hooks.on_start);
     out.fitted = out.search->best();
     // Stopped early: the best start so far, kept as an interrupted fit's.
     if (cancel_requested()) out.fitted.status = fit::FitStatus::Interrupted;
@@ -54,9 +54,9 @@ FitOutcome run_fit(const Experiment& ex, const FitSetup& setup, const std::files
                                         const Eigen::VectorXd& x) { writer.on_step(run, r, x); });
     throw_if_cancelled("the run at the fitted values");
     for (const auto& [name, value] : fit_figures(fitted)) result.figures[name] = value;
-    if (ex.fit->mesh_check != "none" && fit_result_kept(fitted.status)) {
+    if (ex.fit()->mesh_check != "none" && fit_result_kept(fitted.status)) {
       if (hooks.on_phase)
-        hooks.on_phase("mesh check: the fit again on a " + ex.fit->mesh_check + " mesh");
+        hooks.on_phase("mesh check: the fit again on a " + ex.fit()->mesh_check + " mesh");
       out.mesh_check = run_mesh_check(at_fit);
       throw_if_cancelled("the mesh check");
       for (const auto& [name, value] : mesh_check_figures(fitted, *out.mesh_check))
