@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The fiber stencils: the one place where a fiber's weight, strain, force,
 // tangent and parameter derivative are written. Every pair loop (the tiled
-// kernels of pair_kernels.cpp, FiberSystem's rows, Equilibrium's dense
+// kernels of bulk_pairs.cpp and deformed_pairs.cpp, FiberSystem's rows, Equilibrium's dense
 // tangent and dR/dtheta, the stored-coefficient tangent operator, the
 // treecode's pruned corrections) calls these; they are scalar and inline so
 // that the loops around them vectorise.
