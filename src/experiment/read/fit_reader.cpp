@@ -17,13 +17,6 @@ namespace {
 
 using nlohmann::json;
 
-// ------------------------------------------------------------ fit
-// A file's length unit ("m", "cm", "mm", "um"; default m) as the factor to m.
-double length_units(Fields& f, const std::string& key) {
-  const std::string units = f.choice(key, "m", {"m", "cm", "mm", "um"});
-  return units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
-}
-
 // A target of "type": "force": a CSV curve of a paddle's or a support's force.
 FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
   FitForceSpec curve;
@@ -181,6 +174,12 @@ void read_fit_options(Fields& f, FitSpec& spec) {
 }
 
 }  // namespace
+
+// A file's length unit ("m", "cm", "mm", "um"; default m) as the factor to m.
+double length_units(Fields& f, const std::string& key) {
+  const std::string units = f.choice(key, "m", {"m", "cm", "mm", "um"});
+  return units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
+}
 
 FitSpec read_fit(Fields f, const std::filesystem::path& folder) {
   FitSpec spec;

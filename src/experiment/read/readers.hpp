@@ -29,6 +29,10 @@ SurfaceSpec read_surface_spec(Fields& f, const std::filesystem::path& folder);
 CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
                    std::vector<std::string>* warnings);
 
+// A file's length unit ("m", "cm", "mm", "um"; default m) as the factor to m
+// (fit_reader.cpp).
+double length_units(Fields& f, const std::string& key);
+
 // A vertex selection ("vertices", "where", "nearest", ...; case_reader.cpp).
 SelectionSpec read_selection(Fields& f);
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fiberfluid/experiment/read/json_fields.hpp"
+#include "fiberfluid/experiment/read/readers.hpp"
 #include "fiberfluid/experiment/targets/target_kinds.hpp"
 #include "fiberfluid/fit/residuals/residual_block.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -101,8 +102,7 @@ FitKindTargetSpec read_marker_target(Fields& t, const std::filesystem::path&) {
   const FieldName field = t.field();
   // The fields every marker has first, so that the schema's explorer reads
   // them all (it follows the reader until its first refusal).
-  const std::string units = t.choice("units", "m", {"m", "cm", "mm", "um"});
-  const double scale = units == "cm" ? 1e-2 : units == "mm" ? 1e-3 : units == "um" ? 1e-6 : 1.0;
+  const double scale = length_units(t, "units");
   m.displacement = t.vector("displacement", 3) * scale;
   m.step = t.integer("step", 0, 1, 100000);
   m.weight = t.positive("weight", 1.0);
