@@ -22,6 +22,7 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/solve/newton/interactive_stepper.hpp"
+#include "fiberfluid/solve/tangent/tangent_solve.hpp"
 #include "fiberfluid/util/omp_wait_policy.hpp"
 
 namespace {

@@ -26,17 +26,17 @@ class SharedEvaluation {
     // Analytic sensitivities cost a few tangent solves next to a whole
     // forward run: take them always, so that an accepted trial point needs
     // no second run when Ceres asks for its Jacobian.
-    with_jacobian = with_jacobian || cache_.problem().analytic_jacobian();
-    const int P = cache_.problem().parameters().size();
+    with_jacobian = with_jacobian || cache_.objective().analytic_jacobian();
+    const int P = cache_.objective().variables().size();
     return cache_.at(Eigen::Map<const Eigen::VectorXd>(phi, P), with_jacobian);
   }
   // False when the point would need forward runs beyond max_evaluations
   // (a kept point needs none).
   bool affordable(const double* phi, bool with_jacobian) const {
-    const FitProblem& fit_problem = cache_.problem();
+    const Objective& objective = cache_.objective();
     if (cache_.forward_runs < max_runs_) return true;
-    with_jacobian = with_jacobian || fit_problem.analytic_jacobian();
-    return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, fit_problem.parameters().size()),
+    with_jacobian = with_jacobian || objective.analytic_jacobian();
+    return cache_.kept(Eigen::Map<const Eigen::VectorXd>(phi, objective.variables().size()),
                        with_jacobian) != nullptr;
   }
   const EvaluationCache& cache() const { return cache_; }
@@ -90,9 +90,9 @@ struct CeresProblem {
   CeresProblem(EvaluationCache& cache, const FitOptions& options, Eigen::VectorXd& phi,
                int max_runs = std::numeric_limits<int>::max())
       : shared(cache, max_runs), loss(make_loss(options)), problem(problem_options()) {
-    const FitProblem& fit_problem = cache.problem();
-    const ParameterMap& map = fit_problem.parameters();
-    for (int i = 0; i < fit_problem.num_residuals(); ++i)
+    const Objective& objective = cache.objective();
+    const Variables& map = objective.variables();
+    for (int i = 0; i < objective.num_residuals(); ++i)
       problem.AddResidualBlock(new DistanceResidual(&shared, i, map.size()), loss.get(),
                                phi.data());
     const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
@@ -110,9 +110,9 @@ struct CeresProblem {
 
 class Recorder final : public ceres::IterationCallback {
  public:
-  Recorder(const FitProblem& fit_problem, const FitOptions& options, const Eigen::VectorXd& phi,
+  Recorder(const Objective& objective, const FitOptions& options, const Eigen::VectorXd& phi,
            const SharedEvaluation& shared, OptimizerOutcome& outcome)
-      : fit_problem_(fit_problem),
+      : objective_(objective),
         options_(options),
         phi_(phi),
         shared_(shared),
@@ -127,7 +127,7 @@ class Recorder final : public ceres::IterationCallback {
     const int failed = shared_.cache().failed_runs;
     if (failed > failures_seen_) r.trial_failure = shared_.cache().last_failure;
     failures_seen_ = failed;
-    r.values = fit_problem_.parameters().values(phi_);  // update_state_every_iteration
+    r.values = objective_.variables().values(phi_);  // update_state_every_iteration
     r.forward_runs = shared_.cache().forward_runs;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     outcome_.iterations.push_back(r);
@@ -140,7 +140,7 @@ class Recorder final : public ceres::IterationCallback {
   bool evaluations_spent = false;
 
  private:
-  const FitProblem& fit_problem_;
+  const Objective& objective_;
   const FitOptions& options_;
   const Eigen::VectorXd& phi_;
   const SharedEvaluation& shared_;
@@ -165,20 +165,21 @@ IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
 
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start) {
-  const FitProblem& fit_problem = evaluations.problem();
+  const Objective& objective = evaluations.objective();
+  const Variables& variables = objective.variables();
   OptimizerOutcome outcome;
   Eigen::VectorXd phi = start;
   CeresProblem p(evaluations, options, phi, options.max_evaluations);
-  Recorder recorder(fit_problem, options, phi, p.shared, outcome);
+  Recorder recorder(objective, options, phi, p.shared, outcome);
   LmSteps steps;
   steps.max_iterations = options.max_iterations;
   steps.function_tolerance = options.function_tolerance;
   steps.parameter_tolerance = options.parameter_tolerance;
   steps.initial_trust_region_radius = options.initial_trust_region_radius;
   steps.max_step_factor = options.max_step_factor;
-  const ceres::Solver::Summary summary = solve_in_moving_box(
-      p.problem, phi.data(), fit_problem.parameters().parameters(),
-      fit_problem.parameters().lower_phi(), fit_problem.parameters().upper_phi(), steps, &recorder);
+  const ceres::Solver::Summary summary =
+      solve_in_moving_box(p.problem, phi.data(), variables.parameters(), variables.lower_phi(),
+                          variables.upper_phi(), steps, &recorder);
   outcome.phi = phi;  // the best point: Ceres keeps it in phi, also when stopped
   outcome.message = "levenberg-marquardt: " + summary.message;
   switch (summary.termination_type) {
@@ -228,7 +229,7 @@ bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
   const bool ok = c.Compute(blocks, &p.problem);
   FLAGS_minloglevel = log_level;
   if (!ok) return false;
-  const int P = evaluations.problem().parameters().size();
+  const int P = evaluations.objective().variables().size();
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(P, P);
   if (!c.GetCovarianceBlock(phi.data(), phi.data(), C.data())) return false;
   *covariance = C;

@@ -230,7 +230,7 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
 
   const OptimizerOutcome outcome = levenberg_marquardt
                                        ? fit_levenberg_marquardt(evaluations, m.options(), *phi0)
-                                       : fit_nlopt(evaluations, m.options(), *phi0);
+                                       : fit_nlopt(evaluations, m, m.options(), *phi0);
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.values = m.parameters().values(outcome.phi);

@@ -55,7 +55,8 @@ const Evaluation& EvaluationCache::at(const Eigen::VectorXd& phi, bool with_jaco
     if (position != kept_.begin()) std::rotate(kept_.begin(), position, std::next(position));
     return kept_.front().evaluation;
   }
-  return count({phi, with_jacobian, problem_.evaluate(phi, with_jacobian, nearest_state(phi))},
+  ++evaluations;
+  return count({phi, with_jacobian, objective_.evaluate(phi, with_jacobian, nearest_state(phi))},
                true);
 }
 
@@ -78,7 +79,7 @@ const Evaluation& EvaluationCache::count(Entry entry, bool keep) {
     last_failure = entry.evaluation.message;
     ++failures_by_cause[failure_cause(last_failure)];
     if (failed_examples.size() < kKeptFailures)
-      failed_examples.push_back({problem_.parameters().values(entry.phi), last_failure});
+      failed_examples.push_back({objective_.variables().values(entry.phi), last_failure});
   }
   if (!keep) return unkept_ = std::move(entry.evaluation);
   kept_.push_front(std::move(entry));
@@ -87,7 +88,7 @@ const Evaluation& EvaluationCache::count(Entry entry, bool keep) {
 }
 
 Eigen::VectorXd EvaluationCache::nearest_state(const Eigen::VectorXd& phi) const {
-  if (!problem_.warm_starts()) return {};
+  if (!objective_.warm_starts()) return {};
   const Entry* nearest = nullptr;
   for (const Entry& entry : kept_)
     if (entry.evaluation.ok && entry.phi.size() == phi.size() &&

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fiberfluid/fit/fit_types.hpp"
-#include "fiberfluid/fit/problem.hpp"
+#include "fiberfluid/fit/objective.hpp"
 
 namespace fiberfluid::fit {
 
@@ -19,8 +19,8 @@ namespace fiberfluid::fit {
 // point asked for twice (the start, the optimum) costs one run. Counts runs.
 class EvaluationCache {
  public:
-  explicit EvaluationCache(const FitProblem& problem) : problem_(problem) {}
-  const FitProblem& problem() const { return problem_; }
+  explicit EvaluationCache(const Objective& objective) : objective_(objective) {}
+  const Objective& objective() const { return objective_; }
   // The evaluation at phi, with the Jacobian when asked (a kept one without
   // it is evaluated again). The reference stays valid until the next call.
   const Evaluation& at(const Eigen::VectorXd& phi, bool with_jacobian);
@@ -33,6 +33,7 @@ class EvaluationCache {
   // The evaluation at phi if it was kept (with the Jacobian when asked), or null.
   const Evaluation* kept(const Eigen::VectorXd& phi, bool with_jacobian) const;
 
+  int evaluations = 0;  // points evaluated here (not add()ed)
   int forward_runs = 0, sensitivity_solves = 0;
   int warm_started_runs = 0;  // of forward_runs (Calibration::warm_starts)
   int failed_runs = 0;        // points whose forward run failed (rejected, not fatal)
@@ -49,7 +50,7 @@ class EvaluationCache {
     bool has_jacobian = false;
     Evaluation evaluation;
   };
-  const FitProblem& problem_;
+  const Objective& objective_;
   std::deque<Entry> kept_;  // newest first
   Evaluation interrupted_;  // the last evaluation an interrupt cut short (not kept)
   Evaluation unkept_;       // the last evaluation add() did not keep

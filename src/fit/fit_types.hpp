@@ -131,7 +131,7 @@ struct FitOptions {
   // Solve each trial point's final state from the nearest point already run
   // (SteppingOptions::warm_start) instead of walking the load path again:
   // where every target and force curve reads the final step only and the
-  // path's end does not depend on the way there (solve::warm_start_problem).
+  // path's end does not depend on the way there (solve::check_warm_start).
   // A trial whose warm start fails walks the path; the optimum is run along
   // the path once more and checked against its warm-started run.
   bool warm_start = true;

@@ -128,34 +128,37 @@ double curve_travel(const ForceCurve& curve, const model::Model& model, int step
   return count > 0 ? sum / count : 0.0;
 }
 
-std::string force_curve_problem(const ForceCurve& curve, const model::Model& model) {
+Status check_force_curve(const ForceCurve& curve, const model::Model& model) {
   if (curve.at.size() != curve.force.size() || curve.force.empty())
-    return "expected as many travels (or steps) as forces, and at least one";
+    return Status::failure("expected as many travels (or steps) as forces, and at least one");
   if (!(curve.weight >= 0.0) || !std::isfinite(curve.weight))
-    return "weight: expected a finite weight of 0 or more (m per N)";
+    return Status::failure("weight: expected a finite weight of 0 or more (m per N)");
   if (curve.source == ForceCurve::Source::Paddle) {
     if (curve.index < 0 || curve.index >= static_cast<int>(model.paddles.size()))
-      return "paddle " + std::to_string(curve.index) + " does not exist (the model has " +
-             std::to_string(model.paddles.size()) + ")";
+      return Status::failure("paddle " + std::to_string(curve.index) +
+                             " does not exist (the model has " +
+                             std::to_string(model.paddles.size()) + ")");
     return {};
   }
   if (curve.index < 0 || curve.index >= static_cast<int>(model.constraint_groups.size()))
-    return "support group " + std::to_string(curve.index) + " does not exist (the model has " +
-           std::to_string(model.constraint_groups.size()) + ")";
+    return Status::failure("support group " + std::to_string(curve.index) +
+                           " does not exist (the model has " +
+                           std::to_string(model.constraint_groups.size()) + ")");
   if (curve.axis < 0 || curve.axis >= model.dim())
-    return "axis " + std::to_string(curve.axis) + " is not one of the model's";
+    return Status::failure("axis " + std::to_string(curve.axis) + " is not one of the model's");
   bool held = false;
   for (const model::Constraint& c : model.constraints)
     held = held || (c.group == curve.index && c.axis == curve.axis);
   const std::string& group = model.constraint_groups[static_cast<size_t>(curve.index)];
   if (!held)
-    return "support " + group + " holds no vertex along axis " + std::string(1, "xyz"[curve.axis]) +
-           ": it has no reaction there";
+    return Status::failure("support " + group + " holds no vertex along axis " +
+                           std::string(1, "xyz"[curve.axis]) + ": it has no reaction there");
   for (const model::MirrorLayer& layer : model.mirror_layers)
     if (layer.group == curve.index)
-      return "support " + group +
-             " has a mirror layer, whose fibers carry part of its reaction: its force curve "
-             "cannot be fitted (fit a paddle's, or the support without the layer)";
+      return Status::failure(
+          "support " + group +
+          " has a mirror layer, whose fibers carry part of its reaction: its force curve "
+          "cannot be fitted (fit a paddle's, or the support without the layer)");
   return {};
 }
 

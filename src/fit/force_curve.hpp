@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::fit {
 
@@ -54,9 +55,9 @@ double curve_force(const ForceCurve& curve, const model::Model& model,
 // the schedules alone (it does not depend on the material).
 double curve_travel(const ForceCurve& curve, const model::Model& model, int step, int steps);
 
-// "" when the curve fits the model (its paddle or group exists, the axis is
+// Whether the curve fits the model (its paddle or group exists, the axis is
 // one of the model's, a mirror layer does not carry the group's reaction),
-// else why not.
-std::string force_curve_problem(const ForceCurve& curve, const model::Model& model);
+// and if not, why not.
+Status check_force_curve(const ForceCurve& curve, const model::Model& model);
 
 }  // namespace fiberfluid::fit

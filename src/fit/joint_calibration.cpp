@@ -1,20 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/fit/joint_calibration.hpp"
 
-#include <ceres/ceres.h>
-
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <deque>
+#include <limits>
 #include <set>
 
+#include "fiberfluid/fit/evaluation_cache.hpp"
 #include "fiberfluid/fit/fit_archive.hpp"
-#include "fiberfluid/fit/lm_solver.hpp"
+#include "fiberfluid/fit/objective.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/fit/uncertainty.hpp"
 #include "fiberfluid/util/byte_archive.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fit {
 namespace {
@@ -31,9 +30,6 @@ std::string command_bytes(Command command, bool with_jacobian, const Eigen::Vect
   out(command, with_jacobian, phi);
   return out.take();
 }
-
-double phi_of(const Parameter& p, double value) { return p.log_scale ? std::log(value) : value; }
-double value_of(const Parameter& p, double phi) { return p.log_scale ? std::exp(phi) : phi; }
 
 }  // namespace
 
@@ -67,6 +63,7 @@ JointCalibration::JointCalibration(std::vector<std::string> specimen_names,
                        to_string(specimens_[s]->options().loss));
     joint_of_[s].assign(static_cast<size_t>(specimens_[s]->parameters().size()), -1);
   }
+  std::vector<Parameter> parameters;
   for (const std::string& name : shared) {
     const int first = parameter_in(0, name);
     for (size_t s = 0; s < specimens_.size(); ++s) {
@@ -80,24 +77,30 @@ JointCalibration::JointCalibration(std::vector<std::string> specimen_names,
         throw InputError("specimen \"" + specimen_names_[s] + "\": the shared \"" + name +
                          "\" has other bounds or another scale than in specimen \"" +
                          specimen_names_[0] + "\": a shared parameter is one variable");
-      joint_of_[s][static_cast<size_t>(k)] = static_cast<int>(parameters_.size());
+      joint_of_[s][static_cast<size_t>(k)] = static_cast<int>(parameters.size());
     }
-    parameters_.push_back(specimens_[0]->parameters().parameters()[static_cast<size_t>(first)]);
+    parameters.push_back(specimens_[0]->parameters().parameters()[static_cast<size_t>(first)]);
     names_.push_back(name);
   }
-  shared_ = static_cast<int>(parameters_.size());
+  shared_ = static_cast<int>(parameters.size());
   for (size_t s = 0; s < specimens_.size(); ++s) {
     const std::vector<Parameter>& own = specimens_[s]->parameters().parameters();
     for (size_t k = 0; k < own.size(); ++k) {
       if (joint_of_[s][k] >= 0) continue;
-      joint_of_[s][k] = static_cast<int>(parameters_.size());
-      parameters_.push_back(own[k]);
+      joint_of_[s][k] = static_cast<int>(parameters.size());
+      parameters.push_back(own[k]);
       names_.push_back(specimen_names_[s] + "." + own[k].name);
     }
     residuals_ += specimens_[s]->num_residuals();
   }
-  if (shared_ == static_cast<int>(parameters_.size()) && shared.empty())
+  if (shared_ == static_cast<int>(parameters.size()) && shared.empty())
     throw InputError("shared: expected the names of the parameters the specimens share");
+  variables_ = Variables(std::move(parameters));
+}
+
+bool JointCalibration::analytic_jacobian() const {
+  return std::all_of(specimens_.begin(), specimens_.end(),
+                     [](const Calibration* c) { return c->analytic_jacobian(); });
 }
 
 Eigen::VectorXd JointCalibration::specimen_phi(size_t s, const Eigen::VectorXd& phi) const {
@@ -122,145 +125,64 @@ std::string JointCalibration::specimen_result(size_t s, const Eigen::VectorXd& p
 
 namespace {
 
-// The joint residuals (each specimen's in turn) and Jacobian at one point,
-// the specimens dealt out. The last few points are kept: Ceres asks for a
-// point's Jacobian after its residuals, and for the current point again
-// after a rejected trial one.
-class JointEvaluator {
+// The specimens' residual blocks stacked over the joint variables (each
+// specimen's rows in turn, its Jacobian's columns at its variables' joint
+// places), the specimens dealt out at every point: what the optimisers and
+// the covariance of a single fit see.
+class JointObjective final : public Objective {
  public:
-  JointEvaluator(const JointCalibration& joint, const std::vector<const Calibration*>& specimens,
-                 const WorkDealer& deal, const Broadcast& broadcast)
-      : joint_(joint), specimens_(specimens), deal_(deal), broadcast_(broadcast) {}
+  JointObjective(const JointCalibration& joint, const WorkDealer& deal, const Broadcast& broadcast)
+      : joint_(joint), deal_(deal), broadcast_(broadcast) {}
 
-  // False when a specimen's forward run failed (why in message()).
-  bool at(const Eigen::VectorXd& phi, bool with_jacobian) {
-    for (auto it = kept_.begin(); it != kept_.end(); ++it)
-      if (it->phi == phi && (it->has_jacobian || !with_jacobian)) {
-        std::rotate(kept_.begin(), it, std::next(it));
-        return kept_.front().ok;
-      }
-    kept_.push_front(evaluate(phi, with_jacobian));
-    if (kept_.size() > kKept) kept_.pop_back();
-    if (!kept_.front().ok) last_failure_ = kept_.front().message;
-    return kept_.front().ok;
-  }
-  const Eigen::VectorXd& residuals() const { return kept_.front().residuals; }
-  const Eigen::MatrixXd& jacobian() const { return kept_.front().jacobian; }
-  const std::string& message() const { return kept_.front().message; }
-  // Why the last point whose run failed failed ("" if none did).
-  const std::string& last_failure() const { return last_failure_; }
-  int evaluations = 0, forward_runs = 0;
+  const Variables& variables() const override { return joint_.variables(); }
+  int num_residuals() const override { return joint_.num_residuals(); }
+  bool analytic_jacobian() const override { return joint_.analytic_jacobian(); }
+  bool warm_starts() const override { return false; }
 
- private:
-  struct Point {
-    Eigen::VectorXd phi, residuals;
-    Eigen::MatrixXd jacobian;
-    bool has_jacobian = false, ok = true;
-    std::string message;
-  };
-  static constexpr size_t kKept = 3;
-
-  Point evaluate(const Eigen::VectorXd& phi, bool with_jacobian) {
+  Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
+                      const Eigen::VectorXd&) const override {
     std::string command = command_bytes(Command::Evaluate, with_jacobian, phi);
     broadcast_(command);
-    std::vector<Evaluation> parts(specimens_.size());
-    std::vector<char> arrived(specimens_.size(), 0);
+    const size_t specimens = joint_.specimen_names().size();
+    std::vector<Evaluation> parts(specimens);
+    std::vector<char> arrived(specimens, 0);
     deal_(
-        specimens_.size(),
-        [&](size_t s) { return joint_.specimen_evaluation(s, phi, with_jacobian); },
+        specimens, [&](size_t s) { return joint_.specimen_evaluation(s, phi, with_jacobian); },
         [&](size_t s, int, std::string&& bytes) {
           parts[s] = unpack_evaluation(bytes);
           arrived[s] = 1;
         });
-    ++evaluations;
-    Point point;
-    point.phi = phi;
-    point.has_jacobian = with_jacobian;
-    point.residuals.resize(joint_.num_residuals());
-    point.jacobian.setZero(joint_.num_residuals(), phi.size());
+    Evaluation joint;
+    joint.ok = true;
+    joint.residuals.resize(joint_.num_residuals());
+    if (with_jacobian) joint.jacobian.setZero(joint_.num_residuals(), phi.size());
     Eigen::Index row = 0;
     for (size_t s = 0; s < parts.size(); ++s) {
       const Evaluation& e = parts[s];
-      forward_runs += e.forward_runs;
+      joint.forward_runs += e.forward_runs;
+      joint.sensitivity_solves += e.sensitivity_solves;
       if (!arrived[s] || !e.ok) {
-        point.ok = false;
-        if (point.message.empty())
-          point.message = "specimen \"" + joint_.specimen_names()[s] +
+        if (joint.ok)
+          joint.message = "specimen \"" + joint_.specimen_names()[s] +
                           "\": " + (arrived[s] ? e.message : std::string("interrupted"));
+        joint.ok = false;
         continue;
       }
       const Eigen::Index rows = e.residuals.size();
-      point.residuals.segment(row, rows) = e.residuals;
+      joint.residuals.segment(row, rows) = e.residuals;
       if (with_jacobian)
         for (Eigen::Index k = 0; k < e.jacobian.cols(); ++k)
-          point.jacobian.block(row, joint_.joint_index(s, static_cast<int>(k)), rows, 1) =
+          joint.jacobian.block(row, joint_.joint_index(s, static_cast<int>(k)), rows, 1) =
               e.jacobian.col(k);
       row += rows;
     }
-    return point;
+    return joint;
   }
 
+ private:
   const JointCalibration& joint_;
-  const std::vector<const Calibration*>& specimens_;
   const WorkDealer& deal_;
   const Broadcast& broadcast_;
-  std::deque<Point> kept_;
-  std::string last_failure_;
-};
-
-// The whole joint residual as one Ceres block over all the variables.
-class JointCost final : public ceres::CostFunction {
- public:
-  JointCost(JointEvaluator& evaluator, int residuals, int variables) : evaluator_(evaluator) {
-    set_num_residuals(residuals);
-    mutable_parameter_block_sizes()->push_back(variables);
-  }
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const Eigen::Map<const Eigen::VectorXd> phi(parameters[0], parameter_block_sizes()[0]);
-    const bool with_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
-    if (!evaluator_.at(phi, with_jacobian)) return false;
-    Eigen::Map<Eigen::VectorXd>(residuals, num_residuals()) = evaluator_.residuals();
-    if (with_jacobian)  // Ceres' blocks are row-major
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-          jacobians[0], num_residuals(), parameter_block_sizes()[0]) = evaluator_.jacobian();
-    return true;
-  }
-
- private:
-  JointEvaluator& evaluator_;
-};
-
-class JointRecorder final : public ceres::IterationCallback {
- public:
-  JointRecorder(const std::vector<Parameter>& parameters, const Eigen::VectorXd& phi,
-                const JointEvaluator& evaluator, const JointOptions& options,
-                std::vector<IterationRecord>& iterations)
-      : parameters_(parameters),
-        phi_(phi),
-        evaluator_(evaluator),
-        options_(options),
-        iterations_(iterations),
-        start_(std::chrono::steady_clock::now()) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    IterationRecord r = lm_iteration(s.iteration, s.step_is_successful, s.cost, iterations_);
-    r.values.resize(phi_.size());
-    for (Eigen::Index k = 0; k < phi_.size(); ++k)
-      r.values[k] = value_of(parameters_[static_cast<size_t>(k)], phi_[k]);
-    r.forward_runs = evaluator_.forward_runs;
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    iterations_.push_back(r);
-    if (options_.progress) options_.progress(r);
-    return cancel_requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const std::vector<Parameter>& parameters_;
-  const Eigen::VectorXd& phi_;
-  const JointEvaluator& evaluator_;
-  const JointOptions& options_;
-  std::vector<IterationRecord>& iterations_;
-  std::chrono::steady_clock::time_point start_;
 };
 
 // Sends Stop to the serving ranks when the fit ends, however it ends.
@@ -278,119 +200,106 @@ class StopsServers {
   const Broadcast& broadcast_;
 };
 
+// A single fit's options for the joint one: Levenberg-Marquardt on squared
+// distances, bounded by iterations alone.
+FitOptions single_fit_options(const JointOptions& joint) {
+  FitOptions o;
+  o.method = Method::LevenbergMarquardt;
+  o.loss = Loss::Squared;
+  o.max_iterations = joint.max_iterations;
+  o.max_evaluations = std::numeric_limits<int>::max();
+  o.function_tolerance = joint.function_tolerance;
+  o.parameter_tolerance = joint.parameter_tolerance;
+  o.max_step_factor = joint.max_step_factor;
+  o.progress = joint.progress;
+  return o;
+}
+
 }  // namespace
 
+// The single fit's optimiser, covariance and estimate on the stacked
+// objective; what is the joint fit's own is the dealing of the specimens
+// and each specimen's report at the optimum.
 JointFitResult JointCalibration::run(const WorkDealer& deal_given,
                                      const Broadcast& broadcast_given) const {
   const auto began = std::chrono::steady_clock::now();
   const WorkDealer deal = deal_given ? deal_given : WorkDealer(deal_in_order);
   const Broadcast broadcast = broadcast_given ? broadcast_given : Broadcast([](std::string&) {});
   const StopsServers stops(broadcast);
-  const int P = static_cast<int>(parameters_.size());
+  const int P = variables_.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  const FitOptions options = single_fit_options(options_);
+  // The estimate as a single fit describes it (bounds, errors, intervals).
+  FitResult estimate;
+  estimate.names = names_;
+  estimate.initial = estimate.values = variables_.values(variables_.initial_phi());
+  estimate.standard_errors = estimate.lower_95 = estimate.upper_95 =
+      Eigen::VectorXd::Constant(P, nan);
+  estimate.correlation = Eigen::MatrixXd::Constant(P, P, nan);
   JointFitResult result;
   result.names = names_;
   result.shared = shared_;
   result.residuals = residuals_;
-  Eigen::VectorXd phi(P), lower(P), upper(P);
-  for (int k = 0; k < P; ++k) {
-    const Parameter& p = parameters_[static_cast<size_t>(k)];
-    phi[k] = phi_of(p, p.initial);
-    lower[k] = std::isfinite(p.lower) ? phi_of(p, p.lower) : -INFINITY;
-    upper[k] = std::isfinite(p.upper) ? phi_of(p, p.upper) : INFINITY;
-  }
-  const auto values = [&](const Eigen::VectorXd& at) {
-    Eigen::VectorXd v(P);
-    for (int k = 0; k < P; ++k) v[k] = value_of(parameters_[static_cast<size_t>(k)], at[k]);
-    return v;
-  };
-  result.initial = result.values = values(phi);
-  result.standard_errors = result.lower_95 = result.upper_95 = Eigen::VectorXd::Constant(P, nan);
-  result.correlation = Eigen::MatrixXd::Constant(P, P, nan);
   result.initial_cost = result.final_cost = nan;
-  JointEvaluator evaluator(*this, specimens_, deal, broadcast);
+  JointObjective objective(*this, deal, broadcast);
+  EvaluationCache evaluations(objective);
   const auto finish = [&](FitStatus status, std::string message) {
     result.status = status;
     result.success = converged(status);
     if (!message.empty()) result.message = std::move(message);
-    result.evaluations = evaluator.evaluations;
+    result.status_detail = estimate.status_detail;
+    result.initial = estimate.initial;
+    result.values = estimate.values;
+    result.covariance_ok = estimate.covariance_ok;
+    result.standard_errors = estimate.standard_errors;
+    result.lower_95 = estimate.lower_95;
+    result.upper_95 = estimate.upper_95;
+    result.correlation = estimate.correlation;
+    result.evaluations = evaluations.evaluations;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
     return result;
   };
-  if (!evaluator.at(phi, true)) {
+  const Eigen::VectorXd start = variables_.initial_phi();
+  const Evaluation& first = evaluations.at(start, true);
+  if (!first.ok) {
     if (cancel_requested()) return finish(FitStatus::Interrupted, "interrupted at the start");
     return finish(FitStatus::StartFailed,
-                  "the forward run at the starting parameters failed: " + evaluator.message());
+                  "the forward run at the starting parameters failed: " + first.message);
   }
-  result.initial_cost = 0.5 * evaluator.residuals().squaredNorm();
+  result.initial_cost = 0.5 * first.residuals.squaredNorm();
 
-  ceres::Problem problem;
-  problem.AddResidualBlock(new JointCost(evaluator, residuals_, P), nullptr, phi.data());
-  JointRecorder recorder(parameters_, phi, evaluator, options_, result.iterations);
-  LmSteps steps;
-  steps.max_iterations = options_.max_iterations;
-  steps.function_tolerance = options_.function_tolerance;
-  steps.parameter_tolerance = options_.parameter_tolerance;
-  steps.max_step_factor = options_.max_step_factor;
-  const ceres::Solver::Summary summary =
-      solve_in_moving_box(problem, phi.data(), parameters_, lower, upper, steps, &recorder);
-  result.message = "levenberg-marquardt: " + summary.message;
-  result.values = values(phi);
-  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
-  if (summary.termination_type == ceres::NO_CONVERGENCE)
-    return finish(FitStatus::IterationLimit, "");
-  if (summary.termination_type != ceres::CONVERGENCE)
-    return finish(evaluator.last_failure().empty() ? FitStatus::OptimizerFailed
-                                                   : FitStatus::ForwardRunsFailed,
-                  "");
+  const OptimizerOutcome outcome = fit_levenberg_marquardt(evaluations, options, start);
+  result.message = outcome.message;
+  result.iterations = outcome.iterations;
+  estimate.values = variables_.values(outcome.phi);
+  if (outcome.status != FitStatus::Converged) return finish(outcome.status, "");
 
-  // At the optimum: the covariance of phi from the Jacobian, (J^T J)^-1.
-  if (!evaluator.at(phi, true))
+  // At the optimum: the cost, the bounds, each specimen's run and distances
+  // (dealt out too), then the covariance.
+  const Evaluation best = evaluations.at(outcome.phi, true);  // a copy: entries move
+  if (!best.ok)
     return finish(FitStatus::ForwardRunsFailed,
-                  "the forward run at the fitted parameters failed: " + evaluator.message());
-  result.final_cost = 0.5 * evaluator.residuals().squaredNorm();
-  const Eigen::MatrixXd& J = evaluator.jacobian();
-  const Eigen::MatrixXd normal = J.transpose() * J;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(normal);
-  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-  result.covariance_ok = largest > 0.0 && eigen.eigenvalues().minCoeff() > 1e-12 * largest;
-  std::vector<std::string> at_bounds;
-  for (int k = 0; k < P; ++k)
-    if (on_bound(phi[k], lower[k], upper[k])) {
-      at_bounds.push_back(names_[static_cast<size_t>(k)]);
-      result.status_detail += (result.status_detail.empty() ? "" : "; ") +
-                              names_[static_cast<size_t>(k)] + " is on a bound";
-    }
-  // Each specimen's run and distances at the optimum, dealt out too.
-  std::string describe = command_bytes(Command::Describe, false, phi);
+                  "the forward run at the fitted parameters failed: " + best.message);
+  result.final_cost = 0.5 * best.residuals.squaredNorm();
+  describe_bounds(variables_, outcome.phi, false, estimate);
+  std::string describe = command_bytes(Command::Describe, false, outcome.phi);
   broadcast(describe);
   result.specimens.resize(specimens_.size());
   deal(
-      specimens_.size(), [&](size_t s) { return specimen_result(s, phi); },
+      specimens_.size(), [&](size_t s) { return specimen_result(s, outcome.phi); },
       [&](size_t s, int, std::string&& bytes) { result.specimens[s] = unpack_fit_result(bytes); });
-  if (!result.covariance_ok) {
-    result.status_detail =
-        "J^T J at the optimum is singular: the specimens' distances cannot "
-        "tell the parameters apart";
+  Eigen::MatrixXd covariance;
+  estimate.covariance_ok = phi_covariance(evaluations, options, outcome.phi, &covariance);
+  if (!estimate.covariance_ok) {
+    estimate.status_detail = unidentifiable_because(best.jacobian, names_);
     return finish(FitStatus::NotIdentifiable, "");
   }
-  const Eigen::MatrixXd covariance = eigen.eigenvectors() *
-                                     eigen.eigenvalues().cwiseInverse().asDiagonal() *
-                                     eigen.eigenvectors().transpose();
   const int dof = residuals_ - P;
   const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
-  for (int k = 0; k < P; ++k) {
-    for (int j = 0; j < P; ++j)
-      result.correlation(k, j) = covariance(k, j) / std::sqrt(covariance(k, k) * covariance(j, j));
-    if (on_bound(phi[k], lower[k], upper[k])) continue;  // a bound is no estimate
-    const double sigma = std::sqrt(std::max(0.0, variance * covariance(k, k)));
-    const bool log = parameters_[static_cast<size_t>(k)].log_scale;
-    result.standard_errors[k] = log ? result.values[k] * sigma : sigma;
-    result.lower_95[k] = value_of(parameters_[static_cast<size_t>(k)], phi[k] - 1.96 * sigma);
-    result.upper_95[k] = value_of(parameters_[static_cast<size_t>(k)], phi[k] + 1.96 * sigma);
-  }
-  return finish(at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds, "");
+  describe_estimates(variables_, outcome.phi, covariance, variance, estimate);
+  return finish(estimate.at_bounds.empty() ? FitStatus::Converged : FitStatus::ConvergedAtBounds,
+                "");
 }
 
 void JointCalibration::serve(const WorkDealer& deal, const Broadcast& broadcast) const {

@@ -7,8 +7,9 @@
 // of its scans). The cost is the sum of the specimens' costs; the fitted
 // variables are the shared ones, then each specimen's own in its order.
 //
-// Levenberg-Marquardt (Ceres) runs on the gathering process (MPI rank 0). At
-// each point it asks for, the specimens' residuals and Jacobian blocks
+// The fit is a single fit's (Levenberg-Marquardt, the bounded step, the
+// covariance and estimate) on the specimens' residuals stacked as one
+// objective, on the gathering process (MPI rank 0). At each point it asks for, the specimens' residuals and Jacobian blocks
 // (Newton sensitivities) are dealt out as work items (util/work_dealer.hpp:
 // over the ranks, one specimen at a time to whichever rank asks); the other
 // ranks serve them (serve) until the fit ends. The point reaches them by a
@@ -73,6 +74,11 @@ class JointCalibration {
                    JointOptions options = {});
 
   const std::vector<std::string>& names() const { return names_; }
+  // The joint variables (shared, then each specimen's own), with their
+  // bounds and scales.
+  const Variables& variables() const { return variables_; }
+  // Every specimen's Jacobian is analytic (Newton sensitivities).
+  bool analytic_jacobian() const;
   const std::vector<std::string>& specimen_names() const { return specimen_names_; }
   int num_residuals() const { return residuals_; }
   // Specimen s's fitted variables within the joint ones, and the joint
@@ -92,7 +98,7 @@ class JointCalibration {
  private:
   std::vector<std::string> specimen_names_, names_;
   std::vector<const Calibration*> specimens_;
-  std::vector<Parameter> parameters_;       // joint, with their bounds and scales
+  Variables variables_{{}};                 // joint, with their bounds and scales
   std::vector<std::vector<int>> joint_of_;  // per specimen: its k-th variable's joint index
   int shared_ = 0, residuals_ = 0;
   JointOptions options_;

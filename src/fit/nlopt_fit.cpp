@@ -18,9 +18,9 @@ namespace {
 // quadratic models of BOBYQA do not survive infinities).
 constexpr double kFailedCost = 1e30;
 
-struct Objective {
-  Objective(EvaluationCache& e, const FitOptions& o, OptimizerOutcome& out)
-      : evaluations(e), fit_problem(e.problem()), options(o), outcome(out) {}
+struct NloptCost {
+  NloptCost(EvaluationCache& e, const FitProblem& p, const FitOptions& o, OptimizerOutcome& out)
+      : evaluations(e), fit_problem(p), options(o), outcome(out) {}
   EvaluationCache& evaluations;
   const FitProblem& fit_problem;
   const FitOptions& options;
@@ -55,7 +55,7 @@ struct Objective {
     return cost;
   }
   static double call(unsigned, const double* x, double*, void* data) {
-    return (*static_cast<Objective*>(data))(x);
+    return (*static_cast<NloptCost*>(data))(x);
   }
 };
 
@@ -91,7 +91,7 @@ std::string describe(nlopt_result r) {
 
 // One NLopt run of `algorithm` from phi (updated to the best point).
 nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
-                      const FitOptions& options, Objective& objective, Eigen::VectorXd& phi,
+                      const FitOptions& options, NloptCost& objective, Eigen::VectorXd& phi,
                       int max_evaluations) {
   const ParameterMap& map = fit_problem.parameters();
   const int P = map.size();
@@ -99,7 +99,7 @@ nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
   const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
   nlopt_set_lower_bounds(opt, lower.data());
   nlopt_set_upper_bounds(opt, upper.data());
-  nlopt_set_min_objective(opt, &Objective::call, &objective);
+  nlopt_set_min_objective(opt, &NloptCost::call, &objective);
   objective.running = opt;
   nlopt_set_ftol_rel(opt, options.function_tolerance);
   nlopt_set_xtol_rel(opt, options.parameter_tolerance);
@@ -128,13 +128,12 @@ nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
 
 }  // namespace
 
-OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
-                           const Eigen::VectorXd& start) {
-  const FitProblem& fit_problem = evaluations.problem();
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitProblem& fit_problem,
+                           const FitOptions& options, const Eigen::VectorXd& start) {
   OptimizerOutcome outcome;
   const ParameterMap& map = fit_problem.parameters();
   Eigen::VectorXd phi = start;
-  Objective objective(evaluations, options, outcome);
+  NloptCost objective(evaluations, fit_problem, options, outcome);
   nlopt_result result;
   if (options.method == Method::Bobyqa) {
     result =

@@ -10,6 +10,7 @@
 
 #include "fiberfluid/fit/evaluation_cache.hpp"
 #include "fiberfluid/fit/fit_types.hpp"
+#include "fiberfluid/fit/problem.hpp"
 
 namespace fiberfluid::fit {
 
@@ -30,8 +31,9 @@ IterationRecord lm_iteration(int iteration, bool step_taken, double cost,
 // Each from the fitted variables `start`.
 OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const FitOptions& options,
                                          const Eigen::VectorXd& start);
-OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitOptions& options,
-                           const Eigen::VectorXd& start);
+// NLopt's methods minimise the problem's cost under its loss.
+OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitProblem& problem,
+                           const FitOptions& options, const Eigen::VectorXd& start);
 
 // The covariance of the fitted variables phi at the optimum (Ceres
 // Covariance, unscaled: (J^T J)^-1 of the robustified residuals), or false

@@ -53,7 +53,7 @@ bool log_scale_by_default(const std::string& name, const model::Material& materi
 
 ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Material& material,
                            int dim)
-    : parameters_(std::move(parameters)) {
+    : Variables(std::move(parameters)) {
   if (parameters_.empty()) throw InputError("nothing to fit: no parameter given");
   const std::vector<std::string> known = material.parameter_names(dim);
   for (size_t k = 0; k < parameters_.size(); ++k) {
@@ -98,13 +98,13 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
   }
 }
 
-std::vector<std::string> ParameterMap::names() const {
+std::vector<std::string> Variables::names() const {
   std::vector<std::string> out;
   for (const Parameter& p : parameters_) out.push_back(p.name);
   return out;
 }
 
-Eigen::VectorXd ParameterMap::initial_phi() const {
+Eigen::VectorXd Variables::initial_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
@@ -113,7 +113,7 @@ Eigen::VectorXd ParameterMap::initial_phi() const {
   return phi;
 }
 
-Eigen::VectorXd ParameterMap::lower_phi() const {
+Eigen::VectorXd Variables::lower_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
@@ -122,7 +122,7 @@ Eigen::VectorXd ParameterMap::lower_phi() const {
   return phi;
 }
 
-Eigen::VectorXd ParameterMap::upper_phi() const {
+Eigen::VectorXd Variables::upper_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
@@ -131,14 +131,14 @@ Eigen::VectorXd ParameterMap::upper_phi() const {
   return phi;
 }
 
-Eigen::VectorXd ParameterMap::values(const Eigen::VectorXd& phi) const {
+Eigen::VectorXd Variables::values(const Eigen::VectorXd& phi) const {
   Eigen::VectorXd v(size());
   for (int k = 0; k < size(); ++k)
     v[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : phi[k];
   return v;
 }
 
-Eigen::VectorXd ParameterMap::value_derivatives(const Eigen::VectorXd& phi) const {
+Eigen::VectorXd Variables::value_derivatives(const Eigen::VectorXd& phi) const {
   Eigen::VectorXd d(size());
   for (int k = 0; k < size(); ++k)
     d[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : 1.0;

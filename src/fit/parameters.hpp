@@ -48,21 +48,15 @@ bool log_scale_by_default(const std::string& name, const model::Material& materi
 // millionth of its range (of max(1, |phi|) when a bound is infinite).
 bool on_bound(double phi, double lower, double upper);
 
-// The parameters in the optimiser's variables phi (log or linear) and back.
-class ParameterMap {
+// The parameters as the optimiser's variables phi (log or linear) and back:
+// what every fit (one body's, several specimens') needs of its parameters.
+class Variables {
  public:
-  // Throws InputError (naming the parameter) for an unknown name, a name
-  // given twice, bounds that exclude the start, or a log-scaled parameter
-  // that is not positive.
-  ParameterMap(std::vector<Parameter> parameters, const model::Material& material, int dim);
+  explicit Variables(std::vector<Parameter> parameters) : parameters_(std::move(parameters)) {}
 
   int size() const { return static_cast<int>(parameters_.size()); }
   const std::vector<Parameter>& parameters() const { return parameters_; }
   std::vector<std::string> names() const;
-  // The material parameters' names and their positions among all.
-  const std::vector<std::string>& material_names() const { return material_names_; }
-  const std::vector<int>& material_indices() const { return material_indices_; }
-  bool has_alignment() const { return has_alignment_; }
 
   Eigen::VectorXd initial_phi() const;
   Eigen::VectorXd lower_phi() const;
@@ -70,6 +64,24 @@ class ParameterMap {
   Eigen::VectorXd values(const Eigen::VectorXd& phi) const;
   // d value / d phi, per parameter (value for a log-scaled one, else 1).
   Eigen::VectorXd value_derivatives(const Eigen::VectorXd& phi) const;
+
+ protected:
+  std::vector<Parameter> parameters_;
+};
+
+// One body's fitted parameters: the variables, and what they set in the
+// material and the alignment of its targets.
+class ParameterMap : public Variables {
+ public:
+  // Throws InputError (naming the parameter) for an unknown name, a name
+  // given twice, bounds that exclude the start, or a log-scaled parameter
+  // that is not positive.
+  ParameterMap(std::vector<Parameter> parameters, const model::Material& material, int dim);
+
+  // The material parameters' names and their positions among all.
+  const std::vector<std::string>& material_names() const { return material_names_; }
+  const std::vector<int>& material_indices() const { return material_indices_; }
+  bool has_alignment() const { return has_alignment_; }
 
   // The material with the parameters' values set.
   model::Material material(const model::Material& base, const Eigen::VectorXd& values) const;
@@ -81,7 +93,6 @@ class ParameterMap {
   int alignment_index(int k) const { return alignment_index_[static_cast<size_t>(k)]; }
 
  private:
-  std::vector<Parameter> parameters_;
   std::vector<std::string> material_names_;
   std::vector<model::MaterialParameter> material_parameters_;  // resolved once
   std::vector<int> material_indices_;

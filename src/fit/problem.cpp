@@ -73,7 +73,7 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
   state_steps_.erase(std::unique(state_steps_.begin(), state_steps_.end()), state_steps_.end());
 
   analytic_ = !options_.finite_differences && stepping_.scheme == solve::Scheme::Newton &&
-              solve::sensitivity_problem(model_).empty();
+              solve::check_sensitivities(model_).ok;
   if (residuals_ < map_.size())
     throw InputError("fewer distances (" + std::to_string(residuals_) + ") than parameters (" +
                      std::to_string(map_.size()) + ")");
@@ -83,7 +83,7 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
     probe.warm_start = Eigen::VectorXd::Zero(model_.dim() * model_.num_vertices() + 1);
     warm_starts_ = options_.warm_start && stepping_.scheme == solve::Scheme::Newton &&
                    state_steps_ == std::vector<int>{stepping_.steps} &&
-                   solve::warm_start_problem(model_, probe).empty();
+                   solve::check_warm_start(model_, probe).ok;
   }
   // The material with the starts, so that model() shows what the fit begins from.
   model_.material = map_.material(model_.material, map_.values(map_.initial_phi()));

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fiberfluid/fit/fit_types.hpp"
+#include "fiberfluid/fit/objective.hpp"
 #include "fiberfluid/fit/residuals/residual_block.hpp"
 
 namespace fiberfluid::fit {
@@ -36,13 +37,13 @@ inline bool near_a_halving(int step, int n) {
   return false;
 }
 
-class FitProblem {
+class FitProblem final : public Objective {
  public:
   // Throws InputError as Calibration's constructor says.
   FitProblem(model::Model model, solve::SteppingOptions stepping, std::vector<MeasuredStep> targets,
              std::vector<Parameter> parameters, FitOptions options,
              std::vector<ForceCurve> force_curves, std::vector<BlockMaker> more_blocks = {});
-  ~FitProblem();
+  ~FitProblem() override;
   // The blocks refer to the problem's members: it stays where it was made.
   FitProblem(const FitProblem&) = delete;
   FitProblem& operator=(const FitProblem&) = delete;
@@ -50,10 +51,11 @@ class FitProblem {
   const model::Model& model() const { return model_; }
   const solve::SteppingOptions& stepping() const { return stepping_; }
   const ParameterMap& parameters() const { return map_; }
+  const Variables& variables() const override { return map_; }
   const FitOptions& options() const { return options_; }
-  bool analytic_jacobian() const { return analytic_; }
-  bool warm_starts() const { return warm_starts_; }
-  int num_residuals() const { return residuals_; }
+  bool analytic_jacobian() const override { return analytic_; }
+  bool warm_starts() const override { return warm_starts_; }
+  int num_residuals() const override { return residuals_; }
   int num_counted_vertices() const { return static_cast<int>(counted_.size()); }
   double body_length() const { return length_; }
   const std::vector<ForceCurve>& force_curves() const { return curves_; }
@@ -62,7 +64,7 @@ class FitProblem {
   // Calibration::evaluate: the residuals at phi, the final state solved from
   // `warm_start` where the problem takes warm starts.
   Evaluation evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
-                      const Eigen::VectorXd& warm_start) const;
+                      const Eigen::VectorXd& warm_start) const override;
   // The residuals (with_jacobian: and their Jacobian) at phi, run with these
   // stepping options (a warm start in them is used as given);
   // keep_path_states: a failed run's Evaluation::path_states (near_a_halving).

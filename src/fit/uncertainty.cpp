@@ -13,7 +13,7 @@
 
 namespace fiberfluid::fit {
 
-void describe_bounds(const ParameterMap& map, const Eigen::VectorXd& phi, bool with_correlation,
+void describe_bounds(const Variables& map, const Eigen::VectorXd& phi, bool with_correlation,
                      FitResult& result) {
   const int P = map.size();
   const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
@@ -38,7 +38,7 @@ void describe_bounds(const ParameterMap& map, const Eigen::VectorXd& phi, bool w
   }
 }
 
-void describe_estimates(const ParameterMap& map, const Eigen::VectorXd& phi,
+void describe_estimates(const Variables& map, const Eigen::VectorXd& phi,
                         const Eigen::MatrixXd& covariance, double variance, FitResult& result) {
   const int P = map.size();
   const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();

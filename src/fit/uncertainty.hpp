@@ -19,14 +19,14 @@ class EvaluationCache;
 
 // The parameters on a bound at phi, into FitResult::at_bounds and
 // status_detail (with_correlation: each with its strongest correlation).
-void describe_bounds(const ParameterMap& map, const Eigen::VectorXd& phi, bool with_correlation,
+void describe_bounds(const Variables& map, const Eigen::VectorXd& phi, bool with_correlation,
                      FitResult& result);
 
 // From the covariance of phi (unscaled) and the residual variance: the
 // correlations, the bounds again with them, and for every parameter off its
 // bounds the standard error and the linearised 95% interval (in log scale
 // for a log-scaled parameter, so that it stays positive).
-void describe_estimates(const ParameterMap& map, const Eigen::VectorXd& phi,
+void describe_estimates(const Variables& map, const Eigen::VectorXd& phi,
                         const Eigen::MatrixXd& covariance, double variance, FitResult& result);
 
 // The linearised 95% intervals' ends checked on the profile likelihood: an

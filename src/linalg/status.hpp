@@ -1,17 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
+// The linear-algebra floor's steps report the project's Status (util/status.hpp).
 
-#include <string>
-#include <utility>
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::linalg {
-
-// The outcome of a numerical step that can fail on valid input (a matrix
-// that is not positive definite, no convergence): a status and a message.
-struct Status {
-  bool ok = true;
-  std::string message;
-  static Status failure(std::string why) { return {false, std::move(why)}; }
-};
-
+using fiberfluid::Status;
 }  // namespace fiberfluid::linalg

@@ -57,32 +57,34 @@ std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min
   return selected;
 }
 
-std::string singular_setup_reason(const Model& model) {
+Status check_not_singular(const Model& model) {
   if (model.constraints.empty())
-    return "no supports: nothing holds the body, so rigid motion makes the system singular; "
-           "fix some vertices";
+    return Status::failure(
+        "no supports: nothing holds the body, so rigid motion makes the system singular; "
+        "fix some vertices");
   std::set<int> held;
   for (const Constraint& c : model.constraints) held.insert(model.dof(c.vertex, c.axis));
   if (static_cast<int>(held.size()) == model.dim() * model.num_vertices())
-    return "the supports fix every vertex on every axis: nothing is left free to deform "
-           "(select fewer vertices)";
+    return Status::failure(
+        "the supports fix every vertex on every axis: nothing is left free to deform "
+        "(select fewer vertices)");
   const char* names = "xyz";
   for (int a = 0; a < model.dim(); ++a) {
     const bool held = std::any_of(model.constraints.begin(), model.constraints.end(),
                                   [a](const Constraint& c) { return c.axis == a; }) ||
-                      std::any_of(model.paddles.begin(), model.paddles.end(),
-                                  [&](const Paddle& p) {
-                                    return p.axis == a && !touching_at_start(model, p).empty();
-                                  });
+                      std::any_of(model.paddles.begin(), model.paddles.end(), [&](const Paddle& p) {
+                        return p.axis == a && !touching_at_start(model, p).empty();
+                      });
     if (!held)
-      return std::string("no support along ") + names[a] + ": the body can translate along " +
-             names[a] + ", so the system is singular (a support, or a paddle on " + names[a] +
-             " touching the body at its start, holds it)";
+      return Status::failure(std::string("no support along ") + names[a] +
+                             ": the body can translate along " + names[a] +
+                             ", so the system is singular (a support, or a paddle on " + names[a] +
+                             " touching the body at its start, holds it)");
     // Zero stiffness is singular; a negative one is left to the solvers,
     // which report a matrix that is not positive definite.
     if (model.material.young_modulus()[a] == 0.0 && model.material.surface_tension == 0.0)
-      return std::string("no stiffness along ") + names[a] +
-             ": Y and gamma are both zero, so the system is singular";
+      return Status::failure(std::string("no stiffness along ") + names[a] +
+                             ": Y and gamma are both zero, so the system is singular");
   }
   return {};
 }

@@ -7,6 +7,7 @@
 
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/util/names.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::model {
 
@@ -39,12 +40,12 @@ std::vector<int> select_box(const Eigen::MatrixXd& X, const Eigen::VectorXd& min
 double held_value(const Model& model, const Constraint& constraint, int step, int steps);
 
 // ---------------------------------------------------------------- checking
-// Empty when the constraints remove rigid motion; otherwise why the system
-// is singular (e.g. no axis-x constraint: the body can translate along x).
+// Whether the constraints remove rigid motion; if not, the message says why
+// the system is singular (e.g. no axis-x constraint: the body can translate along x).
 // A paddle on an axis that no support holds counts when it touches the body
 // at its start: its contact then holds the body along its axis from the
 // first iterate (a body resting on a floor).
-std::string singular_setup_reason(const Model& model);
+Status check_not_singular(const Model& model);
 
 // The vertices a paddle touches before the first step: on its starting
 // plane, within a billionth of the body's diagonal.

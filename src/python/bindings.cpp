@@ -24,6 +24,7 @@
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
+#include "fiberfluid/model/report_names.hpp"
 #include "fiberfluid/solve/newton/interactive_stepper.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/run_control.hpp"
@@ -88,9 +89,7 @@ py::dict steps_dict(const ff::experiment::Case& c, const ff::solve::SteppingSumm
   out["load_factors"] = load_factors;
   py::dict reaction_dict;
   for (size_t g = 0; g < groups; ++g)
-    reaction_dict[py::str(g < c.model.constraint_groups.size() ? c.model.constraint_groups[g]
-                                                               : std::string("supports"))] =
-        reactions[g];
+    reaction_dict[py::str(ff::model::constraint_group_name(c.model, g))] = reactions[g];
   out["reactions"] = reaction_dict;
   return out;
 }
@@ -203,8 +202,8 @@ ff::fit::ForceCurve force_curve_from(const py::dict& t, const std::string& label
     if (!std::isfinite(x)) throw ff::InputError(label + ": a travel or step is not finite");
   for (const double x : curve.force)
     if (!std::isfinite(x)) throw ff::InputError(label + ": a force is not finite");
-  const std::string why = ff::fit::force_curve_problem(curve, model);
-  if (!why.empty()) throw ff::InputError(label + ": " + why);
+  if (const ff::Status usable = ff::fit::check_force_curve(curve, model); !usable.ok)
+    throw ff::InputError(label + ": " + usable.message);
   return curve;
 }
 

@@ -85,8 +85,7 @@ SteppingSummary solve_incremental_steps(const model::Model& model, const Steppin
   const Clock::time_point start = Clock::now();
   SteppingSummary summary = empty_summary(model, Scheme::Incremental);
   auto fail = [&](const std::string& why) { return failed(summary, why, start); };
-  std::string why = setup_problem(model, options);
-  if (!why.empty()) return fail(why);
+  if (const Status setup = check_setup(model, options); !setup.ok) return fail(setup.message);
   if (!model.paddles.empty())
     return fail(
         "paddles need the Newton scheme (stepping.scheme \"newton\"): contact is an "
@@ -171,9 +170,10 @@ SteppingSummary solve_incremental_steps(const model::Model& model, const Steppin
     summary.unknowns += dx;
     const Eigen::MatrixXd X_now = model::positions(model, summary.unknowns);
     const double volume = geom::enclosed_volume(X_now, model.surface.F);
-    why = runaway_reason(model, options, summary.unknowns, X_now, volume, reference_volume,
-                         last_face_areas);
-    if (!why.empty()) return fail("step " + std::to_string(k) + ": runaway: " + why);
+    if (const Status state = check_no_runaway(model, options, summary.unknowns, X_now, volume,
+                                              reference_volume, last_face_areas);
+        !state.ok)
+      return fail("step " + std::to_string(k) + ": runaway: " + state.message);
 
     reactions->add_step(*system, dx, dB);
     for (int a = 0; a < model.dim(); ++a) applied[a] += dB.segment(a * nv, nv).sum();

@@ -14,6 +14,7 @@
 #include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/solve/linear_solver.hpp"
 #include "fiberfluid/util/names.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::solve {
 
@@ -49,15 +50,7 @@ inline constexpr auto kTangentSolverNames =
                              {TangentSolver::Sparse, "sparse"},
                              {TangentSolver::Reused, "reused"}});
 inline const char* to_string(TangentSolver solver) { return kTangentSolverNames.name(solver); }
-// What `requested` means for a Newton run with `reduced_unknowns` (the
-// unknowns left after the supports): Auto is dense up to 600 then Krylov
-// for the vector spring. Central fibers, whose tangent the secant
-// preconditioner fits poorly, up to 50,000 unknowns: dense up to 600; then
-// stored as neighbour lists (`sparse_fibers`, a horizon) the sparse LU up to
-// 4,000 and the reused sparse LU above; else the reused dense LU (20 GB at
-// 50,000). Above 50,000, Krylov.
-TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
-                             model::FiberKinematics kinematics, bool sparse_fibers);
+// choose_tangent (what Auto means for a run) is in solve/tangent/tangent_solve.hpp.
 
 struct NewtonOptions {
   // Converged when the relative residual (force rows over the largest of the
@@ -127,7 +120,7 @@ struct SteppingOptions {
   // step alone (SteppingSummary::warm_started); where the piece fails, the
   // path is walked from the unloaded start as usual. Only where the end of
   // the path does not depend on the way there: load control, no sticking
-  // paddle (warm_start_problem). Empty: walk the path.
+  // paddle (check_warm_start). Empty: walk the path.
   Eigen::VectorXd warm_start;
 
   bool IsValid(std::string* why) const;
@@ -248,22 +241,22 @@ using StepObserver = std::function<void(const StepRecord&, const Eigen::VectorXd
 SteppingSummary solve_load_steps(const model::Model& model, const SteppingOptions& options,
                                  const StepObserver& observer = {});
 
-// "" when the model's treecode product (Model::treecode_tolerance) can run
+// Whether the model's treecode product (Model::treecode_tolerance) can run
 // with these options, else why not: it approximates the incremental scheme's
 // linear product, needs the constant law and the matrix-free pcg solver.
 // solve_load_steps checks it, so every entry point (JSON, C++, Python) gets
 // the same message.
-std::string treecode_problem(const model::Model& model, const SteppingOptions& options);
+Status check_treecode(const model::Model& model, const SteppingOptions& options);
 
-// "" when the material's fiber kinematics can run with these options, else
+// Whether the material's fiber kinematics can run with these options, else
 // why not: every kinematics but the paper's vector spring needs the Newton
 // scheme (the incremental scheme's matrix is the vector spring's).
-std::string kinematics_problem(const model::Model& model, const SteppingOptions& options);
+Status check_kinematics(const model::Model& model, const SteppingOptions& options);
 
-// "" when the model's support terms (mirror layers, model::MirrorLayer, and
+// Whether the model's support terms (mirror layers, model::MirrorLayer, and
 // split edges, model::HeldEdge) can run with these options, else why not:
 // they need the Newton scheme.
-std::string support_terms_problem(const model::Model& model, const SteppingOptions& options);
+Status check_support_terms(const model::Model& model, const SteppingOptions& options);
 
 // The backend SolverKind::Auto runs: pcg with the treecode, else
 // choose_solver's rule by size (the largest axis block, the distinct factors).

@@ -14,11 +14,12 @@
 
 namespace fiberfluid::solve {
 
-// Why the state reached after a step is a runaway rather than a result, or "".
-std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
-                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
-                           double reference_volume, Eigen::MatrixXd& last_face_areas) {
-  if (!unknowns.allFinite()) return "the solution (displacements or pressure) is not finite";
+// Whether the state reached after a step is a result, not a runaway (why not).
+Status check_no_runaway(const model::Model& model, const SteppingOptions& options,
+                        const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
+                        double reference_volume, Eigen::MatrixXd& last_face_areas) {
+  if (!unknowns.allFinite())
+    return Status::failure("the solution (displacements or pressure) is not finite");
   if (options.stop_on_inverted_faces) {
     // Against the last accepted step, not the reference: only a fold since
     // then stops the run, not a body that rotated far (find_fold).
@@ -27,13 +28,14 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
     if (const auto fold = geom::find_fold(now, last_face_areas)) {
       const std::string face = "face " + std::to_string(fold->face) + " turned over ";
       if (!fold->crossing)
-        return face +
-               "(its normal reversed against its neighbours'): the load is too large for "
-               "the material";
-      return face + "and the surface passes through itself (faces " +
-             std::to_string(fold->crossing->first) + " and " +
-             std::to_string(fold->crossing->second) +
-             " cross): the load is too large for the material";
+        return Status::failure(
+            face +
+            "(its normal reversed against its neighbours'): the load is too large for "
+            "the material");
+      return Status::failure(face + "and the surface passes through itself (faces " +
+                             std::to_string(fold->crossing->first) + " and " +
+                             std::to_string(fold->crossing->second) +
+                             " cross): the load is too large for the material");
     }
     last_face_areas = geom::face_area_vectors(X, model.surface.F);
   }
@@ -43,44 +45,49 @@ std::string runaway_reason(const model::Model& model, const SteppingOptions& opt
     out << "the enclosed volume changed by " << 100.0 * change << "% (limit "
         << 100.0 * options.max_volume_change
         << "%, stepping.max_volume_change): the load is too large for the material";
-    return out.str();
+    return Status::failure(out.str());
   }
   return {};
 }
 
-std::string treecode_problem(const model::Model& model, const SteppingOptions& options) {
+Status check_treecode(const model::Model& model, const SteppingOptions& options) {
   if (!(model.treecode_tolerance > 0.0)) return {};
   const std::string what = "the treecode product (treecode_tolerance) ";
   if (!(model.treecode_tolerance >= 1e-10 && model.treecode_tolerance <= 1e-2))
-    return what + "takes a relative error from 1e-10 to 1e-2, got " +
-           std::to_string(model.treecode_tolerance);
+    return Status::failure(what + "takes a relative error from 1e-10 to 1e-2, got " +
+                           std::to_string(model.treecode_tolerance));
   if (options.scheme != Scheme::Incremental)
-    return what +
-           "approximates the incremental scheme's linear product; Newton's tangent is "
-           "exact (the incremental scheme)";
-  if (!model.material.law.is_constant()) return what + "needs a linear material (a constant law)";
+    return Status::failure(
+        what +
+        "approximates the incremental scheme's linear product; Newton's tangent is "
+        "exact (the incremental scheme)");
+  if (!model.material.law.is_constant())
+    return Status::failure(what + "needs a linear material (a constant law)");
   if (options.solver != SolverKind::Auto && options.solver != SolverKind::PCG)
-    return what + "is matrix-free: it goes with the pcg solver, not " +
-           std::string(to_string(options.solver));
+    return Status::failure(what + "is matrix-free: it goes with the pcg solver, not " +
+                           std::string(to_string(options.solver)));
   return {};
 }
 
-std::string kinematics_problem(const model::Model& model, const SteppingOptions& options) {
+Status check_kinematics(const model::Model& model, const SteppingOptions& options) {
   const model::FiberKinematics k = model.material.kinematics;
   if (k == model::FiberKinematics::VectorSpring || options.scheme == Scheme::Newton) return {};
-  return std::string("the ") + model::kinematics_name(k) +
-         " fiber kinematics needs the Newton scheme (stepping.scheme \"newton\"): the "
-         "incremental scheme's matrix is the paper's vector spring";
+  return Status::failure(
+      std::string("the ") + model::kinematics_name(k) +
+      " fiber kinematics needs the Newton scheme (stepping.scheme \"newton\"): the "
+      "incremental scheme's matrix is the paper's vector spring");
 }
 
-std::string support_terms_problem(const model::Model& model, const SteppingOptions& options) {
+Status check_support_terms(const model::Model& model, const SteppingOptions& options) {
   if (options.scheme == Scheme::Newton) return {};
   if (!model.mirror_layers.empty())
-    return "a support's mirror layer needs the Newton scheme (stepping.scheme \"newton\"): the "
-           "incremental scheme's matrix has no layer fibers";
+    return Status::failure(
+        "a support's mirror layer needs the Newton scheme (stepping.scheme \"newton\"): the "
+        "incremental scheme's matrix has no layer fibers");
   if (!model.held_edges.empty())
-    return "a support's split edge needs the Newton scheme (stepping.scheme \"newton\"): the "
-           "incremental scheme's matrix has no edge fibers";
+    return Status::failure(
+        "a support's split edge needs the Newton scheme (stepping.scheme \"newton\"): the "
+        "incremental scheme's matrix has no edge fibers");
   return {};
 }
 
@@ -92,16 +99,13 @@ SolverKind automatic_solver(const model::Model& model, double largest_block, int
   return choose_solver(largest_block, factors, budget_bytes);
 }
 
-std::string setup_problem(const model::Model& model, const SteppingOptions& options) {
+Status check_setup(const model::Model& model, const SteppingOptions& options) {
   std::string why;
-  if (!options.IsValid(&why)) return why;
-  why = treecode_problem(model, options);
-  if (!why.empty()) return why;
-  why = kinematics_problem(model, options);
-  if (!why.empty()) return why;
-  why = support_terms_problem(model, options);
-  if (!why.empty()) return why;
-  return model::singular_setup_reason(model);
+  if (!options.IsValid(&why)) return Status::failure(why);
+  for (const Status& check : {check_treecode(model, options), check_kinematics(model, options),
+                              check_support_terms(model, options)})
+    if (!check.ok) return check;
+  return model::check_not_singular(model);
 }
 
 bool SteppingOptions::IsValid(std::string* why) const {
@@ -133,32 +137,6 @@ bool NewtonOptions::IsValid(std::string* why) const {
       max_contact_rounds < 1)
     return *why = "newton iteration limits must be at least 1 (max_step_cuts at least 0)", false;
   return true;
-}
-
-TangentSolver choose_tangent(TangentSolver requested, int reduced_unknowns,
-                             model::FiberKinematics kinematics, bool sparse_fibers) {
-  if (requested != TangentSolver::Auto) return requested;
-  // The vector spring's own secant preconditioner fits its tangent at any size.
-  if (kinematics == model::FiberKinematics::VectorSpring)
-    return reduced_unknowns <= 600 ? TangentSolver::Dense : TangentSolver::Krylov;
-  // Krylov's secant preconditioner is far from a central tangent (GMRES
-  // stalls once contact and large rotations couple the axes). Where the
-  // fibers are many (every pair, or a horizon that keeps more than an eighth
-  // of them), one dense LU of the tangent preconditions GMRES on the exact
-  // tangent over many iterations and steps: above 600 unknowns that beats an
-  // LU per iteration (issue 42: a bending phantom of 1,418 vertices in 10 s
-  // with one LU, against 70 s with 34).
-  if (reduced_unknowns > 50000) return TangentSolver::Krylov;
-  if (reduced_unknowns <= 600) return TangentSolver::Dense;
-  if (!sparse_fibers) return TangentSolver::Reused;
-  // A horizon's lists: the tangent has N times the neighbours entries, and
-  // its sparse LU beats the dense one above 600 unknowns (2,600: 0.3 s an
-  // iteration against 0.8 s). Reusing that LU pays once its factorisation
-  // outweighs GMRES's products (6,000 unknowns: 1.4 s a factorisation; the
-  // reuse 2.6 times faster at small strains, 1.2 times on a cylinder bending
-  // under its weight), not below (a bar of 729 unknowns bent to 37%: 2.3
-  // times slower). docs/model.md, the table of `auto`.
-  return reduced_unknowns <= 4000 ? TangentSolver::Sparse : TangentSolver::Reused;
 }
 
 std::string SteppingSummary::BriefReport() const {

@@ -14,6 +14,7 @@
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/stepping.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::solve {
 
@@ -39,17 +40,17 @@ inline SteppingSummary failed(SteppingSummary& summary, const std::string& why,
   return summary;
 }
 
-// Why the run cannot start, or "": invalid options, or a singular setup.
-std::string setup_problem(const model::Model& model, const SteppingOptions& options);
+// Whether the run can start (why not): invalid options, or a singular setup.
+Status check_setup(const model::Model& model, const SteppingOptions& options);
 
-// Why the state reached after a step is a runaway rather than a result, or
-// "": non-finite unknowns, a fold since the last accepted step (a face whose
+// Whether the state reached after a step is a result, not a runaway (why
+// not): non-finite unknowns, a fold since the last accepted step (a face whose
 // normal reversed and now faces against its neighbours, or a surface that
 // crosses itself; last_face_areas, the face area vectors then: updated when
 // the faces pass), a volume change beyond options.max_volume_change.
-std::string runaway_reason(const model::Model& model, const SteppingOptions& options,
-                           const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
-                           double reference_volume, Eigen::MatrixXd& last_face_areas);
+Status check_no_runaway(const model::Model& model, const SteppingOptions& options,
+                        const Eigen::VectorXd& unknowns, const Eigen::MatrixXd& X, double volume,
+                        double reference_volume, Eigen::MatrixXd& last_face_areas);
 
 // How far a state is from equilibrium, relative (Equilibrium::relative_norm):
 // the free rows of R over a force scale, the volume row over dim C0 V0. The

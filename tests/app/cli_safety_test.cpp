@@ -97,7 +97,7 @@ TEST(NamesAreRefusedWhenTheFileIsRead, EveryNameAResultWritesAtItsTopIsReserved)
     for (const fs::directory_entry& entry : fs::directory_iterator(dir.path() / result)) {
       const std::string name = entry.path().filename().string();
       if (std::string(result) == "sweep" && (name == "soft" || name == "stiff")) continue;
-      EXPECT_FALSE(experiment::reserved_name_problem(name).empty())
+      EXPECT_FALSE(experiment::check_not_reserved(name).ok)
           << result << "/" << name << " is written but not reserved";
       ++seen;
     }

@@ -12,7 +12,7 @@
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/solve/stepping.hpp"
-#include "fiberfluid/solve/tangent_solve.hpp"
+#include "fiberfluid/solve/tangent/tangent_solve.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid {

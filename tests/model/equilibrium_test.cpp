@@ -260,7 +260,8 @@ TEST(Equilibrium, TangentMatchesCentralDifferencesIn2D) {
     const Eigen::VectorXd v = random_state(m, 6, 1.0);
     const Eigen::VectorXd Jv = eq.tangent(x, factors) * v;
     EXPECT_LT((eq.tangent_product(x, factors, v) - Jv).norm(), 1e-10 * Jv.norm());
-    EXPECT_TRUE(stored_product_matches(eq.linearize(x, factors).apply(v), eq.tangent(x, factors), v));
+    EXPECT_TRUE(
+        stored_product_matches(eq.linearize(x, factors).apply(v), eq.tangent(x, factors), v));
   }
 }
 

@@ -68,7 +68,8 @@ TEST(FiberLaw, TheVectorExponentialIsWithinTwoUlp) {
 // A law's block evaluation (the kernels') gives its pointwise values.
 TEST(FiberLaw, TheBlockEvaluationGivesThePointwiseValues) {
   const std::vector<FiberLaw> laws = {
-      FiberLaw::exponential(2000.0, 5.0), FiberLaw::exponential(1500.0, -3.0),
+      FiberLaw::exponential(2000.0, 5.0),
+      FiberLaw::exponential(1500.0, -3.0),
       FiberLaw::bilinear(3000.0, 1000.0),
       FiberLaw::tabulated({-0.2, 0.0, 0.1, 0.3}, {-200.0, 0.0, 100.0, 500.0}),
       FiberLaw::tabulated({-0.5, -0.3, -0.1, 0.0, 0.05, 0.2, 0.4, 0.8},
@@ -77,8 +78,8 @@ TEST(FiberLaw, TheBlockEvaluationGivesThePointwiseValues) {
   std::vector<double> strain;
   for (int k = 0; k <= 400; ++k) strain.push_back(-0.9 + k * 0.007);
   // On the breakpoints (a segment starts there) and on both sides of the blend's ends.
-  for (double e : {-0.5, -0.3, -0.2, -0.1, 0.0, 0.05, 0.1, 0.2, 0.25, 0.3, 0.4, 0.8, -0.005,
-                   0.005, std::nextafter(0.005, 0.0), std::nextafter(-0.005, 0.0)})
+  for (double e : {-0.5, -0.3, -0.2, -0.1, 0.0, 0.05, 0.1, 0.2, 0.25, 0.3, 0.4, 0.8, -0.005, 0.005,
+                   std::nextafter(0.005, 0.0), std::nextafter(-0.005, 0.0)})
     strain.push_back(e);
   strain.resize(700, 0.123);  // past one block of 256 values, and a partial one
   for (const FiberLaw& law : laws) {

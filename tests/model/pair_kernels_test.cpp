@@ -202,8 +202,8 @@ TEST(DeformedPairs, MatchTheStencilPairByPair) {
       if (i == j) continue;
       const int low = std::min(i, j), high = std::max(i, j);
       const Eigen::RowVector3d v = W.row(i) - W.row(j), d = U.row(i) - U.row(j);
-      rounded.row(i) += double(f1(high, low)) * v +
-                        double(f2(high, low)) * (X.row(i) - X.row(j)).dot(v) * d;
+      rounded.row(i) +=
+          double(f1(high, low)) * v + double(f2(high, low)) * (X.row(i) - X.row(j)).dot(v) * d;
     }
   const Eigen::MatrixXd stored =
       stored_tangent_product(FiberKinematics::VectorSpring, X, U, f1, f2, W);

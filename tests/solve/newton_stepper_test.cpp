@@ -12,7 +12,7 @@
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/solve/stepping.hpp"
-#include "fiberfluid/solve/tangent_solve.hpp"
+#include "fiberfluid/solve/tangent/tangent_solve.hpp"
 #include "model/model_fixtures.hpp"
 
 namespace fiberfluid::solve {
@@ -128,23 +128,23 @@ TEST(Newton, ContactsHeldByCapacitanceGiveTheirOwnFactorisationsPreconditioner) 
   for (SolverKind preconditioner : {SolverKind::BlockCholesky, SolverKind::Cholmod}) {
     SteppingOptions o = newton(1, TangentSolver::Krylov);
     o.solver = preconditioner;
-    TangentSolve corrected(equilibrium, o, TangentSolver::Krylov);
-    TangentSolve factored(equilibrium, o, TangentSolver::Krylov);
-    ASSERT_TRUE(corrected.prepare(x, factors, held, &supports).ok);
-    ASSERT_TRUE(factored.prepare(x, factors, held, nullptr).ok);
+    const auto corrected = make_tangent_solve(equilibrium, o, TangentSolver::Krylov);
+    const auto factored = make_tangent_solve(equilibrium, o, TangentSolver::Krylov);
+    ASSERT_TRUE(corrected->prepare(x, factors, held, &supports).ok);
+    ASSERT_TRUE(factored->prepare(x, factors, held, nullptr).ok);
     Eigen::VectorXd y_corrected, y_factored;
     int corrected_iterations = 0, factored_iterations = 0;
-    ASSERT_TRUE(corrected.solve(b, 1e-10, &y_corrected, &corrected_iterations).ok);
-    ASSERT_TRUE(factored.solve(b, 1e-10, &y_factored, &factored_iterations).ok);
+    ASSERT_TRUE(corrected->solve(b, 1e-10, &y_corrected, &corrected_iterations).ok);
+    ASSERT_TRUE(factored->solve(b, 1e-10, &y_factored, &factored_iterations).ok);
     EXPECT_EQ(corrected_iterations, factored_iterations) << to_string(preconditioner);
     EXPECT_LT((y_corrected - y_factored).norm(), 1e-8 * y_factored.norm());
-    EXPECT_EQ(corrected.factorizations(), 1);
+    EXPECT_EQ(corrected->factorizations(), 1);
   }
   // Held sets that wander (100 unknowns at a time, 700 in all: the cache of
   // solves drops those no longer held) keep the correction exact.
   SteppingOptions o = newton(1, TangentSolver::Krylov);
   o.solver = SolverKind::BlockCholesky;
-  TangentSolve wandering(equilibrium, o, TangentSolver::Krylov);
+  const auto wandering = make_tangent_solve(equilibrium, o, TangentSolver::Krylov);
   std::vector<int> free_dofs;
   for (int d = 0; d < 3 * m.num_vertices(); ++d)
     if (!supports.held(d)) free_dofs.push_back(d);
@@ -154,17 +154,17 @@ TEST(Newton, ContactsHeldByCapacitanceGiveTheirOwnFactorisationsPreconditioner) 
     for (size_t k = 0; k < 100; ++k) set.push_back(free_dofs[(start + k) % free_dofs.size()]);
     const model::DofMap moved = supports.with_held(set);
     const Eigen::VectorXd c = Eigen::VectorXd::Random(moved.num_reduced());
-    ASSERT_TRUE(wandering.prepare(x, factors, moved, &supports).ok);
-    TangentSolve factored(equilibrium, o, TangentSolver::Krylov);
-    ASSERT_TRUE(factored.prepare(x, factors, moved, nullptr).ok);
+    ASSERT_TRUE(wandering->prepare(x, factors, moved, &supports).ok);
+    const auto factored = make_tangent_solve(equilibrium, o, TangentSolver::Krylov);
+    ASSERT_TRUE(factored->prepare(x, factors, moved, nullptr).ok);
     Eigen::VectorXd y_wandering, y_factored;
     int wandering_iterations = 0, factored_iterations = 0;
-    ASSERT_TRUE(wandering.solve(c, 1e-10, &y_wandering, &wandering_iterations).ok);
-    ASSERT_TRUE(factored.solve(c, 1e-10, &y_factored, &factored_iterations).ok);
+    ASSERT_TRUE(wandering->solve(c, 1e-10, &y_wandering, &wandering_iterations).ok);
+    ASSERT_TRUE(factored->solve(c, 1e-10, &y_factored, &factored_iterations).ok);
     EXPECT_EQ(wandering_iterations, factored_iterations) << start;
     EXPECT_LT((y_wandering - y_factored).norm(), 1e-8 * y_factored.norm()) << start;
   }
-  EXPECT_EQ(wandering.factorizations(), 1);
+  EXPECT_EQ(wandering->factorizations(), 1);
 }
 
 // Issue 25: the line search's residual stores the tangent at its trial, which

@@ -346,22 +346,22 @@ FiberSpec read_fibers(Fields& root) {
   return spec;
 }
 
-// The treecode's rules are the library's (solve::treecode_problem): the
+// The treecode's rules are the library's (solve::check_treecode): the
 // reader names the field.
 void check_treecode(Fields& root, const CaseSpec& c) {
   model::Model probe;
   probe.material = c.material.material;
   probe.treecode_tolerance = c.fibers.treecode_tolerance;
-  const std::string why = solve::treecode_problem(probe, c.stepping);
-  if (!why.empty()) root.fail("fibers", "\"product\": \"treecode\": " + why);
+  if (const Status usable = solve::check_treecode(probe, c.stepping); !usable.ok)
+    root.fail("fibers", "\"product\": \"treecode\": " + usable.message);
 }
 
-// The kinematics' rules are the library's (solve::kinematics_problem).
+// The kinematics' rules are the library's (solve::check_kinematics).
 void check_kinematics(Fields& root, const CaseSpec& c) {
   model::Model probe;
   probe.material.kinematics = c.fibers.kinematics;
-  const std::string why = solve::kinematics_problem(probe, c.stepping);
-  if (!why.empty()) root.fail("fibers", "\"kinematics\": " + why);
+  if (const Status usable = solve::check_kinematics(probe, c.stepping); !usable.ok)
+    root.fail("fibers", "\"kinematics\": " + usable.message);
 }
 
 }  // namespace

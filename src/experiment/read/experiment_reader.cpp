@@ -62,10 +62,10 @@ const char* const kExperimentFields[] = {"name",     "description",   "kind",
 
 void check_variant_name(const Fields& f, const std::string& name,
                         const std::vector<CaseSpec>& earlier) {
-  if (const std::string problem = folder_name_problem(name); !problem.empty())
-    f.fail("name", "expected " + problem);
-  if (const std::string problem = reserved_name_problem(name); !problem.empty())
-    f.fail("name", "expected " + problem);
+  if (const Status problem = check_folder_name(name); !problem.ok)
+    f.fail("name", "expected " + problem.message);
+  if (const Status problem = check_not_reserved(name); !problem.ok)
+    f.fail("name", "expected " + problem.message);
   for (const CaseSpec& c : earlier)
     if (c.variant == name) f.fail("name", "\"" + name + "\" names another variant already");
 }
@@ -139,10 +139,10 @@ CalibrationSpec read_calibration(Fields& root, const std::filesystem::path& fold
     SpecimenSpec specimen;
     specimen.field = f.field();
     specimen.name = f.string("name");
-    if (const std::string problem = folder_name_problem(specimen.name); !problem.empty())
-      f.fail("name", "expected " + problem);
-    if (const std::string problem = reserved_name_problem(specimen.name); !problem.empty())
-      f.fail("name", "expected " + problem);
+    if (const Status problem = check_folder_name(specimen.name); !problem.ok)
+      f.fail("name", "expected " + problem.message);
+    if (const Status problem = check_not_reserved(specimen.name); !problem.ok)
+      f.fail("name", "expected " + problem.message);
     for (const SpecimenSpec& other : spec.specimens)
       if (other.name == specimen.name)
         f.fail("name", "\"" + specimen.name + "\" names another specimen");
@@ -175,8 +175,9 @@ void read_areas(Fields& root, const std::filesystem::path& folder, Experiment& e
 // once its parameters are checked: setup_fit).
 void check_expected_names(const Fields& root, const Experiment& ex) {
   for (size_t k = 0; k < ex.expected.size(); ++k) {
-    const std::string problem = figure_problem(ex, ex.expected[k].figure, /*fit_figures=*/false);
-    if (!problem.empty()) root.fail("expected[" + std::to_string(k) + "].figure", problem);
+    if (const Status figure = check_figure(ex, ex.expected[k].figure, /*fit_figures=*/false);
+        !figure.ok)
+      root.fail("expected[" + std::to_string(k) + "].figure", figure.message);
   }
 }
 
@@ -190,8 +191,8 @@ Experiment read_experiment(const json& document, const std::filesystem::path& fo
   // An editor's pointer to the schema (`fiberfluid schema --help` suggests it): taken, unused.
   if (root.has("$schema")) root.string("$schema");
   ex.name = root.string("name", "experiment");
-  if (const std::string problem = folder_name_problem(ex.name); !problem.empty())
-    root.fail("name", "expected " + problem);
+  if (const Status problem = check_folder_name(ex.name); !problem.ok)
+    root.fail("name", "expected " + problem.message);
   ex.description = root.string("description", "");
   const Experiment::Kind kind =
       root.enumeration("kind", Experiment::Kind::Simulate, kExperimentKindNames);

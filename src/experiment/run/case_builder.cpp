@@ -385,8 +385,8 @@ class ModelBuilder {
     if (static_cast<int>(axes.size()) != dim_)
       spec.field.fail("edge", "a split edge holds every axis: leave \"axes\" out");
     c_.model.held_edges.push_back({group, vertices});
-    const std::string problem = solve::support_terms_problem(c_.model, c_.stepping);
-    if (!problem.empty()) spec.field.fail("edge", problem);
+    if (const Status usable = solve::check_support_terms(c_.model, c_.stepping); !usable.ok)
+      spec.field.fail("edge", usable.message);
   }
 
   // A clamp's mirror layer: a full clamp on a plane, as deep as the horizon.
@@ -403,8 +403,8 @@ class ModelBuilder {
     const std::string why = model::find_clamp_plane(c_.model.surface.V, vertices, &layer);
     if (!why.empty()) spec.field.fail("layer", "the support has no clamp plane: " + why);
     c_.model.mirror_layers.push_back(layer);
-    const std::string problem = solve::support_terms_problem(c_.model, c_.stepping);
-    if (!problem.empty()) spec.field.fail("layer", problem);
+    if (const Status usable = solve::check_support_terms(c_.model, c_.stepping); !usable.ok)
+      spec.field.fail("layer", usable.message);
   }
 
   model::Paddle paddle(const PaddleSpec& spec) const {
@@ -434,7 +434,7 @@ class ModelBuilder {
   // rotation moves most is held at zero (a gauge, in its own group "gauge",
   // whose reaction is zero at equilibrium) and a note says so. Where the
   // loads turn the body, no equilibrium exists: refused, naming the rotation.
-  // Free translations are singular_setup_reason's (solve/stepping_common).
+  // Free translations are check_not_singular's (solve/stepping_common).
   void hold_free_rotations() {
     model::Model& m = c_.model;
     if (spec_.stepping.scheme != solve::Scheme::Newton ||

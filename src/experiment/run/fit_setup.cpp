@@ -50,8 +50,8 @@ fit::ForceCurve force_curve(const FitForceSpec& spec, const Case& c) {
   curve.source = paddle ? fit::ForceCurve::Source::Paddle : fit::ForceCurve::Source::Support;
   curve.index = static_cast<int>(found - labels.begin());
   curve.axis = paddle ? c.model.paddles[static_cast<size_t>(curve.index)].axis : spec.axis;
-  const std::string why = fit::force_curve_problem(curve, c.model);
-  if (!why.empty()) spec.field.fail("", why);
+  if (const Status usable = fit::check_force_curve(curve, c.model); !usable.ok)
+    spec.field.fail("", usable.message);
   return curve;
 }
 
@@ -166,9 +166,9 @@ FitSetup setup_fit(const Experiment& ex,
   }
   // The fit's expected figures, now that its parameters are known good.
   for (size_t k = 0; k < ex.expected.size(); ++k) {
-    const std::string problem = figure_problem(ex, ex.expected[k].figure);
-    if (!problem.empty())
-      FieldName{spec.field.file, ""}.fail("expected[" + std::to_string(k) + "].figure", problem);
+    if (const Status figure = check_figure(ex, ex.expected[k].figure); !figure.ok)
+      FieldName{spec.field.file, ""}.fail("expected[" + std::to_string(k) + "].figure",
+                                          figure.message);
   }
   fit::FitOptions options = spec.options;
   options.progress = std::move(progress);
@@ -334,8 +334,8 @@ JointSetup setup_joint(const Experiment& ex,
     root.fail("shared", e.what());
   }
   for (size_t k = 0; k < ex.expected.size(); ++k)
-    if (const std::string problem = figure_problem(ex, ex.expected[k].figure); !problem.empty())
-      root.fail("expected[" + std::to_string(k) + "].figure", problem);
+    if (const Status figure = check_figure(ex, ex.expected[k].figure); !figure.ok)
+      root.fail("expected[" + std::to_string(k) + "].figure", figure.message);
   return setup;
 }
 

@@ -110,7 +110,7 @@ std::vector<std::string> calibration_figures(const Experiment& ex) {
   return names;
 }
 
-std::string figure_problem(const Experiment& ex, const std::string& figure, bool fit_figures) {
+Status check_figure(const Experiment& ex, const std::string& figure, bool fit_figures) {
   const bool fitted = ex.fit() || ex.kind() == Experiment::Kind::Calibration;
   if (!fit_figures && fitted && figure.rfind("fit.", 0) == 0) return {};
   std::vector<std::string> valid;
@@ -164,8 +164,8 @@ std::string figure_problem(const Experiment& ex, const std::string& figure, bool
   std::string names = listed(std::vector<std::string>(
       valid.begin(), valid.begin() + static_cast<long>(std::min(shown, valid.size()))));
   if (valid.size() > shown) names += ", ... (" + std::to_string(valid.size()) + " in all)";
-  return "no figure \"" + figure + "\" in this experiment (expected one of " + names +
-         "; README, \"Figures\", says what each is)";
+  return Status::failure("no figure \"" + figure + "\" in this experiment (expected one of " +
+                         names + "; README, \"Figures\", says what each is)");
 }
 
 }  // namespace fiberfluid::experiment

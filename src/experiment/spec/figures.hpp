@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::experiment {
 
@@ -25,13 +26,13 @@ std::vector<std::string> run_figure_names(const model::Model& model);
 // fit.SPECIMEN.distance_sd_share (and the other distance statistics).
 std::vector<std::string> calibration_figures(const Experiment& experiment);
 
-// "" when `figure` names a figure this experiment will have; else why not,
+// Whether `figure` names a figure this experiment will have; if not, why not,
 // with the valid names. Benchmarks name their figures after their solvers and
 // metrics: those are checked after the run only. Without `fit_figures` a
 // fit's figures ("fit.*") pass: the reader checks them once the fit's
 // parameters are known good (setup_fit), so that a misnamed parameter is
 // the error a user sees first.
-std::string figure_problem(const Experiment& experiment, const std::string& figure,
-                           bool fit_figures = true);
+Status check_figure(const Experiment& experiment, const std::string& figure,
+                    bool fit_figures = true);
 
 }  // namespace fiberfluid::experiment

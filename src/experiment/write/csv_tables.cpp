@@ -6,15 +6,13 @@
 
 #include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/report_names.hpp"
 
 namespace fiberfluid::experiment {
 namespace {
 
-const char kAxes[] = "xyz";
-
-std::string group_name(const model::Model& m, size_t g) {
-  return g < m.constraint_groups.size() ? m.constraint_groups[g] : "supports";
-}
+using model::axis_name;
+using model::constraint_group_name;
 
 // A CSV field: quoted when it holds a comma, a quote or a line break.
 std::string csv_field(const std::string& text) {
@@ -54,7 +52,7 @@ void paddle_headers(CsvTable& t, const model::Paddle& p, int dim, bool full) {
   t.header("paddle_" + p.label + "_travel_m");
   if (full) {
     t.header("paddle_" + p.label + "_plane_m");
-    for (int a = 0; a < dim; ++a) t.header("paddle_" + p.label + "_force_" + kAxes[a] + "_N");
+    for (int a = 0; a < dim; ++a) t.header("paddle_" + p.label + "_force_" + axis_name(a) + "_N");
     t.header("paddle_" + p.label + "_contacts");
   } else {
     t.header("paddle_" + p.label + "_force_N");
@@ -87,9 +85,10 @@ std::string steps_csv(const Case& c, const RunResult& run) {
   t.header("pressure_Pa");
   t.header(dim == 3 ? "volume_m3" : "area_m2");
   t.header("max_displacement_m");
-  for (int a = 0; a < dim; ++a) t.header(std::string("applied_force_") + kAxes[a] + "_N");
+  for (int a = 0; a < dim; ++a) t.header(std::string("applied_force_") + axis_name(a) + "_N");
   for (size_t g = 0; g < groups; ++g)
-    for (int a = 0; a < dim; ++a) t.header("reaction_" + group_name(m, g) + "_" + kAxes[a] + "_N");
+    for (int a = 0; a < dim; ++a)
+      t.header("reaction_" + constraint_group_name(m, g) + "_" + axis_name(a) + "_N");
   for (const model::Paddle& p : m.paddles) paddle_headers(t, p, dim, true);
   const bool newton = run.summary.scheme == solve::Scheme::Newton;
   if (newton)
@@ -157,10 +156,10 @@ std::string vertices_csv(const Case& c, const RunResult& run) {
           run.summary.reaction_forces.row(static_cast<Eigen::Index>(m));
   CsvTable t;
   t.header("vertex");
-  for (int a = 0; a < dim; ++a) t.header(std::string(1, kAxes[a]) + "_m");
-  for (int a = 0; a < dim; ++a) t.header(std::string("u") + kAxes[a] + "_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string(1, axis_name(a)) + "_m");
+  for (int a = 0; a < dim; ++a) t.header(std::string("u") + axis_name(a) + "_m");
   t.header("u_magnitude_m");
-  for (int a = 0; a < dim; ++a) t.header(std::string("reaction_") + kAxes[a] + "_N");
+  for (int a = 0; a < dim; ++a) t.header(std::string("reaction_") + axis_name(a) + "_N");
   t.end_row();
   for (Eigen::Index i = 0; i < S.rows(); ++i) {
     t.number(static_cast<double>(i));
@@ -188,7 +187,7 @@ std::string comparison_csv(const Experiment& ex, const ExperimentResult& result)
   const size_t groups = first.constraint_groups.size();
   for (size_t g = 0; g < groups; ++g)
     for (int a = 0; a < first.dim(); ++a)
-      t.header("reaction_" + group_name(first, g) + "_" + kAxes[a] + "_N");
+      t.header("reaction_" + constraint_group_name(first, g) + "_" + axis_name(a) + "_N");
   // Paddles at the end (those of the first case, by label): force along the axis, contacts.
   for (const model::Paddle& p : first.paddles) {
     t.header("paddle_" + p.label + "_force_N");

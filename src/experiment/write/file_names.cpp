@@ -18,7 +18,7 @@ const std::vector<std::string>& reserved_result_names() {
   return names;
 }
 
-std::string reserved_name_problem(const std::string& name) {
+Status check_not_reserved(const std::string& name) {
   const std::vector<std::string>& names = reserved_result_names();
   const auto numbered = [&](const fit_files::Numbered& form) {
     const std::string prefix = form.prefix, suffix = form.suffix;
@@ -28,10 +28,11 @@ std::string reserved_name_problem(const std::string& name) {
   const bool reserved =
       std::find(names.begin(), names.end(), name) != names.end() ||
       std::any_of(fit_files::kNumberedForms.begin(), fit_files::kNumberedForms.end(), numbered);
-  if (!reserved) return "";
-  return "a name that is not one of the result's own files (\"" + name +
-         "\" is written at the top of the result folder, beside the folder this name would "
-         "make)";
+  if (!reserved) return {};
+  return Status::failure(
+      "a name that is not one of the result's own files (\"" + name +
+      "\" is written at the top of the result folder, beside the folder this name would "
+      "make)");
 }
 
 }  // namespace fiberfluid::experiment

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "fiberfluid/util/status.hpp"
+
 namespace fiberfluid::experiment {
 
 // The files an OutputWriter writes: at the top of the folder, and per run
@@ -88,8 +90,8 @@ inline constexpr std::array<const char*, 4> kAll = {kMetrics, kReport, kReferenc
 // read, not after the run). Also fit_force_K.csv, fit_target_K.vtu and
 // fit_target_K_scan.obj for any K.
 const std::vector<std::string>& reserved_result_names();
-// Empty when `name` is no reserved result name; else what is wrong, to
-// follow "expected ...".
-std::string reserved_name_problem(const std::string& name);
+// Whether `name` is free of the reserved result names; if not, the message
+// says what was expected, to follow "expected ...".
+Status check_not_reserved(const std::string& name);
 
 }  // namespace fiberfluid::experiment

@@ -66,26 +66,28 @@ bool has_marker(const fs::path& folder) {
          marker.contains("version") && marker["version"].is_number_integer();
 }
 
-// Empty when `folder` may be replaced: absent, an empty folder, or one with
-// the marker; else why not.
-std::string replace_problem(const fs::path& folder) {
+// Whether `folder` may be replaced (why not): absent, an empty folder, or
+// one with the marker.
+Status may_be_replaced(const fs::path& folder) {
   std::error_code error;
   const fs::file_status status = fs::symlink_status(folder, error);
-  if (status.type() == fs::file_type::not_found) return "";
-  if (error) return "cannot be examined: " + error.message();
+  if (status.type() == fs::file_type::not_found) return {};
+  if (error) return Status::failure("cannot be examined: " + error.message());
   if (fs::is_symlink(status))
-    return "is a symbolic link (give the folder it points to, or another one, with -o)";
-  if (!fs::is_directory(status)) return "exists and is not a folder";
-  if (fs::is_empty(folder, error) || has_marker(folder)) return "";
+    return Status::failure(
+        "is a symbolic link (give the folder it points to, or another one, with -o)");
+  if (!fs::is_directory(status)) return Status::failure("exists and is not a folder");
+  if (fs::is_empty(folder, error) || has_marker(folder)) return {};
   const std::string marker = std::string(kOutputMarker);
   std::ifstream summary(folder / "summary.json");
   const nlohmann::json old = nlohmann::json::parse(summary, nullptr, /*allow_exceptions=*/false);
   if (old.is_object() && old.contains("fiberfluid_version"))  // before the marker existed
-    return "holds results of an older fiberfluid (it has no " + marker +
-           "), and only folders "
-           "with it are replaced: remove it by hand, or choose another output folder with -o";
-  return "exists and was not written by fiberfluid (it has no " + marker +
-         "), so it is never replaced; choose another output folder with -o";
+    return Status::failure(
+        "holds results of an older fiberfluid (it has no " + marker +
+        "), and only folders "
+        "with it are replaced: remove it by hand, or choose another output folder with -o");
+  return Status::failure("exists and was not written by fiberfluid (it has no " + marker +
+                         "), so it is never replaced; choose another output folder with -o");
 }
 
 // Removes the previous result that a swap left at `old`; a failure is a warning.
@@ -103,9 +105,9 @@ void remove_previous(const fs::path& old, const fs::path& target,
 // is renamed aside first (atomic), then the new one takes its name.
 void move_by_two_renames(const fs::path& from, const fs::path& to,
                          std::vector<std::string>* warnings) {
-  const std::string problem = replace_problem(to);
-  if (!problem.empty())
-    throw InputError(to.string() + ": " + problem + "; the results are in " + from.string());
+  if (const Status replaceable = may_be_replaced(to); !replaceable.ok)
+    throw InputError(to.string() + ": " + replaceable.message + "; the results are in " +
+                     from.string());
   fs::path old = to;
   old += ".old-" + random_hex();
   const bool had_old = ::rename(to.c_str(), old.c_str()) == 0;
@@ -123,17 +125,18 @@ void move_by_two_renames(const fs::path& from, const fs::path& to,
 
 }  // namespace
 
-std::string folder_name_problem(const std::string& name) {
+Status check_folder_name(const std::string& name) {
   if (name.empty() || name == "." || name == ".." ||
       !std::all_of(name.begin(), name.end(), [](unsigned char ch) { return safe_character(ch); }))
-    return "a name of letters, digits, '_', '-' or '.' (it names an output folder), got \"" +
-           (name.size() > 60 ? name.substr(0, 60) + "..." : name) + "\"";
+    return Status::failure(
+        "a name of letters, digits, '_', '-' or '.' (it names an output folder), got \"" +
+        (name.size() > 60 ? name.substr(0, 60) + "..." : name) + "\"");
   if (name.size() > kLongestName)
-    return "a name of at most " + std::to_string(kLongestName) +
-           " characters (it names an output "
-           "folder), got one of " +
-           std::to_string(name.size());
-  return "";
+    return Status::failure("a name of at most " + std::to_string(kLongestName) +
+                           " characters (it names an output "
+                           "folder), got one of " +
+                           std::to_string(name.size()));
+  return {};
 }
 
 std::string folder_name_from(const std::string& stem) {
@@ -147,8 +150,8 @@ std::string folder_name_from(const std::string& stem) {
 fs::path output_folder(const std::string& flag, const std::string& experiment_name) {
   fs::path folder;
   if (flag.empty()) {
-    const std::string problem = folder_name_problem(experiment_name);
-    if (!problem.empty()) throw InputError("the experiment's name: expected " + problem);
+    if (const Status name = check_folder_name(experiment_name); !name.ok)
+      throw InputError("the experiment's name: expected " + name.message);
     folder = fs::path("out") / experiment_name;
   } else {
     folder = fs::path(flag).lexically_normal();
@@ -199,8 +202,8 @@ void check_not_nested(const fs::path& folder) {
 }
 
 void check_replaceable(const fs::path& folder) {
-  const std::string problem = replace_problem(folder);
-  if (!problem.empty()) throw InputError(folder.string() + ": " + problem);
+  if (const Status replaceable = may_be_replaced(folder); !replaceable.ok)
+    throw InputError(folder.string() + ": " + replaceable.message);
 }
 
 fs::path create_staging_folder(const fs::path& target, const std::string& experiment_name) {
@@ -249,10 +252,9 @@ void move_into_place(const fs::path& from, const fs::path& to, std::vector<std::
   }
   // `from` now holds what was at `to`: checked after the swap, not before it,
   // so that nothing can slip in between.
-  const std::string problem = replace_problem(from);
-  if (!problem.empty()) {
+  if (const Status replaceable = may_be_replaced(from); !replaceable.ok) {
     renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_EXCHANGE);
-    throw InputError(to.string() + ": " + problem +
+    throw InputError(to.string() + ": " + replaceable.message +
                      " (it appeared while this run went on); the "
                      "results are in " +
                      from.string());

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "fiberfluid/util/status.hpp"
+
 namespace fiberfluid::experiment {
 
 // The marker every output folder holds: ".fiberfluid-output.json".
@@ -33,10 +35,10 @@ inline constexpr const char* kInterruptedMark = "INTERRUPTED";
 // (NAME.running-HOST-PID-XXXXXXXX, NAME.failed) stay below NAME_MAX.
 constexpr size_t kLongestName = 100;
 
-// Empty when `name` can be a folder name of its own (letters, digits, '_',
-// '-', '.'; not "." or ".."; at most kLongestName characters); else what is
-// wrong with it, to follow "expected ...".
-std::string folder_name_problem(const std::string& name);
+// Whether `name` can be a folder name of its own (letters, digits, '_',
+// '-', '.'; not "." or ".."; at most kLongestName characters); if not, the
+// message says what was expected, to follow "expected ...".
+Status check_folder_name(const std::string& name);
 
 // A usable stand-in for a file's stem as a default experiment name: every
 // other character becomes '_', cut to kLongestName.

@@ -7,17 +7,15 @@
 #include "fiberfluid/experiment/write/build_info.hpp"
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/held_edge.hpp"
+#include "fiberfluid/model/report_names.hpp"
 
 namespace fiberfluid::experiment {
 namespace {
 
 using nlohmann::json;
 
-const char kAxes[] = "xyz";
-
-std::string group_name(const model::Model& m, size_t g) {
-  return g < m.constraint_groups.size() ? m.constraint_groups[g] : "supports";
-}
+using model::axis_name;
+using model::constraint_group_name;
 
 json vector_json(const Eigen::Vector3d& v, int dim) {
   json out = json::array();
@@ -114,7 +112,7 @@ void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& st
 json reactions_json(const model::Model& m, const solve::StepRecord& r) {
   json out = json::object();
   for (size_t g = 0; g < r.reactions.size(); ++g)
-    out[group_name(m, g)] = vector_json(r.reactions[g], m.dim());
+    out[constraint_group_name(m, g)] = vector_json(r.reactions[g], m.dim());
   return out;
 }
 
@@ -150,7 +148,7 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
     if (name.rfind(prefix, 0) == 0 && (!run.variant.empty() || name.rfind("fibers.", 0) != 0))
       final_figures[name.substr(prefix.size())] = value;
   json paddle_axes = json::object();  // which force component each paddle's curve shows
-  for (const model::Paddle& p : m.paddles) paddle_axes[p.label] = std::string(1, kAxes[p.axis]);
+  for (const model::Paddle& p : m.paddles) paddle_axes[p.label] = std::string(1, axis_name(p.axis));
   return {{"variant", run.variant},
           {"patch", c.patch},
           {"paddle_axes", paddle_axes},

@@ -22,8 +22,8 @@ Eigen::Vector3d curve_force_vector(const ForceCurve& curve, const solve::StepRec
 }
 
 const ForceCurve& checked(const ForceCurve& curve, const model::Model& model) {
-  const std::string why = force_curve_problem(curve, model);
-  if (!why.empty()) throw InputError(curve.label + ": " + why);
+  if (const Status usable = check_force_curve(curve, model); !usable.ok)
+    throw InputError(curve.label + ": " + usable.message);
   return curve;
 }
 

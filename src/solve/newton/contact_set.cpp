@@ -89,10 +89,10 @@ int ContactSet::release_pulling(const Eigen::VectorXd& R) {
   return released;
 }
 
-// Why paddles at these planes cannot work, or "": two on one axis, on
+// Whether paddles at these planes can work (why not): two on one axis, on
 // opposite sides, that meet or pass each other (`where`: when, for the message).
-std::string planes_problem(const model::Model& model, const std::vector<double>& planes,
-                           const std::string& where) {
+Status check_planes(const model::Model& model, const std::vector<double>& planes,
+                    const std::string& where) {
   for (size_t p = 0; p < model.paddles.size(); ++p)
     for (size_t q = p + 1; q < model.paddles.size(); ++q) {
       const model::Paddle& a = model.paddles[p];
@@ -101,34 +101,36 @@ std::string planes_problem(const model::Model& model, const std::vector<double>&
       const size_t top = a.above ? p : q, bottom = a.above ? q : p;
       const double gap = planes[top] - planes[bottom];
       if (!(gap > 0.0))
-        return "paddles " + model.paddles[top].label + " and " + model.paddles[bottom].label +
-               " meet or pass each other" + where + " (gap " + std::to_string(gap) + ")";
+        return Status::failure("paddles " + model.paddles[top].label + " and " +
+                               model.paddles[bottom].label + " meet or pass each other" + where +
+                               " (gap " + std::to_string(gap) + ")");
     }
   return {};
 }
 
-// Why a paddle setup cannot start, or "": an axis out of range, a paddle
+// Whether a paddle setup can start (why not): an axis out of range, a paddle
 // inside the body at its start.
-std::string paddle_start_problem(const model::Model& model) {
+Status check_paddle_start(const model::Model& model) {
   const Eigen::MatrixXd& V = model.surface.V;
   for (const model::Paddle& a : model.paddles) {
-    if (a.axis < 0 || a.axis >= model.dim()) return "paddle " + a.label + ": axis out of range";
+    if (a.axis < 0 || a.axis >= model.dim())
+      return Status::failure("paddle " + a.label + ": axis out of range");
     const double extreme = a.above ? V.col(a.axis).maxCoeff() : V.col(a.axis).minCoeff();
     if (a.penetration(extreme, a.position) > 1e-9 * std::abs(extreme) + 1e-300)
-      return "paddle " + a.label + ": it starts inside the body (position " +
-             std::to_string(a.position) + ", body extends to " + std::to_string(extreme) + ")";
+      return Status::failure("paddle " + a.label + ": it starts inside the body (position " +
+                             std::to_string(a.position) + ", body extends to " +
+                             std::to_string(extreme) + ")");
   }
   return {};
 }
 
-// Why a paddle setup cannot work over `steps` steps, or "".
-std::string paddle_problem(const model::Model& model, int steps) {
-  std::string why = paddle_start_problem(model);
-  for (int k = 0; k <= steps && why.empty(); ++k) {
-    why = planes_problem(model, scheduled_point(model, k, steps).planes,
-                         " at step " + std::to_string(k));
-  }
-  return why;
+// Whether a paddle setup can work over `steps` steps (why not).
+Status check_paddles(const model::Model& model, int steps) {
+  Status status = check_paddle_start(model);
+  for (int k = 0; k <= steps && status.ok; ++k)
+    status = check_planes(model, scheduled_point(model, k, steps).planes,
+                          " at step " + std::to_string(k));
+  return status;
 }
 
 }  // namespace fiberfluid::solve

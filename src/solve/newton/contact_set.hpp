@@ -11,6 +11,7 @@
 #include "fiberfluid/model/dof_map.hpp"
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/newton/newton.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::solve {
 
@@ -66,16 +67,16 @@ class ContactSet {
   double diagonal_ = 1.0;    // the body's bounding-box diagonal
 };
 
-// Why paddles at these planes cannot work, or "": two on one axis, on
+// Whether paddles at these planes can work (why not): two on one axis, on
 // opposite sides, that meet or pass each other (`where`: when, for the message).
-std::string planes_problem(const model::Model& model, const std::vector<double>& planes,
-                           const std::string& where = "");
+Status check_planes(const model::Model& model, const std::vector<double>& planes,
+                    const std::string& where = "");
 
-// Why a paddle setup cannot start, or "": an axis out of range, a paddle
+// Whether a paddle setup can start (why not): an axis out of range, a paddle
 // inside the body at its start.
-std::string paddle_start_problem(const model::Model& model);
+Status check_paddle_start(const model::Model& model);
 
-// Why a paddle setup cannot work over `steps` steps, or "".
-std::string paddle_problem(const model::Model& model, int steps);
+// Whether a paddle setup can work over `steps` steps (why not).
+Status check_paddles(const model::Model& model, int steps);
 
 }  // namespace fiberfluid::solve

@@ -68,9 +68,8 @@ class InteractiveStepper::Impl {
       : model_(model),
         options_(interactive_options(options)),
         summary_(empty_summary(model, Scheme::Newton)) {
-    std::string why = setup_problem(model, options_);
-    if (why.empty()) why = paddle_start_problem(model);
-    if (!why.empty()) throw InputError("interactive stepper: " + why);
+    for (const Status& check : {check_setup(model, options_), check_paddle_start(model)})
+      if (!check.ok) throw InputError("interactive stepper: " + check.message);
     partition_ = model::partition_dofs(model);
     solver_ = std::make_unique<NewtonSolver>(model, options_, summary_);
     finisher_ = std::make_unique<StepFinisher>(model, options_, *solver_, partition_, summary_);
@@ -156,8 +155,8 @@ class InteractiveStepper::Impl {
                        static_cast<size_t>(to.held_values.size()), static_cast<size_t>(held));
     if (!all_finite(to.factors) || !all_finite(to.planes) || !to.held_values.allFinite())
       throw InputError("interactive step: a load factor, paddle plane or held value is not finite");
-    const std::string why = planes_problem(model_, to.planes);
-    if (!why.empty()) throw InputError("interactive step: " + why);
+    if (const Status planes = check_planes(model_, to.planes); !planes.ok)
+      throw InputError("interactive step: " + planes.message);
     return to;
   }
 

@@ -13,6 +13,7 @@
 
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/stepping.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::solve {
 
@@ -32,16 +33,16 @@ LoadPoint scheduled_point(const model::Model& model, double t, int steps);
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
                                    const StepObserver& observer = {});
 
-// "" when the Newton stepper's analytic sensitivities (du/dtheta and the
+// Whether the Newton stepper's analytic sensitivities (du/dtheta and the
 // forces' derivatives) are exact for this model, else why not: a sticking
 // paddle holds each vertex where it first touched, and that place moves with
 // the parameters, which the sensitivities take as fixed.
-std::string sensitivity_problem(const model::Model& model);
+Status check_sensitivities(const model::Model& model);
 
-// "" when SteppingOptions::warm_start can be used for this model, else why
+// Whether SteppingOptions::warm_start can be used for this model, else why
 // not: the Newton scheme by load control, a start of the model's size with
 // finite values, and no sticking paddle (where a vertex sticks depends on
 // the way there).
-std::string warm_start_problem(const model::Model& model, const SteppingOptions& options);
+Status check_warm_start(const model::Model& model, const SteppingOptions& options);
 
 }  // namespace fiberfluid::solve

@@ -37,7 +37,7 @@ NewtonSolver::NewtonSolver(const model::Model& model, const SteppingOptions& opt
   const TangentSolver kind =
       choose_tangent(newton_.tangent, supports_.num_reduced(), model.material.kinematics,
                      equilibrium_->sparse_fibers());
-  tangent_ = std::make_shared<TangentSolve>(equilibrium_, options, kind);
+  tangent_ = make_tangent_solve(equilibrium_, options, kind);
   summary_.tangent = kind;
   summary_.solver = tangent_->preconditioner_kind();
 }

@@ -19,7 +19,7 @@
 #include "fiberfluid/solve/newton/newton.hpp"
 #include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/solve/stepping_common.hpp"
-#include "fiberfluid/solve/tangent_solve.hpp"
+#include "fiberfluid/solve/tangent/tangent_solve.hpp"
 
 namespace fiberfluid::solve {
 

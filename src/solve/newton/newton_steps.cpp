@@ -49,45 +49,53 @@ const model::Paddle* sticking_paddle(const Model& model) {
 
 }  // namespace
 
-std::string sensitivity_problem(const Model& model) {
+Status check_sensitivities(const Model& model) {
   if (const model::Paddle* paddle = sticking_paddle(model))
-    return "paddle " + paddle->label +
-           " sticks: it holds each vertex where it touched, a place that moves with the "
-           "parameters (fit with finite differences)";
+    return Status::failure(
+        "paddle " + paddle->label +
+        " sticks: it holds each vertex where it touched, a place that moves with the "
+        "parameters (fit with finite differences)");
   return {};
 }
 
-std::string warm_start_problem(const Model& model, const SteppingOptions& options) {
+Status check_warm_start(const Model& model, const SteppingOptions& options) {
   if (options.warm_start.size() == 0) return {};
-  if (options.scheme != Scheme::Newton) return "a warm start needs the Newton scheme";
+  if (options.scheme != Scheme::Newton)
+    return Status::failure("a warm start needs the Newton scheme");
   if (options.newton.control != NewtonOptions::Control::Load)
-    return "a warm start needs load control (arc length follows the path from its start)";
+    return Status::failure(
+        "a warm start needs load control (arc length follows the path from its start)");
   const Eigen::Index expected = static_cast<Eigen::Index>(model.dim()) * model.num_vertices() + 1;
   if (options.warm_start.size() != expected)
-    return "expected " + std::to_string(expected) + " unknowns (displacements and pressure), got " +
-           std::to_string(options.warm_start.size());
-  if (!options.warm_start.allFinite()) return "the start has non-finite values";
+    return Status::failure("expected " + std::to_string(expected) +
+                           " unknowns (displacements and pressure), got " +
+                           std::to_string(options.warm_start.size()));
+  if (!options.warm_start.allFinite()) return Status::failure("the start has non-finite values");
   if (const model::Paddle* paddle = sticking_paddle(model))
-    return "paddle " + paddle->label +
-           " sticks: where a vertex sticks depends on the way there, so the end of the path "
-           "cannot be solved from elsewhere";
+    return Status::failure(
+        "paddle " + paddle->label +
+        " sticks: where a vertex sticks depends on the way there, so the end of the path "
+        "cannot be solved from elsewhere");
   return {};
 }
 
 namespace {
 
-// Why the path cannot be followed by arc length, or "": the arc-length
+// Whether the path can be followed by arc length (why not): the arc-length
 // constraint acts on the loads' factor, so the held values must not move
 // along the path (prescribed motions and paddles are displacement control).
-std::string arc_length_problem(const Model& model, int steps) {
+Status check_arc_length(const Model& model, int steps) {
   if (!model.paddles.empty())
-    return "newton.control arc_length: paddles move the body by displacement, which load "
-           "control already follows; use control \"load\"";
+    return Status::failure(
+        "newton.control arc_length: paddles move the body by displacement, which load "
+        "control already follows; use control \"load\"");
   for (int k = 1; k <= steps; ++k)
     if (model::constrained_displacements(model, k, steps).cwiseAbs().maxCoeff() > 0.0)
-      return "newton.control arc_length: a prescribed displacement or rotation moves along the "
-             "path; arc length follows loads only (use control \"load\")";
-  if (model.loads.empty()) return "newton.control arc_length: there is no load to follow";
+      return Status::failure(
+          "newton.control arc_length: a prescribed displacement or rotation moves along the "
+          "path; arc length follows loads only (use control \"load\")");
+  if (model.loads.empty())
+    return Status::failure("newton.control arc_length: there is no load to follow");
   return {};
 }
 
@@ -127,17 +135,16 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   const Clock::time_point start = Clock::now();
   SteppingSummary summary = empty_summary(model, Scheme::Newton);
   auto fail = [&](const std::string& why) { return failed(summary, why, start); };
-  std::string why = setup_problem(model, options);
-  if (!why.empty()) return fail(why);
-  why = paddle_problem(model, options.steps);
-  if (!why.empty()) return fail(why);
   const bool by_arc = options.newton.control == NewtonOptions::Control::ArcLength;
-  if (by_arc && !(why = arc_length_problem(model, options.steps)).empty()) return fail(why);
+  for (const Status& check : {check_setup(model, options), check_paddles(model, options.steps),
+                              by_arc ? check_arc_length(model, options.steps) : Status{}})
+    if (!check.ok) return fail(check.message);
   for (const std::string& name : options.sensitivities.parameters)
     if (!model.material.has_parameter(name, model.dim()))
       return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
-  if (!options.sensitivities.parameters.empty() && (why = sensitivity_problem(model)) != "")
-    return fail("sensitivities: " + why);
+  if (!options.sensitivities.parameters.empty())
+    if (const Status s = check_sensitivities(model); !s.ok)
+      return fail("sensitivities: " + s.message);
   model::DofPartition partition;
   std::unique_ptr<NewtonSolver> solver;
   try {
@@ -163,7 +170,8 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   };
 
   if (options.warm_start.size() > 0) {
-    if (!(why = warm_start_problem(model, options)).empty()) return fail("warm_start: " + why);
+    if (const Status s = check_warm_start(model, options); !s.ok)
+      return fail("warm_start: " + s.message);
     if (solve_from_warm_start(*solver, finisher, options.warm_start, n, keep, summary)) {
       summary.success = true;
       summary.total_seconds = seconds_since(start);
@@ -174,6 +182,7 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   PathPredictor predictor(options.newton.predictor ? 2 : 0);
   predictor.add(0.0, x);
   report_progress("step", 0, n);
+  std::string why;
   int depth = 0;  // the pieces' halvings, carried from step to step
   // Load control: each step to t = k (t = 1 only, the arc's first step, by arc length).
   for (int k = 1; k <= (by_arc ? 1 : n); ++k) {

@@ -39,9 +39,10 @@ std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
   const int nv = model_.num_vertices(), dim = model_.dim(), k = record.step;
   const Eigen::MatrixXd X = model::positions(model_, x);
   const double volume = geom::enclosed_volume(X, model_.surface.F);
-  std::string why =
-      runaway_reason(model_, options_, x, X, volume, reference_volume_, last_face_areas_);
-  if (!why.empty()) return "step " + std::to_string(k) + ": runaway: " + why;
+  if (const Status state =
+          check_no_runaway(model_, options_, x, X, volume, reference_volume_, last_face_areas_);
+      !state.ok)
+    return "step " + std::to_string(k) + ": runaway: " + state.message;
 
   // Forces on the body: supports per group, paddles, and the loads.
   const Eigen::VectorXd& R = solver_.last_residual();
@@ -96,8 +97,8 @@ std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
   if (!options_.sensitivities.parameters.empty() &&
       std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
     Eigen::MatrixXd residual_change;
-    why = solver_.sensitivities(at, x, options_.sensitivities.parameters,
-                                &record.sensitivities.state, &residual_change);
+    const std::string why = solver_.sensitivities(at, x, options_.sensitivities.parameters,
+                                                  &record.sensitivities.state, &residual_change);
     if (!why.empty()) return "step " + std::to_string(k) + ": sensitivities: " + why;
     force_sensitivities(residual_change, record);
   }
