@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A measured material test: nominal stress against stretch in homogeneous
+// tests (Treloar's uniaxial and equibiaxial rubber, say), and how a law
+// misses it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fiberfluid/material/hyperelastic_law.hpp"
+
+namespace fiberfluid::material {
+
+struct TestPoint {
+  HomogeneousTest test = HomogeneousTest::Uniaxial;
+  double stretch = 1.0;
+  double nominal_stress = 0.0;  // Pa
+};
+
+// A CSV file of points: a header naming the columns `test` (uniaxial,
+// equibiaxial, pure_shear), `stretch` and one of `nominal_stress_Pa`,
+// `nominal_stress_kPa`, `nominal_stress_MPa` (other columns are ignored;
+// lines starting with # are comments). Throws InputError naming the file,
+// the line and what was expected.
+std::vector<TestPoint> read_material_test(const std::string& path);
+
+// The relative misfits (law - measured) / measured at every point whose
+// measured stress is not zero (a test's unloaded point carries no
+// information on the scale).
+std::vector<double> relative_misfits(const HyperelasticLaw& law,
+                                     const std::vector<TestPoint>& points);
+// Their root mean square.
+double rms_relative_misfit(const HyperelasticLaw& law, const std::vector<TestPoint>& points);
+
+}  // namespace fiberfluid::material
