@@ -7,15 +7,27 @@
 #include "fiberfluid/fit/evaluation_cache.hpp"
 #include "fiberfluid/fit/objective.hpp"
 #include "fiberfluid/fit/optimizers.hpp"
+#include "fiberfluid/model/material_response.hpp"
 
 namespace fiberfluid::fit {
 namespace {
 
-std::vector<Parameter> law_parameters(const material::HyperelasticLaw& law) {
+std::vector<Parameter> model_parameters(const MaterialModel& m) {
   std::vector<Parameter> out;
-  for (size_t k = 0; k < law.parameter_names().size(); ++k)
-    out.push_back({law.parameter_names()[k], law.parameters()[static_cast<Eigen::Index>(k)]});
+  for (size_t k = 0; k < m.names.size(); ++k)
+    out.push_back({m.names[k], m.start[static_cast<Eigen::Index>(k)]});
   return out;
+}
+
+// Relative misfits at the loaded points (the unloaded point's stress is no
+// information on the scale).
+Eigen::VectorXd misfits_of(const MaterialModel& m, const Eigen::VectorXd& p,
+                           const std::vector<material::TestPoint>& points) {
+  std::vector<double> r;
+  for (const material::TestPoint& t : points)
+    if (t.nominal_stress != 0.0)
+      r.push_back((m.nominal_stress(p, t.test, t.stretch) - t.nominal_stress) / t.nominal_stress);
+  return Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
 }
 
 // The relative misfits of the law at phi (its parameters, linear), and their
@@ -23,12 +35,11 @@ std::vector<Parameter> law_parameters(const material::HyperelasticLaw& law) {
 // body's run.
 class MaterialTestObjective final : public Objective {
  public:
-  MaterialTestObjective(const material::HyperelasticLaw& start,
-                        const std::vector<material::TestPoint>& points)
-      : start_(start),
+  MaterialTestObjective(const MaterialModel& model, const std::vector<material::TestPoint>& points)
+      : model_(model),
         points_(points),
-        variables_(law_parameters(start)),
-        residuals_(static_cast<int>(material::relative_misfits(start, points).size())) {}
+        variables_(model_parameters(model)),
+        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())) {}
 
   const Variables& variables() const override { return variables_; }
   int num_residuals() const override { return residuals_; }
@@ -43,9 +54,12 @@ class MaterialTestObjective final : public Objective {
     e.ok = true;
     if (!with_jacobian) return e;
     e.jacobian.resize(residuals_, phi.size());
-    const double modulus_scale = std::abs(start_.shear_modulus());
+    double modulus_scale = 0.0;  // the start's largest modulus
+    for (Eigen::Index k = 0; k < phi.size(); ++k)
+      if (model_.modulus[static_cast<size_t>(k)])
+        modulus_scale = std::max(modulus_scale, std::abs(model_.start[k]));
     for (Eigen::Index k = 0; k < phi.size(); ++k) {
-      const double scale = start_.is_modulus(static_cast<int>(k)) ? modulus_scale : 1.0;
+      const double scale = model_.modulus[static_cast<size_t>(k)] ? modulus_scale : 1.0;
       const double h = 1e-6 * std::max(std::abs(phi[k]), scale);
       Eigen::VectorXd up = phi, down = phi, r_up, r_down;
       up[k] += h, down[k] -= h;
@@ -62,15 +76,13 @@ class MaterialTestObjective final : public Objective {
 
  private:
   bool misfits(const Eigen::VectorXd& phi, Eigen::VectorXd* r, std::string* why) const {
-    const material::HyperelasticLaw law = start_.with_parameters(phi);
-    if (const Status usable = law.check(); !usable.ok) return *why = usable.message, false;
-    const std::vector<double> m = material::relative_misfits(law, points_);
-    *r = Eigen::Map<const Eigen::VectorXd>(m.data(), static_cast<Eigen::Index>(m.size()));
+    if (const Status usable = model_.check(phi); !usable.ok) return *why = usable.message, false;
+    *r = misfits_of(model_, phi, points_);
     if (!r->allFinite()) return *why = "a stress of the law is not finite", false;
     return true;
   }
 
-  material::HyperelasticLaw start_;
+  const MaterialModel& model_;
   const std::vector<material::TestPoint>& points_;
   Variables variables_;
   int residuals_;
@@ -78,15 +90,53 @@ class MaterialTestObjective final : public Objective {
 
 }  // namespace
 
-MaterialFitResult fit_material_test(const material::HyperelasticLaw& start,
+MaterialModel material_model(const material::HyperelasticLaw& start) {
+  MaterialModel m;
+  m.name = start.name();
+  m.names = start.parameter_names();
+  m.start = start.parameters();
+  for (size_t k = 0; k < m.names.size(); ++k)
+    m.modulus.push_back(start.is_modulus(static_cast<int>(k)));
+  m.nominal_stress = [start](const Eigen::VectorXd& p, material::HomogeneousTest t, double l) {
+    return material::nominal_stress(start.with_parameters(p), t, l);
+  };
+  m.check = [start](const Eigen::VectorXd& p) { return start.with_parameters(p).check(); };
+  return m;
+}
+
+MaterialModel material_model(const model::FiberLaw& start) {
+  MaterialModel m;
+  m.name = start.name();
+  m.names = start.parameter_names();
+  m.start = Eigen::Map<const Eigen::VectorXd>(start.parameters().data(),
+                                              static_cast<Eigen::Index>(start.parameters().size()));
+  for (size_t k = 0; k < m.names.size(); ++k)
+    m.modulus.push_back(start.model().is_positive(static_cast<int>(k)));
+  const auto law_at = [start](const Eigen::VectorXd& p) {
+    model::FiberLaw law = start;
+    for (size_t k = 0; k < start.parameter_names().size(); ++k)
+      law.set_parameter(start.parameter_names()[k], p[static_cast<Eigen::Index>(k)]);
+    return law;
+  };
+  m.nominal_stress = [law_at](const Eigen::VectorXd& p, material::HomogeneousTest t, double l) {
+    return model::fiber_network_nominal_stress(law_at(p), t, l);
+  };
+  m.check = [law_at](const Eigen::VectorXd& p) {
+    const std::string why = law_at(p).check();
+    return why.empty() ? Status{} : Status::failure(why);
+  };
+  return m;
+}
+
+MaterialFitResult fit_material_test(const MaterialModel& model,
                                     const std::vector<material::TestPoint>& points,
                                     const FitOptions& given) {
   MaterialFitResult result;
-  result.law = start;
-  const MaterialTestObjective objective(start, points);
+  result.parameters = model.start;
+  const MaterialTestObjective objective(model, points);
   if (objective.num_residuals() < objective.variables().size()) {
     result.message = "fewer loaded test points (" + std::to_string(objective.num_residuals()) +
-                     ") than the " + start.name() + " law's parameters";
+                     ") than the " + model.name + " law's parameters";
     return result;
   }
   FitOptions options = given;
@@ -105,8 +155,9 @@ MaterialFitResult fit_material_test(const material::HyperelasticLaw& start,
   result.status = outcome.status;
   result.message = outcome.message;
   result.iterations = outcome.iterations;
-  result.law = start.with_parameters(outcome.phi);
-  result.rms = material::rms_relative_misfit(result.law, points);
+  result.parameters = outcome.phi;
+  const Eigen::VectorXd r = misfits_of(model, outcome.phi, points);
+  result.rms = std::sqrt(r.squaredNorm() / static_cast<double>(r.size()));
   result.evaluations = evaluations.evaluations;
   return result;
 }

@@ -1,33 +1,48 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// A hyperelastic law fitted to a material test at material level (no body):
-// the law's parameters so that its homogeneous responses meet the measured
-// nominal stresses, weighed as relative misfits (a test's small stresses
-// count as much as its large ones), by the single fit's Levenberg-Marquardt
-// on an Objective.
+// A law fitted to a material test at material level (no body): its
+// parameters so that its homogeneous responses meet the measured nominal
+// stresses, weighed as relative misfits (a test's small stresses count as
+// much as its large ones), by the single fit's Levenberg-Marquardt on an
+// Objective. The law is a hyperelastic one (material::HyperelasticLaw) or a
+// fiber law's network (model/material_response.hpp).
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "fiberfluid/fit/fit_types.hpp"
 #include "fiberfluid/material/material_test.hpp"
+#include "fiberfluid/model/fiber_law.hpp"
 
 namespace fiberfluid::fit {
+
+// A family of material-level responses over its parameters.
+struct MaterialModel {
+  std::string name;
+  std::vector<std::string> names;
+  Eigen::VectorXd start;
+  std::vector<bool> modulus;  // per parameter: a modulus (Pa), else without unit
+  std::function<double(const Eigen::VectorXd&, material::HomogeneousTest, double)> nominal_stress;
+  std::function<Status(const Eigen::VectorXd&)> check;
+};
+MaterialModel material_model(const material::HyperelasticLaw& start);
+// The fiber law's network response; its parameters from the law's.
+MaterialModel material_model(const model::FiberLaw& start);
 
 struct MaterialFitResult {
   FitStatus status = FitStatus::StartFailed;
   std::string message;
-  material::HyperelasticLaw law = material::HyperelasticLaw::neo_hookean(0.0);  // at the fit
+  Eigen::VectorXd parameters;           // at the fit (the start if it failed)
   double initial_rms = 0.0, rms = 0.0;  // rms relative misfit at the start and the fit
   std::vector<IterationRecord> iterations;
   int evaluations = 0;
 };
 
-// From `start` (its parameters are the start; every one is fitted).
-// options: max_iterations and the tolerances (method and loss are
-// Levenberg-Marquardt on squares).
-MaterialFitResult fit_material_test(const material::HyperelasticLaw& start,
+// Every parameter is fitted, from the model's start. options: max_iterations
+// and the tolerances (method and loss are Levenberg-Marquardt on squares).
+MaterialFitResult fit_material_test(const MaterialModel& model,
                                     const std::vector<material::TestPoint>& points,
                                     const FitOptions& options = {});
 

@@ -10,6 +10,7 @@
 #include "fiberfluid/fit/material_fit.hpp"
 #include "fiberfluid/material/hyperelastic_law.hpp"
 #include "fiberfluid/material/material_test.hpp"
+#include "fiberfluid/model/material_response.hpp"
 #include "fiberfluid/util/error.hpp"
 
 namespace fiberfluid::material {
@@ -131,24 +132,82 @@ TEST(MaterialTest, RefusesABadFileNamingTheLine) {
 // range; three Ogden terms do (Ogden 1972; Ogden, Saccomandi and Sgura 2004).
 TEST(MaterialFit, TreloarsRubberTakesThreeOgdenTermsNotOneModulus) {
   const std::vector<TestPoint> points = read_material_test(treloar());
-  const fit::MaterialFitResult neo =
-      fit::fit_material_test(HyperelasticLaw::named("neo_hookean", 3e5), points);
+  const fit::MaterialFitResult neo = fit::fit_material_test(
+      fit::material_model(HyperelasticLaw::named("neo_hookean", 3e5)), points);
   ASSERT_TRUE(fit::converged(neo.status)) << neo.message;
   // Ogden's exponents and moduli trade along a valley: about 200 iterations
   // from the generic start (each a few microseconds).
   fit::FitOptions options;
   options.max_iterations = 500;
+  const HyperelasticLaw ogden_start = HyperelasticLaw::named("ogden3", 3e5);
   const fit::MaterialFitResult ogden =
-      fit::fit_material_test(HyperelasticLaw::named("ogden3", 3e5), points, options);
+      fit::fit_material_test(fit::material_model(ogden_start), points, options);
+  const HyperelasticLaw fitted = ogden_start.with_parameters(ogden.parameters);
   ASSERT_TRUE(fit::converged(ogden.status)) << ogden.message;
-  EXPECT_LT(ogden.rms, 0.10) << ogden.law.parameters().transpose();
+  EXPECT_LT(ogden.rms, 0.10) << ogden.parameters.transpose();
   EXPECT_GT(neo.rms, 2.0 * ogden.rms);
   // Rubber's small-strain shear modulus is about 0.4 MPa (Treloar).
-  EXPECT_NEAR(ogden.law.shear_modulus(), 4e5, 1.5e5);
+  EXPECT_NEAR(fitted.shear_modulus(), 4e5, 1.5e5);
   std::printf(
       "Treloar at material level: neo-Hookean rms %.1f%% (mu %.3g Pa), three-term Ogden "
       "rms %.1f%% (mu %.3g Pa)\n",
-      100 * neo.rms, neo.law.shear_modulus(), 100 * ogden.rms, ogden.law.shear_modulus());
+      100 * neo.rms, neo.parameters[0], 100 * ogden.rms, fitted.shear_modulus());
+}
+
+// A network of central fibers of a constant law Y is, at small strain, an
+// incompressible material of Young's modulus Y: the slopes of the nominal
+// stress at l = 1 are E, 2E and 4E/3 in uniaxial, equibiaxial and pure-shear
+// tension (a neo-Hookean solid's with mu = E/3).
+TEST(FiberNetwork, AConstantLawIsAMaterialOfYoungsModulusY) {
+  const double Y = 6e4, h = 1e-5;
+  const model::FiberLaw law = model::FiberLaw::constant(Y);
+  const std::pair<HomogeneousTest, double> slopes[] = {{HomogeneousTest::Uniaxial, 1.0},
+                                                       {HomogeneousTest::Equibiaxial, 2.0},
+                                                       {HomogeneousTest::PureShear, 4.0 / 3.0}};
+  for (const auto& [test, slope] : slopes) {
+    const double P = model::fiber_network_nominal_stress(law, test, 1.0 + h);
+    EXPECT_NEAR(P / h, slope * Y, 1e-3 * Y) << to_string(test);
+    EXPECT_NEAR(model::fiber_network_nominal_stress(law, test, 1.0), 0.0, 1e-9 * Y);
+  }
+  // Large stretches: for a constant law, W = 5 Y/2 <(l_d - 1)^2> =
+  // 5 Y/6 (I1 - 3) - 5 Y (<l_d> - 1). Its derivative along the uniaxial path,
+  // the mean <l_d> over a Fibonacci lattice of 200,000 directions (an
+  // independent quadrature), is the nominal stress.
+  const auto energy = [&](double l) {
+    const Eigen::Vector3d s = test_stretches(HomogeneousTest::Uniaxial, l);
+    constexpr int kDirections = 200000;
+    double mean = 0.0;
+    for (int k = 0; k < kDirections; ++k) {
+      const double z = 1.0 - (2.0 * k + 1.0) / kDirections, r = std::sqrt(1.0 - z * z);
+      const double phi = k * M_PI * (3.0 - std::sqrt(5.0));
+      mean += Eigen::Vector3d(s[0] * r * std::cos(phi), s[1] * r * std::sin(phi), s[2] * z).norm();
+    }
+    mean /= kDirections;
+    return 5.0 * Y / 6.0 * (s.squaredNorm() - 3.0) - 5.0 * Y * (mean - 1.0);
+  };
+  for (double l : {0.6, 2.0, 4.0}) {
+    const double dl = 1e-3;
+    const double dW = (energy(l + dl) - energy(l - dl)) / (2.0 * dl);
+    EXPECT_NEAR(model::fiber_network_nominal_stress(law, HomogeneousTest::Uniaxial, l), dW,
+                1e-4 * std::abs(dW))
+        << l;
+  }
+}
+
+// A stiffening fiber law at material level against Treloar's rubber: the
+// figure a body of such fibers could reach if it followed its network.
+TEST(MaterialFit, AFiberLawsNetworkFittedToTreloarsRubber) {
+  const std::vector<TestPoint> points = read_material_test(treloar());
+  fit::FitOptions options;
+  options.max_iterations = 200;
+  const fit::MaterialFitResult exponential = fit::fit_material_test(
+      fit::material_model(model::FiberLaw::exponential(1e6, 0.5)), points, options);
+  ASSERT_TRUE(fit::converged(exponential.status)) << exponential.message;
+  EXPECT_LT(exponential.rms, exponential.initial_rms);
+  std::printf(
+      "Treloar at material level: the exponential fiber law's network rms %.1f%% "
+      "(Y0 %.3g Pa, beta %.3g)\n",
+      100 * exponential.rms, exponential.parameters[0], exponential.parameters[1]);
 }
 
 }  // namespace

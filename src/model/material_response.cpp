@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "fiberfluid/model/material_response.hpp"
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace fiberfluid::model {
+namespace {
+
+// Gauss-Legendre nodes and weights on [0, 1] (Newton on the Legendre
+// polynomial from Chebyshev's guesses).
+struct GaussRule {
+  std::vector<double> x, w;
+};
+GaussRule gauss_legendre(int n) {
+  GaussRule r;
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1.0, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+        p0 = p1, p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1.0);
+      const double step = p1 / dp;
+      z -= step;
+      if (std::abs(step) < 1e-15) break;
+    }
+    r.x.push_back(0.5 * (1.0 - z));
+    r.w.push_back(1.0 / ((1.0 - z * z) * dp * dp));  // 2 / ((1 - z^2) P'^2), halved for [0, 1]
+  }
+  return r;
+}
+
+// Directions over one octant (the integrand is even in each component under
+// a diagonal stretch): Gauss-Legendre in cos(theta) and in phi, 24 x 24
+// points, their weights summing to 1 (the mean over the sphere).
+struct Direction {
+  Eigen::Vector3d d;
+  double weight;
+};
+const std::vector<Direction>& octant_directions() {
+  static const std::vector<Direction> directions = [] {
+    constexpr int kPoints = 24;
+    const GaussRule g = gauss_legendre(kPoints);
+    std::vector<Direction> out;
+    for (int a = 0; a < kPoints; ++a)
+      for (int b = 0; b < kPoints; ++b) {
+        const double u = g.x[static_cast<size_t>(a)],
+                     phi = 0.5 * M_PI * g.x[static_cast<size_t>(b)];
+        const double s = std::sqrt(1.0 - u * u);
+        out.push_back({{s * std::cos(phi), s * std::sin(phi), u},
+                       g.w[static_cast<size_t>(a)] * g.w[static_cast<size_t>(b)]});
+      }
+    return out;
+  }();
+  return directions;
+}
+
+constexpr double kNetworkFactor = 5.0;  // a constant law Y: Young's modulus Y
+
+}  // namespace
+
+// l_i dW/dl_i = 5 < f(l_d) l_i^2 d_i^2 / l_d >, f(l) = Y(l - 1) (l - 1), l_d = |F d|.
+Eigen::Vector3d fiber_network_stretch_work(const FiberLaw& law, const Eigen::Vector3d& l) {
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d l2 = l.cwiseProduct(l);
+  for (const Direction& dir : octant_directions()) {
+    const Eigen::Vector3d d2 = dir.d.cwiseProduct(dir.d);
+    const double ld = std::sqrt(l2.dot(d2)), e = ld - 1.0;
+    const double stress = law.modulus(e) * e;
+    t += dir.weight * stress / ld * l2.cwiseProduct(d2);
+  }
+  return kNetworkFactor * t;
+}
+
+double fiber_network_nominal_stress(const FiberLaw& law, material::HomogeneousTest test, double l) {
+  const Eigen::Vector3d t = fiber_network_stretch_work(law, material::test_stretches(test, l));
+  return (t[0] - t[2]) / l;  // axis 3 free: its zero stress gives the pressure
+}
+
+}  // namespace fiberfluid::model
