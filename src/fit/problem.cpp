@@ -87,8 +87,8 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
   }
   // The material with the starts, so that model() shows what the fit begins from.
   model_.material = map_.material(model_.material, map_.values(map_.initial_phi()));
-  const std::string why = model_.material.law.check();
-  if (!why.empty()) throw InputError("the starting material: " + why);
+  if (const Status law = model_.material.law.check(); !law.ok)
+    throw InputError("the starting material: " + law.message);
 }
 
 FitProblem::~FitProblem() = default;
@@ -153,9 +153,8 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
   const Eigen::VectorXd values = map.values(phi);
   model::Model changed = model_;
   changed.material = map.material(model_.material, values);
-  const std::string bad_law = changed.material.law.check();
-  if (!bad_law.empty()) {
-    e.message = "the material at these parameters: " + bad_law;
+  if (const Status law = changed.material.law.check(); !law.ok) {
+    e.message = "the material at these parameters: " + law.message;
     return e;
   }
   // Sensitivities du/dtheta of the states at the steps read: from the

@@ -28,25 +28,24 @@ void LawModel::evaluate_derivative(const double* p, int k, const double* strain,
 
 namespace {
 
-std::string finite_parameters(const LawModel& law, const double* p) {
+Status finite_parameters(const LawModel& law, const double* p) {
   const std::vector<std::string> names = law.parameter_names();
   for (size_t k = 0; k < names.size(); ++k)
-    if (!std::isfinite(p[k])) return names[k] + " must be a finite number";
+    if (!std::isfinite(p[k])) return Status::failure(names[k] + " must be a finite number");
   return {};
 }
 
 // "" when Y is positive and finite at every strain of `strains`, else the
 // first strain where it is not, and which parameter to look at.
-std::string positive_modulus(const LawModel& law, const double* p,
-                             const std::vector<double>& strains, double lowest, double highest,
-                             const std::string& suspect) {
+Status positive_modulus(const LawModel& law, const double* p, const std::vector<double>& strains,
+                        double lowest, double highest, const std::string& suspect) {
   for (double e : strains) {
     const double y = law.modulus(p, e);
     if (!(y > 0.0) || !std::isfinite(y)) {
       std::ostringstream out;
       out << "the modulus is " << y << " at strain " << e << " (it must be a positive number "
           << "for strains from " << lowest << " to " << highest << "): check " << suspect;
-      return out.str();
+      return Status::failure(out.str());
     }
   }
   return {};
@@ -54,8 +53,8 @@ std::string positive_modulus(const LawModel& law, const double* p,
 
 }  // namespace
 
-std::string LawModel::check(const double* p, double lowest, double highest) const {
-  if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
+Status LawModel::check(const double* p, double lowest, double highest) const {
+  if (Status finite = finite_parameters(*this, p); !finite.ok) return finite;
   std::vector<double> strains;
   constexpr int kSamples = 64;
   for (int k = 0; k <= kSamples; ++k) strains.push_back(lowest + (highest - lowest) * k / kSamples);
@@ -79,9 +78,9 @@ class ConstantLaw final : public LawModel {
     std::fill(Y, Y + n, p[0]);
     std::fill(Yp, Yp + n, 0.0);
   }
-  std::string check(const double* p, double, double) const override {
-    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
-    return p[0] >= 0.0 ? "" : "Y must be a number >= 0";
+  Status check(const double* p, double, double) const override {
+    if (Status finite = finite_parameters(*this, p); !finite.ok) return finite;
+    return p[0] >= 0.0 ? Status{} : Status::failure("Y must be a number >= 0");
   }
   bool is_constant() const override { return true; }
 };
@@ -126,9 +125,9 @@ class ExponentialLaw final : public LawModel {
                            double* dY) const override {
     exponential_derivatives(p[0], p[1], k, strain, n, dY);
   }
-  std::string check(const double* p, double lowest, double highest) const override {
-    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
-    if (!(p[0] > 0.0)) return "Y0 must be positive";
+  Status check(const double* p, double lowest, double highest) const override {
+    if (Status finite = finite_parameters(*this, p); !finite.ok) return finite;
+    if (!(p[0] > 0.0)) return Status::failure("Y0 must be positive");
     // Monotone in e: the ends bound it.
     return positive_modulus(*this, p, {lowest, highest}, lowest, highest, "beta");
   }
@@ -181,11 +180,11 @@ class BilinearLaw final : public LawModel {
                 double* Yp) const override {
     bilinear_moduli(p[0], p[1], w_, strain, n, Y, Yp);
   }
-  std::string check(const double* p, double lowest, double highest) const override {
-    if (std::string why = finite_parameters(*this, p); !why.empty()) return why;
-    if (!(w_ >= 0.0 && w_ < 1.0)) return "transition must be a strain from 0 to 1";
-    if (!(p[0] > 0.0)) return "Y_t must be positive";
-    if (!(p[1] > 0.0)) return "Y_c must be positive";
+  Status check(const double* p, double lowest, double highest) const override {
+    if (Status finite = finite_parameters(*this, p); !finite.ok) return finite;
+    if (!(w_ >= 0.0 && w_ < 1.0)) return Status::failure("transition must be a strain from 0 to 1");
+    if (!(p[0] > 0.0)) return Status::failure("Y_t must be positive");
+    if (!(p[1] > 0.0)) return Status::failure("Y_c must be positive");
     return positive_modulus(*this, p, {lowest, highest}, lowest, highest, "Y_c");
   }
   std::vector<Setting> settings() const override { return {{"transition", {w_}, true}}; }
@@ -295,22 +294,26 @@ class TabulatedLaw final : public LawModel {
   double modulus_derivative(const double* p, int, double e) const override {
     return modulus(p, e) / p[0];
   }
-  std::string check(const double* p, double, double) const override {
+  Status check(const double* p, double, double) const override {
     if (strain_.size() != stress_.size() || strain_.size() < 2)
-      return "the table needs at least two (strain, stress) points, as many strains as stresses";
+      return Status::failure(
+          "the table needs at least two (strain, stress) points, as many strains as stresses");
     for (size_t k = 0; k < strain_.size(); ++k)
       if (!std::isfinite(strain_[k]) || !std::isfinite(stress_[k]))
-        return "the table has a non-finite value at point " + std::to_string(k);
+        return Status::failure("the table has a non-finite value at point " + std::to_string(k));
     for (size_t k = 1; k < strain_.size(); ++k) {
-      if (!(strain_[k] > strain_[k - 1])) return "the strains must be strictly increasing";
+      if (!(strain_[k] > strain_[k - 1]))
+        return Status::failure("the strains must be strictly increasing");
       if (!(stress_[k] > stress_[k - 1]))
-        return "the stresses must be strictly increasing (a monotone stress-strain curve)";
+        return Status::failure(
+            "the stresses must be strictly increasing (a monotone stress-strain curve)");
     }
     const auto zero = std::find(strain_.begin(), strain_.end(), 0.0);
     if (zero == strain_.end() || stress_[static_cast<size_t>(zero - strain_.begin())] != 0.0)
-      return "the table must contain the point (0, 0): no stress at zero strain";
-    if (!(w_ >= 0.0 && w_ < 1.0)) return "transition must be a strain from 0 to 1";
-    if (!(p[0] > 0.0) || !std::isfinite(p[0])) return "scale must be a positive number";
+      return Status::failure("the table must contain the point (0, 0): no stress at zero strain");
+    if (!(w_ >= 0.0 && w_ < 1.0)) return Status::failure("transition must be a strain from 0 to 1");
+    if (!(p[0] > 0.0) || !std::isfinite(p[0]))
+      return Status::failure("scale must be a positive number");
     return {};
   }
   std::vector<Setting> settings() const override {

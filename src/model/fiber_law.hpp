@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "fiberfluid/util/status.hpp"
+
 namespace fiberfluid::model {
 
 // One kind of stress-strain law of a bulk fiber (model.md section 7): its
@@ -33,10 +35,10 @@ class LawModel {
   // one call per row of pairs, not one per pair.
   virtual void evaluate_derivative(const double* p, int k, const double* strain, size_t n,
                                    double* dY) const;
-  // "" when the law is usable, else why not, naming the parameter. The
+  // Whether the law is usable (why not, naming the parameter). The
   // default: every parameter finite, and Y positive and finite at 65 strains
   // spread over [lowest, highest].
-  virtual std::string check(const double* p, double lowest, double highest) const;
+  virtual Status check(const double* p, double lowest, double highest) const;
   // True when Y does not depend on the strain (the linear model).
   virtual bool is_constant() const { return false; }
   // Whether parameter k is positive by nature (a modulus: a fit may vary it
@@ -108,10 +110,10 @@ class FiberLaw {
     model_->evaluate_derivative(p(), index, strain, n, dY);
   }
 
-  // "" when the law is usable, else why not (naming the parameter): a
+  // Whether the law is usable (why not, naming the parameter): a
   // non-positive or non-finite modulus at a strain in [lowest, highest], a
   // table that is not strictly increasing, or one without the point (0, 0).
-  std::string check(double lowest_strain = -0.9, double highest_strain = 2.0) const {
+  Status check(double lowest_strain = -0.9, double highest_strain = 2.0) const {
     return model_->check(p(), lowest_strain, highest_strain);
   }
   std::vector<LawModel::Setting> settings() const { return model_->settings(); }

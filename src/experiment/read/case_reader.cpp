@@ -87,8 +87,8 @@ model::FiberLaw read_law(Fields f) {
     law.set_parameter("scale", f.positive("scale", 1.0));
   }
   f.finish();
-  const std::string why = law.check();
-  if (!why.empty()) f.fail(type == "tabulated" ? "stress" : "", why);
+  if (const Status usable = law.check(); !usable.ok)
+    f.fail(type == "tabulated" ? "stress" : "", usable.message);
   return law;
 }
 
