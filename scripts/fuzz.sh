@@ -9,7 +9,7 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: obj off stl_ascii stl_binary
 #                                             ply_ascii ply_binary experiment model_setup
-#                                             fit_section compare_2d compare_3d
+#                                             fit_section compare_2d compare_3d material_test
 #
 # A target with a dictionary (tests/fuzz/dictionaries/TARGET.dict: the
 # fields, names and path pieces it is likely to miss) is given it.
@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 all=(obj off stl_ascii stl_binary ply_ascii ply_binary experiment model_setup fit_section
-     compare_2d compare_3d)
+     compare_2d compare_3d material_test)
 targets=("${@:-${all[@]}}")
 
 scripts/install-deps.sh
@@ -38,6 +38,7 @@ shared_inputs() {
     stl_*) ls data/meshes/*.stl ;;
     experiment | model_setup | fit_section) ls experiments/*.json ;;
     compare_*) ls data/meshes/*.obj ;;
+    material_test) ls data/measurements/treloar_rubber/*.csv ;;
   esac
 }
 

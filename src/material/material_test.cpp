@@ -38,8 +38,15 @@ double number_at(const std::string& text, const std::string& where) {
 }  // namespace
 
 std::vector<TestPoint> read_material_test(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the material test");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open the material test");
+  std::ostringstream text;
+  text << file.rdbuf();
+  return read_material_test_text(text.str(), path);
+}
+
+std::vector<TestPoint> read_material_test_text(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   std::string line;
   int number = 0, test_column = -1, stretch_column = -1, stress_column = -1;
   double unit = 0.0;
@@ -81,7 +88,11 @@ std::vector<TestPoint> read_material_test(const std::string& path) {
       throw InputError(where + ": " + e.what());
     }
     p.stretch = number_at(fields[static_cast<size_t>(stretch_column)], where + ", stretch");
-    if (!(p.stretch > 0.0)) throw InputError(where + ": expected a positive stretch");
+    if (!(p.stretch >= kLeastStretch && p.stretch <= kMostStretch))
+      throw InputError(where +
+                       ": expected a stretch from 0.001 to 1000 (a length's ratio to its "
+                       "unloaded length), got " +
+                       fields[static_cast<size_t>(stretch_column)]);
     p.nominal_stress =
         unit * number_at(fields[static_cast<size_t>(stress_column)], where + ", stress");
     points.push_back(p);

@@ -11,6 +11,10 @@
 
 namespace fiberfluid::material {
 
+// The stretches a material test may hold (wider than any real test; a
+// law's stress stays finite within them).
+inline constexpr double kLeastStretch = 1e-3, kMostStretch = 1e3;
+
 struct TestPoint {
   HomogeneousTest test = HomogeneousTest::Uniaxial;
   double stretch = 1.0;
@@ -20,9 +24,11 @@ struct TestPoint {
 // A CSV file of points: a header naming the columns `test` (uniaxial,
 // equibiaxial, pure_shear), `stretch` and one of `nominal_stress_Pa`,
 // `nominal_stress_kPa`, `nominal_stress_MPa` (other columns are ignored;
-// lines starting with # are comments). Throws InputError naming the file,
+// lines starting with # are comments). A stretch lies from 0.001 to 1000. Throws InputError naming the file,
 // the line and what was expected.
 std::vector<TestPoint> read_material_test(const std::string& path);
+// The same from the file's text; `name` is the file named in the errors.
+std::vector<TestPoint> read_material_test_text(const std::string& text, const std::string& name);
 
 // The relative misfits (law - measured) / measured at every point whose
 // measured stress is not zero (a test's unloaded point carries no

@@ -15,6 +15,8 @@
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/geom/mesh_check.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
+#include "fiberfluid/material/hyperelastic_law.hpp"
+#include "fiberfluid/material/material_test.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "fiberfluid/util/run_control.hpp"
 
@@ -52,6 +54,29 @@ void read_mesh(geom::MeshFormat format, const char* name, const uint8_t* data, s
   require(std::isfinite(volume) && volume > 0.0, "a usable surface encloses a positive volume");
   const geom::VertexAreaVectors areas = geom::vertex_area_vectors(s.V, s.F);
   require(areas.S.allFinite(), "area vectors are finite");
+}
+
+// ---------------------------------------------------------------- material tests
+// A material test read is finite and positive where it must be, and every
+// law's stress at its points is finite.
+void read_material_test(const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  std::vector<material::TestPoint> points;
+  try {
+    points = material::read_material_test_text(bytes, "fuzz.csv");
+  } catch (const InputError& e) {
+    require(std::string(e.what()).find("fuzz.csv") != std::string::npos,
+            "a refused material test names its file");
+    return;
+  }
+  require(!points.empty(), "a read material test has points");
+  const material::HyperelasticLaw law = material::HyperelasticLaw::named("ogden3", 4e5);
+  for (const material::TestPoint& p : points) {
+    require(std::isfinite(p.stretch) && p.stretch > 0.0, "stretches are positive and finite");
+    require(std::isfinite(p.nominal_stress), "stresses are finite");
+    const double s = material::nominal_stress(law, p.test, p.stretch);
+    require(std::isfinite(s), "a law's stress at a read stretch is finite");
+  }
 }
 
 // ---------------------------------------------------------------- experiments
@@ -234,6 +259,7 @@ const std::vector<Target>& targets() {
       {"fit_section", ".json", set_up_fit},
       {"compare_2d", ".obj", [](const uint8_t* d, size_t n) { compare_with_unit(2, d, n); }},
       {"compare_3d", ".obj", [](const uint8_t* d, size_t n) { compare_with_unit(3, d, n); }},
+      {"material_test", ".csv", read_material_test},
   };
   return all;
 }
