@@ -26,9 +26,9 @@ std::string metres(double value) {
 
 }  // namespace
 
-std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector<int>& held,
-                             MirrorLayer* layer) {
-  if (held.empty()) return "it holds no vertex";
+Status find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector<int>& held,
+                        MirrorLayer* layer) {
+  if (held.empty()) return Status::failure("it holds no vertex");
   const int dim = static_cast<int>(reference.cols());
   const double tolerance = 1e-6 * geom::bounding_box_diagonal(reference);
   Eigen::MatrixXd points(static_cast<Eigen::Index>(held.size()), dim);
@@ -40,21 +40,25 @@ std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector
   // A plane (3D) needs two spreading directions, a line (2D) one.
   const Eigen::VectorXd spread = svd.singularValues();
   if (spread.size() < dim - 1 || spread[dim - 2] <= tolerance * std::sqrt(double(held.size())))
-    return std::string("its vertices do not span a ") + (dim == 3 ? "plane" : "line");
+    return Status::failure(std::string("its vertices do not span a ") +
+                           (dim == 3 ? "plane" : "line"));
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   normal.head(dim) = svd.matrixV().col(dim - 1);
   const double off = (centred * normal.head(dim)).cwiseAbs().maxCoeff();
   if (off > tolerance)
-    return std::string("its vertices are not on one ") + (dim == 3 ? "plane" : "line") +
-           " (one is " + metres(off) + " off their best one)";
+    return Status::failure(std::string("its vertices are not on one ") +
+                           (dim == 3 ? "plane" : "line") + " (one is " + metres(off) +
+                           " off their best one)");
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   point.head(dim) = centre.transpose();
   const Eigen::VectorXd side = (reference.rowwise() - centre) * normal.head(dim);
   const double above = side.maxCoeff(), below = -side.minCoeff();
   if (above > tolerance && below > tolerance)
-    return "the body lies on both sides of its plane (" + metres(above) + " and " + metres(below) +
-           " away): a mirror layer needs the clamp on the body's boundary";
-  if (std::max(above, below) <= tolerance) return "the whole body lies on its plane";
+    return Status::failure("the body lies on both sides of its plane (" + metres(above) + " and " +
+                           metres(below) +
+                           " away): a mirror layer needs the clamp on the body's boundary");
+  if (std::max(above, below) <= tolerance)
+    return Status::failure("the whole body lies on its plane");
   layer->point = point;
   layer->normal = above > below ? normal : Eigen::Vector3d(-normal);
   layer->held = held;

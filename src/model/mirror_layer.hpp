@@ -23,15 +23,16 @@
 
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/model/terms.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::model {
 
 // The plane of a clamped group: its held vertices' best plane (a line in
-// 2D), its normal pointing into the body. "" or why there is none: no
+// 2D), its normal pointing into the body, into `layer`; or why there is none: no
 // vertex held, vertices that do not span a plane or lie off it by more than
 // 1e-6 of the body's size, or a body on both sides of it.
-std::string find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector<int>& held,
-                             MirrorLayer* layer);
+Status find_clamp_plane(const Eigen::MatrixXd& reference, const std::vector<int>& held,
+                        MirrorLayer* layer);
 
 struct LayerFiber {
   int i = 0, j = 0;                                      // the vertex and the mirrored one

@@ -63,7 +63,7 @@ Model held_block(const FiberLaw& law, FiberKinematics kinematics, Options o = {}
   if (o.layer) {
     MirrorLayer mirror;
     mirror.depth = horizon;
-    EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
+    EXPECT_TRUE(find_clamp_plane(m.surface.V, held, &mirror).ok);
     m.mirror_layers.push_back(mirror);
   }
   Load gravity;

@@ -50,7 +50,7 @@ void clamp_at_x_zero(Model& m, double horizon, bool layer) {
   if (!layer) return;
   MirrorLayer mirror;
   mirror.depth = horizon;
-  EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
+  EXPECT_TRUE(find_clamp_plane(m.surface.V, held, &mirror).ok);
   m.mirror_layers.push_back(mirror);
 }
 
@@ -80,7 +80,7 @@ TEST(MirrorLayer, TheClampPlaneIsFoundAndAClampWithoutOneIsNamed) {
   MirrorLayer layer;
   const std::vector<int> end =
       vertices_where(m, [](const Eigen::Vector3d& s) { return s.x() > 0.06 - 1e-9; });
-  ASSERT_EQ(find_clamp_plane(m.surface.V, end, &layer), "");
+  ASSERT_TRUE(find_clamp_plane(m.surface.V, end, &layer).ok);
   EXPECT_LT((layer.normal - Eigen::Vector3d(-1.0, 0.0, 0.0)).norm(), 1e-12);  // into the body
   EXPECT_NEAR(layer.point.x(), 0.06, 1e-12);
 
@@ -88,16 +88,17 @@ TEST(MirrorLayer, TheClampPlaneIsFoundAndAClampWithoutOneIsNamed) {
   bent.push_back(vertices_where(m, [](const Eigen::Vector3d& s) {
                    return std::abs(s.x() - 0.05) < 1e-9;
                  }).front());
-  EXPECT_NE(find_clamp_plane(m.surface.V, bent, &layer).find("not on one plane"),
+  EXPECT_NE(find_clamp_plane(m.surface.V, bent, &layer).message.find("not on one plane"),
             std::string::npos);
   const std::vector<int> edge =
       vertices_where(m, [](const Eigen::Vector3d& s) { return s.x() < 1e-9 && s.y() < 1e-9; });
-  EXPECT_NE(find_clamp_plane(m.surface.V, edge, &layer).find("do not span a plane"),
+  EXPECT_NE(find_clamp_plane(m.surface.V, edge, &layer).message.find("do not span a plane"),
             std::string::npos);
   const std::vector<int> ring =
       vertices_where(m, [](const Eigen::Vector3d& s) { return std::abs(s.x() - 0.03) < 1e-9; });
-  EXPECT_NE(find_clamp_plane(m.surface.V, ring, &layer).find("both sides"), std::string::npos);
-  EXPECT_EQ(find_clamp_plane(m.surface.V, {}, &layer), "it holds no vertex");
+  EXPECT_NE(find_clamp_plane(m.surface.V, ring, &layer).message.find("both sides"),
+            std::string::npos);
+  EXPECT_EQ(find_clamp_plane(m.surface.V, {}, &layer).message, "it holds no vertex");
 }
 
 // Every ordered pair of vertices off the plane whose image is within the
@@ -147,7 +148,7 @@ Model block_clamped_in(const std::vector<std::function<bool(const Eigen::Vector3
     MirrorLayer mirror;
     mirror.group = static_cast<int>(g);
     mirror.depth = 0.025;
-    EXPECT_EQ(find_clamp_plane(m.surface.V, held, &mirror), "");
+    EXPECT_TRUE(find_clamp_plane(m.surface.V, held, &mirror).ok);
     m.mirror_layers.push_back(mirror);
   }
   return m;

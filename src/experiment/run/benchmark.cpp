@@ -126,8 +126,8 @@ void use_central_fibers(model::Model& m, const BenchmarkSpec::FiberModel& spec) 
   std::vector<int> held;
   for (const model::Constraint& c : m.constraints)
     if (c.group == 0 && (held.empty() || held.back() != c.vertex)) held.push_back(c.vertex);
-  const std::string why = model::find_clamp_plane(m.surface.V, held, &layer);
-  if (!why.empty()) throw InputError("benchmark: the rod's clamp has no plane: " + why);
+  if (const Status plane = model::find_clamp_plane(m.surface.V, held, &layer); !plane.ok)
+    throw InputError("benchmark: the rod's clamp has no plane: " + plane.message);
   m.mirror_layers.push_back(layer);
 }
 

@@ -400,8 +400,9 @@ class ModelBuilder {
     model::MirrorLayer layer;
     layer.group = group;
     layer.depth = spec_.fibers.horizon;
-    const std::string why = model::find_clamp_plane(c_.model.surface.V, vertices, &layer);
-    if (!why.empty()) spec.field.fail("layer", "the support has no clamp plane: " + why);
+    if (const Status plane = model::find_clamp_plane(c_.model.surface.V, vertices, &layer);
+        !plane.ok)
+      spec.field.fail("layer", "the support has no clamp plane: " + plane.message);
     c_.model.mirror_layers.push_back(layer);
     if (const Status usable = solve::check_support_terms(c_.model, c_.stepping); !usable.ok)
       spec.field.fail("layer", usable.message);
