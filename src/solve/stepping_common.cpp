@@ -102,10 +102,13 @@ SolverKind automatic_solver(const model::Model& model, double largest_block, int
 Status check_setup(const model::Model& model, const SteppingOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) return Status::failure(why);
-  for (const Status& check : {check_treecode(model, options), check_kinematics(model, options),
-                              check_support_terms(model, options)})
-    if (!check.ok) return check;
-  return model::check_not_singular(model);
+  // In order, each only once the ones before it passed (a later check may
+  // rely on what an earlier one refused).
+  Status status = check_treecode(model, options);
+  if (status.ok) status = check_kinematics(model, options);
+  if (status.ok) status = check_support_terms(model, options);
+  if (status.ok) status = model::check_not_singular(model);
+  return status;
 }
 
 bool SteppingOptions::IsValid(std::string* why) const {

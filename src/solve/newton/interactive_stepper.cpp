@@ -68,8 +68,9 @@ class InteractiveStepper::Impl {
       : model_(model),
         options_(interactive_options(options)),
         summary_(empty_summary(model, Scheme::Newton)) {
-    for (const Status& check : {check_setup(model, options_), check_paddle_start(model)})
-      if (!check.ok) throw InputError("interactive stepper: " + check.message);
+    Status setup = check_setup(model, options_);
+    if (setup.ok) setup = check_paddle_start(model);
+    if (!setup.ok) throw InputError("interactive stepper: " + setup.message);
     partition_ = model::partition_dofs(model);
     solver_ = std::make_unique<NewtonSolver>(model, options_, summary_);
     finisher_ = std::make_unique<StepFinisher>(model, options_, *solver_, partition_, summary_);

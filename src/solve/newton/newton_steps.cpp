@@ -136,9 +136,11 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
   SteppingSummary summary = empty_summary(model, Scheme::Newton);
   auto fail = [&](const std::string& why) { return failed(summary, why, start); };
   const bool by_arc = options.newton.control == NewtonOptions::Control::ArcLength;
-  for (const Status& check : {check_setup(model, options), check_paddles(model, options.steps),
-                              by_arc ? check_arc_length(model, options.steps) : Status{}})
-    if (!check.ok) return fail(check.message);
+  // Each check once the ones before passed: the paddles' schedule needs valid steps.
+  Status setup = check_setup(model, options);
+  if (setup.ok) setup = check_paddles(model, options.steps);
+  if (setup.ok && by_arc) setup = check_arc_length(model, options.steps);
+  if (!setup.ok) return fail(setup.message);
   for (const std::string& name : options.sensitivities.parameters)
     if (!model.material.has_parameter(name, model.dim()))
       return fail("sensitivities: \"" + name + "\" is not a parameter of the material");
