@@ -1,38 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/model/material_response.hpp"
 
-#include <array>
 #include <cmath>
 #include <vector>
 
+#include "fiberfluid/util/quadrature.hpp"
+
 namespace fiberfluid::model {
 namespace {
-
-// Gauss-Legendre nodes and weights on [0, 1] (Newton on the Legendre
-// polynomial from Chebyshev's guesses).
-struct GaussRule {
-  std::vector<double> x, w;
-};
-GaussRule gauss_legendre(int n) {
-  GaussRule r;
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1, p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1.0);
-      const double step = p1 / dp;
-      z -= step;
-      if (std::abs(step) < 1e-15) break;
-    }
-    r.x.push_back(0.5 * (1.0 - z));
-    r.w.push_back(1.0 / ((1.0 - z * z) * dp * dp));  // 2 / ((1 - z^2) P'^2), halved for [0, 1]
-  }
-  return r;
-}
 
 // Directions over one octant (the integrand is even in each component under
 // a diagonal stretch): Gauss-Legendre in cos(theta) and in phi, 24 x 24
@@ -44,15 +19,15 @@ struct Direction {
 const std::vector<Direction>& octant_directions() {
   static const std::vector<Direction> directions = [] {
     constexpr int kPoints = 24;
-    const GaussRule g = gauss_legendre(kPoints);
+    std::vector<double> x, w;
+    gauss_legendre_unit(kPoints, &x, &w);
     std::vector<Direction> out;
     for (int a = 0; a < kPoints; ++a)
       for (int b = 0; b < kPoints; ++b) {
-        const double u = g.x[static_cast<size_t>(a)],
-                     phi = 0.5 * M_PI * g.x[static_cast<size_t>(b)];
+        const double u = x[static_cast<size_t>(a)], phi = 0.5 * M_PI * x[static_cast<size_t>(b)];
         const double s = std::sqrt(1.0 - u * u);
         out.push_back({{s * std::cos(phi), s * std::sin(phi), u},
-                       g.w[static_cast<size_t>(a)] * g.w[static_cast<size_t>(b)]});
+                       w[static_cast<size_t>(a)] * w[static_cast<size_t>(b)]});
       }
     return out;
   }();
