@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/fit/material_fit.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -19,14 +20,14 @@ std::vector<Parameter> model_parameters(const MaterialModel& m) {
   return out;
 }
 
-// Relative misfits at the loaded points (the unloaded point's stress is no
-// information on the scale).
+// The model's response at parameters p.
+material::StressResponse response_at(const MaterialModel& m, const Eigen::VectorXd& p) {
+  return [&m, p](material::HomogeneousTest test, double l) { return m.nominal_stress(p, test, l); };
+}
+
 Eigen::VectorXd misfits_of(const MaterialModel& m, const Eigen::VectorXd& p,
                            const std::vector<material::TestPoint>& points) {
-  std::vector<double> r;
-  for (const material::TestPoint& t : points)
-    if (t.nominal_stress != 0.0)
-      r.push_back((m.nominal_stress(p, t.test, t.stretch) - t.nominal_stress) / t.nominal_stress);
+  const std::vector<double> r = material::relative_misfits(response_at(m, p), points);
   return Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
 }
 
@@ -39,7 +40,12 @@ class MaterialTestObjective final : public Objective {
       : model_(model),
         points_(points),
         variables_(model_parameters(model)),
-        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())) {}
+        residuals_(static_cast<int>(std::count_if(points.begin(), points.end(),
+                                                  [](const auto& t) {
+                                                    return t.nominal_stress !=
+                                                           0.0;  // as relative_misfits counts them
+                                                  }))),
+        difference_scales_(difference_scales(model)) {}
 
   const Variables& variables() const override { return variables_; }
   int num_residuals() const override { return residuals_; }
@@ -54,13 +60,8 @@ class MaterialTestObjective final : public Objective {
     e.ok = true;
     if (!with_jacobian) return e;
     e.jacobian.resize(residuals_, phi.size());
-    double modulus_scale = 0.0;  // the start's largest modulus
-    for (Eigen::Index k = 0; k < phi.size(); ++k)
-      if (model_.modulus[static_cast<size_t>(k)])
-        modulus_scale = std::max(modulus_scale, std::abs(model_.start[k]));
     for (Eigen::Index k = 0; k < phi.size(); ++k) {
-      const double scale = model_.modulus[static_cast<size_t>(k)] ? modulus_scale : 1.0;
-      const double h = 1e-6 * std::max(std::abs(phi[k]), scale);
+      const double h = 1e-6 * std::max(std::abs(phi[k]), difference_scales_[k]);
       Eigen::VectorXd up = phi, down = phi, r_up, r_down;
       up[k] += h, down[k] -= h;
       std::string why;
@@ -75,6 +76,19 @@ class MaterialTestObjective final : public Objective {
   }
 
  private:
+  // Per parameter, the least scale of its difference step: the start's
+  // largest modulus for a modulus, 1 for an exponent.
+  static Eigen::VectorXd difference_scales(const MaterialModel& m) {
+    double largest_modulus = 0.0;
+    for (Eigen::Index k = 0; k < m.start.size(); ++k)
+      if (m.modulus[static_cast<size_t>(k)])
+        largest_modulus = std::max(largest_modulus, std::abs(m.start[k]));
+    Eigen::VectorXd scales(m.start.size());
+    for (Eigen::Index k = 0; k < m.start.size(); ++k)
+      scales[k] = m.modulus[static_cast<size_t>(k)] ? largest_modulus : 1.0;
+    return scales;
+  }
+
   bool misfits(const Eigen::VectorXd& phi, Eigen::VectorXd* r, std::string* why) const {
     if (const Status usable = model_.check(phi); !usable.ok) return *why = usable.message, false;
     *r = misfits_of(model_, phi, points_);
@@ -86,6 +100,7 @@ class MaterialTestObjective final : public Objective {
   const std::vector<material::TestPoint>& points_;
   Variables variables_;
   int residuals_;
+  Eigen::VectorXd difference_scales_;
 };
 
 }  // namespace
@@ -153,8 +168,7 @@ MaterialFitResult fit_material_test(const MaterialModel& model,
   result.message = outcome.message;
   result.iterations = outcome.iterations;
   result.parameters = outcome.phi;
-  const Eigen::VectorXd r = misfits_of(model, outcome.phi, points);
-  result.rms = std::sqrt(r.squaredNorm() / static_cast<double>(r.size()));
+  result.rms = material::rms_relative_misfit(response_at(model, outcome.phi), points);
   result.evaluations = evaluations.evaluations;
   return result;
 }

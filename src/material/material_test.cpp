@@ -101,18 +101,28 @@ std::vector<TestPoint> read_material_test_text(const std::string& text, const st
   return points;
 }
 
-std::vector<double> relative_misfits(const HyperelasticLaw& law,
+std::vector<double> relative_misfits(const StressResponse& stress,
                                      const std::vector<TestPoint>& points) {
   std::vector<double> misfits;
   for (const TestPoint& p : points)
     if (p.nominal_stress != 0.0)
-      misfits.push_back((nominal_stress(law, p.test, p.stretch) - p.nominal_stress) /
-                        p.nominal_stress);
+      misfits.push_back((stress(p.test, p.stretch) - p.nominal_stress) / p.nominal_stress);
   return misfits;
 }
 
+std::vector<double> relative_misfits(const HyperelasticLaw& law,
+                                     const std::vector<TestPoint>& points) {
+  return relative_misfits(
+      [&](HomogeneousTest test, double l) { return nominal_stress(law, test, l); }, points);
+}
+
 double rms_relative_misfit(const HyperelasticLaw& law, const std::vector<TestPoint>& points) {
-  const std::vector<double> m = relative_misfits(law, points);
+  return rms_relative_misfit(
+      [&](HomogeneousTest test, double l) { return nominal_stress(law, test, l); }, points);
+}
+
+double rms_relative_misfit(const StressResponse& stress, const std::vector<TestPoint>& points) {
+  const std::vector<double> m = relative_misfits(stress, points);
   double sum = 0.0;
   for (double r : m) sum += r * r;
   return m.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(m.size()));

@@ -4,6 +4,7 @@
 // misses it.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,12 +31,18 @@ std::vector<TestPoint> read_material_test(const std::string& path);
 // The same from the file's text; `name` is the file named in the errors.
 std::vector<TestPoint> read_material_test_text(const std::string& text, const std::string& name);
 
-// The relative misfits (law - measured) / measured at every point whose
+// A material's nominal stress in a test at a stretch (Pa).
+using StressResponse = std::function<double(HomogeneousTest, double)>;
+
+// The relative misfits (model - measured) / measured at every point whose
 // measured stress is not zero (a test's unloaded point carries no
 // information on the scale).
+std::vector<double> relative_misfits(const StressResponse& stress,
+                                     const std::vector<TestPoint>& points);
 std::vector<double> relative_misfits(const HyperelasticLaw& law,
                                      const std::vector<TestPoint>& points);
 // Their root mean square.
+double rms_relative_misfit(const StressResponse& stress, const std::vector<TestPoint>& points);
 double rms_relative_misfit(const HyperelasticLaw& law, const std::vector<TestPoint>& points);
 
 }  // namespace fiberfluid::material
