@@ -125,7 +125,7 @@ FIBERFLUID_VECTOR_CLONES void block_tile(const SetArrays& s, const Tile& t, Mult
 
 BulkPairs::BulkPairs(const Eigen::MatrixXd& X, const Eigen::VectorXd& area,
                      const PairFactors& factors, const std::vector<int>& vertices)
-    : mask_(factors.mask()), influence_(factors.influence()) {
+    : mask_(factors.mask()), influence_(factors.influence()), lines_(factors.lines()) {
   if (influence_.weighs()) reference_positions_ = factors.reference();
   if (vertices.empty()) {
     vertex_.resize(static_cast<size_t>(X.rows()));
@@ -188,6 +188,10 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
         if (row[q] != 0.0)
           row[q] *=
               influence_((reference_positions_.row(vi) - reference_positions_.row(vj[q])).norm());
+    if (lines_ != nullptr)
+      for (int q = 0; q < t.nj; ++q)
+        if (row[q] != 0.0 && vj[q] != vi)
+          row[q] *= (*lines_)(static_cast<size_t>(vi), static_cast<size_t>(vj[q]));
     if (projection_axis_ >= 0)
       for (int q = 0; q < t.nj; ++q)
         if (row[q] != 0.0 && vj[q] != vi) row[q] *= projection(vi, vj[q]);
@@ -207,8 +211,8 @@ void BulkPairs::multipliers(const Tile& t, double* m) const {
 
 template <class Visit>
 void BulkPairs::for_each_tile(Visit&& visit) const {
-  const bool weighted =
-      mask_ != nullptr || law_ != nullptr || influence_.weighs() || projection_axis_ >= 0;
+  const bool weighted = mask_ != nullptr || law_ != nullptr || influence_.weighs() ||
+                        lines_ != nullptr || projection_axis_ >= 0;
   // Unweighted: one row of ones serves every row of every tile.
   std::vector<std::vector<double>> m(static_cast<size_t>(omp_get_max_threads()),
                                      std::vector<double>(weighted ? kTile * kTile : kTile, 1.0));
@@ -228,6 +232,7 @@ double BulkPairs::listed_weight(int r, int c) const {
     const double length = (reference_->row(vi) - reference_->row(vj)).norm();
     m *= law_->modulus(fiber_strain((strained_->row(vi) - strained_->row(vj)).norm(), length));
   }
+  if (lines_ != nullptr) m *= (*lines_)(static_cast<size_t>(vi), static_cast<size_t>(vj));
   if (projection_axis_ >= 0) m *= projection(vi, vj);
   const auto r_ = static_cast<size_t>(r), c_ = static_cast<size_t>(c);
   const double d0 = x_[0][r_] - x_[0][c_], d1 = x_[1][r_] - x_[1][c_], d2 = x_[2][r_] - x_[2][c_];

@@ -141,6 +141,7 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
       area_(area),
       mask_(factors.mask()),
       influence_(factors.influence()),
+      lines_(factors.lines()),
       law_(law),
       kinematics_(kinematics) {
   for (int a = 0; a < 3; ++a) {
@@ -195,6 +196,7 @@ void DeformedPairs::for_each_listed_row(Visit&& visit) const {
         row.r[q] = pair_length(x_[0][u] - x_[0][j], x_[1][u] - x_[1][j], x_[2][u] - x_[2][j]);
         row.e[q] = fiber_strain(row.r[q], row.L[q]);
         row.m[q] = influence_.weighs() ? influence_(row.L[q]) : 1.0;
+        if (lines_ != nullptr) row.m[q] *= (*lines_)(u, j);
       }
       law_.evaluate(row.e.data(), k, row.Y.data(), row.Yp.data());
       visit(i, partners, row.arrays());
@@ -278,6 +280,13 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
           const auto k = static_cast<size_t>(j - t.j0);
           row.m[k] = (mask_ != nullptr ? mask_->row(i)[j] : 1.0) * influence_(row.L[k]);
         }
+      if (lines_ != nullptr) {
+        if (mask_ == nullptr && !influence_.weighs())
+          std::fill(row.m.begin() + q, row.m.begin() + (end - t.j0), 1.0);
+        for (int j = first; j < end; ++j)
+          row.m[static_cast<size_t>(j - t.j0)] *=
+              (*lines_)(static_cast<size_t>(i), static_cast<size_t>(j));
+      }
       visit(i, t.j0, first, end, row.arrays(), thread);
     }
   });

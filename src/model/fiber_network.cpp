@@ -32,9 +32,37 @@ Eigen::VectorXd counting_areas(const Model& model) {
 }
 }  // namespace
 
+PairFactors PairFactors::lines(const geom::FiberMask* fibers, const Influence& influence,
+                               const Eigen::MatrixXd& reference,
+                               const Eigen::MatrixXd& area_vectors) {
+  const int n = static_cast<int>(reference.rows());
+  if (reference.cols() != 3 || area_vectors.rows() != n || area_vectors.cols() != 3)
+    throw InputError("the line measure weighs fibers through a 3D body (steradians): a " +
+                     std::to_string(reference.cols()) + "D surface has no such weights");
+  // Built as the symmetric count with every kept_ij = 1, then the counts
+  // replaced by the areas (h_ij (|S_i| + |S_j|) = m_ij).
+  PairFactors factors(fibers, ConnectionCount::Symmetric, n, influence, &reference);
+  factors.lines_ = std::make_shared<LineMeasure>(reference, area_vectors);
+  factors.reference_ = reference;
+  factors.kept_.assign(static_cast<size_t>(n), 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double area = area_vectors.row(i).norm();
+    if (!(area > 0.0) || !std::isfinite(area))
+      throw InputError("vertex " + std::to_string(i) + " has no area vector (|S_" +
+                       std::to_string(i) + "| = " + std::to_string(area) +
+                       "): the line measure weighs each fiber by its ends' area vectors");
+    factors.kept_[static_cast<size_t>(i)] = area;
+  }
+  return factors;
+}
+
 PairFactors::PairFactors(const Model& model)
-    : PairFactors(model.fibers.get(), model.connection_count, model.num_vertices(), model.influence,
-                  &model.surface.V, counting_areas(model)) {}
+    : PairFactors(model.fiber_weights == FiberWeights::Lines
+                      ? lines(model.fibers.get(), model.influence, model.surface.V,
+                              geom::vertex_area_vectors(model.surface.V, model.surface.F).S)
+                      : PairFactors(model.fibers.get(), model.connection_count,
+                                    model.num_vertices(), model.influence, &model.surface.V,
+                                    counting_areas(model))) {}
 
 PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, int num_vertices,
                          const Influence& influence, const Eigen::MatrixXd* reference,
@@ -93,7 +121,9 @@ PairFactors::PairFactors(const geom::FiberMask* fibers, ConnectionCount count, i
 }
 
 double PairFactors::weight(int i, int j) const {
-  return influence_.weighs() ? influence_((reference_.row(i) - reference_.row(j)).norm()) : 1.0;
+  const double fade =
+      influence_.weighs() ? influence_((reference_.row(i) - reference_.row(j)).norm()) : 1.0;
+  return lines_ ? fade * (*lines_)(static_cast<size_t>(i), static_cast<size_t>(j)) : fade;
 }
 
 void PairFactors::weights(int i, double* row) const {

@@ -3,7 +3,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
 
+#include "fiberfluid/model/line_measure.hpp"
 #include "fiberfluid/model/model.hpp"
 
 namespace fiberfluid::model {
@@ -22,6 +25,13 @@ class PairFactors {
               const Eigen::VectorXd& areas = {});
   // With ConnectionCount::Area or Mean, `areas` are the reference |S_i| and
   // c_i = sum_j kept_ij omega(L_ij) |S_j| / |S_i| (model.hpp).
+  // The line measure's factors (FiberWeights::Lines): kept_ij times the
+  // influence times line_measure, and c_i = |S_i|, so that
+  // h_ij (|S_i| + |S_j|) = m_ij: the measure is the whole weight, and every
+  // loop that forms h (|S_i| + |S_j|) / L forms it. `reference` and
+  // `area_vectors` are #V by 3.
+  static PairFactors lines(const geom::FiberMask* fibers, const Influence& influence,
+                           const Eigen::MatrixXd& reference, const Eigen::MatrixXd& area_vectors);
   // The factors of a model: its fibers, count and influence at its reference.
   explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.
@@ -37,6 +47,9 @@ class PairFactors {
   bool mean_count() const { return count_ == ConnectionCount::Mean; }
   const geom::FiberMask* mask() const { return fibers_; }  // null: every pair kept
   const Influence& influence() const { return influence_; }
+  // The line measure a weight carries besides the influence (null for the
+  // paper's weights): the pair loops multiply m_ij by it.
+  const LineMeasure* lines() const { return lines_.get(); }
   // The reference positions the influence weighs by (empty unless it weighs).
   const Eigen::MatrixXd& reference() const { return reference_; }
 
@@ -54,6 +67,7 @@ class PairFactors {
   std::vector<double> kept_;   // n_i (weighed by the influence)
   Eigen::VectorXd areas_;      // the reference |S_i|, for the mean count
   double global_ = 0.0;        // the count for ConnectionCount::Global or a full body
+  std::shared_ptr<const LineMeasure> lines_;  // FiberWeights::Lines
 };
 
 // |x_i - x_j|; throws InputError naming both when they coincide (a fiber of

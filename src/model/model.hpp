@@ -180,6 +180,23 @@ inline bool counts_by_area(ConnectionCount count) {
   return count == ConnectionCount::Area || count == ConnectionCount::Mean;
 }
 
+// What a bulk fiber's weight stands for.
+enum class FiberWeights {
+  // The paper's Eq. 6: a_ij = h_ij (|S_i| + |S_j|) / L_ij, h_ij from the
+  // connection count (the default; the paper's figures need it).
+  Paper,
+  // The line measure (pair_stencil.hpp, line_measure): a fiber stands for the
+  // straight lines through the body that cross the surface at its two ends'
+  // patches, so that a homogeneous deformation of any body is an equilibrium
+  // whose stress is the fiber network's material-level response
+  // (material_response.hpp): the body of fibers is a material (issue 57's
+  // patch test). Counts, and an influence, do not enter it.
+  Lines,
+};
+inline constexpr auto kFiberWeightsNames = names_of<FiberWeights>(
+    {{FiberWeights::Paper, "paper"}, {FiberWeights::Lines, "lines"}});
+inline const char* to_string(FiberWeights weights) { return kFiberWeightsNames.name(weights); }
+
 // How a bulk fiber's weight falls off with its reference length L within the
 // horizon delta: the influence function of peridynamics (Seleson and Parks
 // 2011, "On the role of the influence function in the peridynamic theory").
@@ -235,6 +252,7 @@ struct Model {
   // The bulk fibers that exist: null means every pair (a convex body).
   std::shared_ptr<const geom::FiberMask> fibers;
   Influence influence;  // each fiber's weight by its reference length
+  FiberWeights fiber_weights = FiberWeights::Paper;
   ConnectionCount connection_count = ConnectionCount::Symmetric;
   // Above 0: the linear bulk product and diagonal come from a treecode with
   // this relative error (bulk_treecode.hpp) instead of the exact pair sums.

@@ -117,6 +117,7 @@ class BulkPairs {
   const geom::FiberMask* mask_ = nullptr;
   Influence influence_;                  // weighs each pair by its reference length
   Eigen::MatrixXd reference_positions_;  // for a weighing influence
+  const LineMeasure* lines_ = nullptr;   // the factors' (null: the paper's weights)
   const FiberLaw* law_ = nullptr;
   const Eigen::MatrixXd *reference_ = nullptr, *strained_ = nullptr;
   int projection_axis_ = -1;  // none
@@ -202,6 +203,7 @@ class DeformedPairs {
   const Eigen::VectorXd& area_;
   const geom::FiberMask* mask_;
   Influence influence_;
+  const LineMeasure* lines_;  // the factors' (null: the paper's weights)
   const FiberLaw& law_;
   FiberKinematics kinematics_;
   std::vector<size_t> offsets_;  // sparse: where each row's pairs start (N + 1)

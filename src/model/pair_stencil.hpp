@@ -50,6 +50,29 @@ inline double counted_bulk_weight(double kept, double area_i, double area_j, dou
   return kept * areas / (reached * length);
 }
 
+// The line measure of a fiber (FiberWeights::Lines). Straight lines through
+// a body, rho of them per unit area across them and per steradian, cross a
+// surface patch S_i in direction n as rho |n . S_i| per steradian, and the
+// patch S_j at distance L in that direction subtends |n . S_j| / L^2
+// steradians (the measure of lines joining two patches: Santalo, "Integral
+// Geometry and Geometric Probability", 1976, ch. 12; radiosity's form
+// factor). A fiber standing for those lines, each a fiber of stress T, pulls
+// i by rho |n . S_i| |n . S_j| T / L^2 where a fiber gives a Y(e) e L:
+//   a_ij = rho |d . S_i| |d . S_j| / L^5,   d = s_j - s_i.
+// Under an affine deformation every line is strained alike by its direction,
+// so a vertex's force is the network's stress times its area vector: the
+// patch test. rho = 5 / (2 pi) makes that stress the material-level
+// response's (material_response.hpp: 5 <T d d>; the mean over the sphere is
+// 1/(2 pi) times the integral over the half of it that undirected lines span).
+inline constexpr double kLineDensity = 2.5 / 3.14159265358979323846;
+// The multiplier m_ij of the weight a_ij = m_ij / L (the counts being the
+// areas, PairFactors): rho |d . S_i| |d . S_j| / L^4. A fiber along the
+// surface (d . S = 0) stands for no line.
+inline double line_measure(double d_dot_si, double d_dot_sj, double length) {
+  const double squared = length * length;
+  return kLineDensity * std::abs(d_dot_si * d_dot_sj) / (squared * squared);
+}
+
 // Surface fiber weight (paper Eq. 7): (|S_i| + |S_k|) / (2 |s_i - s_k|^2).
 inline double surface_weight(double area_i, double area_k, double length_squared) {
   return (area_i + area_k) / (2.0 * length_squared);

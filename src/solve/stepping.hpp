@@ -258,6 +258,12 @@ Status check_kinematics(const model::Model& model, const SteppingOptions& option
 // they need the Newton scheme.
 Status check_support_terms(const model::Model& model, const SteppingOptions& options);
 
+// Whether the model's fiber weights can run with these options, else why
+// not: the line measure (model::FiberWeights::Lines) is 3D, weighs each pair
+// differently (no treecode), has no mirror layer, and is a reference measure
+// (no matrix rebuilt from the deformed geometry).
+Status check_fiber_weights(const model::Model& model, const SteppingOptions& options);
+
 // The backend SolverKind::Auto runs: pcg with the treecode, else
 // choose_solver's rule by size (the largest axis block, the distinct factors).
 SolverKind automatic_solver(const model::Model& model, double largest_block, int factors,

@@ -78,6 +78,23 @@ Status check_kinematics(const model::Model& model, const SteppingOptions& option
       "incremental scheme's matrix is the paper's vector spring");
 }
 
+Status check_fiber_weights(const model::Model& model, const SteppingOptions& options) {
+  if (model.fiber_weights != model::FiberWeights::Lines) return {};
+  const std::string what = "the line measure (fibers.weights \"lines\") ";
+  if (model.dim() != 3)
+    return Status::failure(what + "weighs fibers through a 3D body: a " +
+                           std::to_string(model.dim()) + "D surface has no such weights");
+  if (model.treecode_tolerance > 0.0)
+    return Status::failure(what + "varies from pair to pair: the treecode needs one count");
+  if (!model.mirror_layers.empty())
+    return Status::failure(what + "has no mirror layer yet: its images' area vectors are not "
+                                  "weighed (hold the clamp without \"layer\")");
+  if (options.scheme != Scheme::Newton && options.rebuild_matrix)
+    return Status::failure(what + "weighs the fibers at the reference: a matrix rebuilt from "
+                                  "the deformed geometry has no measure (use the Newton scheme)");
+  return {};
+}
+
 Status check_support_terms(const model::Model& model, const SteppingOptions& options) {
   if (options.scheme == Scheme::Newton) return {};
   if (!model.mirror_layers.empty())
@@ -107,6 +124,7 @@ Status check_setup(const model::Model& model, const SteppingOptions& options) {
   Status status = check_treecode(model, options);
   if (status.ok) status = check_kinematics(model, options);
   if (status.ok) status = check_support_terms(model, options);
+  if (status.ok) status = check_fiber_weights(model, options);
   if (status.ok) status = model::check_not_singular(model);
   return status;
 }

@@ -238,6 +238,17 @@ TEST(ExperimentConfig, CentralFibersDefaultToTheAreaCountAndAConicalInfluence) {
   expect_config_error(dir, c, "fibers.product: \"treecode\" needs one connection count");
   c["fibers"] = {{"connection_count", "by_area"}};
   expect_config_error(dir, c, "fibers.connection_count");
+
+  // The line measure: no count, and no fading unless asked for.
+  m = model_of({{"kinematics", "central"}, {"weights", "lines"}, {"horizon", 1.5}});
+  EXPECT_EQ(m.fiber_weights, model::FiberWeights::Lines);
+  EXPECT_EQ(m.influence.kind, model::Influence::Kind::Constant);
+  m = model_of({{"kinematics", "central"}});
+  EXPECT_EQ(m.fiber_weights, model::FiberWeights::Paper);
+  c["fibers"] = {{"weights", "lines"}, {"connection_count", "area"}};
+  expect_config_error(dir, c, "fibers.connection_count: \"weights\": \"lines\" weighs each fiber");
+  c["fibers"] = {{"weights", "sideways"}};
+  expect_config_error(dir, c, "fibers.weights");
 }
 
 // Issue 43, "a case is built from its own spec alone": in a sweep, a
@@ -273,6 +284,7 @@ TEST(ACaseIsBuiltFromItsOwnSpecAlone, AReusedCaseEqualsOneBuiltAfreshFieldByFiel
     EXPECT_EQ(r.influence.kind, model::Influence::Kind::Conical);
     EXPECT_EQ(r.influence.horizon, f.influence.horizon);
     EXPECT_EQ(r.connection_count, f.connection_count);
+    EXPECT_EQ(r.fiber_weights, f.fiber_weights);
     EXPECT_EQ(r.treecode_tolerance, f.treecode_tolerance);
     EXPECT_EQ(r.material.kinematics, f.material.kinematics);
     for (const std::string& name : f.material.parameter_names())

@@ -315,11 +315,20 @@ FiberSpec read_fibers(Fields& root) {
   // within a horizon the fibers fade out conically. The vector spring keeps
   // the paper's count, so that its figures are reproduced as published.
   const bool central = spec.kinematics == model::FiberKinematics::Central;
+  spec.weights = f.enumeration("weights", model::FiberWeights::Paper, model::kFiberWeightsNames);
+  const bool lines = spec.weights == model::FiberWeights::Lines;
+  // The line measure is a fiber's whole weight: no count divides it, and no
+  // influence fades it unless asked for.
+  if (lines && f.has("connection_count"))
+    f.fail("connection_count",
+           "\"weights\": \"lines\" weighs each fiber by the lines it stands for, not by a "
+           "count: leave \"connection_count\" out");
   spec.count =
       f.enumeration("connection_count",
-                    central ? model::ConnectionCount::Area : model::ConnectionCount::Symmetric,
+                    central && !lines ? model::ConnectionCount::Area
+                                      : model::ConnectionCount::Symmetric,
                     model::kConnectionCountNames);
-  const bool fades = central && spec.horizon > 0.0;
+  const bool fades = central && spec.horizon > 0.0 && !lines;
   if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) == "conical") {
     if (!(spec.horizon > 0.0))
       f.fail("influence", "a conical influence (1 - L / horizon) needs a \"horizon\"");

@@ -170,6 +170,7 @@ FiberReport choose_fibers(const FiberSpec& spec, bool concave, model::Model& m) 
   m.connection_count = spec.count;
   m.treecode_tolerance = spec.treecode_tolerance;
   m.influence = {spec.influence, spec.horizon};
+  m.fiber_weights = spec.weights;
   const int n = m.num_vertices();
   report.pairs = static_cast<long long>(n) * (n - 1) / 2;
   report.kept = report.pairs;

@@ -112,6 +112,9 @@ struct FiberSpec {
   // "influence": "constant" or "conical" (1 - L / horizon), the default for
   // central fibers with a horizon.
   model::Influence::Kind influence = model::Influence::Kind::Constant;
+  // "weights": "paper" (Eq. 6, with the count) or "lines" (the line
+  // measure: a body of fibers that is a material, model.hpp FiberWeights).
+  model::FiberWeights weights = model::FiberWeights::Paper;
   FieldName field;
 };
 

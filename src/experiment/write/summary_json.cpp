@@ -205,7 +205,11 @@ json fibers_json(const Case& c) {
           {"horizon", f.horizon > 0.0 ? json(f.horizon) : json(nullptr)},  // m; null: every pair
           {"pruning", f.pruning ? "auto" : "off"},
           {"convex", f.convex},
-          {"connection_count", model::to_string(c.model.connection_count)},
+          {"weights", model::to_string(c.model.fiber_weights)},
+          // The line measure has no count (model.hpp, FiberWeights).
+          {"connection_count", c.model.fiber_weights == model::FiberWeights::Lines
+                                   ? json(nullptr)
+                                   : json(model::to_string(c.model.connection_count))},
           {"product", c.model.treecode_tolerance > 0.0 ? "treecode" : "exact"},
           {"treecode_tolerance", c.model.treecode_tolerance},
           {"in_all", f.pairs},
