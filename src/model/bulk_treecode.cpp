@@ -19,7 +19,7 @@ Eigen::MatrixXd as_3d(const Eigen::MatrixXd& X) {
 }  // namespace
 
 bool BulkTreecode::applicable(const PairFactors& factors) {
-  if (factors.mean_count()) return false;  // its weights are not h (|S_i| + |S_j|) / L
+  if (factors.mean_count()) return false;        // its weights are not h (|S_i| + |S_j|) / L
   if (factors.lines() != nullptr) return false;  // a measure per pair, not per vertex
   const std::vector<double> counts = factors.vertex_counts();
   for (double c : counts)

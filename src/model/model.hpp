@@ -193,8 +193,8 @@ enum class FiberWeights {
   // patch test). Counts, and an influence, do not enter it.
   Lines,
 };
-inline constexpr auto kFiberWeightsNames = names_of<FiberWeights>(
-    {{FiberWeights::Paper, "paper"}, {FiberWeights::Lines, "lines"}});
+inline constexpr auto kFiberWeightsNames =
+    names_of<FiberWeights>({{FiberWeights::Paper, "paper"}, {FiberWeights::Lines, "lines"}});
 inline const char* to_string(FiberWeights weights) { return kFiberWeightsNames.name(weights); }
 
 // How a bulk fiber's weight falls off with its reference length L within the

@@ -87,11 +87,13 @@ Status check_fiber_weights(const model::Model& model, const SteppingOptions& opt
   if (model.treecode_tolerance > 0.0)
     return Status::failure(what + "varies from pair to pair: the treecode needs one count");
   if (!model.mirror_layers.empty())
-    return Status::failure(what + "has no mirror layer yet: its images' area vectors are not "
-                                  "weighed (hold the clamp without \"layer\")");
+    return Status::failure(what +
+                           "has no mirror layer yet: its images' area vectors are not "
+                           "weighed (hold the clamp without \"layer\")");
   if (options.scheme != Scheme::Newton && options.rebuild_matrix)
-    return Status::failure(what + "weighs the fibers at the reference: a matrix rebuilt from "
-                                  "the deformed geometry has no measure (use the Newton scheme)");
+    return Status::failure(what +
+                           "weighs the fibers at the reference: a matrix rebuilt from "
+                           "the deformed geometry has no measure (use the Newton scheme)");
   return {};
 }
 

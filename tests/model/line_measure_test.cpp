@@ -33,12 +33,12 @@ TEST(LineMeasure, WeightIsTheMeasureOfTheLinesJoiningTwoPatches) {
       if (i == j) continue;
       const Eigen::Vector3d d = s.V.row(j) - s.V.row(i);
       const double L = d.norm();
-      const double expected = 2.5 / M_PI * std::abs(d.dot(areas.S.row(i).transpose()) *
-                                                    d.dot(areas.S.row(j).transpose())) /
-                              std::pow(L, 5);
+      const double expected =
+          2.5 / M_PI *
+          std::abs(d.dot(areas.S.row(i).transpose()) * d.dot(areas.S.row(j).transpose())) /
+          std::pow(L, 5);
       // The weight every loop forms, h (|S_i| + |S_j|) / L.
-      const double a = bulk_weight(factors.factor(i, j), areas.magnitude[i],
-                                   areas.magnitude[j], L);
+      const double a = bulk_weight(factors.factor(i, j), areas.magnitude[i], areas.magnitude[j], L);
       EXPECT_NEAR(a, expected, 1e-14 * expected + 1e-300) << i << "-" << j;
       EXPECT_DOUBLE_EQ(factors.factor(i, j), factors.factor(j, i));
     }
@@ -102,8 +102,8 @@ PatchMisfit patch_misfit(const geom::Surface& s, const PairFactors& factors,
 }
 
 PatchMisfit lines_misfit(const geom::Surface& s, const Eigen::Vector3d& l, const FiberLaw& law) {
-  const PairFactors factors = PairFactors::lines(
-      nullptr, Influence{}, s.V, geom::vertex_area_vectors(s.V, s.F).S);
+  const PairFactors factors =
+      PairFactors::lines(nullptr, Influence{}, s.V, geom::vertex_area_vectors(s.V, s.F).S);
   return patch_misfit(s, factors, l, law);
 }
 
@@ -146,9 +146,10 @@ TEST(LineMeasure, PatchTestOfACylinderAndACubeAwayFromTheirEdges) {
     const geom::Surface cube = geom::box({0, 0, 0}, {1, 1, 1}, {n, n, n});
     const PatchMisfit shear = lines_misfit(cube, kSmallUniaxial, law);
     const PatchMisfit biaxial = lines_misfit(cube, {1.5, 1.5, 1.0 / 2.25}, law);
-    std::printf("cube %d: small strain rms %.4f largest %.4f; equibiaxial 1.5 rms %.4f largest "
-                "%.4f\n",
-                n, shear.rms, shear.largest, biaxial.rms, biaxial.largest);
+    std::printf(
+        "cube %d: small strain rms %.4f largest %.4f; equibiaxial 1.5 rms %.4f largest "
+        "%.4f\n",
+        n, shear.rms, shear.largest, biaxial.rms, biaxial.largest);
     EXPECT_LT(shear.rms, 0.75 * previous) << n;
     EXPECT_LT(biaxial.rms, 0.2) << n;
     previous = shear.rms;
@@ -196,8 +197,8 @@ TEST(LineMeasure, CylinderBetweenFrictionlessPlatensCompressesHomogeneously) {
   options.steps = 1;
   double force = 0.0;
   Eigen::MatrixXd X;
-  const solve::SteppingSummary run =
-      solve::solve_load_steps(m, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
+  const solve::SteppingSummary run = solve::solve_load_steps(
+      m, options, [&](const solve::StepRecord& r, const Eigen::VectorXd& x) {
         force = -r.paddles[1].force.x();
         X = positions(m, x);
       });
@@ -211,12 +212,13 @@ TEST(LineMeasure, CylinderBetweenFrictionlessPlatensCompressesHomogeneously) {
     const double radius = std::hypot(X(v, 1), X(v, 2));
     worst = std::max(worst, std::abs(radius / homogeneous - 1.0));
   }
-  const double curve = -fiber_network_nominal_stress(m.material.law,
-                                                     material::HomogeneousTest::Uniaxial, l) *
-                       M_PI * kRadius * kRadius;
-  std::printf("pressed 5%%: side's radius off the homogeneous one by at most %.2f%%; "
-              "force %.4f N, material curve %.4f N (%+.2f%%)\n",
-              100 * worst, force, curve, 100 * (force / curve - 1));
+  const double curve =
+      -fiber_network_nominal_stress(m.material.law, material::HomogeneousTest::Uniaxial, l) * M_PI *
+      kRadius * kRadius;
+  std::printf(
+      "pressed 5%%: side's radius off the homogeneous one by at most %.2f%%; "
+      "force %.4f N, material curve %.4f N (%+.2f%%)\n",
+      100 * worst, force, curve, 100 * (force / curve - 1));
   // The tolerances (57: 2% and 3%); the largest misfit is the rim's
   // (1.6% at 5%): the edge the lumped measure misses.
   EXPECT_LT(worst, 0.02);

@@ -323,11 +323,10 @@ FiberSpec read_fibers(Fields& root) {
     f.fail("connection_count",
            "\"weights\": \"lines\" weighs each fiber by the lines it stands for, not by a "
            "count: leave \"connection_count\" out");
-  spec.count =
-      f.enumeration("connection_count",
-                    central && !lines ? model::ConnectionCount::Area
-                                      : model::ConnectionCount::Symmetric,
-                    model::kConnectionCountNames);
+  spec.count = f.enumeration(
+      "connection_count",
+      central && !lines ? model::ConnectionCount::Area : model::ConnectionCount::Symmetric,
+      model::kConnectionCountNames);
   const bool fades = central && spec.horizon > 0.0 && !lines;
   if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) == "conical") {
     if (!(spec.horizon > 0.0))
