@@ -326,17 +326,25 @@ void BulkFiberTerm::add_parameter_derivative(const TermState& s, const MaterialP
         fill_row(c_, i, col, row);
         if (axis < 0) law.evaluate_derivative(p.index, row.e.data(), row.e.size(), row.dY.data());
         const auto u = static_cast<size_t>(i);
+        // The rest tension and its derivative, times the pair's factor (line_measure.hpp).
+        const double rest = law.rest_tension();
+        const double d_rest = axis >= 0 ? 0.0 : law.rest_tension_derivative(p.index);
+        const LineMeasure* lines = c_.pair_factors.lines();
         double sum[3] = {0.0, 0.0, 0.0};
         for (size_t j = 0; j < static_cast<size_t>(n); ++j) {
           if (row.h[j] == 0.0) continue;
           const double a =
               bulk_weight(row.h[j], c_.area0[i], c_.area0[static_cast<Eigen::Index>(j)], row.L[j]);
-          const PairCoefficients pc = K::coefficients(a, row.Y[j], row.Yp[j], row.r[j], row.L[j]);
+          const double factor =
+              (rest != 0.0 || d_rest != 0.0) && lines != nullptr ? lines->rest_factor(u, j) : 1.0;
+          const PairCoefficients pc =
+              K::coefficients(a, row.Y[j], row.Yp[j], row.r[j], row.L[j], rest * factor);
           const double dY = axis >= 0 ? 0.0 : row.dY[j];
           for (int k = 0; k < 3; ++k) {
             const double b = col.x[k][u] - col.x[k][j], d = col.u[k][u] - col.u[k][j];
             sum[k] += axis >= 0 ? pair_force<K>(pc, b, d)
-                                : pair_parameter_force<K>(a, dY, row.r[j], row.L[j], b, d);
+                                : pair_parameter_force<K>(a, dY, row.r[j], row.L[j], b, d,
+                                                          d_rest * factor);
           }
         }
         if (axis >= 0)

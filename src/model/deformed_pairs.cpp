@@ -50,6 +50,7 @@ void lengths_row(const DeformedRow& d, int i, int j0, int first, int end, double
 // The arrays of one tile row: m (mask), L, r, Y, Y' at j - j0.
 struct RowArrays {
   const double *m, *L, *r, *Y, *Yp;
+  const double* T0;  // the pair's rest tension (zeros for a law without one)
 };
 
 // The pair's coefficients from the row arrays at q (stencil: weight, then policy).
@@ -57,7 +58,7 @@ template <class K>
 inline PairCoefficients row_coefficients(const RowArrays& row, int q, double area_i, double area_j,
                                          double count_i, double count_j, bool mean) {
   const double a = counted_bulk_weight(row.m[q], area_i, area_j, count_i, count_j, row.L[q], mean);
-  return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q]);
+  return K::coefficients(a, row.Y[q], row.Yp[q], row.r[q], row.L[q], row.T0[q]);
 }
 
 // The positions and displacements a row kernel reads (three columns each).
@@ -143,6 +144,7 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
       influence_(factors.influence()),
       lines_(factors.lines()),
       law_(law),
+      rest_(law.rest_tension()),
       kinematics_(kinematics) {
   for (int a = 0; a < 3; ++a) {
     s_[a].assign(static_cast<size_t>(n_), 0.0);
@@ -164,12 +166,14 @@ DeformedPairs::DeformedPairs(const Eigen::MatrixXd& S, const Eigen::MatrixXd& X,
 }
 
 struct DeformedPairs::ListedRow {
-  std::vector<double> m, L, r, e, Y, Yp;
+  std::vector<double> m, L, r, e, Y, Yp, T0;
   void resize(size_t k) {
-    for (std::vector<double>* v : {&m, &L, &r, &e, &Y, &Yp})
-      if (v->size() < k) v->resize(k);
+    for (std::vector<double>* v : {&m, &L, &r, &e, &Y, &Yp, &T0})
+      if (v->size() < k) v->resize(k, 0.0);
   }
-  RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
+  RowArrays arrays() const {
+    return {m.data(), L.data(), r.data(), Y.data(), Yp.data(), T0.data()};
+  }
 };
 
 PairPasses& pair_passes() {
@@ -197,6 +201,7 @@ void DeformedPairs::for_each_listed_row(Visit&& visit) const {
         row.e[q] = fiber_strain(row.r[q], row.L[q]);
         row.m[q] = influence_.weighs() ? influence_(row.L[q]) : 1.0;
         if (lines_ != nullptr) row.m[q] *= (*lines_)(u, j);
+        if (rest_ != 0.0) row.T0[q] = rest_ * (lines_ != nullptr ? lines_->rest_factor(u, j) : 1.0);
       }
       law_.evaluate(row.e.data(), k, row.Y.data(), row.Yp.data());
       visit(i, partners, row.arrays());
@@ -245,15 +250,18 @@ void DeformedPairs::listed_coefficients(std::vector<double>* c1, std::vector<dou
 }
 
 struct DeformedPairs::RowScratch {
-  std::vector<double> m, L, r, e, Y, Yp;
+  std::vector<double> m, L, r, e, Y, Yp, T0;
   RowScratch()
       : m(BulkPairs::kTile, 1.0),
         L(BulkPairs::kTile),
         r(BulkPairs::kTile),
         e(BulkPairs::kTile),
         Y(BulkPairs::kTile),
-        Yp(BulkPairs::kTile) {}
-  RowArrays arrays() const { return {m.data(), L.data(), r.data(), Y.data(), Yp.data()}; }
+        Yp(BulkPairs::kTile),
+        T0(BulkPairs::kTile, 0.0) {}
+  RowArrays arrays() const {
+    return {m.data(), L.data(), r.data(), Y.data(), Yp.data(), T0.data()};
+  }
 };
 
 template <class Visit>
@@ -287,6 +295,12 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
           row.m[static_cast<size_t>(j - t.j0)] *=
               (*lines_)(static_cast<size_t>(i), static_cast<size_t>(j));
       }
+      if (rest_ != 0.0)
+        for (int j = first; j < end; ++j)
+          row.T0[static_cast<size_t>(j - t.j0)] =
+              rest_ * (lines_ != nullptr
+                           ? lines_->rest_factor(static_cast<size_t>(i), static_cast<size_t>(j))
+                           : 1.0);
       visit(i, t.j0, first, end, row.arrays(), thread);
     }
   });

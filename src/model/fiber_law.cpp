@@ -85,6 +85,30 @@ class ConstantLaw final : public LawModel {
   bool is_constant() const override { return true; }
 };
 
+// The neo-Hookean network (FiberLaw::neo_hookean): T = 0.6 mu (1 + e).
+class NeoHookeanLaw final : public LawModel {
+ public:
+  std::string name() const override { return "neo_hookean"; }
+  std::vector<std::string> parameter_names() const override { return {"mu"}; }
+  double modulus(const double* p, double) const override { return kShare * p[0]; }
+  double slope(const double*, double) const override { return 0.0; }
+  double modulus_derivative(const double*, int, double) const override { return kShare; }
+  void evaluate(const double* p, const double*, size_t n, double* Y, double* Yp) const override {
+    std::fill(Y, Y + n, kShare * p[0]);
+    std::fill(Yp, Yp + n, 0.0);
+  }
+  double rest_tension(const double* p) const override { return kShare * p[0]; }
+  double rest_tension_derivative(const double*, int) const override { return kShare; }
+  Status check(const double* p, double, double) const override {
+    if (Status finite = finite_parameters(*this, p); !finite.ok) return finite;
+    return p[0] > 0.0 ? Status{} : Status::failure("mu must be a positive number");
+  }
+
+ private:
+  // 5 <0.3 mu l^2> = mu/2 I1 (material_response.hpp's factor 5, <d_i^2> = 1/3).
+  static constexpr double kShare = 0.6;
+};
+
 // Y0 exp(beta e) and its slope at n strains, vectorised (vector_exp): the
 // Newton kernels call this once per row of pairs.
 FIBERFLUID_VECTOR_CLONES
@@ -393,6 +417,11 @@ FiberLaw FiberLaw::exponential(double Y0, double beta) {
   return {model, {Y0, beta}};
 }
 
+FiberLaw FiberLaw::neo_hookean(double mu) {
+  static const auto model = std::make_shared<const NeoHookeanLaw>();
+  return {model, {mu}};
+}
+
 FiberLaw FiberLaw::bilinear(double Y_t, double Y_c, double transition) {
   return {std::make_shared<const BilinearLaw>(transition), {Y_t, Y_c}};
 }
@@ -433,8 +462,8 @@ Registry& registry() {
 }
 
 const std::vector<std::string>& builtin_law_names() {
-  static const std::vector<std::string> names = {"constant", "exponential", "bilinear",
-                                                 "tabulated"};
+  static const std::vector<std::string> names = {"constant", "exponential", "bilinear", "tabulated",
+                                                 "neo_hookean"};
   return names;
 }
 

@@ -41,6 +41,12 @@ class LawModel {
   virtual Status check(const double* p, double lowest, double highest) const;
   // True when Y does not depend on the strain (the linear model).
   virtual bool is_constant() const { return false; }
+  // A tension every fiber carries at rest (Pa, as Y e): the fiber's stress
+  // is T(e) = T0 + Y(e) e. The fluid's pressure balances it at rest (a
+  // network of chains in tension, as the neo-Hookean one). Zero by default.
+  virtual double rest_tension(const double* /*p*/) const { return 0.0; }
+  // dT0/dp_k.
+  virtual double rest_tension_derivative(const double* /*p*/, int /*k*/) const { return 0.0; }
   // Whether parameter k is positive by nature (a modulus: a fit may vary it
   // in log scale), or may take either sign (an exponent).
   virtual bool is_positive(int /*k*/) const { return true; }
@@ -79,8 +85,18 @@ class FiberLaw {
   static FiberLaw tabulated(std::vector<double> strain, std::vector<double> stress,
                             double transition = 0.005);
 
+  // The affine network of a neo-Hookean solid of shear modulus mu: fibers
+  // whose tension grows as their stretch, T = 0.6 mu l, that is Y = 0.6 mu
+  // and a rest tension 0.6 mu (material_response.hpp: 5 <0.3 mu (l_d^2 - 1)>
+  // = mu/2 (I1 - 3); the Gaussian chains of Treloar's network theory).
+  static FiberLaw neo_hookean(double mu);
+
   std::string name() const { return model_->name(); }
   bool is_constant() const { return model_->is_constant(); }
+  double rest_tension() const { return model_->rest_tension(p()); }  // T0
+  double rest_tension_derivative(int index) const {
+    return model_->rest_tension_derivative(p(), index);
+  }
   const LawModel& model() const { return *model_; }
 
   double modulus(double strain) const { return model_->modulus(p(), strain); }  // Y(e)
@@ -127,7 +143,7 @@ class FiberLaw {
 };
 
 // The law kinds that experiment files can name besides the built-ins
-// (constant, exponential, bilinear, tabulated): a registered law is read as
+// (constant, exponential, bilinear, tabulated, neo_hookean): a registered law is read as
 // {"type": name, <each parameter>: number}. Throws std::invalid_argument when
 // the name is taken or empty. Thread-safe.
 void register_law(std::shared_ptr<const LawModel> model);

@@ -34,7 +34,7 @@ Eigen::VectorXd counting_areas(const Model& model) {
 
 PairFactors PairFactors::lines(const geom::FiberMask* fibers, const Influence& influence,
                                const Eigen::MatrixXd& reference,
-                               const Eigen::MatrixXd& area_vectors) {
+                               const Eigen::MatrixXd& area_vectors, bool balance_rest) {
   const int n = static_cast<int>(reference.rows());
   if (reference.cols() != 3 || area_vectors.rows() != n || area_vectors.cols() != 3)
     throw InputError("the line measure weighs fibers through a 3D body (steradians): a " +
@@ -42,7 +42,7 @@ PairFactors PairFactors::lines(const geom::FiberMask* fibers, const Influence& i
   // Built as the symmetric count with every kept_ij = 1, then the counts
   // replaced by the areas (h_ij (|S_i| + |S_j|) = m_ij).
   PairFactors factors(fibers, ConnectionCount::Symmetric, n, influence, &reference);
-  factors.lines_ = std::make_shared<LineMeasure>(reference, area_vectors);
+  factors.lines_ = std::make_shared<LineMeasure>(reference, area_vectors, fibers, balance_rest);
   factors.reference_ = reference;
   factors.kept_.assign(static_cast<size_t>(n), 0.0);
   for (int i = 0; i < n; ++i) {
@@ -59,7 +59,8 @@ PairFactors PairFactors::lines(const geom::FiberMask* fibers, const Influence& i
 PairFactors::PairFactors(const Model& model)
     : PairFactors(model.fiber_weights == FiberWeights::Lines
                       ? lines(model.fibers.get(), model.influence, model.surface.V,
-                              geom::vertex_area_vectors(model.surface.V, model.surface.F).S)
+                              geom::vertex_area_vectors(model.surface.V, model.surface.F).S,
+                              model.material.law.rest_tension() != 0.0)
                       : PairFactors(model.fibers.get(), model.connection_count,
                                     model.num_vertices(), model.influence, &model.surface.V,
                                     counting_areas(model))) {}

@@ -30,8 +30,10 @@ class PairFactors {
   // h_ij (|S_i| + |S_j|) = m_ij: the measure is the whole weight, and every
   // loop that forms h (|S_i| + |S_j|) / L forms it. `reference` and
   // `area_vectors` are #V by 3.
+  // With `balance_rest`, the rest tensions' factors too (line_measure.hpp).
   static PairFactors lines(const geom::FiberMask* fibers, const Influence& influence,
-                           const Eigen::MatrixXd& reference, const Eigen::MatrixXd& area_vectors);
+                           const Eigen::MatrixXd& reference, const Eigen::MatrixXd& area_vectors,
+                           bool balance_rest = false);
   // The factors of a model: its fibers, count and influence at its reference.
   explicit PairFactors(const Model& model);
   // Fills row (length N) with h_ij for j = 0..N-1.

@@ -38,14 +38,14 @@ constexpr double kNetworkFactor = 5.0;  // a constant law Y: Young's modulus Y
 
 }  // namespace
 
-// l_i dW/dl_i = 5 < f(l_d) l_i^2 d_i^2 / l_d >, f(l) = Y(l - 1) (l - 1), l_d = |F d|.
+// l_i dW/dl_i = 5 < f(l_d) l_i^2 d_i^2 / l_d >, f(l) = T0 + Y(l - 1) (l - 1), l_d = |F d|.
 Eigen::Vector3d fiber_network_stretch_work(const FiberLaw& law, const Eigen::Vector3d& l) {
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   const Eigen::Vector3d l2 = l.cwiseProduct(l);
   for (const Direction& dir : octant_directions()) {
     const Eigen::Vector3d d2 = dir.d.cwiseProduct(dir.d);
     const double ld = std::sqrt(l2.dot(d2)), e = ld - 1.0;
-    const double stress = law.modulus(e) * e;
+    const double stress = law.modulus(e) * e + law.rest_tension();
     t += dir.weight * stress / ld * l2.cwiseProduct(d2);
   }
   return kNetworkFactor * t;

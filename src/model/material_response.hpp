@@ -6,10 +6,10 @@
 // energy per volume is
 //
 //   W(F) = 5 < psi(|F d|) >    over unit directions d,
-//   psi(l) = integral from 1 to l of Y(e) e dl',  e = l' - 1,
+//   psi(l) = integral from 1 to l of T0 + Y(e) e dl',  e = l' - 1,
 //
-// the fiber's stress being Y(e) e, as a central fiber's force is a Y(e)
-// (l - L). The factor 5 makes a constant law Y a material of small-strain
+// the fiber's stress being T0 + Y(e) e, as a central fiber's force is
+// a (T0 L + Y(e) (l - L)) (T0 the law's rest tension, FiberLaw::rest_tension). The factor 5 makes a constant law Y a material of small-strain
 // Young's modulus Y (shear modulus Y/3): for a volume-preserving strain
 // eps the affine average <(d . eps d)^2> is 2 eps:eps / 15. This is the
 // curve a body of fibers should follow in a homogeneous test (issue 57's

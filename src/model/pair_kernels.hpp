@@ -205,6 +205,7 @@ class DeformedPairs {
   Influence influence_;
   const LineMeasure* lines_;  // the factors' (null: the paper's weights)
   const FiberLaw& law_;
+  double rest_;  // the law's rest tension T0 (0: none)
   FiberKinematics kinematics_;
   std::vector<size_t> offsets_;  // sparse: where each row's pairs start (N + 1)
 };

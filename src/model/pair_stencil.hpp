@@ -112,13 +112,16 @@ struct PairCoefficients {
 // It resists every relative displacement alike, across the fiber as much as
 // along it, so a body of them shears but cannot bend; with Y constant it is
 // the paper's linear model exactly.
+// (A rest tension has no meaning for it: check_fiber_weights refuses one.)
 struct VectorSpring {
   static constexpr const char* name = "vector";
   static double along(double /*b*/, double d) { return d; }
-  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L) {
+  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L,
+                                       double /*T0*/ = 0.0) {
     return {a * Y, a * Yp / (r * L)};  // d(a Y(e) d)/dx_i = a Y I + a Y' d (de/dx_i)^T
   }
-  static double parameter_coefficient(double a, double dY, double /*r*/, double /*L*/) {
+  static double parameter_coefficient(double a, double dY, double /*r*/, double /*L*/,
+                                      double /*dT0*/ = 0.0) {
     return a * dY;
   }
 };
@@ -131,15 +134,21 @@ struct VectorSpring {
 // gives the same force in both. Its tangent has the material part (Y') and
 // the geometric part (the force turning with the fiber):
 //   df/dx_i = a Y (1 - L/r) I + a (Y' (r - L) / (r^2 L) + Y L / r^3) b b^T.
+// With a rest tension T0 (the law's, times the fiber's own factor) the
+// force gains a T0 L b / r, a constant tension along the fiber: c1 gains
+// a T0 L / r and c2 loses a T0 L / r^3 (the tension turning with the fiber).
 struct CentralFiber {
   static constexpr const char* name = "central";
   static double along(double b, double /*d*/) { return b; }
-  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L) {
+  static PairCoefficients coefficients(double a, double Y, double Yp, double r, double L,
+                                       double T0 = 0.0) {
     const double stretch = 1.0 - L / r;  // (r - L) / r
-    return {a * Y * stretch, a * (Yp * stretch / (r * L) + Y * L / (r * r * r))};
+    const double rest = a * T0 * L / r;
+    return {a * Y * stretch + rest,
+            a * (Yp * stretch / (r * L) + Y * L / (r * r * r)) - rest / (r * r)};
   }
-  static double parameter_coefficient(double a, double dY, double r, double L) {
-    return a * dY * (1.0 - L / r);
+  static double parameter_coefficient(double a, double dY, double r, double L, double dT0 = 0.0) {
+    return a * dY * (1.0 - L / r) + a * dT0 * L / r;
   }
 };
 
@@ -200,8 +209,9 @@ inline double pair_tangent_entry(const PairCoefficients& c, bool same_axis, doub
 
 // The component a of df/dtheta for a law parameter theta: p g_a.
 template <class K>
-inline double pair_parameter_force(double a, double dY, double r, double L, double b, double d) {
-  return K::parameter_coefficient(a, dY, r, L) * K::along(b, d);
+inline double pair_parameter_force(double a, double dY, double r, double L, double b, double d,
+                                   double dT0 = 0.0) {
+  return K::parameter_coefficient(a, dY, r, L, dT0) * K::along(b, d);
 }
 
 }  // namespace fiberfluid::model

@@ -261,7 +261,9 @@ Status check_support_terms(const model::Model& model, const SteppingOptions& opt
 // Whether the model's fiber weights can run with these options, else why
 // not: the line measure (model::FiberWeights::Lines) is 3D, weighs each pair
 // differently (no treecode), has no mirror layer, and is a reference measure
-// (no matrix rebuilt from the deformed geometry).
+// (no matrix rebuilt from the deformed geometry); a law with a rest tension
+// (model::FiberLaw::rest_tension) needs central fibers, the Newton scheme and
+// the line measure, which balances it at rest.
 Status check_fiber_weights(const model::Model& model, const SteppingOptions& options);
 
 // The backend SolverKind::Auto runs: pcg with the treecode, else

@@ -79,6 +79,22 @@ Status check_kinematics(const model::Model& model, const SteppingOptions& option
 }
 
 Status check_fiber_weights(const model::Model& model, const SteppingOptions& options) {
+  if (model.material.law.rest_tension() != 0.0) {
+    const std::string what =
+        "the " + model.material.law.name() + " law's fibers carry a tension at rest: it ";
+    if (model.material.kinematics != model::FiberKinematics::Central)
+      return Status::failure(what + "acts along the fibers (fibers.kinematics \"central\")");
+    if (options.scheme != Scheme::Newton)
+      return Status::failure(what + "needs the Newton scheme (stepping.scheme \"newton\")");
+    if (model.fiber_weights != model::FiberWeights::Lines)
+      return Status::failure(what +
+                             "needs fibers.weights \"lines\": only the line measure puts the "
+                             "tensions' sum at each vertex where the fluid's pressure balances it");
+    if (!model.held_edges.empty())
+      return Status::failure(what + "has no split edge yet (leave out supports[].edge)");
+    if (model.material.axis_factors != Eigen::Vector3d::Ones())
+      return Status::failure(what + "is isotropic: it takes no axis factors");
+  }
   if (model.fiber_weights != model::FiberWeights::Lines) return {};
   const std::string what = "the line measure (fibers.weights \"lines\") ";
   if (model.dim() != 3)

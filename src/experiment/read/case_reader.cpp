@@ -67,6 +67,8 @@ model::FiberLaw read_law(Fields f) {
     law = model::FiberLaw::constant(Y);
   } else if (type == "exponential") {
     law = model::FiberLaw::exponential(required_positive(f, "Y0"), f.number("beta"));
+  } else if (type == "neo_hookean") {
+    law = model::FiberLaw::neo_hookean(required_positive(f, "mu"));
   } else if (type == "bilinear") {
     const double Y_t = required_positive(f, "Y_t"), Y_c = required_positive(f, "Y_c");
     law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
@@ -323,10 +325,12 @@ FiberSpec read_fibers(Fields& root) {
     f.fail("connection_count",
            "\"weights\": \"lines\" weighs each fiber by the lines it stands for, not by a "
            "count: leave \"connection_count\" out");
-  spec.count = f.enumeration(
-      "connection_count",
-      central && !lines ? model::ConnectionCount::Area : model::ConnectionCount::Symmetric,
-      model::kConnectionCountNames);
+  // Not read under the line measure: the resolved file records what is read.
+  spec.count = lines ? model::ConnectionCount::Symmetric
+                     : f.enumeration("connection_count",
+                                     central ? model::ConnectionCount::Area
+                                             : model::ConnectionCount::Symmetric,
+                                     model::kConnectionCountNames);
   const bool fades = central && spec.horizon > 0.0 && !lines;
   if (f.choice("influence", fades ? "conical" : "constant", {"constant", "conical"}) == "conical") {
     if (!(spec.horizon > 0.0))

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "fiberfluid/model/boundary_conditions.hpp"
+#include "fiberfluid/model/line_measure.hpp"
 #include "fiberfluid/model/loads.hpp"
 #include "fiberfluid/solve/newton/contact_set.hpp"
 #include "fiberfluid/solve/newton/newton_solver.hpp"
@@ -181,6 +182,9 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     }
   }
 
+  // A law with a rest tension is at rest an equilibrium at the pressure that
+  // balances it (line_measure.hpp): the path starts there, not at P = 0.
+  x[model.pressure_dof()] = model::rest_pressure(model.material.law.rest_tension());
   PathPredictor predictor(options.newton.predictor ? 2 : 0);
   predictor.add(0.0, x);
   report_progress("step", 0, n);
