@@ -40,11 +40,7 @@ class MaterialTestObjective final : public Objective {
       : model_(model),
         points_(points),
         variables_(model_parameters(model)),
-        residuals_(static_cast<int>(std::count_if(points.begin(), points.end(),
-                                                  [](const auto& t) {
-                                                    return t.nominal_stress !=
-                                                           0.0;  // as relative_misfits counts them
-                                                  }))),
+        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())),
         difference_scales_(difference_scales(model)) {}
 
   const Variables& variables() const override { return variables_; }

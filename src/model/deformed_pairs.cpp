@@ -200,8 +200,13 @@ void DeformedPairs::for_each_listed_row(Visit&& visit) const {
         row.r[q] = pair_length(x_[0][u] - x_[0][j], x_[1][u] - x_[1][j], x_[2][u] - x_[2][j]);
         row.e[q] = fiber_strain(row.r[q], row.L[q]);
         row.m[q] = influence_.weighs() ? influence_(row.L[q]) : 1.0;
-        if (lines_ != nullptr) row.m[q] *= (*lines_)(u, j);
-        if (rest_ != 0.0) row.T0[q] = rest_ * (lines_ != nullptr ? lines_->rest_factor(u, j) : 1.0);
+        if (lines_ != nullptr) {
+          const LineMeasure::Pair line = lines_->pair(u, j);
+          row.m[q] *= line.measure;
+          row.T0[q] = rest_ * line.rest_factor;
+        } else if (rest_ != 0.0) {
+          row.T0[q] = rest_;
+        }
       }
       law_.evaluate(row.e.data(), k, row.Y.data(), row.Yp.data());
       visit(i, partners, row.arrays());
@@ -288,19 +293,19 @@ void DeformedPairs::for_each_row(Visit&& visit) const {
           const auto k = static_cast<size_t>(j - t.j0);
           row.m[k] = (mask_ != nullptr ? mask_->row(i)[j] : 1.0) * influence_(row.L[k]);
         }
-      if (lines_ != nullptr) {
+      if (lines_ != nullptr) {  // the measure and the rest tension's factor, one pass
         if (mask_ == nullptr && !influence_.weighs())
           std::fill(row.m.begin() + q, row.m.begin() + (end - t.j0), 1.0);
-        for (int j = first; j < end; ++j)
-          row.m[static_cast<size_t>(j - t.j0)] *=
-              (*lines_)(static_cast<size_t>(i), static_cast<size_t>(j));
+        for (int j = first; j < end; ++j) {
+          const auto k = static_cast<size_t>(j - t.j0);
+          const LineMeasure::Pair line =
+              lines_->pair(static_cast<size_t>(i), static_cast<size_t>(j));
+          row.m[k] *= line.measure;
+          row.T0[k] = rest_ * line.rest_factor;
+        }
+      } else if (rest_ != 0.0) {
+        std::fill(row.T0.begin() + q, row.T0.begin() + (end - t.j0), rest_);
       }
-      if (rest_ != 0.0)
-        for (int j = first; j < end; ++j)
-          row.T0[static_cast<size_t>(j - t.j0)] =
-              rest_ * (lines_ != nullptr
-                           ? lines_->rest_factor(static_cast<size_t>(i), static_cast<size_t>(j))
-                           : 1.0);
       visit(i, t.j0, first, end, row.arrays(), thread);
     }
   });

@@ -43,7 +43,6 @@ PairFactors PairFactors::lines(const geom::FiberMask* fibers, const Influence& i
   // replaced by the areas (h_ij (|S_i| + |S_j|) = m_ij).
   PairFactors factors(fibers, ConnectionCount::Symmetric, n, influence, &reference);
   factors.lines_ = std::make_shared<LineMeasure>(reference, area_vectors, fibers, balance_rest);
-  factors.reference_ = reference;
   factors.kept_.assign(static_cast<size_t>(n), 0.0);
   for (int i = 0; i < n; ++i) {
     const double area = area_vectors.row(i).norm();

@@ -71,13 +71,12 @@ void LineMeasure::balance_rest_tensions(const geom::FiberMask* fibers) {
     pairs.push_back({i, j, m, d.normalized()});
   };
   for (int i = 0; i < n; ++i) {
-    if (fibers != nullptr && fibers->sparse())
+    if (fibers != nullptr)
       fibers->for_each_kept(i, [&](int j) {
         if (j > i) add(i, j);
       });
     else
-      for (int j = i + 1; j < n; ++j)
-        if (fibers == nullptr || fibers->kept(i, j)) add(i, j);
+      for (int j = i + 1; j < n; ++j) add(i, j);
   }
   // The right side -(sum_j m n + 5/3 S_i), and the block Jacobi preconditioner.
   Eigen::MatrixXd b(n, 3), S(n, 3);
@@ -136,26 +135,18 @@ void LineMeasure::balance_rest_tensions(const geom::FiberMask* fibers) {
   }
 }
 
-double LineMeasure::rest_factor(size_t i, size_t j) const {
-  if (rest_[0].empty()) return 1.0;
-  double d[3], squared = 0.0, along = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    d[a] = s_[a][j] - s_[a][i];
-    squared += d[a] * d[a];
-  }
-  for (int a = 0; a < 3; ++a) along += (rest_[a][i] - rest_[a][j]) * d[a];
-  return 1.0 + along / std::sqrt(squared);
-}
-
-double LineMeasure::operator()(size_t i, size_t j) const {
-  double d_si = 0.0, d_sj = 0.0, squared = 0.0;
+LineMeasure::Pair LineMeasure::pair(size_t i, size_t j) const {
+  double d_si = 0.0, d_sj = 0.0, squared = 0.0, along = 0.0;
+  const bool balanced = !rest_[0].empty();
   for (int a = 0; a < 3; ++a) {
     const double d = s_[a][j] - s_[a][i];
     d_si += d * area_[a][i];
     d_sj += d * area_[a][j];
     squared += d * d;
+    if (balanced) along += (rest_[a][i] - rest_[a][j]) * d;
   }
-  return line_measure(d_si, d_sj, std::sqrt(squared));
+  const double length = std::sqrt(squared);
+  return {line_measure(d_si, d_sj, length), 1.0 + along / length};
 }
 
 }  // namespace fiberfluid::model

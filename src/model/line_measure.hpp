@@ -56,10 +56,16 @@ class LineMeasure {
   // kept pairs of `fibers` (null: every pair).
   LineMeasure(const Eigen::MatrixXd& reference, const Eigen::MatrixXd& area_vectors,
               const geom::FiberMask* fibers = nullptr, bool balance_rest = false);
-  // m_ij = line_measure(d . S_i, d . S_j, |d|), d = s_j - s_i (pair_stencil.hpp).
-  double operator()(size_t i, size_t j) const;
-  // The factor of the pair's rest tension, 1 + (g_i - g_j) . n_ij (1 unbalanced).
-  double rest_factor(size_t i, size_t j) const;
+  // One pair's measure m_ij = line_measure(d . S_i, d . S_j, |d|),
+  // d = s_j - s_i (pair_stencil.hpp), and the factor of its rest tension,
+  // 1 + (g_i - g_j) . n_ij (1 unbalanced): both from one difference d, as
+  // the pair loops need them.
+  struct Pair {
+    double measure, rest_factor;
+  };
+  Pair pair(size_t i, size_t j) const;
+  double operator()(size_t i, size_t j) const { return pair(i, j).measure; }
+  double rest_factor(size_t i, size_t j) const { return pair(i, j).rest_factor; }
   bool balances_rest() const { return !rest_[0].empty(); }
   const RestBalance& rest_balance() const { return balance_; }
 
