@@ -15,8 +15,10 @@ namespace {
 
 std::vector<Parameter> model_parameters(const MaterialModel& m) {
   std::vector<Parameter> out;
-  for (size_t k = 0; k < m.names.size(); ++k)
+  for (size_t k = 0; k < m.names.size(); ++k) {
     out.push_back({m.names[k], m.start[static_cast<Eigen::Index>(k)]});
+    if (k < m.lower.size()) out.back().lower = m.lower[k];
+  }
   return out;
 }
 
@@ -121,8 +123,10 @@ MaterialModel material_model(const model::FiberLaw& start) {
   m.names = start.parameter_names();
   m.start = Eigen::Map<const Eigen::VectorXd>(start.parameters().data(),
                                               static_cast<Eigen::Index>(start.parameters().size()));
-  for (size_t k = 0; k < m.names.size(); ++k)
+  for (size_t k = 0; k < m.names.size(); ++k) {
     m.modulus.push_back(start.model().is_positive(static_cast<int>(k)));
+    m.lower.push_back(m.modulus.back() ? 0.0 : -std::numeric_limits<double>::infinity());
+  }
   const auto law_at = [start](const Eigen::VectorXd& p) {
     model::FiberLaw law = start;
     for (size_t k = 0; k < start.parameter_names().size(); ++k)

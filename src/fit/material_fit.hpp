@@ -24,6 +24,9 @@ struct MaterialModel {
   std::vector<std::string> names;
   Eigen::VectorXd start;
   std::vector<bool> modulus;  // per parameter: a modulus (Pa), else without unit
+  // Per parameter, the least value a fit may give it (empty: none): a fiber
+  // law's positive parameters stay at or above 0.
+  std::vector<double> lower;
   std::function<double(const Eigen::VectorXd&, material::HomogeneousTest, double)> nominal_stress;
   std::function<Status(const Eigen::VectorXd&)> check;
 };

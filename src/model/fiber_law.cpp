@@ -463,7 +463,7 @@ Registry& registry() {
 
 const std::vector<std::string>& builtin_law_names() {
   static const std::vector<std::string> names = {"constant", "exponential", "bilinear", "tabulated",
-                                                 "neo_hookean"};
+                                                 "neo_hookean", "spline"};
   return names;
 }
 

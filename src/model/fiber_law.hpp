@@ -91,6 +91,16 @@ class FiberLaw {
   // = mu/2 (I1 - 3); the Gaussian chains of Treloar's network theory).
   static FiberLaw neo_hookean(double mu);
 
+  // The data-driven law: a fiber's tension T(l) as a monotone quadratic
+  // spline of its stretch l = 1 + e on knots `stretches` (increasing, one
+  // below 1 and one above), T(1) = rest_tension, and rises[k] >= 0 the rise
+  // of its B-spline coefficients at knot k (spline_law.cpp): parameters
+  // "T1", "rise1".."riseN", one rise per knot. Beyond the knots the end
+  // tangents extend it. Throws std::invalid_argument for fewer than two
+  // knots or a rise count that differs.
+  static FiberLaw spline(std::vector<double> stretches, double rest_tension,
+                         const std::vector<double>& rises);
+
   std::string name() const { return model_->name(); }
   bool is_constant() const { return model_->is_constant(); }
   double rest_tension() const { return model_->rest_tension(p()); }  // T0
@@ -143,7 +153,7 @@ class FiberLaw {
 };
 
 // The law kinds that experiment files can name besides the built-ins
-// (constant, exponential, bilinear, tabulated, neo_hookean): a registered law is read as
+// (constant, exponential, bilinear, tabulated, neo_hookean, spline): a registered law is read as
 // {"type": name, <each parameter>: number}. Throws std::invalid_argument when
 // the name is taken or empty. Thread-safe.
 void register_law(std::shared_ptr<const LawModel> model);

@@ -21,6 +21,7 @@
 #include "fiberfluid/model/pair_kernels.hpp"
 #include "fiberfluid/model/pair_stencil.hpp"
 #include "fiberfluid/solve/stepping.hpp"
+#include "model_fixtures.hpp"
 
 namespace fiberfluid::model {
 namespace {
@@ -264,6 +265,34 @@ TEST(NeoHookeanNetwork, CylinderPressedByHalfBetweenFrictionlessPlatens) {
   EXPECT_LT(finer.radius_misfit, 0.02);
   EXPECT_NEAR(coarse.force_ratio, 1.0, 0.07);
   EXPECT_LT(std::abs(finer.force_ratio - 1.0), 0.8 * std::abs(coarse.force_ratio - 1.0));
+}
+
+// The spline law in a body: drawn as the neo-Hookean network's line it is
+// that body to rounding, and a stiffening spline follows its own network's
+// curve, with its force's sensitivity to a rise the central difference of
+// two runs.
+TEST(SplineLaw, RunsABodyAsItsNetworkSays) {
+  const std::vector<double> knots = {0.3, 0.6, 0.8, 1.0, 1.3, 2.0};
+  const double mu = 2e4;
+  const Pressed neo = press_cylinder(FiberLaw::neo_hookean(mu), 6, 26, 0.006, 3);
+  const Pressed line =
+      press_cylinder(testing::spline_of_line(knots, 0.6 * mu, 0.0), 6, 26, 0.006, 3);
+  EXPECT_NEAR(line.force, neo.force, 1e-8 * neo.force);
+
+  // Stiffer the more a fiber shortens: rises grow towards the lowest knot.
+  const std::vector<double> rises = {6e3, 4e3, 2e3, 1.2e3, 1.5e3, 3e3};
+  const FiberLaw stiffening = FiberLaw::spline(knots, 1.2e4, rises);
+  const Pressed p = press_cylinder(stiffening, 6, 26, 0.009, 4, "rise2");
+  EXPECT_LT(p.radius_misfit, 0.02);
+  EXPECT_NEAR(p.force_ratio, 1.0, 0.07);  // the coarse mesh's excess, as the neo-Hookean one's
+  FiberLaw up = stiffening, down = stiffening;
+  const double d = 0.01 * rises[1];
+  up.set_parameter("rise2", rises[1] + d);
+  down.set_parameter("rise2", rises[1] - d);
+  const double fd =
+      (press_cylinder(up, 6, 26, 0.009, 4).force - press_cylinder(down, 6, 26, 0.009, 4).force) /
+      (2 * d);
+  EXPECT_NEAR(p.force_sensitivity, fd, 1e-4 * std::abs(fd));
 }
 
 // Pressed by a displacement, the neo-Hookean body's state does not depend on

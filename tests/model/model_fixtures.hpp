@@ -20,6 +20,19 @@
 
 namespace fiberfluid::testing {
 
+// The spline law (FiberLaw::spline) whose tension is the straight line
+// A l + B on `knots`: a quadratic spline reproduces a line with coefficients
+// A g_j + B at its Greville abscissae g_j = (t_j+1 + t_j+2) / 2 (de Boor, A
+// Practical Guide to Splines, ch. IX), so its rises are A (g_j - g_j-1).
+inline model::FiberLaw spline_of_line(const std::vector<double>& knots, double A, double B) {
+  std::vector<double> g = {knots.front()};
+  for (size_t k = 0; k + 1 < knots.size(); ++k) g.push_back(0.5 * (knots[k] + knots[k + 1]));
+  g.push_back(knots.back());
+  std::vector<double> rises;
+  for (size_t j = 1; j < g.size(); ++j) rises.push_back(A * (g[j] - g[j - 1]));
+  return model::FiberLaw::spline(knots, A + B, rises);
+}
+
 // The fluid's weight under an acceleration (a hydrostatic load).
 inline model::Load hydrostatic_load(const Eigen::Vector3d& acceleration, double density) {
   model::Load load;

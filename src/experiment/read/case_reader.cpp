@@ -58,6 +58,15 @@ double required_positive(Fields& f, const std::string& key) {
   return x;
 }
 
+// The field a law's refusal names: a table's stresses, a spline's knots or
+// rises (the message names the parameter), else the law itself.
+std::string failed_law_field(const std::string& type, const std::string& message) {
+  if (type == "tabulated") return "stress";
+  if (type != "spline") return "";
+  if (message.find("stretches") != std::string::npos) return "stretches";
+  return message.rfind("T1", 0) == 0 ? "T1" : "rises";
+}
+
 model::FiberLaw read_law(Fields f) {
   const std::string type = f.choice("type", "constant", model::law_type_names());
   model::FiberLaw law = model::FiberLaw::constant(1.0);
@@ -72,6 +81,17 @@ model::FiberLaw read_law(Fields f) {
   } else if (type == "bilinear") {
     const double Y_t = required_positive(f, "Y_t"), Y_c = required_positive(f, "Y_c");
     law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
+  } else if (type == "spline") {
+    const Eigen::VectorXd stretches = f.vector("stretches", -1), rises = f.vector("rises", -1);
+    if (stretches.size() < 2)
+      f.fail("stretches", "expected at least two stretches (the spline's knots), got " +
+                              std::to_string(stretches.size()));
+    if (rises.size() != stretches.size())
+      f.fail("rises", "expected one rise per stretch (" + std::to_string(stretches.size()) +
+                          "), got " + std::to_string(rises.size()));
+    law = model::FiberLaw::spline({stretches.data(), stretches.data() + stretches.size()},
+                                  f.non_negative("T1", 0.0),
+                                  {rises.data(), rises.data() + rises.size()});
   } else if (type != "tabulated") {
     // A law registered by the program that links the library: its parameters by name.
     const std::shared_ptr<const model::LawModel> registered = model::find_registered_law(type);
@@ -90,7 +110,7 @@ model::FiberLaw read_law(Fields f) {
   }
   f.finish();
   if (const Status usable = law.check(); !usable.ok)
-    f.fail(type == "tabulated" ? "stress" : "", usable.message);
+    f.fail(failed_law_field(type, usable.message), usable.message);
   return law;
 }
 
