@@ -231,6 +231,12 @@ void print_fit_plan(const experiment::Experiment& ex, const experiment::FitSetup
     std::cout << ")" << (force_rows > 0 ? " and " : "");
   }
   if (force_rows > 0) std::cout << force_rows << " force misfits";
+  if (const auto& others = ex.fit()->kind_targets; !others.empty()) {
+    std::cout << (setup.targets.empty() && force_rows == 0 ? "" : " and ") << others.size()
+              << " target(s) of other kinds (";
+    for (size_t k = 0; k < others.size(); ++k) std::cout << (k ? ", " : "") << others[k].kind;
+    std::cout << ")";
+  }
   std::cout << " (" << fit::to_string(ex.fit()->options.method) << ", "
             << (setup.calibration->analytic_jacobian() ? "analytic Jacobian"
                                                        : "finite differences");

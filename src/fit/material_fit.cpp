@@ -33,17 +33,15 @@ Eigen::VectorXd misfits_of(const MaterialModel& m, const Eigen::VectorXd& p,
   return Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
 }
 
-// The relative misfits of the law at phi (its parameters, linear), and their
-// Jacobian by central differences: a law's stresses cost nothing beside a
-// body's run.
+// The relative misfits of the law at phi (its parameters, linear) and their
+// Jacobian (material_misfits).
 class MaterialTestObjective final : public Objective {
  public:
   MaterialTestObjective(const MaterialModel& model, const std::vector<material::TestPoint>& points)
       : model_(model),
         points_(points),
         variables_(model_parameters(model)),
-        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())),
-        difference_scales_(difference_scales(model)) {}
+        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())) {}
 
   const Variables& variables() const override { return variables_; }
   int num_residuals() const override { return residuals_; }
@@ -54,54 +52,56 @@ class MaterialTestObjective final : public Objective {
                       const Eigen::VectorXd&) const override {
     Evaluation e;
     e.forward_runs = 1;
-    if (!misfits(phi, &e.residuals, &e.message)) return e;
-    e.ok = true;
-    if (!with_jacobian) return e;
-    e.jacobian.resize(residuals_, phi.size());
-    for (Eigen::Index k = 0; k < phi.size(); ++k) {
-      const double h = 1e-6 * std::max(std::abs(phi[k]), difference_scales_[k]);
-      Eigen::VectorXd up = phi, down = phi, r_up, r_down;
-      up[k] += h, down[k] -= h;
-      std::string why;
-      if (!misfits(up, &r_up, &why) || !misfits(down, &r_down, &why)) {
-        e.ok = false;
-        e.message = "near the point: " + why;
-        return e;
-      }
-      e.jacobian.col(k) = (r_up - r_down) / (2.0 * h);
-    }
+    e.message =
+        material_misfits(model_, phi, points_, &e.residuals, with_jacobian ? &e.jacobian : nullptr);
+    e.ok = e.message.empty();
     return e;
   }
 
  private:
-  // Per parameter, the least scale of its difference step: the start's
-  // largest modulus for a modulus, 1 for an exponent.
-  static Eigen::VectorXd difference_scales(const MaterialModel& m) {
-    double largest_modulus = 0.0;
-    for (Eigen::Index k = 0; k < m.start.size(); ++k)
-      if (m.modulus[static_cast<size_t>(k)])
-        largest_modulus = std::max(largest_modulus, std::abs(m.start[k]));
-    Eigen::VectorXd scales(m.start.size());
-    for (Eigen::Index k = 0; k < m.start.size(); ++k)
-      scales[k] = m.modulus[static_cast<size_t>(k)] ? largest_modulus : 1.0;
-    return scales;
-  }
-
-  bool misfits(const Eigen::VectorXd& phi, Eigen::VectorXd* r, std::string* why) const {
-    if (const Status usable = model_.check(phi); !usable.ok) return *why = usable.message, false;
-    *r = misfits_of(model_, phi, points_);
-    if (!r->allFinite()) return *why = "a stress of the law is not finite", false;
-    return true;
-  }
-
   const MaterialModel& model_;
   const std::vector<material::TestPoint>& points_;
   Variables variables_;
   int residuals_;
-  Eigen::VectorXd difference_scales_;
 };
 
+// Why the model cannot be evaluated at p, or "", with its misfits.
+std::string misfits_at(const MaterialModel& m, const Eigen::VectorXd& p,
+                       const std::vector<material::TestPoint>& points, Eigen::VectorXd* r) {
+  if (const Status usable = m.check(p); !usable.ok) return usable.message;
+  *r = misfits_of(m, p, points);
+  if (!r->allFinite()) return "a stress of the law is not finite";
+  return "";
+}
+
 }  // namespace
+
+std::string material_misfits(const MaterialModel& m, const Eigen::VectorXd& p,
+                             const std::vector<material::TestPoint>& points, Eigen::VectorXd* r,
+                             Eigen::MatrixXd* jacobian) {
+  if (std::string why = misfits_at(m, p, points, r); !why.empty()) return why;
+  if (jacobian == nullptr) return "";
+  double largest_modulus = 0.0;
+  for (Eigen::Index k = 0; k < p.size(); ++k)
+    if (m.modulus[static_cast<size_t>(k)])
+      largest_modulus = std::max(largest_modulus, std::abs(p[k]));
+  jacobian->resize(r->size(), p.size());
+  for (Eigen::Index k = 0; k < p.size(); ++k) {
+    const double scale = m.modulus[static_cast<size_t>(k)] ? largest_modulus : 1.0;
+    const double h = 1e-6 * std::max(std::abs(p[k]), scale);
+    Eigen::VectorXd up = p, down = p, r_up, r_down;
+    up[k] += h, down[k] -= h;
+    // At a lower bound (a rise at 0) the step is one-sided.
+    const bool at_lower =
+        k < static_cast<Eigen::Index>(m.lower.size()) && down[k] < m.lower[static_cast<size_t>(k)];
+    if (at_lower) down[k] = p[k];
+    std::string why = misfits_at(m, up, points, &r_up);
+    if (why.empty()) why = misfits_at(m, down, points, &r_down);
+    if (!why.empty()) return "near the point: " + why;
+    jacobian->col(k) = (r_up - r_down) / (up[k] - down[k]);
+  }
+  return "";
+}
 
 MaterialModel material_model(const material::HyperelasticLaw& start) {
   MaterialModel m;

@@ -34,6 +34,17 @@ MaterialModel material_model(const material::HyperelasticLaw& start);
 // The fiber law's network response; its parameters from the law's.
 MaterialModel material_model(const model::FiberLaw& start);
 
+// The model's relative misfits at parameters p to the loaded points
+// (material::relative_misfits) and, when `jacobian` is given, their
+// derivatives by p by central differences (a step of 1e-6 of the parameter,
+// or of the largest modulus for a modulus and 1 for an exponent when that
+// is larger): a law's stresses cost microseconds. Returns why they cannot
+// be formed (a law the check refuses near p, a stress that is not finite),
+// or "".
+std::string material_misfits(const MaterialModel& model, const Eigen::VectorXd& p,
+                             const std::vector<material::TestPoint>& points,
+                             Eigen::VectorXd* misfits, Eigen::MatrixXd* jacobian = nullptr);
+
 struct MaterialFitResult {
   FitStatus status = FitStatus::StartFailed;
   std::string message;

@@ -163,8 +163,13 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
   if (sensitivities_wanted && analytic_)
     stepping.sensitivities = {map.material_names(), state_steps_};
   std::map<int, StepState> states;
-  e.summary = run_forward(changed, stepping, states, keep_path_states ? &e.path_states : nullptr);
-  e.forward_runs = 1;
+  if (state_steps_.empty()) {
+    // No target reads the body (material tests alone): its run would go unread.
+    e.summary.success = true;
+  } else {
+    e.summary = run_forward(changed, stepping, states, keep_path_states ? &e.path_states : nullptr);
+    e.forward_runs = 1;
+  }
   e.warm_started_runs = e.summary.warm_started ? 1 : 0;
   if (!e.summary.success) {
     e.message = e.summary.message;
@@ -187,7 +192,7 @@ Evaluation FitProblem::evaluate(const Eigen::VectorXd& phi, bool with_jacobian,
       for (size_t b = 0; b < nb; ++b)
         readings[b][step].sensitivities = blocks_[b]->observed_sensitivities(changed, record, nm);
     }
-  } else if (sensitivities_wanted) {
+  } else if (sensitivities_wanted && !state_steps_.empty()) {
     e.message = central_differences(phi, states, run, readings,
                                     keep_path_states ? &e.path_states : nullptr, e);
     if (!e.message.empty()) return e;

@@ -82,9 +82,12 @@ Status check_not_singular(const Model& model) {
                              " touching the body at its start, holds it)");
     // Zero stiffness is singular; a negative one is left to the solvers,
     // which report a matrix that is not positive definite.
-    if (model.material.young_modulus()[a] == 0.0 && model.material.surface_tension == 0.0)
+    // A tension at rest stiffens every fiber across its length (T0 / L).
+    if (model.material.young_modulus()[a] == 0.0 && model.material.surface_tension == 0.0 &&
+        model.material.law.rest_tension() == 0.0)
       return Status::failure(std::string("no stiffness along ") + names[a] +
-                             ": Y and gamma are both zero, so the system is singular");
+                             ": Y, gamma and the fibers' rest tension are all zero, so the "
+                             "system is singular");
   }
   return {};
 }

@@ -127,7 +127,19 @@ class SplineLaw final : public LawModel {
         return Status::failure(names_[k] + " must be a number >= 0" +
                                (k == 0 ? std::string(" (the tension at rest)")
                                        : std::string(" (the tension never falls)")));
-    return LawModel::check(p, lowest, highest);
+    // Rises >= 0 keep the tension from falling, so the secant modulus is
+    // never negative; where the tension is flat it is 0, which a fiber in
+    // tension at rest bears (its tension stiffens it across). What a body
+    // needs is a network stiff at rest: its small-strain Young's modulus
+    // T'(1) + 4 T(1) (material_response.hpp) positive.
+    (void)lowest, (void)highest;
+    const std::vector<double> c = coefficients(p);
+    const double stiffness = tension(c.data(), 1.0, false).slope + 4.0 * p[0];
+    if (!(stiffness > 0.0) || !std::isfinite(stiffness))
+      return Status::failure("the spline's network has no stiffness at rest (T'(1) + 4 T1 is " +
+                             std::to_string(stiffness) +
+                             "): give T1 > 0 or a rise where the knots meet 1");
+    return {};
   }
 
   std::vector<Setting> settings() const override { return {{"stretches", stretches_, false}}; }

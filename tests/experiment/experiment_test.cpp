@@ -476,6 +476,29 @@ TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   c["material"] = {{"law", {{"type", "exponential"}, {"Y0", 1}, {"beta", 900}}}};
   expect_config_error(dir, c, "check beta");
 
+  // The spline law: its knots, its rises and its rest tension, each by name.
+  const nlohmann::json spline = {{"type", "spline"},
+                                 {"stretches", {0.5, 1.5, 3}},
+                                 {"rises", {1e3, 2e3, 4e3}},
+                                 {"T1", 0}};
+  c = base_config();
+  c["material"] = {{"law", spline}};
+  const model::FiberLaw read =
+      load_experiment(write_config(dir, c)).simulation().cases[0].model.material.law;
+  EXPECT_EQ(read.name(), "spline");
+  EXPECT_EQ(read.parameter("rise3"), 4e3);
+  c["material"]["law"]["rises"] = {1e3, 2e3};
+  expect_config_error(dir, c, "material.law.rises: expected one rise per stretch (3), got 2");
+  c["material"]["law"] = spline;
+  c["material"]["law"]["rises"] = {1e3, -2e3, 4e3};
+  expect_config_error(dir, c, "material.law.rises: rise2 must be a number >= 0");
+  c["material"]["law"] = spline;
+  c["material"]["law"]["stretches"] = {1.1, 1.5, 3};
+  expect_config_error(dir, c, "material.law.stretches: the stretches must span the rest stretch");
+  c["material"]["law"] = spline;
+  c["material"]["law"]["T1"] = -1;
+  expect_config_error(dir, c, "material.law.T1");
+
   c = base_config();
   c["material"] = {{"law", {{"type", "hyperelastic"}}}};
   expect_config_error(dir, c, "material.law.type: expected one of");

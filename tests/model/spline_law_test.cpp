@@ -77,6 +77,19 @@ TEST(SplineLaw, DerivativesAreTheCentralDifferences) {
   }
 }
 
+// A network's small-strain Young's modulus is T'(1) + 4 T(1): the slope of
+// its uniaxial nominal stress at rest (a constant law's Y; the neo-Hookean
+// network's 0.6 mu + 4 x 0.6 mu = 3 mu).
+TEST(SplineLaw, SmallStrainModulusIsTheSlopePlusFourTimesTheRestTension) {
+  for (double T1 : {0.0, 2e4, 1e5}) {
+    const FiberLaw law = FiberLaw::spline(kKnots, T1, {1e3, 2e4, 5e4, 1e5, 4e4, 2e5, 5e5, 1e6});
+    const double h = 1e-6;
+    const double slope_at_rest = law.modulus(0.0);  // T'(1)
+    const double E = fiber_network_nominal_stress(law, HomogeneousTest::Uniaxial, 1.0 + h) / h;
+    EXPECT_NEAR(E, slope_at_rest + 4.0 * T1, 1e-4 * E) << T1;
+  }
+}
+
 // Rises >= 0 make a tension that never falls, whatever their values: the
 // property a fit keeps by keeping them positive.
 TEST(SplineLaw, NonNegativeRisesNeverLetTheTensionFall) {
@@ -110,18 +123,22 @@ TEST(SplineLaw, RefusesKnotsAndRisesThatMakeNoLawNamingThem) {
   EXPECT_NE(refusal(FiberLaw::spline({0.5, 1.5, 2.0}, 0.0, {1e4, -1.0, 1e4})).find("rise2"),
             std::string::npos);
   EXPECT_NE(refusal(FiberLaw::spline({0.5, 1.5, 2.0}, -5.0, rises)).find("T1"), std::string::npos);
-  // Flat through rest: the modulus vanishes there.
-  EXPECT_FALSE(FiberLaw::spline({0.5, 1.5, 2.0}, 0.0, {0.0, 0.0, 1e4}).check().ok);
+  // Flat through rest with no tension there: the network has no stiffness.
+  EXPECT_NE(refusal(FiberLaw::spline({0.5, 1.5, 2.0}, 0.0, {0.0, 0.0, 1e4})).find("no stiffness"),
+            std::string::npos);
+  // Flat through rest in tension is a material: its tension stiffens it.
+  EXPECT_TRUE(FiberLaw::spline({0.5, 1.5, 2.0}, 1e3, {0.0, 0.0, 1e4}).check().ok);
 }
 
 // Treloar's uniaxial and equibiaxial tests fitted together at material level
-// by the spline's network, from the neo-Hookean network's line. A network of
-// fibers whose tension follows their own stretch (an affine network) gains
-// on the neo-Hookean one but stays near 16% however the knots are laid (five
-// layouts of 3 to 14 knots: 15.9-21.0%): the fit flattens the tension near
-// l = 1.2-1.6 (a rise at its bound 0) and cannot follow the rubber's
-// Mooney-type softening, for which Miehe, Goektepe and Lulei (JMPS 52 (2004)
-// 2617) add a non-affine stretch and a tube (area) part to the microsphere.
+// by the spline's network, from the neo-Hookean network's line: 11.5% rms
+// (uniaxial 9.1%, equibiaxial 14.3%) where the neo-Hookean network is at
+// 23.6% (11.5% too on a second layout of 9 knots). The fit makes the tension
+// flat from l = 0.6 to 1.6 (three rises on their bound 0) and the shortened
+// fibers very stiff, and still misses the rubber's Mooney-type softening: a
+// network of fibers each following its own stretch (an affine network) has
+// no more to give, and Miehe, Goektepe and Lulei (JMPS 52 (2004) 2617) add a
+// non-affine stretch and a tube (area) part to the microsphere for it.
 TEST(SplineLaw, TreloarsRubberFittedByItsNetwork) {
   const std::vector<material::TestPoint> points =
       material::read_material_test(std::string(FIBERFLUID_MEASUREMENTS) +
@@ -142,7 +159,7 @@ TEST(SplineLaw, TreloarsRubberFittedByItsNetwork) {
   std::printf("\n");
   // The start is the neo-Hookean network, whose closed-form fit is 23.6%.
   EXPECT_NEAR(fitted.initial_rms, 0.236, 0.01);
-  EXPECT_LT(fitted.rms, 0.75 * fitted.initial_rms);
+  EXPECT_LT(fitted.rms, 0.55 * fitted.initial_rms);
   EXPECT_GT(fitted.rms, 0.10);  // the affine network's floor, documented in docs/materials.md
   for (double p : fitted.parameters) EXPECT_GE(p, 0.0);
   // The rubber's small-strain shear modulus, about 0.4 MPa (Treloar): E / 3

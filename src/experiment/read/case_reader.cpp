@@ -83,6 +83,7 @@ model::FiberLaw read_law(Fields f) {
     law = model::FiberLaw::bilinear(Y_t, Y_c, f.non_negative("transition", 0.005));
   } else if (type == "spline") {
     const Eigen::VectorXd stretches = f.vector("stretches", -1), rises = f.vector("rises", -1);
+    const double rest_tension = f.non_negative("T1", 0.0);
     if (stretches.size() < 2)
       f.fail("stretches", "expected at least two stretches (the spline's knots), got " +
                               std::to_string(stretches.size()));
@@ -90,8 +91,7 @@ model::FiberLaw read_law(Fields f) {
       f.fail("rises", "expected one rise per stretch (" + std::to_string(stretches.size()) +
                           "), got " + std::to_string(rises.size()));
     law = model::FiberLaw::spline({stretches.data(), stretches.data() + stretches.size()},
-                                  f.non_negative("T1", 0.0),
-                                  {rises.data(), rises.data() + rises.size()});
+                                  rest_tension, {rises.data(), rises.data() + rises.size()});
   } else if (type != "tabulated") {
     // A law registered by the program that links the library: its parameters by name.
     const std::shared_ptr<const model::LawModel> registered = model::find_registered_law(type);

@@ -208,6 +208,9 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
     figures["fit.force_largest"] = force.largest;
     figures["fit.force_rms_share"] = force.scale > 0.0 ? force.rms / force.scale : 0.0;
   }
+  for (size_t k = 0; k < r.other_targets.size(); ++k)
+    for (const auto& [name, value] : r.other_targets[k].figures)
+      figures["fit.other_targets." + std::to_string(k) + "." + name] = value;
   return figures;
 }
 

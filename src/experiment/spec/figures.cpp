@@ -150,6 +150,13 @@ Status check_figure(const Experiment& ex, const std::string& figure, bool fit_fi
           if (figure == "fit." + f) return {};
           valid.push_back("fit." + f);
         }
+        // A target of another kind's figures, as fit.json's other_targets[K]
+        // lists them: what they are is the kind's.
+        for (size_t k = 0; k < ex.fit()->kind_targets.size(); ++k) {
+          const std::string prefix = "fit.other_targets." + std::to_string(k) + ".";
+          if (figure.rfind(prefix, 0) == 0 && figure.size() > prefix.size()) return {};
+          valid.push_back(prefix + "<figure>");
+        }
       }
       for (const CaseSpec& spec : ex.simulation().specs) {
         const std::string prefix = spec.variant.empty() ? "" : spec.variant + ".";
