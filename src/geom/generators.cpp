@@ -216,7 +216,11 @@ Surface cylinder(double radius, double length, int along, int around, int cap_ri
     }
   };
   std::vector<int> wall;
-  for (int i = 0; i <= along; ++i) wall.push_back(ring(length * i / along, radius));
+  // The last ring at `length` exactly, where the far cap is: length * i / along
+  // can miss it by an ulp (0.03 * 9 / 9), and a cap an ulp out of its plane
+  // is a concave body, whose fibers across the rim are pruned.
+  for (int i = 0; i <= along; ++i)
+    wall.push_back(ring(i == along ? length : length * i / along, radius));
   for (int i = 0; i < along; ++i)
     band(wall[static_cast<size_t>(i)], wall[static_cast<size_t>(i + 1)], false);
   // Each cap: from its centre out to the wall's end ring.

@@ -129,6 +129,16 @@ bool solve_from_warm_start(NewtonSolver& solver, StepFinisher& finisher,
   return false;
 }
 
+// A step that fails on a body whose fibers are in tension at rest: its rest
+// state is a saddle on a mesh, which the failure is most likely about.
+std::string rest_tension_note(const model::Model& model) {
+  if (model.material.law.rest_tension() == 0.0) return "";
+  return "; the " + model.material.law.name() +
+         " law's fibers are in tension at rest, balanced by the fluid's pressure, and that rest "
+         "state is not stable on a mesh: a load that is not symmetric (gravity, a clamp, a "
+         "point load) leaves it at the first step (docs/model.md, \"The neo-Hookean network\")";
+}
+
 }  // namespace
 
 SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOptions& options,
@@ -198,7 +208,8 @@ SteppingSummary solve_newton_steps(const model::Model& model, const SteppingOpti
     why = walk_step(
         *solver, [&](double t) { return scheduled_point(model, t, n); }, k - 1.0, k, options.newton,
         predictor, x, record, depth);
-    if (!why.empty()) return fail("step " + std::to_string(k) + ": " + why);
+    if (!why.empty())
+      return fail("step " + std::to_string(k) + ": " + why + rest_tension_note(model));
     if (!(why = keep(record, k, step_start)).empty()) return fail(why);
     report_progress("step", k, n);
   }
