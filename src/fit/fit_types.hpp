@@ -181,6 +181,10 @@ struct ForceMisfit {
 struct TargetReport {
   std::string kind, label;
   std::map<std::string, double> figures;
+  // Its rows, when it has any to show (a material test's points): the
+  // columns' names and one row of values each, written as fit_other_K.csv.
+  std::vector<std::string> columns;
+  std::vector<std::vector<std::string>> rows;
 };
 
 struct FitResult {

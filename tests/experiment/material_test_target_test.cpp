@@ -9,6 +9,7 @@
 
 #include "fiberfluid/experiment/read/schema.hpp"
 #include "fiberfluid/experiment/run/fit_setup.hpp"
+#include "fiberfluid/experiment/write/fit_files.hpp"
 #include "fiberfluid/fit/material_fit.hpp"
 #include "fiberfluid/material/material_test.hpp"
 #include "fiberfluid/model/material_response.hpp"
@@ -54,6 +55,18 @@ TEST(MaterialTestTarget, FitsTheLawAtMaterialLevelWithoutRunningTheBody) {
   const Experiment at_fit = with_fitted_material(ex, *setup.calibration, fitted);
   ExperimentResult result = run_experiment(at_fit);
   ASSERT_TRUE(result.runs_succeeded());
+  // The points with the fitted stress beside them, as fit_other_0.csv.
+  testing::ScratchDir dir;
+  write_fit_files(dir.path(), at_fit, setup, fitted, result);
+  std::ifstream rows(dir.path() / "fit_other_0.csv");
+  std::string header, first;
+  std::getline(rows, header);
+  std::getline(rows, first);
+  EXPECT_EQ(header, "test,stretch,measured_Pa,fitted_Pa,relative_misfit");
+  EXPECT_EQ(first.rfind("uniaxial,1.02,25497,", 0), 0u) << first;
+  int count = 1;
+  for (std::string line; std::getline(rows, line);) ++count;
+  EXPECT_EQ(count, 40);
   for (const auto& [name, value] : fit_figures(fitted)) result.figures[name] = value;
   result.checks = check_expected(at_fit, result);
   EXPECT_FALSE(result.checks.empty());

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,13 @@
 
 namespace fiberfluid::experiment {
 namespace {
+
+std::string csv_number(double x) {
+  std::ostringstream out;
+  out.precision(12);
+  out << x;
+  return out.str();
+}
 
 struct MaterialTestSpec {
   std::string label;  // the target's "label", or the file's name
@@ -78,13 +86,20 @@ class MaterialTestMisfits : public fit::ResidualBlock {
     report.figures = {{"points", static_cast<double>(rows_)},
                       {"rms_relative_misfit", std::sqrt(misfits.squaredNorm() / rows_)},
                       {"largest_relative_misfit", misfits.cwiseAbs().maxCoeff()}};
-    // Per test kind held, its own rms (Treloar's uniaxial and equibiaxial).
+    // Per test kind held, its own rms (Treloar's uniaxial and equibiaxial),
+    // and the points with the law's stress beside them (fit_other_K.csv).
     std::map<std::string, std::pair<double, int>> by_test;
+    report.columns = {"test", "stretch", "measured_Pa", "fitted_Pa", "relative_misfit"};
     Eigen::Index r = 0;
     for (const material::TestPoint& point : points_) {
       if (point.nominal_stress == 0.0) continue;  // not a row (relative_misfits)
       auto& [sum, count] = by_test[material::to_string(point.test)];
-      sum += misfits[r] * misfits[r], ++count, ++r;
+      sum += misfits[r] * misfits[r], ++count;
+      report.rows.push_back({material::to_string(point.test), csv_number(point.stretch),
+                             csv_number(point.nominal_stress),
+                             csv_number(point.nominal_stress * (1.0 + misfits[r])),
+                             csv_number(misfits[r])});
+      ++r;
     }
     for (const auto& [test, sum_count] : by_test)
       report.figures["rms_relative_misfit_" + test] = std::sqrt(sum_count.first / sum_count.second);

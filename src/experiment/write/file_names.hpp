@@ -50,7 +50,9 @@ inline constexpr std::array<const char*, 18> kAll = {
 
 // The files a fit adds at the top of the output folder (and in each
 // specimen's folder), and the numbered ones, K the target's index:
-// fit_force_K.csv, fit_target_K.vtu, fit_target_K_scan.obj.
+// fit_force_K.csv, fit_target_K.vtu, fit_target_K_scan.obj, and
+// fit_other_K.csv for a target of another kind with rows (K its index among
+// those: fit.json's other_targets[K]).
 namespace fit_files {
 inline constexpr const char* kReport = "fit.json";
 inline constexpr const char* kDistances = "fit_distances.csv";
@@ -69,9 +71,10 @@ struct Numbered {
 inline constexpr Numbered kForceCurve{"fit_force_", ".csv"};
 inline constexpr Numbered kTargetSurface{"fit_target_", ".vtu"};
 inline constexpr Numbered kTargetScan{"fit_target_", "_scan.obj"};
+inline constexpr Numbered kOtherTarget{"fit_other_", ".csv"};
 // What a name must not look like (kTargetScan within the last: any .obj).
-inline constexpr std::array<Numbered, 3> kNumberedForms = {kForceCurve, kTargetSurface,
-                                                           Numbered{"fit_target_", ".obj"}};
+inline constexpr std::array<Numbered, 4> kNumberedForms = {
+    kForceCurve, kTargetSurface, Numbered{"fit_target_", ".obj"}, kOtherTarget};
 }  // namespace fit_files
 
 // The files a benchmark adds at the top of the output folder.

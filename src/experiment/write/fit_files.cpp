@@ -316,6 +316,18 @@ void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
     iterations << "\n";
   }
   geom::write_text_file(folder / fit_files::kIterations, iterations.str());
+  for (size_t k = 0; k < r.other_targets.size(); ++k) {  // a target of another kind's rows
+    const fit::TargetReport& t = r.other_targets[k];
+    if (t.columns.empty()) continue;
+    std::ostringstream rows;
+    for (size_t c = 0; c < t.columns.size(); ++c) rows << (c ? "," : "") << t.columns[c];
+    rows << "\n";
+    for (const std::vector<std::string>& row : t.rows) {
+      for (size_t c = 0; c < row.size(); ++c) rows << (c ? "," : "") << row[c];
+      rows << "\n";
+    }
+    geom::write_text_file(folder / fit_files::kOtherTarget.name(k), rows.str());
+  }
   if (r.positions.size() != setup.targets.size()) return;  // no run at the fitted values
   for (size_t k = 0; k < r.force_misfits.size() && k < setup.force_curves.size(); ++k) {
     const fit::ForceCurve& f = setup.force_curves[k];
