@@ -4,6 +4,8 @@
   fit_convergence.png  the cost per iteration and each parameter's path (relative to its final value)
   fit_distance.png     the simulated surface at each target's step, coloured by its distance to
                        the target (as the method paper's Fig. 1 shows its liver)
+  fit_material_K.png   a material test's measured and fitted nominal stress against stretch,
+                       per test (fit_other_K.csv of a "material_test" target)
 Usage: /usr/bin/python3 experiments/plot_fit.py OUT_DIR
 """
 import json
@@ -52,11 +54,13 @@ def convergence(fit, path):
     a.set_title(f"{fit['experiment']}: {fit['method']}")
     a.grid(True, which="both", alpha=0.3)
     for p in fit["parameters"]:
-        values = [i["values"][p["name"]] / p["value"] for i in its]
+        # Relative to the fitted value; one fitted at 0 (a bound) relative to its largest.
+        scale = p["value"] or max(abs(i["values"][p["name"]]) for i in its) or 1.0
+        values = [i["values"][p["name"]] / scale for i in its]
         b.plot([i["iteration"] for i in its], values, "o-", label=p["name"])
     b.axhline(1.0, color="k", lw=0.5)
     b.set_xlabel("iteration")
-    b.set_ylabel("value / fitted value")
+    b.set_ylabel("value / fitted value (or / largest, fitted at 0)")
     b.legend()
     b.grid(True, alpha=0.3)
     fig.tight_layout()
@@ -91,6 +95,38 @@ def distance(folder, fit, path):
     plt.close(fig)
 
 
+def material_tests(folder, fit):
+    """One picture per material-test target: measured points, the fitted law's curve through them."""
+    written = []
+    for k, target in enumerate(fit.get("other_targets", [])):
+        rows_path = os.path.join(folder, "fit_other_%d.csv" % k)
+        if target.get("type") != "material_test" or not os.path.exists(rows_path):
+            continue
+        tests = {}
+        with open(rows_path) as rows:
+            next(rows)
+            for line in rows:
+                test, stretch, measured, fitted, _ = line.strip().split(",")
+                tests.setdefault(test, []).append((float(stretch), float(measured), float(fitted)))
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+        for test, points in sorted(tests.items()):
+            points.sort()
+            stretch, measured, fitted = (np.array(c) for c in zip(*points))
+            line = ax.plot(stretch, fitted / 1e6, "-", label="%s, fitted" % test)[0]
+            ax.plot(stretch, measured / 1e6, "o", color=line.get_color(), label="%s, measured" % test)
+        rms = target["figures"].get("rms_relative_misfit", float("nan"))
+        ax.set_xlabel("stretch")
+        ax.set_ylabel("nominal stress (MPa)")
+        ax.set_title("%s: rms relative misfit %.1f%%" % (target.get("label", ""), 100 * rms))
+        ax.legend()
+        fig.tight_layout()
+        path = os.path.join(folder, "fit_material_%d.png" % k)
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
@@ -98,7 +134,9 @@ def main():
     fit = json.load(open(os.path.join(folder, "fit.json")))
     convergence(fit, os.path.join(folder, "fit_convergence.png"))
     distance(folder, fit, os.path.join(folder, "fit_distance.png"))
-    print("plots:", os.path.join(folder, "fit_convergence.png"), os.path.join(folder, "fit_distance.png"))
+    written = material_tests(folder, fit)
+    print("plots:", os.path.join(folder, "fit_convergence.png"), os.path.join(folder, "fit_distance.png"),
+          *written)
 
 
 if __name__ == "__main__":
