@@ -41,7 +41,7 @@ class MaterialTestObjective final : public Objective {
       : model_(model),
         points_(points),
         variables_(model_parameters(model)),
-        residuals_(static_cast<int>(misfits_of(model, model.start, points).size())) {}
+        residuals_(static_cast<int>(material::loaded_points(points).size())) {}
 
   const Variables& variables() const override { return variables_; }
   int num_residuals() const override { return residuals_; }

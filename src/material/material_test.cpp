@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/material/material_test.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "fiberfluid/util/error.hpp"
@@ -101,11 +103,17 @@ std::vector<TestPoint> read_material_test_text(const std::string& text, const st
   return points;
 }
 
+std::vector<TestPoint> loaded_points(const std::vector<TestPoint>& points) {
+  std::vector<TestPoint> loaded;
+  std::copy_if(points.begin(), points.end(), std::back_inserter(loaded), is_loaded);
+  return loaded;
+}
+
 std::vector<double> relative_misfits(const StressResponse& stress,
                                      const std::vector<TestPoint>& points) {
   std::vector<double> misfits;
   for (const TestPoint& p : points)
-    if (p.nominal_stress != 0.0)
+    if (is_loaded(p))
       misfits.push_back((stress(p.test, p.stretch) - p.nominal_stress) / p.nominal_stress);
   return misfits;
 }

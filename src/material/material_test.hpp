@@ -34,6 +34,12 @@ std::vector<TestPoint> read_material_test_text(const std::string& text, const st
 // A material's nominal stress in a test at a stretch (Pa).
 using StressResponse = std::function<double(HomogeneousTest, double)>;
 
+// Whether a point carries information on the scale: a measured stress that
+// is not 0 (a test's unloaded point does not). The points a misfit weighs.
+inline bool is_loaded(const TestPoint& p) { return p.nominal_stress != 0.0; }
+// The loaded points, in order: one per relative misfit.
+std::vector<TestPoint> loaded_points(const std::vector<TestPoint>& points);
+
 // The relative misfits (model - measured) / measured at every point whose
 // measured stress is not zero (a test's unloaded point carries no
 // information on the scale).

@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -95,9 +94,21 @@ class SplineLaw final : public LawModel {
   double slope(const double* p, double e) const override {
     return secant(coefficients(p).data(), p[0], e).slope;
   }
-  double modulus_derivative(const double*, int k, double e) const override {
-    if (k == 0) return 0.0;  // T1 shifts the tension, not its secant modulus
-    return secant(indicator(k).data(), rest_share_[static_cast<size_t>(k)], e).value;
+  double modulus_derivative(const double* p, int k, double e) const override {
+    double dY = 0.0;
+    evaluate_derivative(p, k, &e, 1, &dY);
+    return dY;
+  }
+  // One row of pairs: J_k's coefficients built once, not once per pair.
+  void evaluate_derivative(const double*, int k, const double* strain, size_t n,
+                           double* dY) const override {
+    if (k == 0) {  // T1 shifts the tension, not its secant modulus
+      std::fill(dY, dY + n, 0.0);
+      return;
+    }
+    const std::vector<double> c = indicator(k);
+    for (size_t j = 0; j < n; ++j)
+      dY[j] = secant(c.data(), rest_share_[static_cast<size_t>(k)], strain[j]).value;
   }
   void evaluate(const double* p, const double* strain, size_t n, double* Y,
                 double* Yp) const override {
@@ -111,7 +122,7 @@ class SplineLaw final : public LawModel {
   double rest_tension(const double* p) const override { return p[0]; }
   double rest_tension_derivative(const double*, int k) const override { return k == 0 ? 1.0 : 0.0; }
 
-  Status check(const double* p, double lowest, double highest) const override {
+  Status check(const double* p, double, double) const override {
     for (size_t k = 0; k < stretches_.size(); ++k) {
       if (!std::isfinite(stretches_[k]) || !(stretches_[k] > 0.0))
         return Status::failure("the stretches must be positive numbers (knot " +
@@ -132,7 +143,6 @@ class SplineLaw final : public LawModel {
     // tension at rest bears (its tension stiffens it across). What a body
     // needs is a network stiff at rest: its small-strain Young's modulus
     // T'(1) + 4 T(1) (material_response.hpp) positive.
-    (void)lowest, (void)highest;
     const std::vector<double> c = coefficients(p);
     const double stiffness = tension(c.data(), 1.0, false).slope + 4.0 * p[0];
     if (!(stiffness > 0.0) || !std::isfinite(stiffness))

@@ -41,14 +41,13 @@ struct MaterialTestSpec {
   double weight = 1.0;
 };
 
+// A row per point: `points` are the file's loaded ones (material::loaded_points).
 class MaterialTestMisfits : public fit::ResidualBlock {
  public:
   MaterialTestMisfits(MaterialTestSpec spec, std::vector<material::TestPoint> points)
-      : spec_(std::move(spec)), points_(std::move(points)) {
-    rows_ = static_cast<int>(
-        material::relative_misfits([](material::HomogeneousTest, double) { return 0.0; }, points_)
-            .size());
-  }
+      : spec_(std::move(spec)),
+        points_(std::move(points)),
+        rows_(static_cast<int>(points_.size())) {}
 
   int rows() const override { return rows_; }
   std::vector<int> steps() const override { return {}; }  // no body state
@@ -90,16 +89,14 @@ class MaterialTestMisfits : public fit::ResidualBlock {
     // and the points with the law's stress beside them (fit_other_K.csv).
     std::map<std::string, std::pair<double, int>> by_test;
     report.columns = {"test", "stretch", "measured_Pa", "fitted_Pa", "relative_misfit"};
-    Eigen::Index r = 0;
-    for (const material::TestPoint& point : points_) {
-      if (point.nominal_stress == 0.0) continue;  // not a row (relative_misfits)
+    for (Eigen::Index r = 0; r < rows_; ++r) {
+      const material::TestPoint& point = points_[static_cast<size_t>(r)];
       auto& [sum, count] = by_test[material::to_string(point.test)];
       sum += misfits[r] * misfits[r], ++count;
       report.rows.push_back({material::to_string(point.test), csv_number(point.stretch),
                              csv_number(point.nominal_stress),
                              csv_number(point.nominal_stress * (1.0 + misfits[r])),
                              csv_number(misfits[r])});
-      ++r;
     }
     for (const auto& [test, sum_count] : by_test)
       report.figures["rms_relative_misfit_" + test] = std::sqrt(sum_count.first / sum_count.second);
@@ -127,12 +124,11 @@ FitKindTargetSpec read_material_test_target(Fields& t, const std::filesystem::pa
   spec.bind = [m, field](const Case&, size_t) -> fit::BlockMaker {
     std::vector<material::TestPoint> points;
     try {
-      points = material::read_material_test(m.file.string());
+      points = material::loaded_points(material::read_material_test(m.file.string()));
     } catch (const InputError& e) {
       field.fail("file", e.what());
     }
-    if (material::relative_misfits([](material::HomogeneousTest, double) { return 0.0; }, points)
-            .empty())
+    if (points.empty())
       field.fail("file", m.file.string() + " holds no loaded point (every stress is 0)");
     return [m, points](const fit::BlockContext&) {
       return std::make_unique<MaterialTestMisfits>(m, points);
