@@ -64,9 +64,10 @@ std::filesystem::path plot_script() {
   return FIBERFLUID_PLOT_SCRIPT;
 }
 
-// The python3 on PATH first, else Debian's.
-void draw_plot(const std::filesystem::path& folder, const std::string& input) {
-  const std::filesystem::path script = plot_script();
+// Runs a plot script on the python3 on PATH first, else Debian's, with
+// `arguments` (quoted) after it; a plot that cannot be drawn is a warning.
+static void run_plot_script(const std::filesystem::path& script, const std::string& arguments,
+                            const std::filesystem::path& png) {
   if (!std::filesystem::exists(script)) {
     std::cerr << "warning: no plot: the plot script " << script.string() << " is missing\n";
     return;
@@ -74,11 +75,9 @@ void draw_plot(const std::filesystem::path& folder, const std::string& input) {
   for (const char* python : {"python3", "/usr/bin/python3"}) {
     if (std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0)
       continue;
-    const std::filesystem::path png = folder / experiment::output_files::kPlot;
-    const std::string command = std::string(python) + " " + shell_quoted(script.string()) + " " +
-                                shell_quoted((folder / input).string()) + " " +
-                                shell_quoted(png.string());
-    if (std::system(command.c_str()) == 0 && std::filesystem::exists(png))
+    const std::string command =
+        std::string(python) + " " + shell_quoted(script.string()) + " " + arguments;
+    if (std::system((command + " >/dev/null").c_str()) == 0 && std::filesystem::exists(png))
       std::cout << "  plot: " << png.string() << "\n";
     else
       std::cerr << "warning: no plot: " << command << " failed\n";
@@ -86,6 +85,20 @@ void draw_plot(const std::filesystem::path& folder, const std::string& input) {
   }
   std::cerr << "warning: no plot: no python3 with matplotlib (Debian: apt-get install "
                "python3-matplotlib)\n";
+}
+
+void draw_plot(const std::filesystem::path& folder, const std::string& input) {
+  const std::filesystem::path png = folder / experiment::output_files::kPlot;
+  run_plot_script(plot_script(),
+                  shell_quoted((folder / input).string()) + " " + shell_quoted(png.string()), png);
+}
+
+void draw_prediction_plot(const std::filesystem::path& folder,
+                          const std::filesystem::path& measured) {
+  const std::filesystem::path png = folder / experiment::output_files::kPredictionPlot;
+  std::string arguments = shell_quoted(folder.string()) + " -o " + shell_quoted(png.string());
+  if (!measured.empty()) arguments += " --measured " + shell_quoted(measured.string());
+  run_plot_script(plot_script().parent_path() / "plot_prediction.py", arguments, png);
 }
 
 bool every_rank_fails = false;

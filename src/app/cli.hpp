@@ -55,6 +55,10 @@ experiment::Experiment load_showing_progress(const std::string& path, bool quiet
 // first python3 that has matplotlib. A plot that cannot be drawn is a
 // warning: the results are written already.
 void draw_plot(const std::filesystem::path& folder, const std::string& input = "summary.json");
+// A prediction's DIR/prediction.png (experiments/plot_prediction.py): its
+// force against travel with the 95% band, and the measured curve if given.
+void draw_prediction_plot(const std::filesystem::path& folder,
+                          const std::filesystem::path& measured);
 
 // Thrown on a rank whose own part of a step succeeded when another rank's failed.
 struct AnotherRankFailed : InputError {
@@ -86,5 +90,12 @@ void require_one_experiment(const parallel::Ranks& ranks, const experiment::Expe
 // fiberfluid run (run_command.cpp) and fiberfluid fit (fit_command.cpp).
 int run_command(const std::string& path, const RunFlags& flags, const parallel::Ranks& ranks);
 int fit_command(const std::string& path, const RunFlags& flags, const parallel::Ranks& ranks);
+// fiberfluid predict (predict_command.cpp): EXPERIMENT run at the values of
+// the fit in FIT_FOLDER, with bands.
+struct PredictFlags {
+  std::string fit_folder, experiment;
+  std::string measured;  // a measured force curve to plot beside the prediction
+};
+int predict_command(const PredictFlags& predict, const RunFlags& flags);
 
 }  // namespace fiberfluid::app

@@ -207,14 +207,39 @@ class SilencedOutput {
 // The command line's subcommands and what they read into.
 struct Commands {
   std::string experiment, mesh;
-  RunFlags flags, fit_flags;
+  RunFlags flags, fit_flags, predict_flags;
+  PredictFlags predict_paths;
   bool flip = false;
   std::string compared_reference, compared, undeformed;
   bool as_json = false;
   StudyFlags study_flags;
-  CLI::App *run = nullptr, *fit = nullptr, *check = nullptr, *compare = nullptr, *study = nullptr,
-           *mesh_study = nullptr, *schema = nullptr;
+  CLI::App *run = nullptr, *fit = nullptr, *predict = nullptr, *check = nullptr, *compare = nullptr,
+           *study = nullptr, *mesh_study = nullptr, *schema = nullptr;
 };
+
+void define_predict(CLI::App& cli, Commands& c) {
+  c.predict = cli.add_subcommand(
+      "predict",
+      "Run an experiment at the values a fit found, with 95% bands on its figures, pressure, "
+      "reactions and paddle forces from the fit's covariance (steps.csv: COLUMN_lower95, "
+      "COLUMN_upper95; summary.json: \"prediction\")");
+  c.predict
+      ->add_option("fit_folder", c.predict_paths.fit_folder, "The folder `fiberfluid fit` wrote")
+      ->required();
+  c.predict->add_option("experiment", c.predict_paths.experiment, "Experiment file (JSON) to run")
+      ->required();
+  c.predict->add_option("-o,--output", c.predict_flags.output,
+                        "Output folder (default: out/<experiment name>)");
+  c.predict->add_flag("-q,--quiet", c.predict_flags.quiet, "No progress lines");
+  c.predict->add_flag("--plot", c.predict_flags.plot,
+                      "Also draw DIR/plot.png, as `run --plot` does, and DIR/prediction.png (the "
+                      "force against travel with its band)");
+  c.predict->add_option("--measured", c.predict_paths.measured,
+                        "A measured force curve (CSV: a travel* or compression* column in mm, a "
+                        "mean_N or force column in N) drawn against the prediction in "
+                        "DIR/prediction.png");
+  add_resource_limits(c.predict, c.predict_flags);
+}
 
 void define_commands(CLI::App& cli, Commands& c) {
   c.run = cli.add_subcommand("run", "Run an experiment file");
@@ -246,6 +271,8 @@ void define_commands(CLI::App& cli, Commands& c) {
                   "Exit with status 3 when an expected figure of the file is not met");
   c.fit->add_flag("-q,--quiet", c.fit_flags.quiet, "No progress lines");
   add_resource_limits(c.fit, c.fit_flags);
+
+  define_predict(cli, c);
 
   c.check = cli.add_subcommand("check", "Check a mesh file and print its report");
   c.check->add_option("mesh", c.mesh, "Mesh file (.obj, .off, .stl, .ply)")->required();
@@ -346,6 +373,10 @@ int main(int argc, char** argv) {
   try {
     if (c.run->parsed()) return run_command(c.experiment, c.flags, ranks);
     if (c.fit->parsed()) return fit_command(c.experiment, c.fit_flags, ranks);
+    if (c.predict->parsed()) {
+      if (!ranks.root()) return kOk;  // one process runs the prediction
+      return predict_command(c.predict_paths, c.predict_flags);
+    }
     if (!ranks.root()) return kOk;  // the other commands run on rank 0 alone
     if (c.schema->parsed()) {
       std::cout << fiberfluid::experiment::experiment_schema().dump(2) << "\n";

@@ -257,11 +257,6 @@ std::map<std::string, double> mesh_check_figures(const fit::FitResult& fitted,
   return figures;
 }
 
-namespace {
-
-// The values of `m` written into an experiment's "material" section in the
-// form the section already has: a law's parameters and axis factors, or the
-// linear model's Y (one, or one per axis), and gamma.
 void write_material_values(const model::Material& m, int dim, json& material) {
   material["gamma"] = m.surface_tension;
   if (material.contains("law")) {
@@ -284,8 +279,6 @@ void write_material_values(const model::Material& m, int dim, json& material) {
   material["Y"] = json::array();
   for (int a = 0; a < dim; ++a) material["Y"].push_back(Y * m.axis_factors[a]);
 }
-
-}  // namespace
 
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
                                 const fit::FitResult& result) {

@@ -68,6 +68,11 @@ std::map<std::string, double> mesh_check_figures(const fit::FitResult& fitted,
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
                                 const fit::FitResult& result);
 
+// The values of `m` written into an experiment's "material" section in the
+// form the section already has: a law's parameters and axis factors, or the
+// linear model's Y (one, or one per axis), and gamma.
+void write_material_values(const model::Material& m, int dim, nlohmann::json& material);
+
 // A calibration over specimens ("kind": "calibration") set up: each
 // specimen's fit (its targets read, its calibration) and the joint one over
 // them. Throws InputError naming the specimen and field.

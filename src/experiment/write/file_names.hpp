@@ -39,13 +39,16 @@ inline constexpr const char* kFibersFinal = "fibers_final.vtu";
 inline constexpr const char* kFinal = "final.obj";
 // Drawn from summary.json by `--plot` (the command line's, app/cli.cpp).
 inline constexpr const char* kPlot = "plot.png";
-inline constexpr std::array<const char*, 18> kAll = {
+// Drawn by `predict --measured` or `--plot` (experiments/plot_prediction.py).
+inline constexpr const char* kPredictionPlot = "prediction.png";
+inline constexpr std::array<const char*, 19> kAll = {
     kSummary,         kComparison,      kExperiment,
     kResolved,        kInputSurface,    kFibers,
     kFemReference,    kFemReferenceVtu, kFemReferenceSeries,
     kFemReferenceVtk, kSteps,           kLoadDisplacement,
     kVertices,        kSeries,          kVtk,
-    kFibersFinal,     kFinal,           kPlot};
+    kFibersFinal,     kFinal,           kPlot,
+    kPredictionPlot};
 }  // namespace output_files
 
 // The files a fit adds at the top of the output folder (and in each
