@@ -73,9 +73,13 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
   for (size_t k = 0; k < fitted.names.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     std::cout << "  " << fitted.names[k] << " = " << fitted.values[i];
-    if (std::find(fitted.at_bounds.begin(), fitted.at_bounds.end(), fitted.names[k]) !=
-        fitted.at_bounds.end())
+    const auto listed = [&](const std::vector<std::string>& names) {
+      return std::find(names.begin(), names.end(), fitted.names[k]) != names.end();
+    };
+    if (listed(fitted.at_bounds))
       std::cout << " (on its bound: no standard error";
+    else if (listed(fitted.unseen))
+      std::cout << " (not seen by the data: held, no standard error";
     else if (std::isfinite(fitted.standard_errors[i]))
       std::cout << " +- " << fitted.standard_errors[i] << " (95%: " << fitted.lower_95[i] << " .. "
                 << fitted.upper_95[i];
@@ -336,6 +340,10 @@ int fit_command(const std::string& path, const RunFlags& flags,
   if (fitted.status == fit::FitStatus::ConvergedAtBounds)
     std::cerr << "warning: the fit converged on bounds: " << fitted.status_detail
               << ". A bound is no estimate: widen it, fix the parameter, or check the model\n";
+  else if (!fitted.unseen.empty())
+    std::cerr << "warning: the data cannot see " << fitted.unseen.size()
+              << " of the fitted parameters: " << fitted.status_detail
+              << ". Fix them, or add targets that see them\n";
   else if (!experiment::fit_result_kept(fitted.status))
     std::cerr << "error: " << result.failure << "\n";
   if (const int status = experiment::fit_exit_status(fitted.status); status != kOk) return status;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Levenberg-Marquardt (Ceres) and the covariance at the optimum.
 #include <ceres/ceres.h>
+#include <ceres/manifold.h>
 #include <glog/logging.h>
 
 #include <chrono>
@@ -214,9 +215,13 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
 }
 
 bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
-                    const Eigen::VectorXd& at, Eigen::MatrixXd* covariance) {
+                    const Eigen::VectorXd& at, Eigen::MatrixXd* covariance,
+                    const std::vector<int>& held) {
   Eigen::VectorXd phi = at;
   CeresProblem p(evaluations, options, phi);
+  if (!held.empty())  // the covariance is then the ambient one, 0 where held
+    p.problem.SetManifold(phi.data(),
+                          new ceres::SubsetManifold(static_cast<int>(phi.size()), held));
   ceres::Covariance::Options o;
   o.algorithm_type = ceres::DENSE_SVD;  // reports a rank-deficient J instead of failing obscurely
   o.num_threads = 1;

@@ -77,6 +77,28 @@ void FitDriver::check_along_path(const Eigen::VectorXd& phi, const Evaluation& w
 
 namespace {
 
+// When the covariance at the optimum fails: the parameters the data cannot
+// see one by one (a column of zeros, a log-scaled one sunk to its bound) are
+// held at their values, so that the others keep their estimates and
+// intervals (`covariance`, `held`). Returns "" when that gives a covariance,
+// else why the fit is not identifiable.
+std::string hold_unseen(const FitProblem& m, EvaluationCache& evaluations,
+                        const Eigen::VectorXd& phi, Eigen::MatrixXd* covariance,
+                        std::vector<int>* held) {
+  const Evaluation* with_jacobian = evaluations.kept(phi, true);
+  if (with_jacobian == nullptr || !with_jacobian->ok)
+    return "the Jacobian at the optimum could not be evaluated: " + evaluations.last_failure;
+  const Eigen::MatrixXd& J = with_jacobian->jacobian;
+  *held = parameters_to_hold(J, m.parameters(), phi);
+  if (!held->empty() && static_cast<int>(held->size()) < m.parameters().size() &&
+      phi_covariance(evaluations, m.options(), phi, covariance, *held))
+    return "";
+  held->clear();
+  std::vector<std::string> names;
+  for (const Parameter& p : m.parameters().parameters()) names.push_back(p.name);
+  return unidentifiable_because(J, names);
+}
+
 // The fitted parameters that scale the body's stiffness: the law's moduli
 // (Y, Y0, Y_t, Y_c), gamma and the axis factors.
 bool scales_stiffness(const std::string& name) {
@@ -260,17 +282,17 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   Eigen::MatrixXd covariance;
   result.covariance_ok = phi_covariance(evaluations, m.options(), outcome.phi, &covariance);
   if (cancel_requested()) return finish(FitStatus::Interrupted, "");
+  std::vector<int> held;
   if (!result.covariance_ok) {
-    const Evaluation* with_jacobian = evaluations.kept(outcome.phi, true);
-    result.status_detail =
-        with_jacobian != nullptr && with_jacobian->ok
-            ? unidentifiable_because(with_jacobian->jacobian, result.names)
-            : "the Jacobian at the optimum could not be evaluated: " + evaluations.last_failure;
-    return finish(FitStatus::NotIdentifiable, "");
+    // Why not, and whether holding the parameters the data cannot see mends it.
+    result.status_detail = hold_unseen(m, evaluations, outcome.phi, &covariance, &held);
+    if (!result.status_detail.empty()) return finish(FitStatus::NotIdentifiable, "");
+    result.covariance_ok = true;
   }
   const int dof = m.num_residuals() - P;
   const double variance = dof > 0 ? 2.0 * result.final_cost / dof : 0.0;
   describe_estimates(m.parameters(), outcome.phi, covariance, variance, result);
+  describe_unseen(held, result);
   if (m.options().check_intervals) {
     const int runs_before = evaluations.forward_runs;
     check_interval_ends(evaluations, problem_, outcome.phi, covariance, variance, result);

@@ -28,13 +28,18 @@ void fields(A& a, ForceMisfit& m) {
   a(m.simulated, m.rms, m.largest, m.scale, m.weight);
 }
 template <class A>
+void fields(A& a, TargetReport& t) {
+  a(t.kind, t.label, t.figures, t.columns, t.rows);
+}
+template <class A>
 void fields(A& a, FitResult& r) {
   a(r.status, r.success, r.message, r.status_detail, r.start_note, r.warm_started_runs,
-    r.warm_start_note, r.at_bounds, r.method, r.analytic_jacobian, r.names, r.initial, r.values,
-    r.covariance_ok, r.standard_errors, r.lower_95, r.upper_95, r.interval_notes, r.interval_runs,
-    r.correlation, r.iterations, r.initial_cost, r.final_cost, r.forward_runs, r.sensitivity_solves,
-    r.failed_runs, r.failures_by_cause, r.failed_examples, r.seconds, r.summary, r.positions,
-    r.vertex_distances, r.statistics, r.overall, r.force_misfits);
+    r.warm_start_note, r.at_bounds, r.unseen, r.method, r.analytic_jacobian, r.names, r.initial,
+    r.values, r.covariance_ok, r.standard_errors, r.lower_95, r.upper_95, r.interval_notes,
+    r.interval_runs, r.correlation, r.iterations, r.initial_cost, r.final_cost, r.forward_runs,
+    r.sensitivity_solves, r.failed_runs, r.failures_by_cause, r.failed_examples, r.seconds,
+    r.summary, r.positions, r.vertex_distances, r.statistics, r.overall, r.force_misfits,
+    r.other_targets);
 }
 template <class A>
 void fields(A& a, Evaluation& e) {

@@ -206,6 +206,10 @@ struct FitResult {
   int warm_started_runs = 0;
   std::string warm_start_note;
   std::vector<std::string> at_bounds;  // the parameters on a bound (ConvergedAtBounds)
+  // The parameters the data cannot see (a Jacobian column that is 0, or lost
+  // in the others'): held at their values, with no interval, so that the
+  // others keep theirs (those of a fit with these fixed).
+  std::vector<std::string> unseen;
   Method method = Method::LevenbergMarquardt;
   bool analytic_jacobian = true;
   std::vector<std::string> names;

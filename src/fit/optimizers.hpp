@@ -38,7 +38,11 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitProblem& probl
 // The covariance of the fitted variables phi at the optimum (Ceres
 // Covariance, unscaled: (J^T J)^-1 of the robustified residuals), or false
 // when J is rank deficient.
+// `held`: fitted variables taken as known (a parameter the data cannot see):
+// their rows and columns are 0, and the others' covariance is that of a fit
+// with them fixed.
 bool phi_covariance(EvaluationCache& evaluations, const FitOptions& options,
-                    const Eigen::VectorXd& phi, Eigen::MatrixXd* covariance);
+                    const Eigen::VectorXd& phi, Eigen::MatrixXd* covariance,
+                    const std::vector<int>& held = {});
 
 }  // namespace fiberfluid::fit

@@ -82,6 +82,32 @@ std::string unidentifiable_because(const Eigen::MatrixXd& J,
          "one of them, or add targets that separate them";
 }
 
+void describe_unseen(const std::vector<int>& held, FitResult& result) {
+  for (const int k : held) {
+    const std::string& name = result.names[static_cast<size_t>(k)];
+    result.unseen.push_back(name);
+    result.standard_errors[k] = result.lower_95[k] = result.upper_95[k] = std::nan("");
+    const bool bound =
+        std::find(result.at_bounds.begin(), result.at_bounds.end(), name) != result.at_bounds.end();
+    std::ostringstream why;
+    why << "the data cannot see \"" << name << "\"" << (bound ? " on its bound" : "")
+        << " (= " << result.values[k]
+        << "): it is held at that value with no interval, and the other parameters' intervals "
+           "are those of a fit with it fixed";
+    result.status_detail += (result.status_detail.empty() ? "" : "; ") + why.str();
+  }
+}
+
+std::vector<int> parameters_to_hold(const Eigen::MatrixXd& J, const Variables& map,
+                                    const Eigen::VectorXd& phi) {
+  const Eigen::VectorXd lower = map.lower_phi(), upper = map.upper_phi();
+  std::vector<int> held;
+  for (Eigen::Index k = 0; k < J.cols(); ++k)
+    if (!J.col(k).allFinite() || J.col(k).norm() == 0.0 || on_bound(phi[k], lower[k], upper[k]))
+      held.push_back(static_cast<int>(k));
+  return held;
+}
+
 // A linearised interval is the quadratic model's: where a parameter's
 // effect fades (gamma far below what the load feels, so the cost flattens
 // as it goes to zero) the quadratic closes an interval the data leave open,
@@ -112,10 +138,11 @@ void check_interval_ends(EvaluationCache& evaluations, const FitProblem& m,
   // throw the run far off, to where it may not even run.
   Eigen::VectorXd reach(P);
   for (int j = 0; j < P; ++j)
-    reach[j] = on_bound(phi[j], lower[j], upper[j]) ? 0.0
-               : m.parameters().parameters()[static_cast<size_t>(j)].log_scale
-                   ? std::log(m.options().max_step_factor)
-                   : 1.96 * std::sqrt(std::max(0.0, variance * covariance(j, j)));
+    reach[j] = on_bound(phi[j], lower[j], upper[j]) || covariance(j, j) == 0.0  // or held
+                   ? 0.0
+                   : m.parameters().parameters()[static_cast<size_t>(j)].log_scale
+                         ? std::log(m.options().max_step_factor)
+                         : 1.96 * std::sqrt(std::max(0.0, variance * covariance(j, j)));
   // The checks' forward runs, at most kRunsPerParameter per parameter: past
   // it a profile point is not run, and an end moves out only as far as the
   // points already run show (each run's cost is an upper bound of the

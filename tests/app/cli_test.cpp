@@ -389,7 +389,7 @@ TEST(Cli, UsageErrors) {
   } cases[] = {
       {"", "A subcommand is required"},
       {"run", "experiment is required"},
-      {"frobnicate", "unknown command 'frobnicate' (expected one of: run, fit, check, compare"},
+      {"frobnicate", "unknown command 'frobnicate' (expected one of: run, fit, predict, check, compare"},
       {"runn x.json", "unknown command 'runn'"},
       {"run x.json --plott", "--plott ('run' takes the options: -h,--help, -o,--output, --check"},
       {"check a.obj b.obj", "b.obj ('check' takes the options: -h,--help, --flip;"},

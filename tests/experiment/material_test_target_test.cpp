@@ -85,6 +85,49 @@ TEST(MaterialTestTarget, FitsTheLawAtMaterialLevelWithoutRunningTheBody) {
 
 // Beside a body's parameter (gamma, which no material test sees) and in log
 // scale, the block's Jacobian is the central difference of its residuals.
+// A parameter the data cannot see (a material test does not read gamma) is
+// held and named; the law's mu keeps its estimate and interval, and the fit
+// converges instead of ending "not identifiable".
+TEST(MaterialTestTarget, AParameterTheDataCannotSeeIsHeldAndTheOthersKeepTheirIntervals) {
+  nlohmann::json doc = treloar_document();
+  doc["material"] = {{"law", {{"type", "neo_hookean"}, {"mu", 3e5}}}, {"gamma", 0.5}};
+  doc["fit"]["parameters"] = {{{"name", "mu"}},
+                              {{"name", "gamma"}, {"lower", 1e-3}, {"upper", 10}}};
+  doc.erase("expected");
+  const Experiment ex = parse_experiment(doc, testing::experiment_file("").parent_path(), "doc");
+  const FitSetup setup = setup_fit(ex);
+  const fit::FitResult fitted = setup.calibration->run();
+  ASSERT_TRUE(fitted.success) << fitted.message << " " << fitted.status_detail;
+  EXPECT_EQ(fitted.status, fit::FitStatus::Converged);
+  EXPECT_EQ(fitted.unseen, std::vector<std::string>{"gamma"});
+  EXPECT_NE(fitted.status_detail.find("the data cannot see \"gamma\""), std::string::npos)
+      << fitted.status_detail;
+  EXPECT_DOUBLE_EQ(fitted.values[1], 0.5);  // held where it started
+  EXPECT_TRUE(std::isnan(fitted.standard_errors[1]));
+  // mu's estimate is the one-parameter fit's, with its interval.
+  fit::FitOptions options;
+  const fit::MaterialFitResult alone = fit::fit_material_test(
+      fit::material_model(model::FiberLaw::neo_hookean(3e5)), treloar_points(), options);
+  EXPECT_NEAR(fitted.values[0], alone.parameters[0], 1e-4 * alone.parameters[0]);
+  ASSERT_TRUE(std::isfinite(fitted.standard_errors[0]));
+  EXPECT_GT(fitted.standard_errors[0], 0.0);
+  EXPECT_LT(fitted.lower_95[0], fitted.values[0]);
+  EXPECT_GT(fitted.upper_95[0], fitted.values[0]);
+
+  // The same parameter on its bound: named there, the fit "converged at
+  // bounds" (exit 4), mu's interval the same.
+  doc["material"]["gamma"] = 1e-3;
+  const Experiment at_bound =
+      parse_experiment(doc, testing::experiment_file("").parent_path(), "doc");
+  const fit::FitResult bounded = setup_fit(at_bound).calibration->run();
+  ASSERT_TRUE(bounded.success) << bounded.message << " " << bounded.status_detail;
+  EXPECT_EQ(bounded.status, fit::FitStatus::ConvergedAtBounds);
+  EXPECT_EQ(bounded.at_bounds, std::vector<std::string>{"gamma"});
+  EXPECT_NE(bounded.status_detail.find("cannot see \"gamma\" on its bound"), std::string::npos)
+      << bounded.status_detail;
+  EXPECT_NEAR(bounded.upper_95[0], fitted.upper_95[0], 1e-6 * fitted.upper_95[0]);
+}
+
 TEST(MaterialTestTarget, JacobianIsTheCentralDifferenceOfItsMisfits) {
   nlohmann::json d = treloar_document();
   d.erase("expected");

@@ -160,5 +160,26 @@ TEST(Multistart, ASmallSearchFindsTheTruthFromEveryStart) {
   EXPECT_THROW(unpack_fit_result(pack_fit_result(best) + "!"), std::runtime_error);
 }
 
+// What a fit on another rank reports comes back whole: a material test's
+// report (its figures and rows) and the parameters the data could not see.
+TEST(FitArchive, AnotherKindsReportAndTheUnseenParametersComeBack) {
+  FitResult r;
+  r.names = {"mu", "gamma"};
+  r.unseen = {"gamma"};
+  TargetReport report;
+  report.kind = "material_test";
+  report.label = "Treloar 1944";
+  report.figures = {{"rms_relative_misfit", 0.115}, {"points", 40.0}};
+  report.columns = {"test", "stretch"};
+  report.rows = {{"uniaxial", "1.02"}, {"equibiaxial", "1.1"}};
+  r.other_targets = {report};
+  const FitResult back = unpack_fit_result(pack_fit_result(r));
+  EXPECT_EQ(back.unseen, r.unseen);
+  ASSERT_EQ(back.other_targets.size(), 1u);
+  EXPECT_EQ(back.other_targets[0].label, "Treloar 1944");
+  EXPECT_EQ(back.other_targets[0].figures, report.figures);
+  EXPECT_EQ(back.other_targets[0].rows, report.rows);
+}
+
 }  // namespace
 }  // namespace fiberfluid::fit

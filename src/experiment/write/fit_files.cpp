@@ -133,6 +133,8 @@ json parameters_json(const fit::Calibration& c, const fit::FitResult& r) {
                           {"initial", r.initial[i]},
                           {"value", number(r.values[i])},
                           {"at_bound", at_bound},
+                          {"seen_by_the_data", std::find(r.unseen.begin(), r.unseen.end(),
+                                                         r.names[k]) == r.unseen.end()},
                           {"standard_error", number(r.standard_errors[i])},
                           {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}},
                           {"interval_note", k < r.interval_notes.size() ? r.interval_notes[k] : ""},
@@ -235,6 +237,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
                                        "residual variance"
                                      : "not available (see status)"},
       {"correlation", matrix_json(r.correlation)},
+      {"unseen", r.unseen},
       {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
       {"iterations", iterations},
       {"forward_runs", r.forward_runs},
