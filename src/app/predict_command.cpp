@@ -35,7 +35,7 @@ int predict_command(const PredictFlags& predict, const RunFlags& flags) {
   experiment::RunOptions options;
   options.jobs = flags.jobs;
   writer.begin();
-  const experiment::ExperimentResult result = experiment::run_experiment(
+  experiment::ExperimentResult result = experiment::run_experiment(
       ex,
       [&](size_t run, const fiberfluid::solve::StepRecord& r, const Eigen::VectorXd& x) {
         writer.on_step(run, r, x);
@@ -50,9 +50,10 @@ int predict_command(const PredictFlags& predict, const RunFlags& flags) {
   stop_if_interrupted("the prediction");
   const std::vector<experiment::RunBands> bands =
       experiment::prediction_bands(ex, result, estimate, unknowns);
-  writer.finish(result, [&](const std::filesystem::path& folder) {
-    experiment::write_prediction(folder, ex, estimate, bands);
-  });
+  for (size_t r = 0; r < bands.size() && r < result.runs.size(); ++r)
+    result.runs[r].bands = bands[r];
+  result.summary_sections["prediction"] = experiment::prediction_json(ex, estimate, bands);
+  writer.finish(result);
   for (const std::string& w : writer.warnings()) std::cerr << "warning: " << w << "\n";
 
   std::cout << ex.name << " at the values of " << estimate.source.string() << ": results in "

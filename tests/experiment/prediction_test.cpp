@@ -4,13 +4,15 @@
 // against finite differences of whole runs at the intervals' ends.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "fiberfluid/experiment/experiment.hpp"
 #include "fiberfluid/experiment/run/prediction.hpp"
 #include "fiberfluid/experiment/run/runner.hpp"
-#include "fiberfluid/experiment/write/prediction_files.hpp"
+#include "fiberfluid/experiment/write/csv_tables.hpp"
 #include "fiberfluid/solve/stepping.hpp"
 #include "fiberfluid/util/error.hpp"
 #include "test_support.hpp"
@@ -135,18 +137,57 @@ TEST(Prediction, AParameterWithoutAStandardErrorIsHeldAndNamed) {
   EXPECT_NEAR(force.sd, 0.05 * std::abs(force.value), 0.01 * 0.05 * std::abs(force.value));
 }
 
+// The cells of each line of a CSV without quoted cells.
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    rows.emplace_back();
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) rows.back().push_back(cell);
+  }
+  return rows;
+}
+
 TEST(Prediction, BandColumnsStandBesideTheirColumns) {
-  RunBands bands;
-  bands.steps.resize(2);
-  bands.steps[0]["paddle_upper_force_x_N"] = Band{10.0, 0.5};
-  bands.steps[1]["paddle_upper_force_x_N"] = Band{20.0, 1.0};
-  const std::string csv =
-      "step,pressure_Pa,paddle_upper_force_x_N,seconds\n1,5,10,0.1\n2,6,20,0.1\n";
-  EXPECT_EQ(with_band_columns(csv, bands),
-            "step,pressure_Pa,paddle_upper_force_x_N,paddle_upper_force_x_N_lower95,"
-            "paddle_upper_force_x_N_upper95,seconds\n"
-            "1,5,10,9.0199999999999996,10.98,0.1\n"
-            "2,6,20,18.039999999999999,21.960000000000001,0.1\n");
+  const testing::ScratchDir dir;
+  dir.write("fit.json", fit_document().dump());
+  Predicted p = predict(pressed_cylinder(), read_fitted_estimate(dir.path()));
+  ASSERT_TRUE(p.result.runs_succeeded());
+  const Case& c = p.experiment.simulation().cases.front();
+  RunResult run = p.result.runs[0];
+  const auto plain = csv_rows(steps_csv(c, run));
+  run.bands = p.bands[0];
+  const auto banded = csv_rows(steps_csv(c, run));
+  ASSERT_EQ(banded.size(), 4u);  // the header and three steps
+
+  // Each banded column is followed by its two ends; the others are as before.
+  const std::vector<std::string>& header = banded[0];
+  size_t plain_column = 0;
+  for (size_t k = 0; k < header.size(); ++k, ++plain_column) {
+    ASSERT_LT(plain_column, plain[0].size());
+    ASSERT_EQ(header[k], plain[0][plain_column]);
+    const bool has_band = p.bands[0].steps.back().count(header[k]) > 0;
+    if (!has_band) {
+      for (size_t r = 1; r < banded.size(); ++r) EXPECT_EQ(banded[r][k], plain[r][plain_column]);
+      continue;
+    }
+    ASSERT_LT(k + 2, header.size());
+    EXPECT_EQ(header[k + 1], header[k] + "_lower95");
+    EXPECT_EQ(header[k + 2], header[k] + "_upper95");
+    for (size_t r = 1; r < banded.size(); ++r) {
+      const Band& b = p.bands[0].steps[r - 1].at(header[k]);
+      EXPECT_DOUBLE_EQ(std::stod(banded[r][k + 1]), b.lower95()) << header[k] << " row " << r;
+      EXPECT_DOUBLE_EQ(std::stod(banded[r][k + 2]), b.upper95()) << header[k] << " row " << r;
+      EXPECT_LE(b.lower95(), b.upper95());  // equal where symmetry zeroes a component
+    }
+    k += 2;
+  }
+  EXPECT_EQ(plain_column, plain[0].size());
+  const auto force = std::find(header.begin(), header.end(), "paddle_upper_force_x_N");
+  ASSERT_NE(force, header.end());
+  EXPECT_EQ(*(force + 1), "paddle_upper_force_x_N_lower95");
+  EXPECT_GT(p.bands[0].steps.back().at("paddle_upper_force_x_N").sd, 0.0);
 }
 
 TEST(Prediction, WhatCannotBePredictedIsRefusedByName) {

@@ -7,8 +7,6 @@
 
 #include <Eigen/Core>
 #include <filesystem>
-#include <limits>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -43,24 +41,6 @@ FittedEstimate read_fitted_estimate(const std::filesystem::path& fit_folder);
 // parameter the experiment's material does not have, a scheme other than
 // Newton (stepping.scheme), a set-up whose sensitivities are not exact.
 void apply_estimate(const FittedEstimate& estimate, Experiment& experiment);
-
-// A predicted value and its standard deviation; the 95% band is value +-
-// 1.96 sd. NaN sd: no band (a mirror layer's reaction, nothing banded).
-struct Band {
-  double value = std::numeric_limits<double>::quiet_NaN();
-  double sd = std::numeric_limits<double>::quiet_NaN();
-  double lower95() const { return value - 1.96 * sd; }
-  double upper95() const { return value + 1.96 * sd; }
-};
-
-// One run's bands: per step, by steps.csv column (pressure_Pa,
-// max_displacement_m, reaction_GROUP_AXIS_N, paddle_LABEL_force_AXIS_N);
-// and its figures by name (max_displacement, final_pressure,
-// paddle_force.LABEL along its axis).
-struct RunBands {
-  std::vector<std::map<std::string, Band>> steps;
-  std::map<std::string, Band> figures;
-};
 
 // The bands of every run of `result`, from the sensitivities each step
 // holds; `unknowns[run][k]` is the state after step k + 1 (where the largest

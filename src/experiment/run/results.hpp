@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,8 @@ struct ExperimentResult {
   std::shared_ptr<const BenchmarkResult> benchmark;         // a benchmark's series
   std::shared_ptr<const FemReferenceResult> fem_reference;  // when the experiment asks for one
   std::string failure;  // what failed besides the runs (a benchmark's reference)
+  // Sections a command adds to summary.json, by name (a prediction's).
+  nlohmann::json summary_sections = nlohmann::json::object();
   bool runs_succeeded() const;
   bool checks_passed() const;
 };

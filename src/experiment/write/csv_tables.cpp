@@ -2,7 +2,9 @@
 #include "fiberfluid/experiment/write/csv_tables.hpp"
 
 #include <iomanip>
+#include <map>
 #include <sstream>
+#include <utility>
 
 #include "fiberfluid/experiment/run/runner.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -22,24 +24,64 @@ std::string csv_field(const std::string& text) {
   return out + "\"";
 }
 
-// Rows of cells joined by commas, numbers with 17 significant digits.
+std::string number_text(double value) {
+  std::ostringstream out;
+  out << std::setprecision(17) << value;
+  return out.str();
+}
+
+// Rows of cells joined by commas, numbers with 17 significant digits. Given a
+// prediction's bands (one map per data row, by column name), every column
+// they name is followed by COLUMN_lower95 and COLUMN_upper95 ("nan" in a row
+// without that band).
 class CsvTable {
  public:
-  void header(const std::string& name) { cells_.push_back(csv_field(name)); }
-  void text(const std::string& value) { cells_.push_back(csv_field(value)); }
+  CsvTable() = default;
+  explicit CsvTable(const RunBands& bands) : bands_(&bands) {}
+
+  void header(const std::string& name) {
+    cells_.push_back(csv_field(name));
+    bool banded = false;
+    if (bands_)
+      for (const std::map<std::string, Band>& row : bands_->steps) banded |= row.count(name) > 0;
+    columns_.push_back(banded ? name : std::string());
+    if (!banded) return;
+    cells_.push_back(csv_field(name + "_lower95"));
+    cells_.push_back(csv_field(name + "_upper95"));
+  }
+  void text(const std::string& value) { add(csv_field(value), Band{}); }
   void number(double value) {
-    std::ostringstream out;
-    out << std::setprecision(17) << value;
-    cells_.push_back(out.str());
+    Band band;
+    const size_t column = column_;
+    if (column < columns_.size() && !columns_[column].empty() && row_ >= 1 &&
+        row_ - 1 < bands_->steps.size()) {
+      const std::map<std::string, Band>& row = bands_->steps[row_ - 1];
+      if (const auto found = row.find(columns_[column]); found != row.end()) band = found->second;
+    }
+    add(number_text(value), band);
   }
   void end_row() {
     for (size_t k = 0; k < cells_.size(); ++k) out_ << (k ? "," : "") << cells_[k];
     out_ << "\n";
     cells_.clear();
+    column_ = 0;
+    ++row_;
   }
   std::string str() const { return out_.str(); }
 
  private:
+  void add(std::string cell, const Band& band) {
+    cells_.push_back(std::move(cell));
+    const bool banded = column_ < columns_.size() && !columns_[column_].empty();
+    ++column_;
+    if (!banded) return;
+    cells_.push_back(number_text(band.lower95()));
+    cells_.push_back(number_text(band.upper95()));
+  }
+
+  const RunBands* bands_ = nullptr;
+  std::vector<std::string> columns_;  // the header's names, empty where unbanded
+  size_t column_ = 0, row_ = 0;       // the row's next data column; rows so far
   std::vector<std::string> cells_;
   std::ostringstream out_;
 };
@@ -79,7 +121,7 @@ std::string steps_csv(const Case& c, const RunResult& run) {
   const model::Model& m = c.model;
   const int dim = m.dim();
   const size_t groups = std::max<size_t>(1, m.constraint_groups.size());
-  CsvTable t;
+  CsvTable t(run.bands);
   t.header("step");
   for (const model::Load& load : m.loads) t.header("load_factor_" + load.label);
   t.header("pressure_Pa");

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "fiberfluid/experiment/write/summary_json.hpp"
 #include "fiberfluid/geom/mesh_io.hpp"
 #include "fiberfluid/geom/vtk_writer.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -20,19 +21,18 @@ namespace {
 using nlohmann::json;
 
 // NaN and infinities as JSON null.
-json number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 json statistics_json(const fit::DistanceStatistics& s) {
   return {{"count", s.count},
-          {"mean", number(s.mean)},
-          {"rms", number(s.rms)},
-          {"standard_deviation", number(s.standard_deviation)},
-          {"largest", number(s.largest)},
+          {"mean", finite_or_null(s.mean)},
+          {"rms", finite_or_null(s.rms)},
+          {"standard_deviation", finite_or_null(s.standard_deviation)},
+          {"largest", finite_or_null(s.largest)},
           {"share_of_length",
-           {{"mean", number(s.share(s.mean))},
-            {"rms", number(s.share(s.rms))},
-            {"standard_deviation", number(s.share(s.standard_deviation))},
-            {"largest", number(s.share(s.largest))}}}};
+           {{"mean", finite_or_null(s.share(s.mean))},
+            {"rms", finite_or_null(s.share(s.rms))},
+            {"standard_deviation", finite_or_null(s.share(s.standard_deviation))},
+            {"largest", finite_or_null(s.share(s.largest))}}}};
 }
 
 // Row by row; a NaN entry (no estimate) as null.
@@ -40,7 +40,7 @@ json matrix_json(const Eigen::MatrixXd& m) {
   json rows = json::array();
   for (Eigen::Index a = 0; a < m.rows(); ++a) {
     json row = json::array();
-    for (Eigen::Index b = 0; b < m.cols(); ++b) row.push_back(number(m(a, b)));
+    for (Eigen::Index b = 0; b < m.cols(); ++b) row.push_back(finite_or_null(m(a, b)));
     rows.push_back(row);
   }
   return rows;
@@ -51,7 +51,7 @@ json checks_json(const std::vector<FigureCheck>& checks) {
   for (const FigureCheck& check : checks)
     out.push_back({{"figure", check.expected.figure},
                    {"passed", check.passed},
-                   {"actual", number(check.actual)},
+                   {"actual", finite_or_null(check.actual)},
                    {"text", check.Describe()}});
   return out;
 }
@@ -60,8 +60,8 @@ json iteration_json(const fit::IterationRecord& it, const std::vector<std::strin
   json values = json::object();
   for (size_t k = 0; k < names.size(); ++k)
     values[names[k]] = it.values[static_cast<Eigen::Index>(k)];
-  json out = {{"iteration", it.iteration}, {"cost", number(it.cost)},
-              {"accepted", it.accepted},   {"trial_cost", number(it.trial_cost)},
+  json out = {{"iteration", it.iteration}, {"cost", finite_or_null(it.cost)},
+              {"accepted", it.accepted},   {"trial_cost", finite_or_null(it.trial_cost)},
               {"values", values},          {"forward_runs", it.forward_runs},
               {"seconds", it.seconds}};
   if (!it.trial_failure.empty()) out["trial_failure"] = it.trial_failure;
@@ -93,7 +93,7 @@ json multistart_json(const fit::MultistartResult& search, const std::vector<std:
                       {"end", values_json(o.fit.values)},
                       {"status", fit::to_string(o.fit.status)},
                       {"message", o.fit.message},
-                      {"cost", number(o.fit.final_cost)},
+                      {"cost", finite_or_null(o.fit.final_cost)},
                       {"optimum", optimum_of(search, static_cast<int>(s))},
                       {"iterations", o.fit.iterations.size()},
                       {"forward_runs", o.fit.forward_runs},
@@ -103,7 +103,7 @@ json multistart_json(const fit::MultistartResult& search, const std::vector<std:
   json optima = json::array();
   for (const fit::Optimum& o : search.optima)
     optima.push_back({{"values", values_json(o.values)},
-                      {"cost", number(o.cost)},
+                      {"cost", finite_or_null(o.cost)},
                       {"starts_reached", o.starts.size()},
                       {"starts", o.starts}});
   return {{"starts", starts},
@@ -129,17 +129,18 @@ json parameters_json(const fit::Calibration& c, const fit::FitResult& r) {
     const fit::Parameter& p = c.parameters().parameters()[k];
     const bool at_bound =
         std::find(r.at_bounds.begin(), r.at_bounds.end(), r.names[k]) != r.at_bounds.end();
-    parameters.push_back({{"name", r.names[k]},
-                          {"initial", r.initial[i]},
-                          {"value", number(r.values[i])},
-                          {"at_bound", at_bound},
-                          {"seen_by_the_data", std::find(r.unseen.begin(), r.unseen.end(),
-                                                         r.names[k]) == r.unseen.end()},
-                          {"standard_error", number(r.standard_errors[i])},
-                          {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}},
-                          {"interval_note", k < r.interval_notes.size() ? r.interval_notes[k] : ""},
-                          {"bounds", {number(p.lower), number(p.upper)}},
-                          {"log_scale", p.log_scale}});
+    parameters.push_back(
+        {{"name", r.names[k]},
+         {"initial", r.initial[i]},
+         {"value", finite_or_null(r.values[i])},
+         {"at_bound", at_bound},
+         {"seen_by_the_data",
+          std::find(r.unseen.begin(), r.unseen.end(), r.names[k]) == r.unseen.end()},
+         {"standard_error", finite_or_null(r.standard_errors[i])},
+         {"interval_95", {finite_or_null(r.lower_95[i]), finite_or_null(r.upper_95[i])}},
+         {"interval_note", k < r.interval_notes.size() ? r.interval_notes[k] : ""},
+         {"bounds", {finite_or_null(p.lower), finite_or_null(p.upper)}},
+         {"log_scale", p.log_scale}});
   }
   return parameters;
 }
@@ -180,12 +181,12 @@ json force_curves_json(const Experiment& ex, const FitSetup& setup, const fit::C
         {"weight_is", "m per N: a force misfit of 1 N counts as a distance of this many m"}};
     if (k < r.force_misfits.size()) {
       const fit::ForceMisfit& m = r.force_misfits[k];
-      curve["misfit"] = {
-          {"rms", number(m.rms)},
-          {"largest", number(m.largest)},
-          {"largest_measured", number(m.scale)},
-          {"share_of_largest_measured",
-           {{"rms", number(m.share(m.rms))}, {"largest", number(m.share(m.largest))}}}};
+      curve["misfit"] = {{"rms", finite_or_null(m.rms)},
+                         {"largest", finite_or_null(m.largest)},
+                         {"largest_measured", finite_or_null(m.scale)},
+                         {"share_of_largest_measured",
+                          {{"rms", finite_or_null(m.share(m.rms))},
+                           {"largest", finite_or_null(m.share(m.largest))}}}};
     }
     curves.push_back(curve);
   }
@@ -238,7 +239,8 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
                                      : "not available (see status)"},
       {"correlation", matrix_json(r.correlation)},
       {"unseen", r.unseen},
-      {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
+      {"cost",
+       {{"initial", finite_or_null(r.initial_cost)}, {"final", finite_or_null(r.final_cost)}}},
       {"iterations", iterations},
       {"forward_runs", r.forward_runs},
       {"interval_runs", r.interval_runs},
@@ -271,7 +273,7 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     for (size_t k = 0; k < r.other_targets.size(); ++k) {
       const fit::TargetReport& t = r.other_targets[k];
       json figures = json::object();
-      for (const auto& [name, value] : t.figures) figures[name] = number(value);
+      for (const auto& [name, value] : t.figures) figures[name] = finite_or_null(value);
       others.push_back({{"type", t.kind}, {"label", t.label}, {"figures", figures}});
     }
     doc["other_targets"] = others;
@@ -378,12 +380,13 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
   json parameters = json::array();
   for (size_t k = 0; k < r.names.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
-    parameters.push_back({{"name", r.names[k]},
-                          {"shared", static_cast<int>(k) < r.shared},
-                          {"initial", r.initial[i]},
-                          {"value", number(r.values[i])},
-                          {"standard_error", number(r.standard_errors[i])},
-                          {"interval_95", {number(r.lower_95[i]), number(r.upper_95[i])}}});
+    parameters.push_back(
+        {{"name", r.names[k]},
+         {"shared", static_cast<int>(k) < r.shared},
+         {"initial", r.initial[i]},
+         {"value", finite_or_null(r.values[i])},
+         {"standard_error", finite_or_null(r.standard_errors[i])},
+         {"interval_95", {finite_or_null(r.lower_95[i]), finite_or_null(r.upper_95[i])}}});
   }
   json specimens = json::array();
   for (size_t s = 0; s < setup.specimens.size(); ++s) {
@@ -398,7 +401,7 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
       for (size_t k = 0; k < f.names.size(); ++k)
         values[f.names[k]] = f.values[static_cast<Eigen::Index>(k)];
       specimen["values"] = values;
-      specimen["cost"] = number(f.final_cost);
+      specimen["cost"] = finite_or_null(f.final_cost);
     }
     specimens.push_back(specimen);
   }
@@ -418,7 +421,8 @@ void write_joint_files(const std::filesystem::path& folder, const Experiment& ex
        "95%, from (J^T J)^-1 at the optimum scaled by the residual variance 2 "
        "cost / (residuals - parameters); in log scale for log-scaled parameters"},
       {"correlation", matrix_json(r.correlation)},
-      {"cost", {{"initial", number(r.initial_cost)}, {"final", number(r.final_cost)}}},
+      {"cost",
+       {{"initial", finite_or_null(r.initial_cost)}, {"final", finite_or_null(r.final_cost)}}},
       {"residuals", r.residuals},
       {"evaluations", r.evaluations},
       {"seconds", r.seconds},

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/experiment/write/summary_json.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "fiberfluid/experiment/run/resources.hpp"
@@ -223,6 +224,8 @@ json fibers_json(const Case& c) {
 
 }  // namespace
 
+json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
 json summary_json(const Experiment& ex, const ExperimentResult& result) {
   json doc;
   doc["experiment"] = ex.name;
@@ -256,6 +259,7 @@ json summary_json(const Experiment& ex, const ExperimentResult& result) {
     doc["runs"] = runs;
   }
   doc["figures"] = result.figures;
+  for (const auto& [name, section] : result.summary_sections.items()) doc[name] = section;
   json checks = json::array();
   for (const FigureCheck& c : result.checks)
     checks.push_back({{"figure", c.expected.figure},
