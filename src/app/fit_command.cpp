@@ -96,10 +96,13 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
               << 100.0 * d.share(d.standard_deviation) << "% of the body's length " << d.length
               << "), largest " << d.largest << " m\n";
   }
-  for (const fit::ForceMisfit& m : fitted.force_misfits)
+  for (const fit::ForceMisfit& m : fitted.force_misfits) {
     std::cout << "  force misfit (" << m.simulated.size() << " rows): rms " << m.rms << " N ("
               << 100.0 * m.share(m.rms) << "% of the largest measured force " << m.scale
-              << " N), largest " << m.largest << " N\n";
+              << " N; " << 100.0 * m.rms_relative << "% rms relative), largest " << m.largest
+              << " N\n";
+    if (!m.verdict.empty()) std::cout << "    residuals: " << m.verdict << "\n";
+  }
   std::cout << "  " << fitted.forward_runs << " forward runs";
   if (fitted.failed_runs > 0) std::cout << " (" << fitted.failed_runs << " failed)";
   if (fitted.warm_started_runs > 0)
@@ -221,7 +224,8 @@ void print_fit_plan(const experiment::Experiment& ex, const experiment::FitSetup
     force_rows += static_cast<int>(f.force.size());
     std::cout << "force curve " << f.label << ": " << f.force.size() << " rows at "
               << (f.by_step ? "load steps" : "travels") << ", weight "
-              << calibration.force_weight(k) << " m per N\n";
+              << calibration.force_weight(k) << " m per N"
+              << (f.relative ? ", each row's misfit as a share of its force" : "") << "\n";
   }
   const int counted = calibration.num_counted_vertices();
   const int forward = counted * static_cast<int>(setup.targets.size());

@@ -178,6 +178,7 @@ OptimizerOutcome fit_levenberg_marquardt(EvaluationCache& evaluations, const Fit
   steps.parameter_tolerance = options.parameter_tolerance;
   steps.initial_trust_region_radius = options.initial_trust_region_radius;
   steps.max_step_factor = options.max_step_factor;
+  steps.max_step_share = options.max_step_share;
   const ceres::Solver::Summary summary =
       solve_in_moving_box(p.problem, phi.data(), variables.parameters(), variables.lower_phi(),
                           variables.upper_phi(), steps, &recorder);

@@ -4,7 +4,9 @@
 // started), and the estimate's ending.
 #include "fiberfluid/fit/driver.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <sstream>
 
@@ -216,6 +218,85 @@ std::optional<Eigen::VectorXd> FitDriver::starting_point(
   return start_phi;
 }
 
+namespace {
+
+// The factor s that brings a run's small-load forces onto the measured ones,
+// by weighted least squares over each curve's rows below a quarter of its
+// largest measured force (at least its first three): where an exponent or a
+// stiffening barely acts. NaN when there are no such rows.
+double small_load_factor(const FitProblem& m, const Evaluation& e) {
+  double fitted = 0.0, own = 0.0;
+  for (size_t k = 0; k < m.force_curves().size() && k < e.forces.size(); ++k) {
+    const ForceCurve& curve = m.force_curves()[k];
+    double largest = 0.0;
+    for (const double f : curve.force) largest = std::max(largest, std::abs(f));
+    for (size_t r = 0; r < curve.force.size() && r < e.forces[k].size(); ++r) {
+      const double measured = curve.force[r], simulated = e.forces[k][r];
+      if (r >= 3 && std::abs(measured) > 0.25 * largest) continue;
+      if (measured == 0.0 && curve.relative) continue;
+      const double w = m.force_weight(k) * (curve.relative ? largest / std::abs(measured) : 1.0);
+      fitted += w * w * simulated * measured;
+      own += w * w * simulated * simulated;
+    }
+  }
+  return own > 0.0 ? fitted / own : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+// With every modulus and gamma times s, a body moved by paddles and held
+// motions alone passes through the same states with every force (and the
+// pressure) times s. So the start's own run tells the scale that its
+// small-load forces want, and the fit's steps are left the law's shape.
+Eigen::VectorXd FitDriver::scaled_start(const Eigen::VectorXd& phi, bool with_sensitivities,
+                                        EvaluationCache& evaluations, FitResult& result) const {
+  const FitProblem& m = problem_;
+  if (!m.options().scale_start || m.options().method != Method::LevenbergMarquardt ||
+      !m.model().loads.empty() || m.force_curves().empty())
+    return phi;
+  const std::vector<Parameter>& parameters = m.parameters().parameters();
+  // The law's stresses (its moduli, a spline's tension and rises) and gamma;
+  // the axis factors only where no modulus is fitted (they multiply it).
+  std::vector<int> stiffness, factors;
+  for (int k = 0; k < m.parameters().size(); ++k) {
+    const std::string& name = parameters[static_cast<size_t>(k)].name;
+    if (name.rfind("factor_", 0) == 0) {
+      factors.push_back(k);
+    } else if (scales_stiffness(name) || name == "mu" || name == "T1" ||
+               name.rfind("rise", 0) == 0) {
+      stiffness.push_back(k);
+    }
+  }
+  const bool modulus = std::any_of(stiffness.begin(), stiffness.end(), [&](int k) {
+    return parameters[static_cast<size_t>(k)].name != "gamma";
+  });
+  if (!modulus) stiffness.insert(stiffness.end(), factors.begin(), factors.end());
+  if (stiffness.empty()) return phi;
+  const Evaluation start = evaluations.at(phi, with_sensitivities);  // kept: no run
+  const double s = small_load_factor(m, start);
+  if (!(s > 0.0) || !std::isfinite(s) || std::abs(std::log(s)) < std::log(1.05)) return phi;
+  const Eigen::VectorXd values = m.parameters().values(phi);
+  const Eigen::VectorXd lower = m.parameters().lower_phi(), upper = m.parameters().upper_phi();
+  Eigen::VectorXd scaled = phi;
+  for (int k : stiffness) {
+    const double value = s * values[k];
+    const double wanted = parameters[static_cast<size_t>(k)].log_scale ? std::log(value) : value;
+    scaled[k] = std::clamp(wanted, lower[k], upper[k]);
+  }
+  const Evaluation& at = evaluations.at(scaled, with_sensitivities);
+  std::ostringstream note;
+  note << "the moduli and gamma scaled by " << s << " to the start's small-load forces";
+  if (at.ok && m.cost(at.residuals) < m.cost(start.residuals)) {
+    note << " (cost " << m.cost(start.residuals) << " to " << m.cost(at.residuals) << ")";
+    result.start_note += (result.start_note.empty() ? "" : "; then ") + note.str();
+    return scaled;
+  }
+  note << ": not kept (" << (at.ok ? "its cost is not lower" : "its run failed: " + at.message)
+       << ")";
+  result.start_note += (result.start_note.empty() ? "" : "; then ") + note.str();
+  return phi;
+}
+
 FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   const FitProblem& m = problem_;
   const auto start = std::chrono::steady_clock::now();
@@ -242,12 +323,14 @@ FitResult FitDriver::run_from(const Eigen::VectorXd& start_phi) const {
   const bool levenberg_marquardt = m.options().method == Method::LevenbergMarquardt;
   const bool with_sensitivities = levenberg_marquardt && m.analytic_jacobian();
   std::pair<FitStatus, std::string> ending;
-  const std::optional<Eigen::VectorXd> phi0 =
+  std::optional<Eigen::VectorXd> phi0 =
       starting_point(start_phi, with_sensitivities, evaluations, result, &ending);
   if (!phi0) return finish(ending.first, ending.second);
+  result.initial_cost = problem_.cost(evaluations.at(*phi0, with_sensitivities).residuals);
+  phi0 = scaled_start(*phi0, with_sensitivities, evaluations, result);
+  if (cancel_requested()) return finish(FitStatus::Interrupted, "");
   const Evaluation& first = evaluations.at(*phi0, with_sensitivities);
-  result.initial_cost = problem_.cost(first.residuals);
-  if (!std::isfinite(result.initial_cost))
+  if (!std::isfinite(problem_.cost(first.residuals)))
     return finish(FitStatus::NotIdentifiable, "the cost at the start is not finite");
 
   const OptimizerOutcome outcome = levenberg_marquardt

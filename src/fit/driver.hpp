@@ -58,6 +58,13 @@ class FitDriver {
                                                 EvaluationCache& evaluations, FitResult& result,
                                                 std::pair<FitStatus, std::string>* ending) const;
 
+  // A start whose moduli and gamma are scaled to its small-load forces
+  // (FitOptions::scale_start): the scaled point, evaluated and kept, when its
+  // cost is below the start's; else `phi` itself. FitResult::start_note says
+  // what was done.
+  Eigen::VectorXd scaled_start(const Eigen::VectorXd& phi, bool with_sensitivities,
+                               EvaluationCache& evaluations, FitResult& result) const;
+
   const FitProblem& problem_;
 };
 

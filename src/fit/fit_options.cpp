@@ -26,6 +26,9 @@ void check_options(const FitOptions& o) {
   positive("parameter_tolerance", o.parameter_tolerance, 1.0, "a relative change in (0, 1]");
   positive("initial_trust_region_radius", o.initial_trust_region_radius,
            std::numeric_limits<double>::max(), "a positive finite number");
+  if (!(o.max_step_share > 0.0 && o.max_step_share <= 1.0))
+    throw InputError("max_step_share: expected a share of the range above 0 and at most 1, got " +
+                     std::to_string(o.max_step_share));
   if (!(o.max_step_factor > 1.0 && o.max_step_factor <= std::numeric_limits<double>::max()))
     throw InputError("max_step_factor: expected a finite factor above 1, got " +
                      std::to_string(o.max_step_factor));

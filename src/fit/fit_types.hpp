@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -128,6 +129,18 @@ struct FitOptions {
   // without a forward run, and the region shrinks): a far start takes a few
   // more steps instead of trial runs at the bounds that fail slowly.
   double max_step_factor = 4.0;
+  // And a linear parameter between finite bounds (an exponent: beta in
+  // [-20, 20]) by at most this share of its range: every such step is
+  // bounded, not only the log-scaled ones'. (One with an open bound has no
+  // scale to share and is not boxed.)
+  double max_step_share = 0.05;
+  // Levenberg-Marquardt on force curves of a body moved by paddles and held
+  // motions alone: before the first step, every fitted modulus and gamma is
+  // scaled by the factor that matches the start's small-load forces (rows
+  // below a quarter of the curve's largest force), since every force scales
+  // with them exactly. One forward run; the scaled start is kept only when
+  // its cost is lower.
+  bool scale_start = true;
   // Solve each trial point's final state from the nearest point already run
   // (SteppingOptions::warm_start) instead of walking the load path again:
   // where every target and force curve reads the final step only and the
@@ -173,7 +186,19 @@ struct ForceMisfit {
   double rms = 0.0, largest = 0.0;  // of simulated - measured (N)
   double scale = 0.0;               // the largest measured |force| (N): the shares' reference
   double weight = 0.0;              // m per N, as used
+  bool relative = false;            // weighed by each row's share of its force
   double share(double value) const { return scale > 0.0 ? value / scale : 0.0; }
+  // The rms of (simulated - measured) / |measured| over the rows with a force.
+  double rms_relative = std::numeric_limits<double>::quiet_NaN();
+  // Whether what is left is the data's noise or the model's form: the
+  // measurement's scatter (the rms of its sd column, N; NaN without one), and
+  // the runs test on the misfit's signs in row order (Wald and Wolfowitz
+  // 1940: the runs of one sign against those that random signs would give).
+  double scatter = std::numeric_limits<double>::quiet_NaN();
+  int runs = 0;
+  double runs_expected = 0.0, runs_z = std::numeric_limits<double>::quiet_NaN();
+  bool systematic = false;
+  std::string verdict;  // one sentence saying which, and why
 };
 
 // What a target of a registered kind (ResidualBlock::describe) reports at the

@@ -2,6 +2,7 @@
 #include "fiberfluid/fit/force_curve.hpp"
 
 #include <cerrno>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -30,16 +31,15 @@ std::vector<std::string> cells(const std::string& line) {
 
 }  // namespace
 
-ForceCurve read_force_curve(const std::filesystem::path& path, double travel_scale,
-                            double force_scale, const std::string& rows_at) {
+ForceCurve read_force_curve(const std::filesystem::path& path, const ForceCurveColumns& wanted) {
   const std::string file = path.string();
   std::ifstream in(path);
   if (!in) throw InputError(file + ": cannot open (expected a CSV force curve)");
   ForceCurve curve;
   curve.label = file;
   std::string line;
-  int number = 0, force_column = -1, at_column = -1;
-  size_t columns = 0;
+  int number = 0, force_column = -1, at_column = -1, sd_column = -1;
+  size_t columns = 0, rows_read = 0;
   while (std::getline(in, line)) {
     ++number;
     const std::string text = trimmed(line);
@@ -56,16 +56,23 @@ ForceCurve read_force_curve(const std::filesystem::path& path, double travel_sca
                              row[c].substr(0, 40) + "\" twice (columns " +
                              std::to_string(earlier + 1) + " and " + std::to_string(c + 1) +
                              "): expected each column once");
-        if (row[c] == "force") force_column = column;
-        if (row[c] == "travel") travel_column = column;
-        if (row[c] == "step") step_column = column;
+        if (row[c] == wanted.force) force_column = column;
+        if (row[c] == wanted.travel) travel_column = column;
+        if (row[c] == wanted.step) step_column = column;
+        if (!wanted.sd.empty() && row[c] == wanted.sd) sd_column = column;
       }
-      curve.by_step = rows_at == "step" || (rows_at.empty() && travel_column < 0);
+      curve.by_step = wanted.rows_at == "step" || (wanted.rows_at.empty() && travel_column < 0);
       at_column = curve.by_step ? step_column : travel_column;
-      if (force_column < 0 || at_column < 0)
+      const std::string at_name =
+          wanted.rows_at == "step"     ? wanted.step
+          : wanted.rows_at == "travel" ? wanted.travel
+                                       : wanted.travel + " or " + wanted.step;
+      if (force_column < 0 || at_column < 0 || (!wanted.sd.empty() && sd_column < 0))
         throw InputError(file + ": line " + std::to_string(number) + ": expected a header with " +
-                         "the columns force and " +
-                         (rows_at.empty() ? std::string("travel or step") : rows_at) + ", got \"" +
+                         "the columns " + wanted.force +
+                         (wanted.sd.empty() ? " and " + at_name
+                                            : ", " + at_name + ", and " + wanted.sd) +
+                         ", got \"" +
                          text.substr(0, 80) + "\"");
       columns = row.size();
       continue;
@@ -74,29 +81,39 @@ ForceCurve read_force_curve(const std::filesystem::path& path, double travel_sca
       throw InputError(file + ": line " + std::to_string(number) + ": expected " +
                        std::to_string(columns) + " values as in the header, got " +
                        std::to_string(row.size()));
-    double values[2];
-    const int wanted[2] = {at_column, force_column};
-    for (int k = 0; k < 2; ++k) {
-      const std::string& cell = row[static_cast<size_t>(wanted[k])];
+    ++rows_read;
+    double values[3] = {0.0, 0.0, 0.0};
+    const int read[3] = {at_column, force_column, sd_column};
+    for (int k = 0; k < 3; ++k) {
+      if (read[k] < 0) continue;
+      const std::string& cell = row[static_cast<size_t>(read[k])];
       char* end = nullptr;
       errno = 0;
       values[k] = std::strtod(cell.c_str(), &end);
       if (cell.empty() || end != cell.c_str() + cell.size() || errno == ERANGE ||
-          !std::isfinite(values[k]))
-        throw InputError(file + ": line " + std::to_string(number) + ": expected a finite number " +
-                         "in column " + std::to_string(wanted[k] + 1) + ", got \"" +
-                         cell.substr(0, 40) + "\"");
+          !std::isfinite(values[k]) || (k == 2 && values[k] < 0.0))
+        throw InputError(file + ": line " + std::to_string(number) + ": expected a finite " +
+                         (k == 2 ? "scatter of 0 or more" : "number") + " in column " +
+                         std::to_string(read[k] + 1) + ", got \"" + cell.substr(0, 40) + "\"");
     }
     if (curve.by_step && (values[0] < 1 || values[0] > 1e6 || values[0] != std::floor(values[0])))
       throw InputError(file + ": line " + std::to_string(number) +
                        ": expected a load step (a whole number from 1), got " +
                        row[static_cast<size_t>(at_column)]);
-    curve.at.push_back(curve.by_step ? values[0] : values[0] * travel_scale);
-    curve.force.push_back(values[1] * force_scale);
+    if (!(values[0] >= wanted.from && values[0] <= wanted.to)) continue;
+    curve.at.push_back(curve.by_step ? values[0] : values[0] * wanted.travel_scale);
+    curve.force.push_back(values[1] * wanted.force_scale);
+    if (sd_column >= 0) curve.sd.push_back(values[2] * wanted.force_scale);
   }
   if (force_column < 0)
     throw InputError(file + ": empty (expected a CSV force curve with a header)");
-  if (curve.force.empty()) throw InputError(file + ": a header but no rows: nothing to fit");
+  if (rows_read == 0) throw InputError(file + ": a header but no rows: nothing to fit");
+  if (curve.force.empty()) {
+    std::ostringstream why;
+    why << file << ": no row has its " << (curve.by_step ? wanted.step : wanted.travel)
+        << " between " << wanted.from << " and " << wanted.to << " (the range asked): nothing to fit";
+    throw InputError(why.str());
+  }
   for (const double f : curve.force)
     if (!std::isfinite(f)) throw InputError(file + ": a force is not finite after scaling");
   for (const double t : curve.at)

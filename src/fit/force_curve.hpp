@@ -8,6 +8,7 @@
 // alone a modulus and the surface tension act only through their ratio).
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,20 +32,37 @@ struct ForceCurve {
   bool by_step = false;
   std::vector<double> at;     // per row: the travel (m) or the step
   std::vector<double> force;  // per row (N)
+  // Per row, the measurement's own scatter (N: the sd over repeat tests),
+  // when the file has it; else empty. It weighs nothing: it tells whether the
+  // misfit left is the data's noise or the model's form (ForceMisfit).
+  std::vector<double> sd;
+  // Misfits in newtons (the largest forces rule the fit) or each as a share
+  // of its measured force (every part of the curve counts alike).
+  bool relative = false;
   // How a force misfit counts against the surface distances: a misfit of
   // 1 N is a residual of `weight` m. 0: the body's length over the largest
   // measured force (a misfit of the whole force weighs as one body length).
   double weight = 0.0;
 };
 
-// Reads a curve from CSV: a header naming the columns, `force` and
-// `travel` or `step` (other columns are ignored); '#' starts a comment line.
-// The rows are placed by `rows_at` ("travel" or "step"; "": by travel when
-// the file has that column, else by step). Travel and force are multiplied
-// by the scales (mm: 1e-3). Throws InputError naming the file, and the line
-// for a bad value.
-ForceCurve read_force_curve(const std::filesystem::path& path, double travel_scale = 1.0,
-                            double force_scale = 1.0, const std::string& rows_at = "");
+// How to read a curve's file: which columns, in which units, which rows.
+struct ForceCurveColumns {
+  std::string travel = "travel", step = "step", force = "force";
+  std::string sd;  // the scatter's column, or none
+  // "travel" or "step"; "": by travel when the file has that column, else by step.
+  std::string rows_at;
+  double travel_scale = 1.0, force_scale = 1.0;  // the file's units to m and N (mm: 1e-3)
+  // Only the rows whose travel (or step), in the file's units, lies in
+  // [from, to]: the part of a measured curve the fit sees.
+  double from = -std::numeric_limits<double>::infinity();
+  double to = std::numeric_limits<double>::infinity();
+};
+
+// Reads a curve from CSV: a header naming the columns (other columns are
+// ignored); '#' starts a comment line. Throws InputError naming the file,
+// and the line for a bad value, or the range when it holds no row.
+ForceCurve read_force_curve(const std::filesystem::path& path,
+                            const ForceCurveColumns& columns = {});
 
 // A curve's force at a step from the run's record, by the curve's
 // convention: a paddle's push into the body, a support's reaction component.

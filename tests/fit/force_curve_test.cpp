@@ -5,8 +5,11 @@
 // act through their ratio (a surface cannot tell them apart); the force
 // fixes the scale.
 #include "fiberfluid/fit/force_curve.hpp"
+#include "fiberfluid/fit/force_misfit.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "fit/fit_fixtures.hpp"
 
@@ -35,11 +38,28 @@ void expect_input_error(const std::function<void()>& action, const std::string& 
   }
 }
 
+ForceCurveColumns scaled(double travel_scale, double force_scale) {
+  ForceCurveColumns c;
+  c.travel_scale = travel_scale;
+  c.force_scale = force_scale;
+  return c;
+}
+ForceCurveColumns rows_by_step() {
+  ForceCurveColumns c;
+  c.rows_at = "step";
+  return c;
+}
+ForceCurveColumns with_sd(const std::string& column) {
+  ForceCurveColumns c;
+  c.sd = column;
+  return c;
+}
+
 TEST(ForceCurve, TheReaderTakesTravelOrStepAndNamesWhatIsWrong) {
   testing::ScratchDir dir;
   const ForceCurve curve = read_force_curve(
       dir.write("a.csv", "# a compression test\ntime, travel ,force\n0,0,0\n1, 2.5, -1.5\n\n"),
-      1e-3, 2.0);
+      scaled(1e-3, 2.0));
   EXPECT_FALSE(curve.by_step);
   ASSERT_EQ(curve.at.size(), 2u);
   EXPECT_DOUBLE_EQ(curve.at[1], 2.5e-3);
@@ -50,10 +70,10 @@ TEST(ForceCurve, TheReaderTakesTravelOrStepAndNamesWhatIsWrong) {
   // With both columns the travel places the rows, unless the step is asked for.
   const auto both = dir.write("c.csv", "step,travel,force\n3,0.01,1\n");
   EXPECT_FALSE(read_force_curve(both).by_step);
-  EXPECT_TRUE(read_force_curve(both, 1.0, 1.0, "step").by_step);
-  EXPECT_EQ(read_force_curve(both, 1.0, 1.0, "step").at[0], 3.0);
+  EXPECT_TRUE(read_force_curve(both, rows_by_step()).by_step);
+  EXPECT_EQ(read_force_curve(both, rows_by_step()).at[0], 3.0);
   expect_input_error(
-      [&] { read_force_curve(dir.write("d.csv", "travel,force\n1,1\n"), 1, 1, "step"); },
+      [&] { read_force_curve(dir.write("d.csv", "travel,force\n1,1\n"), rows_by_step()); },
       "expected a header with the columns force and step");
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"", "empty"},
@@ -71,6 +91,42 @@ TEST(ForceCurve, TheReaderTakesTravelOrStepAndNamesWhatIsWrong) {
     expect_input_error([&] { read_force_curve(file); }, file.string());
   }
   expect_input_error([&] { read_force_curve(dir.path() / "missing.csv"); }, "cannot open");
+}
+
+// A measured file as a test machine's software exports it: its own column
+// names, the scatter over repeat tests, a curve longer than the part fitted.
+TEST(ForceCurve, AMeasuredFileIsReadByItsColumnsScatterAndRange) {
+  testing::ScratchDir dir;
+  const auto file = dir.write("measured.csv",
+                              "compression_mm,A1_N,mean_N,sd_N\n0,0,0,0\n0.5,1.1,1.0,0.1\n"
+                              "5,9,10,0.5\n10,41,40,1.5\n15,99,100,4\n");
+  ForceCurveColumns columns;
+  columns.travel = "compression_mm";
+  columns.force = "mean_N";
+  columns.sd = "sd_N";
+  columns.travel_scale = 1e-3;
+  columns.from = 0.5;
+  columns.to = 10;
+  const ForceCurve curve = read_force_curve(file, columns);
+  ASSERT_EQ(curve.at.size(), 3u);  // 0 and 15 mm are outside the range
+  EXPECT_DOUBLE_EQ(curve.at[0], 0.5e-3);
+  EXPECT_DOUBLE_EQ(curve.at[2], 10e-3);
+  EXPECT_EQ(curve.force, (std::vector<double>{1.0, 10.0, 40.0}));
+  EXPECT_EQ(curve.sd, (std::vector<double>{0.1, 0.5, 1.5}));
+  EXPECT_FALSE(curve.by_step);
+
+  columns.sd = "scatter";
+  expect_input_error(
+      [&] { read_force_curve(file, columns); },
+      "expected a header with the columns mean_N, compression_mm or step, and scatter");
+  columns.sd = "";
+  columns.from = 20;
+  columns.to = 30;
+  expect_input_error([&] { read_force_curve(file, columns); },
+                     "no row has its compression_mm between 20 and 30");
+  const auto negative = dir.write("negative.csv", "travel,force,sd\n1,1,-0.5\n");
+  expect_input_error([&] { read_force_curve(negative, with_sd("sd")); },
+                     "line 2: expected a finite scatter of 0 or more in column 3");
 }
 
 // A small sphere (42 vertices) on supports that sink along z as a paddle
@@ -261,6 +317,141 @@ TEST(ForceCurve, APaddlesOnlySurfaceFitCannotTellYFromGammaAndTheForceCurveCan) 
   ASSERT_EQ(force_only.status, FitStatus::Converged) << force_only.status_detail;
   EXPECT_NEAR(force_only.values[0] / 3000.0, 1.0, 1e-5);
   EXPECT_EQ(force_only.overall.count, 0);
+}
+
+// Fits that go straight (issue 58). With every modulus and gamma times s a
+// body moved by paddles alone has every force times s: the start's own run
+// gives s, and from a start ten times too soft in both the fit starts at the
+// truth. An exponent between bounds moves by at most 5% of its range a step.
+TEST(ForceCurve, TheStartIsScaledToItsSmallLoadForcesAndEveryStepIsBounded) {
+  const model::Model m = pressed_sphere(false, model::FiberLaw::exponential(3000.0, 5.0));
+  const Measured truth = measure(m, 4, {});
+  const ForceCurve curve =
+      paddle_curve({0.005, 0.01, 0.015, 0.02},
+                   {truth.paddle[0], truth.paddle[1], truth.paddle[2], truth.paddle[3]});
+  const std::vector<Parameter> soft = {parameter("Y0", 300.0), parameter("beta", 5.0, false),
+                                       parameter("gamma", 0.5)};
+  const FitResult scaled = Calibration(m, newton(4), {}, soft, {}, {curve}).run();
+  ASSERT_TRUE(scaled.success) << scaled.message;
+  EXPECT_NE(scaled.start_note.find("scaled by 10"), std::string::npos) << scaled.start_note;
+  ASSERT_FALSE(scaled.iterations.empty());
+  EXPECT_NEAR(scaled.iterations.front().values[0] / 3000.0, 1.0, 1e-9);  // iteration 0
+  EXPECT_NEAR(scaled.iterations.front().values[2] / 5.0, 1.0, 1e-9);
+  EXPECT_LT(scaled.iterations.front().cost, 1e-16);
+  FitOptions unscaled;
+  unscaled.scale_start = false;
+  const FitResult plain = Calibration(m, newton(4), {}, soft, unscaled, {curve}).run();
+  EXPECT_TRUE(plain.start_note.empty());
+  EXPECT_NEAR(plain.iterations.front().values[0], 300.0, 1e-9);
+  EXPECT_GT(plain.forward_runs, scaled.forward_runs);
+
+  // beta in [-10, 10] from 0: no step moves it by more than 1 (5% of 20).
+  Parameter beta = parameter("beta", 0.0, false);
+  beta.lower = -10.0;
+  beta.upper = 10.0;
+  const FitResult boxed =
+      Calibration(m, newton(4), {}, {parameter("Y0", 3000.0), beta}, {}, {curve}).run();
+  ASSERT_TRUE(boxed.success) << boxed.message;
+  EXPECT_NEAR(boxed.values[1], 5.0, 1e-4);
+  double from = 0.0;
+  for (const IterationRecord& it : boxed.iterations) {
+    EXPECT_LE(std::abs(it.values[1] - from), 1.0 + 1e-12) << "iteration " << it.iteration;
+    from = it.values[1];
+  }
+  EXPECT_GE(boxed.iterations.size(), 6u);  // five steps of at most 1 to reach 5
+  FitOptions bad;
+  bad.max_step_share = 0.0;
+  EXPECT_THROW(check_options(bad), InputError);
+}
+
+// misfit: relative: each row's miss as a share of its own force, a share of
+// 1 weighing what the largest force's whole miss weighs in newtons.
+TEST(ForceCurve, ARelativeMisfitWeighsEachRowByItsOwnForce) {
+  const model::Model m = pressed_sphere(true, model::FiberLaw::exponential(3000.0, 5.0));
+  const Measured truth = measure(m, 4, {4});
+  const std::vector<Parameter> parameters = {parameter("Y0", 2500.0),
+                                             parameter("beta", 4.0, false)};
+  ForceCurve newtons = paddle_curve({0.0075, 0.02}, {1.0, 4.0});
+  ForceCurve relative = newtons;
+  relative.relative = true;
+  const Calibration a(m, newton(4), truth.surfaces, parameters, {}, {newtons});
+  const Calibration r(m, newton(4), truth.surfaces, parameters, {}, {relative});
+  const Eigen::VectorXd phi = a.parameters().initial_phi();
+  const Evaluation ea = a.evaluate(phi, true), er = r.evaluate(phi, true);
+  ASSERT_TRUE(ea.ok && er.ok);
+  const Eigen::Index first = a.num_residuals() - 2;
+  for (Eigen::Index row = 0; row < 2; ++row) {
+    const double factor = 4.0 / newtons.force[static_cast<size_t>(row)];  // largest / own
+    EXPECT_NEAR(er.residuals[first + row], factor * ea.residuals[first + row], 1e-14);
+    for (Eigen::Index k = 0; k < phi.size(); ++k)
+      EXPECT_NEAR(er.jacobian(first + row, k), factor * ea.jacobian(first + row, k),
+                  1e-12 * std::abs(er.jacobian(first + row, k)) + 1e-15);
+  }
+  relative.force[0] = 0.0;
+  expect_input_error([&] { Calibration(m, newton(4), truth.surfaces, parameters, {}, {relative}); },
+                     "row 1: a measured force of 0 has no relative misfit");
+}
+
+// The misfit's verdict: noise or the model's form. A runs test on the signs
+// (Wald and Wolfowitz: R runs of n1 and n2 signs, mean 1 + 2 n1 n2 / n,
+// variance (mean - 1)(mean - 2) / (n - 1)) and the measurement's scatter.
+TEST(ForceCurve, AMisfitThatRunsInLongStretchesOrExceedsTheScatterIsSystematic) {
+  ForceCurve curve;
+  for (int r = 0; r < 12; ++r) {
+    curve.at.push_back(1e-3 * (r + 1));
+    curve.force.push_back(10.0 * (r + 1));
+    curve.sd.push_back(0.5);
+  }
+  const auto simulated = [&](const std::function<double(int)>& miss) {
+    std::vector<double> s;
+    for (int r = 0; r < 12; ++r) s.push_back(curve.force[static_cast<size_t>(r)] + miss(r));
+    return s;
+  };
+  // Alternating signs of 0.2 N: 12 runs where chance gives 7, within the scatter.
+  const ForceMisfit noise =
+      force_misfit(curve, simulated([](int r) { return r % 2 ? 0.2 : -0.2; }), 1);
+  EXPECT_EQ(noise.runs, 12);
+  EXPECT_DOUBLE_EQ(noise.runs_expected, 7.0);
+  EXPECT_NEAR(noise.runs_z, 5.0 / std::sqrt(6.0 * 5.0 / 11.0), 1e-12);
+  EXPECT_DOUBLE_EQ(noise.scatter, 0.5);
+  EXPECT_NEAR(noise.rms, 0.2, 1e-12);
+  EXPECT_FALSE(noise.systematic) << noise.verdict;
+  EXPECT_NE(noise.verdict.find("as noise"), std::string::npos) << noise.verdict;
+
+  // Six over, then six under: 2 runs, z = -5 / sqrt(30 / 11).
+  const ForceMisfit bowed =
+      force_misfit(curve, simulated([](int r) { return r < 6 ? 0.2 : -0.2; }), 1);
+  EXPECT_EQ(bowed.runs, 2);
+  EXPECT_NEAR(bowed.runs_z, -5.0 / std::sqrt(30.0 / 11.0), 1e-12);
+  EXPECT_TRUE(bowed.systematic);
+  EXPECT_NE(bowed.verdict.find("2 runs where random signs would give 7"), std::string::npos)
+      << bowed.verdict;
+  EXPECT_NE(bowed.verdict.find("the model's form, not the data's noise"), std::string::npos);
+
+  // Alternating, but four times the scatter.
+  const ForceMisfit large =
+      force_misfit(curve, simulated([](int r) { return r % 2 ? 2.0 : -2.0; }), 1);
+  EXPECT_TRUE(large.systematic);
+  EXPECT_NE(large.verdict.find("4 times the measurement's scatter"), std::string::npos)
+      << large.verdict;
+  // Relative: each miss over its force, 2 / (10 (r + 1)).
+  double squares = 0.0;
+  for (int r = 0; r < 12; ++r) squares += std::pow(2.0 / (10.0 * (r + 1)), 2);
+  EXPECT_NEAR(large.rms_relative, std::sqrt(squares / 12.0), 1e-15);
+
+  // One side only: systematic whatever the runs' statistics.
+  const ForceMisfit above = force_misfit(curve, simulated([](int) { return 0.1; }), 1);
+  EXPECT_TRUE(above.systematic);
+  EXPECT_NE(above.verdict.find("every row misses on one side"), std::string::npos);
+  // Without a scatter and with few rows there is no verdict to give.
+  ForceCurve short_curve = curve;
+  short_curve.sd.clear();
+  short_curve.at.resize(5);
+  short_curve.force.resize(5);
+  const ForceMisfit few = force_misfit(short_curve, {1, 2, 3, 4, 5}, 1);
+  EXPECT_FALSE(few.systematic);
+  EXPECT_TRUE(std::isnan(few.scatter));
+  EXPECT_NE(few.verdict.find("too few rows"), std::string::npos) << few.verdict;
 }
 
 }  // namespace

@@ -37,10 +37,24 @@ FitForceSpec read_force_target(Fields& t, const std::filesystem::path& folder) {
   if (t.has("paddle") && t.has("axis"))
     t.fail("axis", "a paddle's force is along its own axis: give axis only with a support");
   if (t.has("weight")) curve.weight = t.positive("weight", 1.0);
-  if (t.has("rows_at")) curve.rows_at = t.choice("rows_at", "", {"travel", "step"});
-  curve.travel_scale = length_units(t, "travel_units");
+  fit::ForceCurveColumns& columns = curve.columns;
+  if (t.has("rows_at")) columns.rows_at = t.choice("rows_at", "", {"travel", "step"});
+  columns.travel_scale = length_units(t, "travel_units");
   const std::string force = t.choice("force_units", "N", {"N", "mN", "kN"});
-  curve.force_scale = force == "mN" ? 1e-3 : force == "kN" ? 1e3 : 1.0;
+  columns.force_scale = force == "mN" ? 1e-3 : force == "kN" ? 1e3 : 1.0;
+  // A measured file's own column names, its scatter, the part of it fitted.
+  columns.travel = t.string("travel_column", columns.travel);
+  columns.step = t.string("step_column", columns.step);
+  columns.force = t.string("force_column", columns.force);
+  if (t.has("sd_column")) columns.sd = t.string("sd_column");
+  if (t.has("range")) {
+    const Eigen::VectorXd range = t.vector("range", 2);
+    if (!(range[0] <= range[1]))
+      t.fail("range", "expected [from, to] with from <= to (in the file's travel units or steps)");
+    columns.from = range[0];
+    columns.to = range[1];
+  }
+  curve.relative = t.choice("misfit", "newtons", {"newtons", "relative"}) == "relative";
   t.finish();
   return curve;
 }
@@ -130,7 +144,8 @@ void read_fit_options(Fields& f, FitSpec& spec) {
       if (f.has(key)) f.fail(key, "only with \"method\": \"multistart\"");
     // Every option is honoured by the method it is given with, or refused.
     if (o.method != fit::Method::LevenbergMarquardt)
-      for (const char* key : {"max_iterations", "initial_trust_region_radius", "max_step_factor"})
+      for (const char* key : {"max_iterations", "initial_trust_region_radius", "max_step_factor",
+                              "max_step_share", "scale_start"})
         if (f.has(key))
           f.fail(key, "only with levenberg-marquardt or multistart (" + method +
                           " takes no trust-region steps: max_evaluations bounds its runs)");
@@ -162,6 +177,8 @@ void read_fit_options(Fields& f, FitSpec& spec) {
   o.initial_trust_region_radius =
       f.number("initial_trust_region_radius", o.initial_trust_region_radius);
   o.max_step_factor = f.number("max_step_factor", o.max_step_factor);
+  o.max_step_share = f.number("max_step_share", o.max_step_share);
+  o.scale_start = f.boolean("scale_start", o.scale_start);
   o.warm_start = f.boolean("warm_start", o.warm_start);
   o.check_intervals = f.boolean("check_intervals", o.check_intervals);
   try {

@@ -27,11 +27,12 @@ using nlohmann::json;
 fit::ForceCurve force_curve(const FitForceSpec& spec, const Case& c) {
   fit::ForceCurve curve;
   try {
-    curve = fit::read_force_curve(spec.file, spec.travel_scale, spec.force_scale, spec.rows_at);
+    curve = fit::read_force_curve(spec.file, spec.columns);
   } catch (const InputError& e) {
     spec.field.fail("file", e.what());
   }
   curve.weight = spec.weight;
+  curve.relative = spec.relative;
   const std::vector<std::string>& names = c.model.constraint_groups;
   std::vector<std::string> paddles;
   for (const model::Paddle& p : c.model.paddles) paddles.push_back(p.label);
@@ -207,6 +208,11 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
     figures["fit.force_rms"] = force.rms;
     figures["fit.force_largest"] = force.largest;
     figures["fit.force_rms_share"] = force.scale > 0.0 ? force.rms / force.scale : 0.0;
+    for (size_t k = 0; k < r.force_misfits.size(); ++k) {
+      const std::string curve = "fit.force_curves." + std::to_string(k) + ".";
+      figures[curve + "rms_relative"] = r.force_misfits[k].rms_relative;
+      figures[curve + "systematic"] = r.force_misfits[k].systematic ? 1.0 : 0.0;
+    }
   }
   for (size_t k = 0; k < r.other_targets.size(); ++k)
     for (const auto& [name, value] : r.other_targets[k].figures)

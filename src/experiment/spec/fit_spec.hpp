@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "fiberfluid/fit/force_curve.hpp"
 #include "fiberfluid/experiment/spec/case_spec.hpp"
 #include "fiberfluid/fit/calibration.hpp"
 #include "fiberfluid/fit/multistart.hpp"
@@ -28,8 +29,8 @@ struct FitForceSpec {
   std::string paddle, support;  // the label of one of them
   int axis = -1;                // a support's force component (0, 1, 2); -1 for a paddle
   double weight = 0.0;          // m per N; 0: the default (fit::ForceCurve::weight)
-  std::string rows_at;          // "travel", "step", or "": as the file's columns allow
-  double travel_scale = 1.0, force_scale = 1.0;  // the file's units to m and N
+  fit::ForceCurveColumns columns;  // which of the file's columns and rows, in which units
+  bool relative = false;           // "misfit": "relative" (each row's share) or "newtons"
 };
 
 // A target of a registered kind (experiment/targets/target_kinds.hpp), as

@@ -77,6 +77,7 @@ class ForceCurveMisfits : public ResidualBlock {
   size_t index_;
   std::vector<Row> rows_;
   double weight_ = 0.0;
+  std::vector<double> row_weights_;  // weight_, or for a relative misfit weight_ max|F| / |F_r|
 };
 
 }  // namespace fiberfluid::fit

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fiberfluid/fit/force_misfit.hpp"
 #include "fiberfluid/fit/residuals/blocks.hpp"
 #include "fiberfluid/util/error.hpp"
 
@@ -38,6 +39,17 @@ ForceCurveMisfits::ForceCurveMisfits(const ForceCurve& curve, size_t index,
     throw InputError(curve_.label +
                      ": every measured force is 0: give the curve a weight (m per N)");
   weight_ = curve_.weight > 0.0 ? curve_.weight : length / largest;
+  // A relative misfit: each row's share of its own force, a share of 1 weighing
+  // what the largest force's would in newtons (by default a body length).
+  row_weights_.assign(curve_.force.size(), weight_);
+  if (!curve_.relative) return;
+  for (size_t r = 0; r < curve_.force.size(); ++r) {
+    if (curve_.force[r] == 0.0)
+      throw InputError(curve_.label + ": row " + std::to_string(r + 1) +
+                       ": a measured force of 0 has no relative misfit (misfit: relative); "
+                       "leave the row out (range) or weigh in newtons");
+    row_weights_[r] = weight_ * largest / std::abs(curve_.force[r]);
+  }
 }
 
 // The rows: where each reads the run. Throws InputError naming the curve for
@@ -139,30 +151,19 @@ std::string ForceCurveMisfits::evaluate(const ForwardRun& run,
       if (run.with_jacobian && nm > 0) gradient += share * reading.sensitivities.row(0);
     }
     forces.push_back(force);
-    e.residuals[row] = weight_ * (force - curve_.force[r]);
+    e.residuals[row] = row_weights_[r] * (force - curve_.force[r]);
     if (!run.with_jacobian) continue;
     for (int j = 0; j < nm; ++j) {
       const int k = map.material_indices()[static_cast<size_t>(j)];
-      e.jacobian(row, k) = weight_ * gradient[j] * run.dvalue[k];
+      e.jacobian(row, k) = row_weights_[r] * gradient[j] * run.dvalue[k];
     }
   }
   return "";
 }
 
 void ForceCurveMisfits::describe(const Evaluation& e, Eigen::Index, FitResult& result) const {
-  ForceMisfit misfit;
-  misfit.simulated = e.forces.at(index_);
-  misfit.weight = weight_;
-  double squares = 0.0;
-  for (size_t r = 0; r < misfit.simulated.size(); ++r) {
-    const double miss = misfit.simulated[r] - curve_.force[r];
-    squares += miss * miss;
-    misfit.largest = std::max(misfit.largest, std::abs(miss));
-    misfit.scale = std::max(misfit.scale, std::abs(curve_.force[r]));
-  }
-  misfit.rms = std::sqrt(squares / static_cast<double>(misfit.simulated.size()));
   if (result.force_misfits.size() <= index_) result.force_misfits.resize(index_ + 1);
-  result.force_misfits[index_] = misfit;
+  result.force_misfits[index_] = force_misfit(curve_, e.forces.at(index_), weight_);
 }
 
 }  // namespace fiberfluid::fit
