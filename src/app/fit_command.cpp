@@ -98,9 +98,8 @@ void print_fit(const fiberfluid::fit::FitResult& fitted) {
   }
   for (const fit::ForceMisfit& m : fitted.force_misfits) {
     std::cout << "  force misfit (" << m.simulated.size() << " rows): rms " << m.rms << " N ("
-              << 100.0 * m.share(m.rms) << "% of the largest measured force " << m.scale
-              << " N; " << 100.0 * m.rms_relative << "% rms relative), largest " << m.largest
-              << " N\n";
+              << 100.0 * m.share(m.rms) << "% of the largest measured force " << m.scale << " N; "
+              << 100.0 * m.rms_relative << "% rms relative), largest " << m.largest << " N\n";
     if (!m.verdict.empty()) std::cout << "    residuals: " << m.verdict << "\n";
   }
   std::cout << "  " << fitted.forward_runs << " forward runs";

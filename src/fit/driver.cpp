@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "fiberfluid/fit/evaluation_cache.hpp"

@@ -25,8 +25,8 @@ void fields(A& a, DistanceStatistics& d) {
 }
 template <class A>
 void fields(A& a, ForceMisfit& m) {
-  a(m.simulated, m.rms, m.largest, m.scale, m.weight, m.relative, m.rms_relative, m.scatter,
-    m.runs, m.runs_expected, m.runs_z, m.systematic, m.verdict);
+  a(m.simulated, m.rms, m.largest, m.scale, m.weight, m.relative, m.rms_relative, m.scatter, m.runs,
+    m.runs_expected, m.runs_z, m.systematic, m.verdict);
 }
 template <class A>
 void fields(A& a, TargetReport& t) {

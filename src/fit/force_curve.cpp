@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "fiberfluid/fit/force_curve.hpp"
 
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -63,17 +63,16 @@ ForceCurve read_force_curve(const std::filesystem::path& path, const ForceCurveC
       }
       curve.by_step = wanted.rows_at == "step" || (wanted.rows_at.empty() && travel_column < 0);
       at_column = curve.by_step ? step_column : travel_column;
-      const std::string at_name =
-          wanted.rows_at == "step"     ? wanted.step
-          : wanted.rows_at == "travel" ? wanted.travel
-                                       : wanted.travel + " or " + wanted.step;
+      const std::string at_name = wanted.rows_at == "step" ? wanted.step
+                                  : wanted.rows_at == "travel"
+                                      ? wanted.travel
+                                      : wanted.travel + " or " + wanted.step;
       if (force_column < 0 || at_column < 0 || (!wanted.sd.empty() && sd_column < 0))
-        throw InputError(file + ": line " + std::to_string(number) + ": expected a header with " +
-                         "the columns " + wanted.force +
-                         (wanted.sd.empty() ? " and " + at_name
-                                            : ", " + at_name + ", and " + wanted.sd) +
-                         ", got \"" +
-                         text.substr(0, 80) + "\"");
+        throw InputError(
+            file + ": line " + std::to_string(number) + ": expected a header with " +
+            "the columns " + wanted.force +
+            (wanted.sd.empty() ? " and " + at_name : ", " + at_name + ", and " + wanted.sd) +
+            ", got \"" + text.substr(0, 80) + "\"");
       columns = row.size();
       continue;
     }
@@ -111,7 +110,8 @@ ForceCurve read_force_curve(const std::filesystem::path& path, const ForceCurveC
   if (curve.force.empty()) {
     std::ostringstream why;
     why << file << ": no row has its " << (curve.by_step ? wanted.step : wanted.travel)
-        << " between " << wanted.from << " and " << wanted.to << " (the range asked): nothing to fit";
+        << " between " << wanted.from << " and " << wanted.to
+        << " (the range asked): nothing to fit";
     throw InputError(why.str());
   }
   for (const double f : curve.force)

@@ -37,7 +37,8 @@ ForceMisfit force_misfit(const ForceCurve& curve, const std::vector<double>& sim
   }
   if (n == 0) return m;
   m.rms = std::sqrt(squares / static_cast<double>(n));
-  if (with_force > 0) m.rms_relative = std::sqrt(relative_squares / static_cast<double>(with_force));
+  if (with_force > 0)
+    m.rms_relative = std::sqrt(relative_squares / static_cast<double>(with_force));
   if (curve.sd.size() >= n) m.scatter = std::sqrt(scatter_squares / static_cast<double>(n));
 
   m.runs = runs;

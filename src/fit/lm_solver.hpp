@@ -132,8 +132,8 @@ inline ceres::Solver::Summary solve_in_moving_box(ceres::Problem& problem, doubl
     // A linear variable with an open bound has no scale to share: unboxed.
     widest[static_cast<size_t>(k)] =
         parameters[static_cast<size_t>(k)].log_scale ? std::log(steps.max_step_factor)
-        : std::isfinite(range) ? steps.max_step_share * range
-                               : std::numeric_limits<double>::infinity();
+        : std::isfinite(range)                       ? steps.max_step_share * range
+                                                     : std::numeric_limits<double>::infinity();
   }
   double reach = 1.0;
   double radius = steps.initial_trust_region_radius;

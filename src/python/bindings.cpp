@@ -302,6 +302,10 @@ py::dict fit_experiment(const ff::experiment::Experiment& ex, const py::list& ta
     misfit["largest"] = f.largest;
     misfit["share_of_largest_measured"] = f.share(f.rms);
     misfit["weight"] = f.weight;
+    misfit["rms_relative"] = f.rms_relative;
+    misfit["measurement_scatter"] = f.scatter;
+    misfit["systematic"] = f.systematic;
+    misfit["verdict"] = f.verdict;
     forces.append(misfit);
   }
   out["force_misfits"] = forces;
@@ -615,7 +619,8 @@ PYBIND11_MODULE(fiberfluid, m) {
       "success, message, failed_runs, values, standard_errors, interval_95, correlation, "
       "cost_per_iteration, "
       "distance (mean, rms, standard_deviation, largest, share_of_length), force_misfits (per "
-      "curve: simulated, rms, largest, share_of_largest_measured, weight), forward_runs, "
+      "curve: simulated, rms, largest, share_of_largest_measured, weight, rms_relative, "
+      "measurement_scatter, systematic, verdict), forward_runs, "
       "sensitivity_solves, seconds, positions (per target, the model's vertices at the fit).");
 
   m.def(

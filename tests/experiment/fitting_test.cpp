@@ -528,6 +528,40 @@ TEST(FitConfig, BadForceTargetsAreNamed) {
       "row 1: travel 5.92714 m is outside the run's, from 0 to 0.0592714 m");  // mm read as m
   expect_fit_error(with([](nlohmann::json& t) { t["colour"] = "red"; }),
                    "fit.targets[1].colour: unknown field");
+  // A measured file's own columns, its range and how its misfit is weighed.
+  expect_fit_error(with([](nlohmann::json& t) { t["misfit"] = "squared"; }),
+                   "fit.targets[1].misfit: expected one of");
+  expect_fit_error(with([](nlohmann::json& t) {
+                     t["range"] = {10, 0.5};
+                   }),
+                   "fit.targets[1].range: expected [from, to] with from <= to");
+  expect_fit_error(with([](nlohmann::json& t) { t["range"] = 3; }), "fit.targets[1].range: ");
+  expect_fit_error(with([](nlohmann::json& t) { t["force_column"] = "mean_N"; }),
+                   "fit.targets[1].file: ");
+  expect_fit_error(with([](nlohmann::json& t) { t["force_column"] = "mean_N"; }),
+                   "expected a header with the columns mean_N and travel");
+  expect_fit_error(with([](nlohmann::json& t) {
+                     t["range"] = {500, 600};
+                   }),
+                   "no row has its travel between 500 and 600");
+}
+
+// The shipped Ecoflex experiments read the real files: 39 rows of the mean
+// force from 0.5 to 10 mm, each with the ten tests' sd, weighed relatively.
+TEST(FitConfig, TheShippedSiliconeFitsReadTheirMeasuredCurve) {
+  for (const char* material : {"EF10_0T", "EF50_0T"}) {
+    const std::string name = std::string("silicone_") + material + "_fit_half.json";
+    const Experiment ex = load_experiment(testing::experiment_file(name));
+    const FitSetup setup = setup_fit(ex);
+    ASSERT_EQ(setup.force_curves.size(), 1u) << name;
+    const fit::ForceCurve& curve = setup.force_curves[0];
+    ASSERT_EQ(curve.force.size(), 39u) << name;
+    EXPECT_DOUBLE_EQ(curve.at.front(), 0.5e-3);
+    EXPECT_DOUBLE_EQ(curve.at.back(), 10e-3);
+    EXPECT_EQ(curve.sd.size(), 39u);
+    EXPECT_TRUE(curve.relative);
+    for (size_t r = 1; r < curve.force.size(); ++r) EXPECT_GT(curve.force[r], curve.force[r - 1]);
+  }
 }
 
 }  // namespace

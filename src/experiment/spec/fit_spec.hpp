@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "fiberfluid/fit/force_curve.hpp"
 #include "fiberfluid/experiment/spec/case_spec.hpp"
 #include "fiberfluid/fit/calibration.hpp"
+#include "fiberfluid/fit/force_curve.hpp"
 #include "fiberfluid/fit/multistart.hpp"
 
 namespace fiberfluid::experiment {
@@ -26,9 +26,9 @@ struct FitTargetSpec {
 struct FitForceSpec {
   FieldName field;
   std::filesystem::path file;
-  std::string paddle, support;  // the label of one of them
-  int axis = -1;                // a support's force component (0, 1, 2); -1 for a paddle
-  double weight = 0.0;          // m per N; 0: the default (fit::ForceCurve::weight)
+  std::string paddle, support;     // the label of one of them
+  int axis = -1;                   // a support's force component (0, 1, 2); -1 for a paddle
+  double weight = 0.0;             // m per N; 0: the default (fit::ForceCurve::weight)
   fit::ForceCurveColumns columns;  // which of the file's columns and rows, in which units
   bool relative = false;           // "misfit": "relative" (each row's share) or "newtons"
 };

@@ -181,21 +181,21 @@ json force_curves_json(const Experiment& ex, const FitSetup& setup, const fit::C
         {"weight_is", "m per N: a force misfit of 1 N counts as a distance of this many m"}};
     if (k < r.force_misfits.size()) {
       const fit::ForceMisfit& m = r.force_misfits[k];
-      curve["misfit"] = {{"weighed", m.relative ? "relative: each row's share of its force"
-                                                 : "in newtons"},
-                         {"rms", finite_or_null(m.rms)},
-                         {"largest", finite_or_null(m.largest)},
-                         {"largest_measured", finite_or_null(m.scale)},
-                         {"share_of_largest_measured",
-                          {{"rms", finite_or_null(m.share(m.rms))},
-                           {"largest", finite_or_null(m.share(m.largest))}}},
-                         {"rms_relative", finite_or_null(m.rms_relative)},
-                         {"measurement_scatter", finite_or_null(m.scatter)},
-                         {"sign_runs", m.runs},
-                         {"sign_runs_of_noise", finite_or_null(m.runs_expected)},
-                         {"sign_runs_z", finite_or_null(m.runs_z)},
-                         {"systematic", m.systematic},
-                         {"verdict", m.verdict}};
+      curve["misfit"] = {
+          {"weighed", m.relative ? "relative: each row's share of its force" : "in newtons"},
+          {"rms", finite_or_null(m.rms)},
+          {"largest", finite_or_null(m.largest)},
+          {"largest_measured", finite_or_null(m.scale)},
+          {"share_of_largest_measured",
+           {{"rms", finite_or_null(m.share(m.rms))},
+            {"largest", finite_or_null(m.share(m.largest))}}},
+          {"rms_relative", finite_or_null(m.rms_relative)},
+          {"measurement_scatter", finite_or_null(m.scatter)},
+          {"sign_runs", m.runs},
+          {"sign_runs_of_noise", finite_or_null(m.runs_expected)},
+          {"sign_runs_z", finite_or_null(m.runs_z)},
+          {"systematic", m.systematic},
+          {"verdict", m.verdict}};
     }
     curves.push_back(curve);
   }
