@@ -228,13 +228,12 @@ double small_load_factor(const FitProblem& m, const Evaluation& e) {
   double fitted = 0.0, own = 0.0;
   for (size_t k = 0; k < m.force_curves().size() && k < e.forces.size(); ++k) {
     const ForceCurve& curve = m.force_curves()[k];
-    double largest = 0.0;
-    for (const double f : curve.force) largest = std::max(largest, std::abs(f));
+    const double largest = largest_measured(curve);
+    const std::vector<double> weights = row_weights(curve, m.force_weight(k));  // as the fit's
     for (size_t r = 0; r < curve.force.size() && r < e.forces[k].size(); ++r) {
       const double measured = curve.force[r], simulated = e.forces[k][r];
       if (r >= 3 && std::abs(measured) > 0.25 * largest) continue;
-      if (measured == 0.0 && curve.relative) continue;
-      const double w = m.force_weight(k) * (curve.relative ? largest / std::abs(measured) : 1.0);
+      const double w = weights[r];
       fitted += w * w * simulated * measured;
       own += w * w * simulated * simulated;
     }

@@ -121,6 +121,26 @@ ForceCurve read_force_curve(const std::filesystem::path& path, const ForceCurveC
   return curve;
 }
 
+double largest_measured(const ForceCurve& curve) {
+  double largest = 0.0;
+  for (const double f : curve.force) largest = std::max(largest, std::abs(f));
+  return largest;
+}
+
+std::vector<double> row_weights(const ForceCurve& curve, double weight) {
+  std::vector<double> weights(curve.force.size(), weight);
+  if (!curve.relative) return weights;
+  const double largest = largest_measured(curve);
+  for (size_t r = 0; r < curve.force.size(); ++r) {
+    if (curve.force[r] == 0.0)
+      throw InputError(curve.label + ": row " + std::to_string(r + 1) +
+                       ": a measured force of 0 has no relative misfit (misfit: relative); "
+                       "leave the row out (range) or weigh in newtons");
+    weights[r] = weight * largest / std::abs(curve.force[r]);
+  }
+  return weights;
+}
+
 double curve_force(const ForceCurve& curve, const model::Model& model,
                    const Eigen::Vector3d& force) {
   if (curve.source == ForceCurve::Source::Support) return force[curve.axis];

@@ -64,6 +64,15 @@ struct ForceCurveColumns {
 ForceCurve read_force_curve(const std::filesystem::path& path,
                             const ForceCurveColumns& columns = {});
 
+// The largest measured |force| (N).
+double largest_measured(const ForceCurve& curve);
+
+// Each row's weight (m per N) from the curve's `weight`: that weight, or for
+// a relative misfit weight max|F| / |F_r| (a share of 1 weighs what the
+// largest force's whole miss weighs in newtons). Throws InputError naming a
+// row of zero force under a relative misfit.
+std::vector<double> row_weights(const ForceCurve& curve, double weight);
+
 // A curve's force at a step from the run's record, by the curve's
 // convention: a paddle's push into the body, a support's reaction component.
 double curve_force(const ForceCurve& curve, const model::Model& model,

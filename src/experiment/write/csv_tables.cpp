@@ -3,6 +3,7 @@
 
 #include <iomanip>
 #include <map>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -37,29 +38,21 @@ std::string number_text(double value) {
 class CsvTable {
  public:
   CsvTable() = default;
-  explicit CsvTable(const RunBands& bands) : bands_(&bands) {}
+  explicit CsvTable(const RunBands& bands) : bands_(&bands) {
+    for (const std::map<std::string, Band>& row : bands.steps)
+      for (const auto& [name, band] : row) banded_.insert(name);
+  }
 
   void header(const std::string& name) {
     cells_.push_back(csv_field(name));
-    bool banded = false;
-    if (bands_)
-      for (const std::map<std::string, Band>& row : bands_->steps) banded |= row.count(name) > 0;
+    const bool banded = banded_.count(name) > 0;
     columns_.push_back(banded ? name : std::string());
     if (!banded) return;
     cells_.push_back(csv_field(name + "_lower95"));
     cells_.push_back(csv_field(name + "_upper95"));
   }
-  void text(const std::string& value) { add(csv_field(value), Band{}); }
-  void number(double value) {
-    Band band;
-    const size_t column = column_;
-    if (column < columns_.size() && !columns_[column].empty() && row_ >= 1 &&
-        row_ - 1 < bands_->steps.size()) {
-      const std::map<std::string, Band>& row = bands_->steps[row_ - 1];
-      if (const auto found = row.find(columns_[column]); found != row.end()) band = found->second;
-    }
-    add(number_text(value), band);
-  }
+  void text(const std::string& value) { add(csv_field(value)); }
+  void number(double value) { add(number_text(value)); }
   void end_row() {
     for (size_t k = 0; k < cells_.size(); ++k) out_ << (k ? "," : "") << cells_[k];
     out_ << "\n";
@@ -70,16 +63,22 @@ class CsvTable {
   std::string str() const { return out_.str(); }
 
  private:
-  void add(std::string cell, const Band& band) {
+  // A data cell, and after it its row's band when its column has one.
+  void add(std::string cell) {
     cells_.push_back(std::move(cell));
-    const bool banded = column_ < columns_.size() && !columns_[column_].empty();
-    ++column_;
-    if (!banded) return;
+    const size_t column = column_++;
+    if (column >= columns_.size() || columns_[column].empty()) return;
+    Band band;
+    if (row_ >= 1 && row_ - 1 < bands_->steps.size()) {
+      const std::map<std::string, Band>& row = bands_->steps[row_ - 1];
+      if (const auto found = row.find(columns_[column]); found != row.end()) band = found->second;
+    }
     cells_.push_back(number_text(band.lower95()));
     cells_.push_back(number_text(band.upper95()));
   }
 
   const RunBands* bands_ = nullptr;
+  std::set<std::string> banded_;      // every column name a step's bands hold
   std::vector<std::string> columns_;  // the header's names, empty where unbanded
   size_t column_ = 0, row_ = 0;       // the row's next data column; rows so far
   std::vector<std::string> cells_;

@@ -33,23 +33,12 @@ const ForceCurve& checked(const ForceCurve& curve, const model::Model& model) {
 ForceCurveMisfits::ForceCurveMisfits(const ForceCurve& curve, size_t index,
                                      const model::Model& model, int steps, double length)
     : curve_(checked(curve, model)), index_(index), rows_(plan(model, steps)) {
-  double largest = 0.0;
-  for (const double f : curve_.force) largest = std::max(largest, std::abs(f));
+  const double largest = largest_measured(curve_);
   if (curve_.weight == 0.0 && largest == 0.0)
     throw InputError(curve_.label +
                      ": every measured force is 0: give the curve a weight (m per N)");
   weight_ = curve_.weight > 0.0 ? curve_.weight : length / largest;
-  // A relative misfit: each row's share of its own force, a share of 1 weighing
-  // what the largest force's would in newtons (by default a body length).
-  row_weights_.assign(curve_.force.size(), weight_);
-  if (!curve_.relative) return;
-  for (size_t r = 0; r < curve_.force.size(); ++r) {
-    if (curve_.force[r] == 0.0)
-      throw InputError(curve_.label + ": row " + std::to_string(r + 1) +
-                       ": a measured force of 0 has no relative misfit (misfit: relative); "
-                       "leave the row out (range) or weigh in newtons");
-    row_weights_[r] = weight_ * largest / std::abs(curve_.force[r]);
-  }
+  row_weights_ = row_weights(curve_, weight_);
 }
 
 // The rows: where each reads the run. Throws InputError naming the curve for
