@@ -57,6 +57,9 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
   if (parameters_.empty()) throw InputError("nothing to fit: no parameter given");
   const std::vector<std::string> known = material.parameter_names(dim);
   for (size_t k = 0; k < parameters_.size(); ++k) {
+    // A friction coefficient below 0 has no meaning: an open lower bound is 0.
+    if (parameters_[k].name == "friction" && std::isinf(parameters_[k].lower))
+      parameters_[k].lower = 0.0;
     const Parameter& p = parameters_[k];
     const std::string who = "parameter \"" + p.name + "\"";
     for (size_t j = 0; j < k; ++j)
@@ -79,6 +82,8 @@ ParameterMap::ParameterMap(std::vector<Parameter> parameters, const model::Mater
                        list + ", rotation_x..z, translation_x..z)");
     }
     if (!std::isfinite(p.initial)) throw InputError(who + ": the start is not finite");
+    if (p.name == "friction" && p.lower < 0.0)
+      throw InputError(who + ": expected a lower bound of at least 0, got " + number(p.lower));
     if (std::isnan(p.lower) || std::isnan(p.upper) || (std::isinf(p.lower) && p.lower > 0) ||
         (std::isinf(p.upper) && p.upper < 0))
       throw InputError(who + ": expected numbers for the bounds, got [" + number(p.lower) + ", " +

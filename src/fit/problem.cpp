@@ -38,6 +38,14 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
   if (targets.empty() && curves_.empty() && more_blocks.empty())
     throw InputError(
         "nothing to fit to: no target surface and no force curve (nor another target)");
+  for (const std::string& name : map_.material_names())
+    if (name == "friction" &&
+        std::none_of(model_.paddles.begin(), model_.paddles.end(), [](const model::Paddle& p) {
+          return p.contact == model::Paddle::Contact::Coulomb;
+        }))
+      throw InputError(
+          "parameter \"friction\": no paddle has \"contact\": \"coulomb\", so no run "
+          "would feel it");
   const int n = model_.num_vertices();
   if (options_.counted_vertices.empty()) {
     for (int i = 0; i < n; ++i) counted_.push_back(i);

@@ -249,6 +249,9 @@ Eigen::MatrixXd Equilibrium::parameter_derivatives(const Eigen::VectorXd& x,
     // Resolved once (throws for an unknown name), not per pair.
     const MaterialParameter p = model_.material.resolve(names[k], model_.dim());
     const auto column = static_cast<Eigen::Index>(k);
+    // The body's forces do not depend on the paddles' friction (a Coulomb
+    // contact's sensitivities are refused: check_sensitivities).
+    if (p.kind == MaterialParameter::Kind::Friction) continue;
     bulk_.add_parameter_derivative(s, p, D.col(column));
     for (const auto& term : terms_) term->add_parameter_derivative(s, p, D.col(column));
   }

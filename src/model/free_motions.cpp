@@ -53,9 +53,11 @@ Eigen::MatrixXd held_rows(const Model& model, const RigidModes& r) {
   for (const Paddle& p : model.paddles) {
     for (Eigen::Index k = 0; k < m; ++k) {
       const bool translation = k < dim;
-      const int axis = translation ? static_cast<int>(k) : (dim == 3 ? static_cast<int>(k) - dim : 2);
+      const int axis =
+          translation ? static_cast<int>(k) : (dim == 3 ? static_cast<int>(k) - dim : 2);
       // Frictionless: its own translation, and the tilts about the other axes.
-      const bool held = p.sticking || (translation ? axis == p.axis : axis != p.axis);
+      // Coulomb counts as frictionless: its hold across the axis is bounded.
+      const bool held = p.sticking() || (translation ? axis == p.axis : axis != p.axis);
       if (held) rows.push_back(Eigen::RowVectorXd::Unit(m, k));
     }
   }
@@ -81,8 +83,8 @@ std::string direction_text(const Eigen::Vector3d& d) {
 
 std::string FreeMotion::describe() const {
   if (rotation.isZero()) return "translation along " + direction_text(translation);
-  std::string text = "rotation about the axis " + direction_text(rotation) + " through " +
-                     vector_text(point);
+  std::string text =
+      "rotation about the axis " + direction_text(rotation) + " through " + vector_text(point);
   if (!translation.isZero()) text += " with a translation along " + direction_text(translation);
   return text;
 }
@@ -140,7 +142,8 @@ std::vector<FreeMotion> free_rigid_motions(const Model& model) {
       motion.translation = t.normalized();
     }
     const Eigen::VectorXd field = r.modes * coefficients;
-    motion.driven = std::abs(F.dot(field)) / (load_scale * std::max(field.cwiseAbs().maxCoeff(), 1e-300));
+    motion.driven =
+        std::abs(F.dot(field)) / (load_scale * std::max(field.cwiseAbs().maxCoeff(), 1e-300));
     motions.push_back(motion);
   }
   return motions;
@@ -149,7 +152,8 @@ std::vector<FreeMotion> free_rigid_motions(const Model& model) {
 std::pair<int, int> gauge_unknown(const Model& model, const FreeMotion& motion) {
   const int n = model.num_vertices(), dim = model.dim();
   std::vector<char> held(static_cast<size_t>(dim * n), 0);
-  for (const Constraint& c : model.constraints) held[static_cast<size_t>(c.axis * n + c.vertex)] = 1;
+  for (const Constraint& c : model.constraints)
+    held[static_cast<size_t>(c.axis * n + c.vertex)] = 1;
   std::pair<int, int> best{-1, -1};
   double largest = 0.0;
   for (int i = 0; i < n; ++i) {

@@ -10,6 +10,7 @@ std::vector<std::string> Material::parameter_names(int dim) const {
   std::vector<std::string> names = law.parameter_names();
   names.push_back("gamma");
   for (int a = 0; a < dim; ++a) names.push_back(std::string("factor_") + "xyz"[a]);
+  names.push_back("friction");
   return names;
 }
 
@@ -21,6 +22,7 @@ MaterialParameter Material::resolve(const std::string& name, int dim) const {
   if (name == "gamma") return {MaterialParameter::Kind::SurfaceTension, 0};
   for (int a = 0; a < dim; ++a)
     if (name == std::string("factor_") + "xyz"[a]) return {MaterialParameter::Kind::AxisFactor, a};
+  if (name == "friction") return {MaterialParameter::Kind::Friction, 0};
   std::string known;
   for (const std::string& n : parameter_names(dim)) known += (known.empty() ? "" : ", ") + n;
   throw std::invalid_argument("\"" + name + "\" is not a parameter of this material (" + known +
@@ -40,6 +42,8 @@ double Material::parameter(const MaterialParameter& p) const {
       return surface_tension;
     case MaterialParameter::Kind::AxisFactor:
       return axis_factors[p.index];
+    case MaterialParameter::Kind::Friction:
+      return friction;
   }
   return 0.0;
 }
@@ -55,11 +59,16 @@ void Material::set_parameter(const MaterialParameter& p, double value) {
     case MaterialParameter::Kind::AxisFactor:
       axis_factors[p.index] = value;
       return;
+    case MaterialParameter::Kind::Friction:
+      friction = value;
+      return;
   }
 }
 
 bool Material::is_positive_parameter(const std::string& name) const {
   const MaterialParameter p = resolve(name);
+  // Friction is fitted in its own units: 0 (frictionless) is a value it takes.
+  if (p.kind == MaterialParameter::Kind::Friction) return false;
   return p.kind != MaterialParameter::Kind::Law || law.model().is_positive(p.index);
 }
 

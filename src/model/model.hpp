@@ -22,6 +22,7 @@ struct MaterialParameter {
     Law,             // the law's parameter `index` ("Y", "Y0", "beta", ...)
     SurfaceTension,  // "gamma"
     AxisFactor,      // "factor_x", "factor_y", "factor_z": axis `index`
+    Friction,        // "friction": the Coulomb coefficient against paddles
   };
   Kind kind = Kind::Law;
   int index = 0;
@@ -35,6 +36,9 @@ struct Material {
   FiberLaw law = FiberLaw::constant(1.0);
   Eigen::Vector3d axis_factors = Eigen::Vector3d::Ones();
   double surface_tension = 0.0;  // gamma, force per length (N/m)
+  // The Coulomb coefficient between the body's surface and the paddles whose
+  // contact is "coulomb": a sliding vertex feels friction * its normal force.
+  double friction = 0.0;
   // How a bulk fiber's force follows its ends (pair_stencil.hpp).
   FiberKinematics kinematics = FiberKinematics::VectorSpring;
 
@@ -50,7 +54,8 @@ struct Material {
   }
 
   // The parameters by name, the one list every front end and the fitter use:
-  // the law's, "gamma", then "factor_x" ... (one per axis of a dim-D model).
+  // the law's, "gamma", then "factor_x" ... (one per axis of a dim-D model),
+  // then "friction".
   std::vector<std::string> parameter_names(int dim = 3) const;
   // Throws std::invalid_argument for a name not in parameter_names(dim),
   // listing them.
@@ -61,7 +66,8 @@ struct Material {
   void set_parameter(const MaterialParameter& p, double value);
   void set_parameter(const std::string& name, double value) { set_parameter(resolve(name), value); }
   // Whether the parameter is positive by nature (a modulus, gamma, a
-  // factor), so that a fit may vary it in log scale; false for an exponent.
+  // factor), so that a fit may vary it in log scale; false for an exponent
+  // and for friction (0, frictionless, is one of its values).
   bool is_positive_parameter(const std::string& name) const;
 };
 
@@ -141,7 +147,16 @@ struct Paddle {
   double position = 0.0;  // the plane's coordinate before the first step (m)
   double travel = 0.0;    // its displacement along the axis at full schedule (m)
   Schedule schedule;
-  bool sticking = false;  // hold every component of a vertex in contact, not only the normal
+  enum class Contact {
+    Frictionless,  // the normal component of a vertex in contact held
+    Sticking,      // every component held where the vertex touched
+    Coulomb,       // held where it touched while |tangential force| <= friction * normal force,
+                   // else sliding against friction * normal force (Material::friction)
+  };
+  Contact contact = Contact::Frictionless;
+  bool sticking() const { return contact == Contact::Sticking; }
+  // Whether the contact can depend on the way there (where a vertex stuck).
+  bool holds_where_touched() const { return contact != Contact::Frictionless; }
 
   double plane(double factor) const { return position + factor * travel; }
   // How far a coordinate is past the plane (> 0: penetrating).

@@ -71,6 +71,10 @@ struct NewtonOptions {
   int krylov_restart = 50;
   int krylov_max_iterations = 500;
   int max_contact_rounds = 30;  // active-set updates per step
+  // Coulomb paddles: the active set is settled when no friction force changed
+  // by more than this share of the largest friction bound between solutions
+  // (1e-4: the cylinder's rolled-over ring settles in 3-5 rounds a step).
+  double friction_tolerance = 1e-4;
   // Start each step from the solution extrapolated along the load path
   // (quadratic in the last three converged points) rather than from the last
   // solution: fewer iterations on a smooth path.
@@ -179,11 +183,15 @@ struct StepRecord {
   // Paddles: the active-set rounds of the step (over its pieces), and the
   // vertices that joined and left the contact set in them.
   int contact_rounds = 0, contacts_added = 0, contacts_released = 0;
+  // Coulomb paddles: the changes of a vertex's stick, slide or friction force
+  // between the rounds' solutions.
+  int friction_updates = 0;
   struct PaddleState {
     double plane = 0.0;                               // the plane's coordinate
     double travel = 0.0;                              // how far it has moved
     Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the body
     int contacts = 0;                                 // vertices held on it
+    int sliding = 0;                                  // of them, sliding (Coulomb)
   };
   std::vector<PaddleState> paddles;  // one per Model::paddles
   // What a fit asks of the step (SteppingOptions::sensitivities): empty

@@ -170,7 +170,8 @@ bool SteppingOptions::IsValid(std::string* why) const {
 }
 
 bool NewtonOptions::IsValid(std::string* why) const {
-  if (!(residual_tolerance > 0.0) || !(increment_tolerance > 0.0) || !(krylov_tolerance > 0.0))
+  if (!(residual_tolerance > 0.0) || !(increment_tolerance > 0.0) || !(krylov_tolerance > 0.0) ||
+      !(friction_tolerance > 0.0))
     return *why = "newton tolerances must be positive", false;
   if (max_iterations < 1 || max_step_cuts < 0 || krylov_restart < 1 || krylov_max_iterations < 1 ||
       max_contact_rounds < 1)

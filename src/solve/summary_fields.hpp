@@ -22,7 +22,7 @@ void fields(A& a, StepRecord::HeldForce& h) {
 }
 template <class A>
 void fields(A& a, StepRecord::PaddleState& p) {
-  a(p.plane, p.travel, p.force, p.contacts);
+  a(p.plane, p.travel, p.force, p.contacts, p.sliding);
 }
 template <class A>
 void fields(A& a, StepSensitivities& s) {
@@ -33,8 +33,8 @@ void fields(A& a, StepRecord& r) {
   a(r.step, r.load_factors, r.pressure, r.volume, r.max_displacement, r.residual, r.seconds,
     r.reactions, r.applied_force, r.held_forces, r.newton_iterations, r.residual_norms,
     r.line_search_halvings, r.krylov_iterations, r.pair_passes, r.step_cuts, r.pieces,
-    r.volume_drift, r.contact_rounds, r.contacts_added, r.contacts_released, r.paddles,
-    r.sensitivities);
+    r.volume_drift, r.contact_rounds, r.contacts_added, r.contacts_released, r.friction_updates,
+    r.paddles, r.sensitivities);
 }
 template <class A>
 void fields(A& a, SolverStatistics& s) {

@@ -401,13 +401,49 @@ TEST(ExperimentConfig, LawsPaddlesAndNewtonOptionsAreRead) {
   ASSERT_EQ(m.paddles.size(), 1u);
   EXPECT_EQ(m.paddles[0].axis, 2);
   EXPECT_FALSE(m.paddles[0].above);
-  EXPECT_TRUE(m.paddles[0].sticking);
+  EXPECT_TRUE(m.paddles[0].sticking());
   const double bottom = m.surface.V.col(2).minCoeff(), top = m.surface.V.col(2).maxCoeff();
   EXPECT_EQ(m.paddles[0].position, bottom);                       // touching by default
   EXPECT_NEAR(m.paddles[0].travel, 0.2 * (top - bottom), 1e-15);  // upwards, into the body
   EXPECT_EQ(ex.simulation().cases[0].stepping.scheme, solve::Scheme::Newton);
   EXPECT_EQ(ex.simulation().cases[0].stepping.newton.tangent, solve::TangentSolver::Krylov);
   EXPECT_EQ(ex.simulation().cases[0].stepping.newton.max_step_cuts, 3);
+}
+
+// Coulomb contact: "contact": "coulomb" on a paddle, the coefficient on the
+// material, its tolerance in newton; a coefficient nothing would feel, a
+// negative one or a bad tolerance refused by name.
+TEST(ExperimentConfig, CoulombPaddlesAndTheirFrictionAreRead) {
+  ScratchDir dir;
+  nlohmann::json c = base_config();
+  c["material"]["friction"] = 0.4;
+  c["paddles"] = {{{"label", "press"},
+                   {"axis", "z"},
+                   {"side", "above"},
+                   {"travel", -0.1},
+                   {"contact", "coulomb"}}};
+  c["stepping"] = {{"steps", 2}, {"scheme", "newton"}, {"newton", {{"friction_tolerance", 1e-5}}}};
+  const Experiment ex = load_experiment(write_config(dir, c));
+  const Case& read = ex.simulation().cases[0];
+  EXPECT_EQ(read.model.paddles[0].contact, model::Paddle::Contact::Coulomb);
+  EXPECT_EQ(read.model.material.friction, 0.4);
+  EXPECT_EQ(read.stepping.newton.friction_tolerance, 1e-5);
+  EXPECT_EQ(read.model.material.parameter("friction"), 0.4);
+
+  nlohmann::json unfelt = c;
+  unfelt["paddles"][0]["contact"] = "sticking";
+  expect_config_error(dir, unfelt,
+                      "a friction coefficient acts at paddles with \"contact\": "
+                      "\"coulomb\", and this experiment has none");
+  nlohmann::json negative = c;
+  negative["material"]["friction"] = -0.1;
+  expect_config_error(dir, negative, "friction");
+  nlohmann::json tolerance = c;
+  tolerance["stepping"]["newton"]["friction_tolerance"] = 0;
+  expect_config_error(dir, tolerance, "friction_tolerance");
+  nlohmann::json contact = c;
+  contact["paddles"][0]["contact"] = "rough";
+  expect_config_error(dir, contact, "coulomb");
 }
 
 // Every name a reader offers for an enum reads as the value it names (an
@@ -477,10 +513,8 @@ TEST(ExperimentConfig, BadLawsAndPaddlesAreNamed) {
   expect_config_error(dir, c, "check beta");
 
   // The spline law: its knots, its rises and its rest tension, each by name.
-  const nlohmann::json spline = {{"type", "spline"},
-                                 {"stretches", {0.5, 1.5, 3}},
-                                 {"rises", {1e3, 2e3, 4e3}},
-                                 {"T1", 0}};
+  const nlohmann::json spline = {
+      {"type", "spline"}, {"stretches", {0.5, 1.5, 3}}, {"rises", {1e3, 2e3, 4e3}}, {"T1", 0}};
   c = base_config();
   c["material"] = {{"law", spline}};
   const model::FiberLaw read =

@@ -319,6 +319,37 @@ TEST(ForceCurve, APaddlesOnlySurfaceFitCannotTellYFromGammaAndTheForceCurveCan) 
   EXPECT_EQ(force_only.overall.count, 0);
 }
 
+// Friction is fitted like a material parameter (issue 58): a Coulomb
+// paddle's coefficient from the force it pushes with, by finite differences
+// of whole runs (where a vertex sticks depends on the way there). Fitting it
+// where no paddle has Coulomb contact is refused.
+TEST(ForceCurve, TheFrictionAtAPaddleIsFittedFromItsForce) {
+  model::Model m = pressed_sphere(false, model::FiberLaw::constant(3000.0));
+  m.paddles[0].contact = model::Paddle::Contact::Coulomb;
+  m.material.friction = 0.08;
+  solve::SteppingOptions stepping = newton(4);
+  stepping.newton.friction_tolerance = 1e-9;  // finite differences read it
+  const solve::SteppingSummary run = solve::solve_load_steps(m, stepping);
+  ASSERT_TRUE(run.success) << run.message;
+  std::vector<double> force;
+  for (const solve::StepRecord& r : run.steps) force.push_back(-r.paddles[0].force.z());
+  ASSERT_GT(run.steps.back().paddles[0].sliding, 0);  // friction is felt, not a stick
+  const ForceCurve curve = paddle_curve({0.005, 0.01, 0.015, 0.02}, force);
+  Parameter friction = parameter("friction", 0.02, false);
+  friction.upper = 0.3;
+  const FitResult fitted =
+      Calibration(m, stepping, {}, {parameter("Y", 3000.0), friction}, {}, {curve}).run();
+  ASSERT_TRUE(fitted.success) << fitted.message << fitted.status_detail;
+  EXPECT_NEAR(fitted.values[1], 0.08, 2e-3);
+  EXPECT_NEAR(fitted.values[0] / 3000.0, 1.0, 1e-4);
+
+  model::Model frictionless = m;
+  frictionless.paddles[0].contact = model::Paddle::Contact::Frictionless;
+  expect_input_error(
+      [&] { Calibration(frictionless, stepping, {}, {friction}, {}, {curve}).run(); },
+      "no paddle has \"contact\": \"coulomb\"");
+}
+
 // Fits that go straight (issue 58). With every modulus and gamma times s a
 // body moved by paddles alone has every force times s: the start's own run
 // gives s, and from a start ten times too soft in both the fit starts at the

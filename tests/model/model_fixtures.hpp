@@ -101,7 +101,8 @@ inline model::Model pressed_sphere(bool sticking = false) {
   for (int v : model::select_half_space(m.surface.V, model::parse_half_space("z <= -0.9", 3)))
     for (int a = 0; a < 3; ++a) m.constraints.push_back({v, a, 0.0, {}});
   m.paddles = {paddle_on_top(m, "top", -0.3)};
-  m.paddles[0].sticking = sticking;
+  m.paddles[0].contact =
+      sticking ? model::Paddle::Contact::Sticking : model::Paddle::Contact::Frictionless;
   return m;
 }
 

@@ -136,6 +136,7 @@ MaterialSpec read_material(Fields f) {
     m.law = model::FiberLaw::constant(f.non_negative("Y", 0.0));
   }
   m.surface_tension = f.non_negative("gamma", 0.0);
+  m.friction = f.non_negative("friction", 0.0);
   f.finish();
   return spec;
 }
@@ -249,7 +250,11 @@ std::vector<PaddleSpec> read_paddles(Fields& root) {
         f.fail("compression", "expected a share of the body's extent between 0 and 1");
     }
     p.schedule = read_schedule(f, model::Schedule::Kind::Ramp);
-    p.sticking = f.choice("contact", "frictionless", {"frictionless", "sticking"}) == "sticking";
+    const std::string contact =
+        f.choice("contact", "frictionless", {"frictionless", "sticking", "coulomb"});
+    p.contact = contact == "sticking"  ? model::Paddle::Contact::Sticking
+                : contact == "coulomb" ? model::Paddle::Contact::Coulomb
+                                       : model::Paddle::Contact::Frictionless;
     f.finish();
     paddles.push_back(spec);
   }
@@ -267,6 +272,7 @@ solve::NewtonOptions read_newton(Fields f, solve::NewtonOptions o) {
   o.krylov_restart = f.integer("krylov_restart", o.krylov_restart, 1, 1000);
   o.krylov_max_iterations = f.integer("krylov_max_iterations", o.krylov_max_iterations, 1, 100000);
   o.max_contact_rounds = f.integer("max_contact_rounds", o.max_contact_rounds, 1, 1000);
+  o.friction_tolerance = f.positive("friction_tolerance", o.friction_tolerance);
   o.predictor = f.boolean("predictor", o.predictor);
   f.finish();
   return o;

@@ -280,6 +280,7 @@ class ModelBuilder {
     c_.model.paddles.clear();
     for (const PaddleSpec& p : spec_.paddles) c_.model.paddles.push_back(paddle(p));
     check_paddles_leave_room();
+    check_friction_is_felt();
     c_.notes.clear();
     hold_free_rotations();
   }
@@ -478,6 +479,17 @@ class ModelBuilder {
           spec_.paddles_field.fail("", "paddles " + a.label + " and " + b.label +
                                            " meet or pass each other: their travels leave no "
                                            "room for the body");
+  }
+
+  // A friction coefficient acts through Coulomb paddles only: refused where
+  // none would feel it, rather than ignored.
+  void check_friction_is_felt() const {
+    if (c_.model.material.friction == 0.0) return;
+    for (const model::Paddle& p : c_.model.paddles)
+      if (p.contact == model::Paddle::Contact::Coulomb) return;
+    spec_.material.field.fail("friction",
+                              "a friction coefficient acts at paddles with \"contact\": "
+                              "\"coulomb\", and this experiment has none");
   }
 
   const CaseSpec& spec_;

@@ -36,6 +36,7 @@ json newton_options_json(const solve::NewtonOptions& n) {
       {"krylov_restart", n.krylov_restart},
       {"krylov_max_iterations", n.krylov_max_iterations},
       {"max_contact_rounds", n.max_contact_rounds},
+      {"friction_tolerance", n.friction_tolerance},
       {"predictor", n.predictor},
       {"control", n.control == solve::NewtonOptions::Control::ArcLength ? "arc_length" : "load"},
       {"max_arc_steps", n.max_arc_steps}};
@@ -101,12 +102,14 @@ void add_newton_json(const model::Model& m, const solve::StepRecord& r, json& st
     paddles[m.paddles[p].label] = {{"plane", r.paddles[p].plane},
                                    {"travel", r.paddles[p].travel},
                                    {"force", vector_json(r.paddles[p].force, m.dim())},
-                                   {"contacts", r.paddles[p].contacts}};
+                                   {"contacts", r.paddles[p].contacts},
+                                   {"sliding", r.paddles[p].sliding}};
   if (!m.paddles.empty()) {
     step["paddles"] = paddles;
     step["newton"]["contact"] = {{"rounds", r.contact_rounds},
                                  {"added", r.contacts_added},
-                                 {"released", r.contacts_released}};
+                                 {"released", r.contacts_released},
+                                 {"friction_updates", r.friction_updates}};
   }
 }
 

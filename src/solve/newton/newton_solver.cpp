@@ -74,10 +74,18 @@ std::string NewtonSolver::solve(const LoadPoint& at, Eigen::VectorXd& x, StepRec
     const int added = contacts_.add_penetrating(at, x);
     record.contacts_released += released;
     record.contacts_added += added;
-    if (converged && released == 0 && added == 0) return {};
+    if (!converged || released > 0 || added > 0) continue;
+    // The set is settled; Coulomb's law then settles the friction forces.
+    const int slid = contacts_.update_friction(residual_, x, newton_.friction_tolerance);
+    record.friction_updates += slid;
+    if (slid == 0) {
+      contacts_.accept(x);
+      return {};
+    }
   }
   return "the paddle contact did not settle in " + std::to_string(newton_.max_contact_rounds) +
-         " active-set rounds (newton.max_contact_rounds)";
+         " active-set rounds (newton.max_contact_rounds" +
+         (contacts_.any_friction() ? std::string(", newton.friction_tolerance") : "") + ")";
 }
 
 // du/dtheta = -K_T^{-1} dR/dtheta at the solution x, one tangent solve per
@@ -103,6 +111,15 @@ std::string NewtonSolver::sensitivities(const LoadPoint& at, const Eigen::Vector
   return {};
 }
 
+// The residual at x (and the tangent prepared there), the sliding contacts'
+// friction forces in: they are held fixed within a solve (update_friction).
+Eigen::VectorXd NewtonSolver::residual(const Eigen::VectorXd& x,
+                                       const std::vector<double>& factors) {
+  Eigen::VectorXd R = tangent_->residual(x, factors);
+  contacts_.add_friction(R);
+  return R;
+}
+
 // The relative residual of the state x (gauge: the scale of x's loads and
 // reactions, or of the states accepted before, whichever is larger).
 double NewtonSolver::measure(const LoadPoint& at, const model::DofMap& dofs,
@@ -120,7 +137,7 @@ double NewtonSolver::measure(const LoadPoint& at, const model::DofMap& dofs,
 std::string NewtonSolver::newton(const LoadPoint& at, const model::DofMap& dofs, Eigen::VectorXd& x,
                                  StepRecord& record, bool* converged) {
   *converged = false;
-  Eigen::VectorXd R = tangent_->residual(x, at.factors);  // and the tangent there
+  Eigen::VectorXd R = residual(x, at.factors);
   double last_move = std::numeric_limits<double>::infinity();
   for (int it = 0;; ++it) {
     if (cancel_requested()) return "interrupted";
@@ -160,7 +177,7 @@ std::string NewtonSolver::newton(const LoadPoint& at, const model::DofMap& dofs,
     Eigen::VectorXd trial, R_trial;
     for (int halving = 0;; ++halving) {
       trial = x + alpha * step;
-      R_trial = tangent_->residual(trial, at.factors);  // and the tangent there
+      R_trial = residual(trial, at.factors);
       const double trial_norm = measure(at, dofs, trial, R_trial);
       if (!newton_.line_search || trial_norm <= (1.0 - 1e-4 * alpha) * norm ||
           trial_norm <= newton_.residual_tolerance)

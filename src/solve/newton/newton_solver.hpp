@@ -60,6 +60,9 @@ class NewtonSolver {
   // After a successful solve: the residual at the held unknowns is the force
   // each support or paddle exerts on the body.
   const Eigen::VectorXd& last_residual() const { return residual_; }
+  // A sliding contact's friction force on the body (zero for the others).
+  Eigen::Vector3d friction_force(int vertex) const { return contacts_.friction_force(vertex); }
+  bool sliding(int vertex) const { return contacts_.sliding(vertex); }
   // Per vertex: the paddle in contact, or -1.
   const std::vector<int>& contact_paddle() const { return contacts_.paddle_of(); }
   // The supports' map with the contact unknowns held too.
@@ -74,6 +77,8 @@ class NewtonSolver {
   void restore(const ContactState& state) { contacts_.restore(state); }
 
  private:
+  // The residual at x, the sliding contacts' friction forces in.
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, const std::vector<double>& factors);
   // The relative residual of the state x (gauge: the scale of x's loads and
   // reactions, or of the states accepted before, whichever is larger).
   double measure(const LoadPoint& at, const model::DofMap& dofs, const Eigen::VectorXd& x,

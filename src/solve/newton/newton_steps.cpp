@@ -41,21 +41,26 @@ LoadPoint scheduled_point(const model::Model& m, double t, int steps) {
 
 namespace {
 
-// The first paddle that sticks (holds each vertex where it touched), or null.
+// The first paddle that holds a vertex where it touched (sticking or
+// Coulomb contact), or null.
 const model::Paddle* sticking_paddle(const Model& model) {
   for (const model::Paddle& paddle : model.paddles)
-    if (paddle.sticking) return &paddle;
+    if (paddle.holds_where_touched()) return &paddle;
   return nullptr;
+}
+
+// How a paddle holds what it touched, for a message.
+std::string how_it_holds(const model::Paddle& paddle) {
+  return paddle.sticking() ? " sticks: it holds" : " has Coulomb friction: it holds or slides";
 }
 
 }  // namespace
 
 Status check_sensitivities(const Model& model) {
   if (const model::Paddle* paddle = sticking_paddle(model))
-    return Status::failure(
-        "paddle " + paddle->label +
-        " sticks: it holds each vertex where it touched, a place that moves with the "
-        "parameters (fit with finite differences)");
+    return Status::failure("paddle " + paddle->label + how_it_holds(*paddle) +
+                           " each vertex from where it touched, a place that moves with the "
+                           "parameters (fit with finite differences)");
   return {};
 }
 
@@ -74,9 +79,9 @@ Status check_warm_start(const Model& model, const SteppingOptions& options) {
   if (!options.warm_start.allFinite()) return Status::failure("the start has non-finite values");
   if (const model::Paddle* paddle = sticking_paddle(model))
     return Status::failure(
-        "paddle " + paddle->label +
-        " sticks: where a vertex sticks depends on the way there, so the end of the path "
-        "cannot be solved from elsewhere");
+        "paddle " + paddle->label + how_it_holds(*paddle) +
+        " each vertex from where it touched, which depends on the way there, so the end of "
+        "the path cannot be solved from elsewhere");
   return {};
 }
 

@@ -70,10 +70,16 @@ std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
     if (p < 0) continue;
     StepRecord::PaddleState& state = record.paddles[static_cast<size_t>(p)];
     ++state.contacts;
+    // A sliding vertex's tangential force is its friction, not a held row's.
+    const Eigen::Vector3d friction = solver_.friction_force(v);
+    if (solver_.sliding(v)) ++state.sliding;
     for (int a = 0; a < dim; ++a)
       if (held.held(a * nv + v) && !partition_holds(partition_, a * nv + v)) {
         state.force[a] += R[a * nv + v];
         summary_.reaction_forces(v, a) = R[a * nv + v];
+      } else if (friction[a] != 0.0) {
+        state.force[a] += friction[a];
+        summary_.reaction_forces(v, a) = friction[a];
       }
   }
   for (int a = 0; a < dim; ++a) record.applied_force[a] = F.segment(a * nv, nv).sum();
