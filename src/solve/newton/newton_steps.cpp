@@ -43,7 +43,7 @@ namespace {
 
 // The first paddle that holds a vertex where it touched (sticking or
 // Coulomb contact), or null.
-const model::Paddle* sticking_paddle(const Model& model) {
+const model::Paddle* paddle_holding_where_touched(const Model& model) {
   for (const model::Paddle& paddle : model.paddles)
     if (paddle.holds_where_touched()) return &paddle;
   return nullptr;
@@ -57,7 +57,7 @@ std::string how_it_holds(const model::Paddle& paddle) {
 }  // namespace
 
 Status check_sensitivities(const Model& model) {
-  if (const model::Paddle* paddle = sticking_paddle(model))
+  if (const model::Paddle* paddle = paddle_holding_where_touched(model))
     return Status::failure("paddle " + paddle->label + how_it_holds(*paddle) +
                            " each vertex from where it touched, a place that moves with the "
                            "parameters (fit with finite differences)");
@@ -77,7 +77,7 @@ Status check_warm_start(const Model& model, const SteppingOptions& options) {
                            " unknowns (displacements and pressure), got " +
                            std::to_string(options.warm_start.size()));
   if (!options.warm_start.allFinite()) return Status::failure("the start has non-finite values");
-  if (const model::Paddle* paddle = sticking_paddle(model))
+  if (const model::Paddle* paddle = paddle_holding_where_touched(model))
     return Status::failure(
         "paddle " + paddle->label + how_it_holds(*paddle) +
         " each vertex from where it touched, which depends on the way there, so the end of "
