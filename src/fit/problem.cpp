@@ -39,10 +39,7 @@ FitProblem::FitProblem(model::Model model, solve::SteppingOptions stepping,
     throw InputError(
         "nothing to fit to: no target surface and no force curve (nor another target)");
   for (const std::string& name : map_.material_names())
-    if (name == "friction" &&
-        std::none_of(model_.paddles.begin(), model_.paddles.end(), [](const model::Paddle& p) {
-          return p.contact == model::Paddle::Contact::Coulomb;
-        }))
+    if (name == "friction" && !model_.has_coulomb_paddle())
       throw InputError(
           "parameter \"friction\": no paddle has \"contact\": \"coulomb\", so no run "
           "would feel it");

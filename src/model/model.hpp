@@ -155,6 +155,7 @@ struct Paddle {
   };
   Contact contact = Contact::Frictionless;
   bool sticking() const { return contact == Contact::Sticking; }
+  bool coulomb() const { return contact == Contact::Coulomb; }
   // Whether the contact can depend on the way there (where a vertex stuck).
   bool holds_where_touched() const { return contact != Contact::Frictionless; }
 
@@ -280,6 +281,12 @@ struct Model {
   int num_unknowns() const { return dim() * num_vertices() + 1; }
   int dof(int vertex, int axis) const { return axis * num_vertices() + vertex; }
   int pressure_dof() const { return dim() * num_vertices(); }
+  // Whether a paddle has Coulomb contact (Material::friction acts).
+  bool has_coulomb_paddle() const {
+    for (const Paddle& paddle : paddles)
+      if (paddle.coulomb()) return true;
+    return false;
+  }
 };
 
 }  // namespace fiberfluid::model

@@ -183,8 +183,8 @@ struct StepRecord {
   // Paddles: the active-set rounds of the step (over its pieces), and the
   // vertices that joined and left the contact set in them.
   int contact_rounds = 0, contacts_added = 0, contacts_released = 0;
-  // Coulomb paddles: the changes of a vertex's stick, slide or friction force
-  // between the rounds' solutions.
+  // Coulomb paddles: the vertices that changed between sticking and sliding
+  // at the rounds' solutions.
   int friction_updates = 0;
   struct PaddleState {
     double plane = 0.0;                               // the plane's coordinate

@@ -8,6 +8,8 @@
 #include <map>
 
 #include "fiberfluid/model/assembly.hpp"
+#include "fiberfluid/model/dof_map.hpp"
+#include "fiberfluid/solve/newton/contact_set.hpp"
 #include "fiberfluid/solve/newton/newton.hpp"
 #include "fiberfluid/solve/stepping.hpp"
 #include "model/model_fixtures.hpp"
@@ -119,6 +121,93 @@ TEST(PaddleFriction, EveryContactObeysCoulombsLaw) {
   const Eigen::Vector3d total = last.reactions[0] + last.paddles[0].force + last.applied_force;
   EXPECT_LT(total.norm(), 1e-8 * last.paddles[0].force.norm());
   EXPECT_LT(std::abs(last.volume_drift), 1e-8);
+}
+
+// The friction's tangent (what every tangent strategy adds to the bulk's) is
+// the derivative of the friction in the residual, by the slide and by the
+// normal force: central differences at slides inside the cone, near its rim
+// and far past it, vertex by vertex.
+TEST(PaddleFriction, TheFrictionsTangentIsTheDerivativeOfItsForce) {
+  const model::Model m = pressed(Contact::Coulomb, 0.2);
+  const int n = m.num_vertices(), steps = 4;
+  const model::DofMap supports = model::DofMap::from_constraints(m);
+  ContactSet contacts(m, supports);
+  // Press the paddle's plane 0.05 into the sphere: the vertices past it join.
+  LoadPoint at = scheduled_point(m, 0.0, steps);
+  at.planes[0] -= 0.05;
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(m.num_unknowns());
+  ASSERT_GT(contacts.add_penetrating(at, rest), 2);
+  // A residual whose tangential forces exceed 0.2 times the normal ones,
+  // each vertex pushed its own way: every contact starts to slide.
+  Eigen::VectorXd R = Eigen::VectorXd::Zero(m.num_unknowns()), normal = R;
+  std::vector<int> touching;
+  for (int v = 0; v < n; ++v) {
+    if (contacts.paddle_of()[static_cast<size_t>(v)] < 0) continue;
+    touching.push_back(v);
+    R[2 * n + v] = normal[2 * n + v] = 1.0 + 0.1 * v / n;  // the body pushes the paddle up
+    R[v] = 0.5 * std::cos(v), R[n + v] = 0.5 * std::sin(v);
+  }
+  ASSERT_EQ(contacts.update_friction(R, rest, 1e-9), static_cast<int>(touching.size()));
+  // The friction in a residual whose normal rows are `bulk`'s.
+  const auto friction = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& bulk) {
+    Eigen::VectorXd out = bulk;
+    contacts.add_friction(x, out);
+    return Eigen::VectorXd(out - bulk);
+  };
+  // Slides about 1e-9 (inside the cone: the elastic part is 1e-8 of the
+  // sphere's diagonal, 3.5), 1e-8 (near the rim) and 1e-3 (far past it).
+  for (double size : {1e-9, 1e-8, 1e-3}) {
+    Eigen::VectorXd x = rest;
+    for (int v : touching) x[v] = size * std::sin(3.0 * v), x[n + v] = size * std::cos(5.0 * v);
+    const AddedTangent tangent = contacts.friction_tangent(x, normal);
+    const double h = 1e-4 * size;
+    double largest = 0.0, worst = 0.0, largest_mix = 0.0, worst_mix = 0.0;
+    for (int v : touching) {
+      for (int a = 0; a < 2; ++a) {
+        const int d = a * n + v;
+        Eigen::VectorXd plus = x, minus = x;
+        plus[d] += h;
+        minus[d] -= h;
+        const Eigen::VectorXd column =
+            (friction(plus, normal) - friction(minus, normal)) / (2.0 * h);
+        const Eigen::VectorXd exact = tangent.stiffness * Eigen::VectorXd::Unit(x.size(), d);
+        largest = std::max(largest, exact.cwiseAbs().maxCoeff());
+        worst = std::max(worst, (column - exact).cwiseAbs().maxCoeff());
+      }
+      // By the normal force, through the mix of the normal row into the
+      // tangential ones.
+      const int d = 2 * n + v;
+      const double dN = 1e-6 * normal[d];
+      Eigen::VectorXd more = normal, less = normal;
+      more[d] += dN;
+      less[d] -= dN;
+      const Eigen::VectorXd column = (friction(x, more) - friction(x, less)) / (2.0 * dN);
+      const Eigen::VectorXd exact = tangent.row_mix * Eigen::VectorXd::Unit(x.size(), d);
+      largest_mix = std::max(largest_mix, exact.cwiseAbs().maxCoeff());
+      worst_mix = std::max(worst_mix, (column - exact).cwiseAbs().maxCoeff());
+    }
+    EXPECT_GT(largest, 0.0) << "slide " << size;
+    EXPECT_LT(worst, 1e-6 * largest) << "slide " << size;
+    EXPECT_LT(worst_mix, 1e-6 * std::max(largest_mix, 0.2)) << "slide " << size;
+    if (size == 1e-3) EXPECT_GT(largest_mix, 0.1);  // every slide past its rim feels N
+  }
+}
+
+// Each tangent strategy takes the friction's tangent in (the LU ones in
+// their factors, the GMRES ones in their operator): all find the same slides.
+TEST(PaddleFriction, EveryTangentStrategyFindsTheSameSlides) {
+  const model::Model m = pressed(Contact::Coulomb, 0.15);
+  const SteppingSummary dense = solve_load_steps(m, newton(5));
+  ASSERT_TRUE(dense.success) << dense.message;
+  ASSERT_GT(dense.steps.back().paddles[0].sliding, 0);
+  for (TangentSolver kind : {TangentSolver::Sparse, TangentSolver::Krylov, TangentSolver::Reused}) {
+    SteppingOptions o = newton(5);
+    o.newton.tangent = kind;
+    const SteppingSummary other = solve_load_steps(m, o);
+    ASSERT_TRUE(other.success) << other.message;
+    EXPECT_LT(relative_difference(other.unknowns, dense.unknowns), 1e-7);
+    EXPECT_EQ(other.steps.back().paddles[0].sliding, dense.steps.back().paddles[0].sliding);
+  }
 }
 
 // Friction resists the contact's outward slide: the paddle pushes harder the

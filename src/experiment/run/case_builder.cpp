@@ -484,9 +484,7 @@ class ModelBuilder {
   // A friction coefficient acts through Coulomb paddles only: refused where
   // none would feel it, rather than ignored.
   void check_friction_is_felt() const {
-    if (c_.model.material.friction == 0.0) return;
-    for (const model::Paddle& p : c_.model.paddles)
-      if (p.contact == model::Paddle::Contact::Coulomb) return;
+    if (c_.model.material.friction == 0.0 || c_.model.has_coulomb_paddle()) return;
     spec_.material.field.fail("friction",
                               "a friction coefficient acts at paddles with \"contact\": "
                               "\"coulomb\", and this experiment has none");

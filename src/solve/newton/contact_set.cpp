@@ -16,12 +16,10 @@ ContactSet::ContactSet(const model::Model& model, const model::DofMap& supports)
       stuck_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())),
       sliding_(static_cast<size_t>(model.num_vertices()), 0),
       friction_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())),
-      history_(static_cast<size_t>(model.num_vertices()), 0),
-      compliance_(static_cast<size_t>(model.num_vertices()), 0.0),
-      last_friction_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())),
-      last_slide_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())) {
-  for (const model::Paddle& paddle : model.paddles)
-    has_coulomb_ = has_coulomb_ || paddle.contact == model::Paddle::Contact::Coulomb;
+      start_friction_(Eigen::MatrixXd::Zero(model.num_vertices(), model.dim())),
+      bound_(static_cast<size_t>(model.num_vertices()), 0.0),
+      penalty_(static_cast<size_t>(model.num_vertices()), 0.0) {
+  has_coulomb_ = model.has_coulomb_paddle();
   const Eigen::MatrixXd& V = model.surface.V;
   diagonal_ = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
   for (size_t p = 0; p < model.paddles.size(); ++p)
@@ -122,119 +120,205 @@ int ContactSet::release_pulling(const Eigen::VectorXd& R) {
 
 // Coulomb's law by the return mapping of an implicit step (Simo and Laursen,
 // Comput. Struct. 42 (1992) 97; Wriggers, Computational Contact Mechanics,
-// 2nd ed. 2006, section 5.2): a held vertex's tangential force within
-// friction * N is its stick; one past it slides, the friction of a slide
-// opposing the slide over the increment (backward Euler), its size
-// friction * N. The normal force N is the last solution's: the solver
-// repeats until the friction forces stop changing.
-//
-// Between solutions a sliding vertex's slide s answers its friction f as
-// s(f) = e + c f near the solution, e the slide friction-free and c its
-// compliance, measured by the secant of its last two rounds, and the next
-// friction is f = -friction N e / |e|: at a fixed point e and s are
-// parallel, so this is Coulomb's law, but taking the direction from e rather
-// than from s is what converges, a short slide's direction turning with its
-// friction (the plain fixed point f = -friction N s / |s| stalled at 0.6 a
-// round, and did not converge, on the pressed sphere's slowest vertices). A
-// sliding vertex that moves with its friction is held again.
+// 2nd ed. 2006, sections 5.2 and 6.4): a held vertex whose tangential force
+// stays within friction * N sticks; past it the vertex slides, its
+// tangential unknowns free. A sliding vertex's friction follows its slide s
+// over the increment and its normal force N within Newton itself: the trial
+// force t = f0 - k s (f0 its friction at the increment's start, k a penalty
+// that keeps the elastic part of a slide within kElasticSlide of the body's
+// size) is returned onto the cone |f| <= friction * N (f = friction N t/|t|),
+// N being the bulk's force at the vertex's held normal row; its consistent
+// tangent is friction_tangent's. A sliding vertex whose trial falls inside
+// its cone at a solution sticks, held again where its increment started.
+// (Lagging the friction's direction and size between solutions instead was a
+// fixed point that stalled at the rim of a pressed cylinder.)
 int ContactSet::update_friction(const Eigen::VectorXd& R, const Eigen::VectorXd& x,
                                 double tolerance) {
   if (!has_coulomb_) return 0;
-  const int n = model_.num_vertices(), dim = model_.dim();
-  const double mu = model_.material.friction;
-  const auto coulomb = [&](int v) {
-    const int p = paddle_[static_cast<size_t>(v)];
-    return p >= 0 &&
-           model_.paddles[static_cast<size_t>(p)].contact == model::Paddle::Contact::Coulomb;
-  };
-  // Per Coulomb vertex: its friction bound.
-  std::vector<double> bound(static_cast<size_t>(n), 0.0);
+  const int n = model_.num_vertices();
   double largest = 0.0;
-  for (int v = 0; v < n; ++v) {
-    if (!coulomb(v)) continue;
-    const int axis = model_.paddles[static_cast<size_t>(paddle_[static_cast<size_t>(v)])].axis;
-    bound[static_cast<size_t>(v)] = mu * std::abs(R[axis * n + v]);
-    largest = std::max(largest, bound[static_cast<size_t>(v)]);
-  }
-  const double slack = tolerance * largest, still = 1e-12 * diagonal_;
+  for (int v = 0; v < n; ++v)
+    if (coulomb_axis(v) >= 0) largest = std::max(largest, bound_at(v, R));
+  const double slack = tolerance * largest;
   int changed = 0;
   for (int v = 0; v < n; ++v) {
-    if (!coulomb(v)) continue;
+    const int axis = coulomb_axis(v);
+    if (axis < 0) continue;
     const size_t i = static_cast<size_t>(v);
-    const int axis = model_.paddles[static_cast<size_t>(paddle_[i])].axis;
-    const double limit = bound[i];
-    Eigen::VectorXd tangential = Eigen::VectorXd::Zero(dim), slide = Eigen::VectorXd::Zero(dim);
-    for (int a = 0; a < dim; ++a) {
-      if (a == axis || supports_.held(a * n + v)) continue;
-      tangential[a] = R[a * n + v];
-      slide[a] = x[a * n + v] - stuck_(v, a);
-    }
-    const Eigen::VectorXd old = friction_.row(v).transpose();
+    const double limit = bound_at(v, R);
     if (!sliding_[i]) {
+      Eigen::VectorXd tangential = Eigen::VectorXd::Zero(model_.dim());
+      for (int a : tangential_axes(v, axis)) tangential[a] = R[a * n + v];
       if (tangential.norm() <= limit + slack) continue;  // it sticks
       sliding_[i] = 1;
-      history_[i] = 0;
-      friction_.row(v) = (tangential * (limit / tangential.norm())).transpose();
+      start_friction_.row(v) = (tangential * (limit / tangential.norm())).transpose();
+      penalty_[i] = std::max(penalty_[i], limit / (kElasticSlide * diagonal_));
+      bound_[i] = limit;
+      friction_.row(v) = start_friction_.row(v);
       ++changed;
       continue;
     }
-    // The slide's compliance: the secant of the last two rounds.
-    // (Only from a change of friction that rounding does not swamp; the
-    // last good estimate is kept until the next.)
-    if (!history_[i]) {
-      compliance_[i] = 0.0;
-      last_friction_.row(v) = old.transpose();
-      last_slide_.row(v) = slide.transpose();
-      history_[i] = 1;
-    } else {
-      const Eigen::VectorXd df = old - last_friction_.row(v).transpose();
-      const Eigen::VectorXd ds = slide - last_slide_.row(v).transpose();
-      if (df.norm() > 1e-3 * limit) {
-        compliance_[i] = std::max(0.0, ds.dot(df) / df.squaredNorm());
-        last_friction_.row(v) = old.transpose();
-        last_slide_.row(v) = slide.transpose();
-      }
-    }
-    Eigen::VectorXd free_slide = slide - compliance_[i] * old;  // e
-    // A secant that turns e away from the slide has read a neighbour's
-    // answer, not the vertex's own: the plain step then.
-    if (free_slide.dot(slide) <= 0.0) free_slide = slide;
-    const bool reversed = slide.norm() > still && slide.dot(old) > 0.0;
-    if (reversed) {  // friction outweighs what drives it
+    bound_[i] = limit;
+    // Inside the cone: it sticks, held where the increment started (its
+    // slide since is the trial's elastic part, a few kElasticSlide).
+    if (trial_friction(v, x).norm() < (1.0 - 1e-9) * limit) {
       sliding_[i] = 0;
-      history_[i] = 0;
       friction_.row(v).setZero();
       ++changed;
       continue;
     }
-    Eigen::VectorXd next = Eigen::VectorXd::Zero(dim);
-    if (free_slide.norm() > still) {
-      next = -limit * free_slide / free_slide.norm();
-    } else if (old.norm() > 0.0) {
-      next = limit * old / old.norm();
-    }
-    if ((next - old).norm() > slack) ++changed;
-    friction_.row(v) = next.transpose();
+    friction_.row(v) = friction_at(v, x, limit).transpose();
   }
   return changed;
 }
 
-void ContactSet::add_friction(Eigen::VectorXd& R) const {
+// On the cone's rim, where every slide starts, the side the residual pushes
+// the vertex to: on (R_t . t > 0: Newton's step slides it on, against its
+// friction) the slide's, else the stick's. Either tangent alone would stall
+// there: the stick's stiffness against a slide that the cone caps, the
+// slide's freedom through a cone 2 kElasticSlide across (stop_at_cones).
+bool ContactSet::sticks(int vertex, const Eigen::VectorXd& trial, double bound,
+                        const Eigen::VectorXd& R) const {
+  const double size = trial.norm();
+  if (size < (1.0 - 1e-9) * bound) return true;
+  if (size > (1.0 + 1e-9) * bound) return false;
+  const int n = model_.num_vertices();
+  double push = 0.0;
+  for (int a : tangential_axes(vertex, coulomb_axis(vertex))) push += R[a * n + vertex] * trial[a];
+  return push <= 0.0;
+}
+
+int ContactSet::coulomb_axis(int vertex) const {
+  const int p = paddle_[static_cast<size_t>(vertex)];
+  if (p < 0) return -1;
+  const model::Paddle& paddle = model_.paddles[static_cast<size_t>(p)];
+  return paddle.coulomb() ? paddle.axis : -1;
+}
+
+std::vector<int> ContactSet::tangential_axes(int vertex, int axis) const {
+  std::vector<int> axes;
+  for (int a = 0; a < model_.dim(); ++a)
+    if (a != axis && !supports_.held(a * model_.num_vertices() + vertex)) axes.push_back(a);
+  return axes;
+}
+
+double ContactSet::bound_at(int vertex, const Eigen::VectorXd& R) const {
+  return model_.material.friction *
+         std::abs(R[coulomb_axis(vertex) * model_.num_vertices() + vertex]);
+}
+
+Eigen::VectorXd ContactSet::trial_friction(int vertex, const Eigen::VectorXd& x) const {
+  const int n = model_.num_vertices();
+  Eigen::VectorXd trial = Eigen::VectorXd::Zero(model_.dim());
+  for (int a : tangential_axes(vertex, coulomb_axis(vertex)))
+    trial[a] = start_friction_(vertex, a) -
+               penalty_[static_cast<size_t>(vertex)] * (x[a * n + vertex] - stuck_(vertex, a));
+  return trial;
+}
+
+Eigen::VectorXd ContactSet::friction_at(int vertex, const Eigen::VectorXd& x, double bound) const {
+  const Eigen::VectorXd trial = trial_friction(vertex, x);
+  const double size = trial.norm();
+  return size <= bound ? trial : Eigen::VectorXd(trial * (bound / size));
+}
+
+// A slide's cone is thin, 2 kElasticSlide of the body's size across: a
+// Newton step that moves a sliding vertex back along its friction would pass
+// through it to a friction reversed, and the next step back again. Such a
+// vertex's step stops just inside the cone's rim, its friction unchanged,
+// where the stick's exact tangent takes over.
+void ContactSet::stop_at_cones(const Eigen::VectorXd& x, const Eigen::VectorXd& R,
+                               Eigen::VectorXd& step) const {
   if (!has_coulomb_) return;
   const int n = model_.num_vertices();
-  for (int v = 0; v < n; ++v)
-    if (sliding_[static_cast<size_t>(v)])
-      for (int a = 0; a < model_.dim(); ++a)
-        R[a * n + v] -= friction_(v, a);  // R: what a held row would have to supply
+  for (int v = 0; v < n; ++v) {
+    const size_t i = static_cast<size_t>(v);
+    if (!sliding_[i]) continue;
+    const double bound = bound_at(v, R);
+    const Eigen::VectorXd t0 = trial_friction(v, x);
+    if (!(bound > 0.0) || sticks(v, t0, bound, R)) continue;  // the stick's tangent is exact
+    const std::vector<int> axes = tangential_axes(v, coulomb_axis(v));
+    Eigen::VectorXd dt = Eigen::VectorXd::Zero(model_.dim());
+    for (int a : axes) dt[a] = -penalty_[i] * step[a * n + v];
+    // |t0 + l dt| = bound: the step's entry into the cone and exit from it.
+    const double A = dt.squaredNorm(), B = 2.0 * t0.dot(dt), C = t0.squaredNorm() - bound * bound;
+    const double discriminant = B * B - 4.0 * A * C;
+    if (!(A > 0.0) || discriminant <= 0.0) continue;
+    const double root = std::sqrt(discriminant);
+    const double entry = (-B - root) / (2.0 * A), exit = (-B + root) / (2.0 * A);
+    if (entry <= 0.0 || entry >= 1.0) continue;
+    const double stop = entry + 1e-3 * (std::min(exit, 1.0) - entry);
+    for (int a : axes) step[a * n + v] *= stop;
+  }
+}
+
+void ContactSet::add_friction(const Eigen::VectorXd& x, Eigen::VectorXd& R) const {
+  if (!has_coulomb_) return;
+  const int n = model_.num_vertices();
+  for (int v = 0; v < n; ++v) {
+    if (!sliding_[static_cast<size_t>(v)]) continue;
+    // The normal row is the bulk's (friction enters tangential rows alone).
+    const Eigen::VectorXd f = friction_at(v, x, bound_at(v, R));
+    for (int a = 0; a < model_.dim(); ++a)
+      R[a * n + v] -= f[a];  // R: what a held row would have to supply
+  }
+}
+
+// dR/dx of the friction in add_friction: R -= f(t, N), t = f0 - k s, so
+// dR/ds = k I inside the cone and k (friction N / |t|) (I - n n^T) on it,
+// where also dR_t = -friction n dN, dN = sign(R_N) dR_N: the normal row's.
+AddedTangent ContactSet::friction_tangent(const Eigen::VectorXd& x,
+                                          const Eigen::VectorXd& R) const {
+  const Eigen::Index size = x.size();
+  AddedTangent added;
+  added.stiffness.resize(size, size);
+  added.row_mix.resize(size, size);
+  if (!has_coulomb_) return added;
+  const int n = model_.num_vertices();
+  const double mu = model_.material.friction;
+  std::vector<Eigen::Triplet<double>> stiffness, mix;
+  for (int v = 0; v < n; ++v) {
+    const size_t i = static_cast<size_t>(v);
+    if (!sliding_[i]) continue;
+    const double bound = bound_at(v, R);
+    if (!(bound > 0.0)) continue;  // no friction, no stiffness
+    const int axis = coulomb_axis(v);
+    const std::vector<int> axes = tangential_axes(v, axis);
+    const Eigen::VectorXd trial = trial_friction(v, x);
+    const double k = penalty_[i], length = trial.norm();
+    const bool inside = sticks(v, trial, bound, R);
+    const Eigen::VectorXd direction = inside ? trial : Eigen::VectorXd(trial / length);
+    const double scale = inside ? k : k * bound / length;
+    const int normal_row = axis * n + v;
+    const double sign = R[normal_row] >= 0.0 ? 1.0 : -1.0;
+    for (int a : axes) {
+      for (int b : axes) {
+        const double value =
+            scale * ((a == b ? 1.0 : 0.0) - (inside ? 0.0 : direction[a] * direction[b]));
+        if (value != 0.0) stiffness.emplace_back(a * n + v, b * n + v, value);
+      }
+      if (!inside && direction[a] != 0.0)
+        mix.emplace_back(a * n + v, normal_row, -mu * sign * direction[a]);
+    }
+  }
+  added.stiffness.setFromTriplets(stiffness.begin(), stiffness.end());
+  added.row_mix.setFromTriplets(mix.begin(), mix.end());
+  return added;
 }
 
 void ContactSet::accept(const Eigen::VectorXd& x) {
   if (!has_coulomb_) return;
-  std::fill(history_.begin(), history_.end(), 0);
   const int n = model_.num_vertices();
-  for (int v = 0; v < n; ++v)
-    if (sliding_[static_cast<size_t>(v)])
-      for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
+  for (int v = 0; v < n; ++v) {
+    const size_t i = static_cast<size_t>(v);
+    if (!sliding_[i]) continue;
+    const Eigen::VectorXd f = friction_at(v, x, bound_[i]);
+    friction_.row(v) = f.transpose();
+    start_friction_.row(v) = f.transpose();
+    // The penalty keeps up with a normal force that grew.
+    penalty_[i] = std::max(penalty_[i], bound_[i] / (kElasticSlide * diagonal_));
+    for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
+  }
 }
 
 Eigen::Vector3d ContactSet::friction_force(int vertex) const {
@@ -270,7 +354,7 @@ Status check_paddle_start(const model::Model& model) {
     if (a.axis < 0 || a.axis >= model.dim())
       return Status::failure("paddle " + a.label + ": axis out of range");
     const double mu = model.material.friction;
-    if (a.contact == model::Paddle::Contact::Coulomb && !(mu >= 0.0 && std::isfinite(mu)))
+    if (a.coulomb() && !(mu >= 0.0 && std::isfinite(mu)))
       return Status::failure("paddle " + a.label +
                              ": Coulomb contact needs a friction coefficient of at least 0, got " +
                              std::to_string(mu));

@@ -12,6 +12,7 @@
 #include "fiberfluid/model/dof_map.hpp"
 #include "fiberfluid/model/model.hpp"
 #include "fiberfluid/solve/newton/newton.hpp"
+#include "fiberfluid/solve/tangent/added_tangent.hpp"
 #include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::solve {
@@ -24,7 +25,9 @@ namespace fiberfluid::solve {
 // sticking one while its tangential force stays within friction times its
 // normal force; past that the vertex slides, its tangential unknowns free and
 // pushed by friction times its normal force against its slide over the load
-// increment (update_friction, at each solution of the current set).
+// increment, both followed within Newton's iterations (add_friction,
+// friction_tangent); update_friction decides at each solution of the current
+// set which vertices slide.
 class ContactSet {
  public:
   // A body resting on a paddle is held by it from the first iterate.
@@ -49,17 +52,24 @@ class ContactSet {
   int release_pulling(const Eigen::VectorXd& R);
   // Coulomb's law at a solution (R: its residual, the friction forces in):
   // a held vertex whose tangential force exceeds friction times its normal
-  // force slides; a sliding one whose slide turned against its friction is
-  // held again; a sliding one's friction follows its normal force and its
-  // slide. How many vertices changed state or friction force (by more than
-  // `tolerance` of its bound).
+  // force (by more than `tolerance` of the largest such bound) slides; a
+  // sliding one whose friction falls inside that bound sticks, held again
+  // where its increment started. How many vertices changed state.
   int update_friction(const Eigen::VectorXd& R, const Eigen::VectorXd& x, double tolerance);
-  // Puts the sliding vertices' friction forces (on the body) into a residual
+  // Puts the sliding vertices' friction forces at x (on the body) into the
+  // bulk's residual R there, whose held normal rows give their normal forces
   // (R at a held unknown is the force its hold exerts on the body, so a
   // force on the body enters with a minus sign).
-  void add_friction(Eigen::VectorXd& R) const;
+  void add_friction(const Eigen::VectorXd& x, Eigen::VectorXd& R) const;
+  // A Newton step from x (R: the residual there) that would take a sliding
+  // vertex into its cone (or through it) stops that vertex just inside.
+  void stop_at_cones(const Eigen::VectorXd& x, const Eigen::VectorXd& R,
+                     Eigen::VectorXd& step) const;
+  // The friction's part of the tangent at x (R: the residual there), the
+  // derivative of add_friction (full layout; empty without sliding vertices).
+  AddedTangent friction_tangent(const Eigen::VectorXd& x, const Eigen::VectorXd& R) const;
   // The step is accepted at x: a sliding vertex's next slide is measured
-  // from where it is now.
+  // from where it is now, from the friction it has now.
   void accept(const Eigen::VectorXd& x);
   // A sliding vertex's friction force on the body (zero for the others).
   Eigen::Vector3d friction_force(int vertex) const;
@@ -76,15 +86,20 @@ class ContactSet {
     std::vector<int> paddle;
     Eigen::MatrixXd stuck;
     std::vector<char> sliding;
-    Eigen::MatrixXd friction;
+    Eigen::MatrixXd friction, start_friction;
+    std::vector<double> bound, penalty;
   };
-  State state() const { return {paddle_, stuck_, sliding_, friction_}; }
+  State state() const {
+    return {paddle_, stuck_, sliding_, friction_, start_friction_, bound_, penalty_};
+  }
   void restore(const State& state) {
     paddle_ = state.paddle;
     stuck_ = state.stuck;
     sliding_ = state.sliding;
     friction_ = state.friction;
-    std::fill(history_.begin(), history_.end(), 0);
+    start_friction_ = state.start_friction;
+    bound_ = state.bound;
+    penalty_ = state.penalty;
   }
 
  private:
@@ -97,16 +112,36 @@ class ContactSet {
   // Leaves contact: no paddle, no slide.
   void release(int vertex);
 
-  Eigen::MatrixXd stuck_;      // held tangential contact: where it is held (displacement)
+  // A Coulomb contact's paddle axis (-1: not one), and the axes along which
+  // it may slide (not its paddle's, not a support's).
+  int coulomb_axis(int vertex) const;
+  std::vector<int> tangential_axes(int vertex, int axis) const;
+  // A sliding vertex's trial friction at x, f0 - k s, and its friction, the
+  // trial returned onto the cone of `bound` (update_friction).
+  Eigen::VectorXd trial_friction(int vertex, const Eigen::VectorXd& x) const;
+  Eigen::VectorXd friction_at(int vertex, const Eigen::VectorXd& x, double bound) const;
+  // A Coulomb vertex's bound friction * N, N from R's normal row.
+  double bound_at(int vertex, const Eigen::VectorXd& R) const;
+  // Whether a sliding vertex's trial friction takes the stick's tangent:
+  // inside the cone of `bound`, or on its rim with the residual R pushing it in.
+  bool sticks(int vertex, const Eigen::VectorXd& trial, double bound,
+              const Eigen::VectorXd& R) const;
+
+  // The elastic part of a slide, within which a sliding vertex's trial stays
+  // inside its cone: this share of the body's diagonal (sets the penalty).
+  static constexpr double kElasticSlide = 1e-8;
+
+  Eigen::MatrixXd stuck_;      // held tangential contact: where it is held (displacement);
+                               // sliding: where its slide over the increment starts
   std::vector<char> sliding_;  // per vertex: a Coulomb contact that slides
   Eigen::MatrixXd friction_;   // per sliding vertex: its friction force on the body (N)
-  double diagonal_ = 1.0;      // the body's bounding-box diagonal
-  bool has_coulomb_ = false;   // a paddle with Coulomb contact
-  // A sliding vertex's last round (update_friction): whether there is one in
-  // this step, its friction and slide then, and the secant compliance.
-  std::vector<char> history_;
-  std::vector<double> compliance_;
-  Eigen::MatrixXd last_friction_, last_slide_;
+                               // at the last solution
+  // Per sliding vertex: its friction at the increment's start (f0), its
+  // bound friction * N at the last solution and its penalty k.
+  Eigen::MatrixXd start_friction_;
+  std::vector<double> bound_, penalty_;
+  double diagonal_ = 1.0;     // the body's bounding-box diagonal
+  bool has_coulomb_ = false;  // a paddle with Coulomb contact
 };
 
 // Whether paddles at these planes can work (why not): two on one axis, on

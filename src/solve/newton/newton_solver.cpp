@@ -45,6 +45,7 @@ NewtonSolver::NewtonSolver(const model::Model& model, const SteppingOptions& opt
 // The tangent solve prepared at x (the solution), for the summary.
 std::shared_ptr<TangentSolve> NewtonSolver::final_tangent(const LoadPoint& at,
                                                           const Eigen::VectorXd& x) {
+  tangent_->set_added_tangent(contacts_.friction_tangent(x, residual_));
   if (!tangent_->prepare(x, at.factors, held_map(), &supports_).ok) return nullptr;
   return tangent_;
 }
@@ -112,11 +113,11 @@ std::string NewtonSolver::sensitivities(const LoadPoint& at, const Eigen::Vector
 }
 
 // The residual at x (and the tangent prepared there), the sliding contacts'
-// friction forces in: they are held fixed within a solve (update_friction).
+// friction forces at x in (their tangent is set before each prepare).
 Eigen::VectorXd NewtonSolver::residual(const Eigen::VectorXd& x,
                                        const std::vector<double>& factors) {
   Eigen::VectorXd R = tangent_->residual(x, factors);
-  contacts_.add_friction(R);
+  contacts_.add_friction(x, R);
   return R;
 }
 
@@ -168,11 +169,13 @@ std::string NewtonSolver::newton(const LoadPoint& at, const model::DofMap& dofs,
     }
     Eigen::VectorXd dx;
     const double forcing = forcing_term(norm, newton_);
+    tangent_->set_added_tangent(contacts_.friction_tangent(x, R));
     const Status status = prepare_and_solve(x, at.factors, dofs, -r, forcing, record, &dx);
     if (!status.ok) return status.message;
     // Backtracking: halve the step until the residual falls (Armijo).
     Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
     dofs.scatter(dx, step);
+    contacts_.stop_at_cones(x, R, step);
     double alpha = 1.0;
     Eigen::VectorXd trial, R_trial;
     for (int halving = 0;; ++halving) {

@@ -43,7 +43,10 @@ Eigen::VectorXd KrylovTangent::residual(const Eigen::VectorXd& x,
 Eigen::VectorXd KrylovTangent::apply(const Eigen::VectorXd& reduced) const {
   Eigen::VectorXd w = Eigen::VectorXd::Zero(equilibrium_->num_unknowns());
   dofs_.scatter(reduced, w);  // held entries stay zero
-  return dofs_.reduce(store_ ? stored_.apply(w) : equilibrium_->tangent_product(x_, factors_, w));
+  Eigen::VectorXd product =
+      store_ ? stored_.apply(w) : equilibrium_->tangent_product(x_, factors_, w);
+  added_.add_to_product(w, product);
+  return dofs_.reduce(product);
 }
 
 // The held unknowns of the tangent that the preconditioner leaves free (at

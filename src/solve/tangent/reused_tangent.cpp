@@ -85,7 +85,7 @@ bool ReusedTangent::factor_still_serves() const {
 Status ReusedTangent::factor_tangent() {
   factor_ok_ = false;
   const Status status =
-      lu_.factor(*equilibrium_, x_, factors_, preconditioner_dofs_, single_factor_);
+      lu_.factor(*equilibrium_, x_, factors_, preconditioner_dofs_, added_, single_factor_);
   if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
   if (single_factor_ && lu_.rounded_to_single()) ++single_precision_factorizations_;
   factor_ok_ = true;

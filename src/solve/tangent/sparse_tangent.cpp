@@ -18,7 +18,7 @@ class SparseTangent final : public TangentSolve {
   Status prepare(const Eigen::VectorXd& x, const std::vector<double>& factors,
                  const model::DofMap& dofs, const model::DofMap* preconditioner_dofs) override {
     take_state(x, factors, dofs, preconditioner_dofs);
-    const Status status = lu_.factor(*equilibrium_, x_, factors_, dofs_);
+    const Status status = lu_.factor(*equilibrium_, x_, factors_, dofs_, added_);
     ++factorizations_;
     if (!status.ok) return Status::failure("newton: the tangent: " + status.message);
     ready_ = true;

@@ -74,14 +74,18 @@ Eigen::SparseMatrix<double> reduce(const model::DofMap& dofs,
 
 Status TangentLU::factor(const model::Equilibrium& equilibrium, const Eigen::VectorXd& x,
                          const std::vector<double>& factors, const model::DofMap& dofs,
-                         bool single) {
+                         const AddedTangent& added, bool single) {
   if (storage_ == Storage::Sparse) {
-    Eigen::SparseMatrix<double> J = reduce(dofs, equilibrium.sparse_tangent(x, factors));
+    Eigen::SparseMatrix<double> full = equilibrium.sparse_tangent(x, factors);
+    added.add_to(full);
+    Eigen::SparseMatrix<double> J = reduce(dofs, full);
     equilibrate(J, &row_scale_, &column_scale_);
     if (!sparse_) sparse_ = std::make_unique<SparseLU>();
     return sparse_->factorize(J);
   }
-  Eigen::MatrixXd J = dofs.reduce(equilibrium.tangent(x, factors));
+  Eigen::MatrixXd full = equilibrium.tangent(x, factors);
+  added.add_to(full);
+  Eigen::MatrixXd J = dofs.reduce(full);
   equilibrate(J, &row_scale_, &column_scale_);
   dense_ = std::make_unique<DenseLU>();
   const Status status = dense_->factorize(std::move(J));

@@ -14,6 +14,7 @@
 #include "fiberfluid/solve/dense_lu.hpp"
 #include "fiberfluid/solve/sparse_lu.hpp"
 #include "fiberfluid/solve/status.hpp"
+#include "fiberfluid/solve/tangent/added_tangent.hpp"
 
 namespace fiberfluid::solve {
 
@@ -22,11 +23,12 @@ class TangentLU {
   enum class Storage { Dense, Sparse };
   explicit TangentLU(Storage storage) : storage_(storage) {}
 
-  // Factors J(x) reduced to `dofs`. `single` (dense only) rounds the factors
-  // to single precision where that serves; rounded_to_single() says whether
-  // it did.
+  // Factors J(x) with `added` in, reduced to `dofs`.
+  // `single` (dense only) rounds the factors to single precision where that
+  // serves; rounded_to_single() says whether it did.
   Status factor(const model::Equilibrium& equilibrium, const Eigen::VectorXd& x,
-                const std::vector<double>& factors, const model::DofMap& dofs, bool single = false);
+                const std::vector<double>& factors, const model::DofMap& dofs,
+                const AddedTangent& added, bool single = false);
   // J_ff^-1 b through the scaling.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   bool rounded_to_single() const { return dense_ && dense_->single(); }

@@ -26,6 +26,7 @@
 #include "fiberfluid/solve/linear_solver.hpp"
 #include "fiberfluid/solve/status.hpp"
 #include "fiberfluid/solve/stepping.hpp"
+#include "fiberfluid/solve/tangent/added_tangent.hpp"
 
 namespace fiberfluid::solve {
 
@@ -46,6 +47,11 @@ class TangentSolve {
   int single_precision_factorizations() const { return single_precision_factorizations_; }
   const model::DofMap& dofs() const { return dofs_; }
   const Eigen::VectorXd& state() const { return x_; }
+
+  // What the contacts add to the bulk's tangent from the next prepare() on
+  // (empty: nothing): the sliding contacts' friction. A GMRES strategy takes
+  // it into its operator, and into its factor when it refactors.
+  void set_added_tangent(AddedTangent added) { added_ = std::move(added); }
 
   // Makes the tangent at x (loads `factors`, held set `dofs`) ready to solve;
   // a preconditioner holds `preconditioner_dofs` (a subset of `dofs`;
@@ -81,6 +87,7 @@ class TangentSolve {
   std::vector<double> factors_;
   model::DofMap dofs_;
   model::DofMap preconditioner_dofs_;
+  AddedTangent added_;
   bool ready_ = false;
   int factorizations_ = 0, single_precision_factorizations_ = 0;
 
