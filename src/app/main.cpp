@@ -104,6 +104,21 @@ int check_command(const std::string& path, bool flip) {
   return kOk;
 }
 
+// A number option's check: CLI11's ranges compare, and NaN fails no
+// comparison, so `--max-time nan` would pass as a budget and disable it.
+// Every floating-point option is checked through here: a finite number, then
+// `range`.
+CLI::Validator finite_and(const CLI::Validator& range) {
+  return CLI::Validator(
+      [range](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value))
+          return "expected a finite number, got '" + text + "'";
+        return range(text);
+      },
+      range.get_description());
+}
+
 // --max-memory SIZE: the memory budget that every case's estimate and every
 // dense factor is checked against before it is allocated; --max-time: the
 // longest estimate that may start.
@@ -111,7 +126,7 @@ void add_resource_limits(CLI::App* command, RunFlags& flags) {
   command
       ->add_option("--max-time", flags.max_time,
                    "Refuse a case whose estimated time exceeds this many seconds")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_and(CLI::PositiveNumber));
   command
       ->add_option_function<std::string>(
           "--max-memory",
@@ -311,7 +326,7 @@ void define_commands(CLI::App& cli, Commands& c) {
   c.mesh_study
       ->add_option("--ratio", c.study_flags.ratio,
                    "Refinement between levels (element size, coarse over fine)")
-      ->check(CLI::Range(1.1, 4.0));
+      ->check(finite_and(CLI::Range(1.1, 4.0)));
   c.mesh_study->add_option("--figure", c.study_flags.figures,
                            "A figure to study (repeatable; default: every figure)");
   c.mesh_study->add_flag("--plot", c.study_flags.plot,

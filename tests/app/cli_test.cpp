@@ -389,11 +389,18 @@ TEST(Cli, UsageErrors) {
   } cases[] = {
       {"", "A subcommand is required"},
       {"run", "experiment is required"},
-      {"frobnicate", "unknown command 'frobnicate' (expected one of: run, fit, predict, check, compare"},
+      {"frobnicate",
+       "unknown command 'frobnicate' (expected one of: run, fit, predict, check, compare"},
       {"runn x.json", "unknown command 'runn'"},
       {"run x.json --plott", "--plott ('run' takes the options: -h,--help, -o,--output, --check"},
       {"check a.obj b.obj", "b.obj ('check' takes the options: -h,--help, --flip;"},
-      {"run x.json -j -3", "--jobs"}};
+      {"run x.json -j -3", "--jobs"},
+      // Not a number is no number: NaN fails every comparison a range makes.
+      {"run x.json --max-time nan", "--max-time: expected a finite number, got 'nan'"},
+      {"fit x.json --max-time inf", "--max-time: expected a finite number, got 'inf'"},
+      {"predict f x.json --max-time -nan", "--max-time: expected a finite number"},
+      {"study mesh x.json --ratio nan", "--ratio: expected a finite number, got 'nan'"},
+      {"study mesh x.json --ratio 9", "--ratio"}};
   for (const auto& c : cases) {
     const Outcome o = run_cli(c.arguments);
     EXPECT_EQ(o.status, 64) << c.arguments << "\n" << o.output;

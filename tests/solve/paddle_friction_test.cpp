@@ -189,7 +189,9 @@ TEST(PaddleFriction, TheFrictionsTangentIsTheDerivativeOfItsForce) {
     EXPECT_GT(largest, 0.0) << "slide " << size;
     EXPECT_LT(worst, 1e-6 * largest) << "slide " << size;
     EXPECT_LT(worst_mix, 1e-6 * std::max(largest_mix, 0.2)) << "slide " << size;
-    if (size == 1e-3) EXPECT_GT(largest_mix, 0.1);  // every slide past its rim feels N
+    if (size == 1e-3) {
+      EXPECT_GT(largest_mix, 0.1);  // every slide past its rim feels N
+    }
   }
 }
 
