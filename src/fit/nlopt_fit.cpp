@@ -3,6 +3,7 @@
 // within the bounds, then BOBYQA from the best point the global search found.
 #include <nlopt.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -30,10 +31,21 @@ struct NloptCost {
   Eigen::VectorXd best_phi;
   int calls = 0;
   nlopt_opt running = nullptr;  // the optimiser calling, stopped on a requested interruption
+  bool spent = false;           // a point was refused: max_evaluations ran out
 
   double operator()(const double* x) {
     const int P = fit_problem.parameters().size();
     const Eigen::VectorXd phi = Eigen::Map<const Eigen::VectorXd>(x, P);
+    // max_evaluations bounds the forward runs, the start's included (as for
+    // Levenberg-Marquardt), not NLopt's calls: its own limit counts calls
+    // that the cache answers and DIRECT-L finishes a sweep past it. A point
+    // that would need one run more is not run, and the search stops.
+    if (evaluations.kept(phi, false) == nullptr &&
+        evaluations.forward_runs >= options.max_evaluations) {
+      spent = true;
+      if (running) nlopt_force_stop(running);
+      return kFailedCost;
+    }
     const Evaluation& e = evaluations.at(phi, false);
     ++calls;
     const double cost = e.ok && std::isfinite(fit_problem.cost(e.residuals))
@@ -93,6 +105,10 @@ std::string describe(nlopt_result r) {
 nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
                       const FitOptions& options, NloptCost& objective, Eigen::VectorXd& phi,
                       int max_evaluations) {
+  // NLopt reads a limit of 0 or less as none: a phase left without
+  // evaluations (the global half of max_evaluations 1, or the local rest
+  // after a global phase that spent them all) does not run.
+  if (max_evaluations < 1) return NLOPT_MAXEVAL_REACHED;
   const ParameterMap& map = fit_problem.parameters();
   const int P = map.size();
   nlopt_opt opt = nlopt_create(algorithm, static_cast<unsigned>(P));
@@ -134,6 +150,9 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitProblem& fit_p
   const ParameterMap& map = fit_problem.parameters();
   Eigen::VectorXd phi = start;
   NloptCost objective(evaluations, fit_problem, options, outcome);
+  // The start (run before the search) is its first point: the best so far
+  // even when max_evaluations leaves no run for another.
+  objective(start.data());
   nlopt_result result;
   if (options.method == Method::Bobyqa) {
     result =
@@ -145,13 +164,15 @@ OptimizerOutcome fit_nlopt(EvaluationCache& evaluations, const FitProblem& fit_p
         throw InputError("parameter \"" + map.parameters()[static_cast<size_t>(k)].name +
                          "\": a global search (" + to_string(options.method) +
                          ") needs finite lower and upper bounds");
-    const int global = options.max_evaluations / 2;
+    const int global = std::max(1, options.max_evaluations / 2);
     minimise(options.method == Method::DirectL ? NLOPT_GN_DIRECT_L : NLOPT_GN_CRS2_LM, fit_problem,
              options, objective, phi, global);
-    result = cancel_requested() ? NLOPT_FORCED_STOP
-                                : minimise(NLOPT_LN_BOBYQA, fit_problem, options, objective, phi,
-                                           options.max_evaluations - objective.calls);
+    result = cancel_requested() || objective.spent
+                 ? NLOPT_FORCED_STOP
+                 : minimise(NLOPT_LN_BOBYQA, fit_problem, options, objective, phi,
+                            options.max_evaluations - evaluations.forward_runs);
   }
+  if (objective.spent && !cancel_requested()) result = NLOPT_MAXEVAL_REACHED;
   outcome.phi = phi;
   if (cancel_requested())
     outcome.status = FitStatus::Interrupted;

@@ -516,6 +516,23 @@ TEST(Calibration, BadFitsAreNamed) {
       [&] { Calibration(m, newton(1), targets, {parameter("Y0", 3000.0)}, global).run(); },
       "needs finite lower and upper bounds");
 
+  // A global search stays within max_evaluations, however small: NLopt reads
+  // a phase's limit of 0 as none (DIRECT-L's global half of 1 made 156,168 runs).
+  Parameter boxed = parameter("Y0", 3000.0);
+  boxed.lower = 1000.0;
+  boxed.upper = 10000.0;
+  for (Method method : {Method::DirectL, Method::Crs2}) {
+    for (int most : {1, 2, 5}) {
+      FitOptions few;
+      few.method = method;
+      few.max_evaluations = most;
+      few.warm_start = false;  // a warm-started optimum's check from rest is a run more
+      const FitResult r = Calibration(m, newton(1), targets, {boxed}, few).run();
+      EXPECT_LE(r.forward_runs, most) << to_string(method) << " " << most;
+      EXPECT_EQ(r.status, FitStatus::IterationLimit) << to_string(method) << " " << most;
+    }
+  }
+
   // A forward run that fails is a result with a message, not a crash.
   const Calibration soft(m, newton(1), targets, {parameter("Y0", 1e-3)});
   const Evaluation e = soft.evaluate(soft.parameters().initial_phi(), true);
