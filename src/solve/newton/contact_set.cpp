@@ -152,7 +152,7 @@ int ContactSet::update_friction(const Eigen::VectorXd& R, const Eigen::VectorXd&
       if (tangential.norm() <= limit + slack) continue;  // it sticks
       sliding_[i] = 1;
       start_friction_.row(v) = (tangential * (limit / tangential.norm())).transpose();
-      penalty_[i] = std::max(penalty_[i], limit / (kElasticSlide * diagonal_));
+      penalty_[i] = std::max(penalty_[i], penalty_for(limit));
       bound_[i] = limit;
       friction_.row(v) = start_friction_.row(v);
       ++changed;
@@ -161,7 +161,7 @@ int ContactSet::update_friction(const Eigen::VectorXd& R, const Eigen::VectorXd&
     bound_[i] = limit;
     // Inside the cone: it sticks, held where the increment started (its
     // slide since is the trial's elastic part, a few kElasticSlide).
-    if (trial_friction(v, x).norm() < (1.0 - 1e-9) * limit) {
+    if (strictly_inside(trial_friction(v, x), limit)) {
       sliding_[i] = 0;
       friction_.row(v).setZero();
       ++changed;
@@ -179,14 +179,19 @@ int ContactSet::update_friction(const Eigen::VectorXd& R, const Eigen::VectorXd&
 // slide's freedom through a cone 2 kElasticSlide across (stop_at_cones).
 bool ContactSet::sticks(int vertex, const Eigen::VectorXd& trial, double bound,
                         const Eigen::VectorXd& R) const {
-  const double size = trial.norm();
-  if (size < (1.0 - 1e-9) * bound) return true;
-  if (size > (1.0 + 1e-9) * bound) return false;
+  if (strictly_inside(trial, bound)) return true;
+  if (trial.norm() > (1.0 + 1e-9) * bound) return false;
   const int n = model_.num_vertices();
   double push = 0.0;
   for (int a : tangential_axes(vertex, coulomb_axis(vertex))) push += R[a * n + vertex] * trial[a];
   return push <= 0.0;
 }
+
+bool ContactSet::strictly_inside(const Eigen::VectorXd& trial, double bound) {
+  return trial.norm() < (1.0 - 1e-9) * bound;
+}
+
+double ContactSet::penalty_for(double bound) const { return bound / (kElasticSlide * diagonal_); }
 
 int ContactSet::coulomb_axis(int vertex) const {
   const int p = paddle_[static_cast<size_t>(vertex)];
@@ -269,11 +274,11 @@ void ContactSet::add_friction(const Eigen::VectorXd& x, Eigen::VectorXd& R) cons
 // where also dR_t = -friction n dN, dN = sign(R_N) dR_N: the normal row's.
 AddedTangent ContactSet::friction_tangent(const Eigen::VectorXd& x,
                                           const Eigen::VectorXd& R) const {
+  AddedTangent added;  // empty (0 x 0) without Coulomb paddles: nothing to add
+  if (!has_coulomb_) return added;
   const Eigen::Index size = x.size();
-  AddedTangent added;
   added.stiffness.resize(size, size);
   added.row_mix.resize(size, size);
-  if (!has_coulomb_) return added;
   const int n = model_.num_vertices();
   const double mu = model_.material.friction;
   std::vector<Eigen::Triplet<double>> stiffness, mix;
@@ -316,7 +321,7 @@ void ContactSet::accept(const Eigen::VectorXd& x) {
     friction_.row(v) = f.transpose();
     start_friction_.row(v) = f.transpose();
     // The penalty keeps up with a normal force that grew.
-    penalty_[i] = std::max(penalty_[i], bound_[i] / (kElasticSlide * diagonal_));
+    penalty_[i] = std::max(penalty_[i], penalty_for(bound_[i]));
     for (int a = 0; a < model_.dim(); ++a) stuck_(v, a) = x[a * n + v];
   }
 }

@@ -126,6 +126,10 @@ class ContactSet {
   // inside the cone of `bound`, or on its rim with the residual R pushing it in.
   bool sticks(int vertex, const Eigen::VectorXd& trial, double bound,
               const Eigen::VectorXd& R) const;
+  // Whether a trial lies inside the cone of `bound`, clear of its rim.
+  static bool strictly_inside(const Eigen::VectorXd& trial, double bound);
+  // The penalty k that keeps a slide's elastic part within kElasticSlide.
+  double penalty_for(double bound) const;
 
   // The elastic part of a slide, within which a sliding vertex's trial stays
   // inside its cone: this share of the body's diagonal (sets the penalty).

@@ -13,7 +13,6 @@ namespace fiberfluid::solve {
 struct AddedTangent {
   Eigen::SparseMatrix<double> stiffness;  // K
   Eigen::SparseMatrix<double> row_mix;    // C: row r of J gets C(r, s) times row s
-  bool empty() const { return stiffness.nonZeros() == 0 && row_mix.nonZeros() == 0; }
 
   // J <- J + K + C J. The mixed rows are never themselves mixed into others
   // (tangential rows take normal ones), so C J is read from J in place.
