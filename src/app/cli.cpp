@@ -4,7 +4,13 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <iostream>
+#include <iterator>
+#include <string>
+#include <system_error>
 
 #include "fiberfluid/experiment/write/file_names.hpp"
 #include "fiberfluid/util/progress.hpp"
@@ -123,36 +129,12 @@ void fail_if_injected(const fiberfluid::parallel::Ranks& ranks) {
     throw std::runtime_error("a failure injected by FIBERFLUID_FAIL_RANK");
 }
 
-// A digest of what a rank will run: the resolved experiment and every
-// case's surface, bit for bit (FNV-1a, 64 bits).
-std::string experiment_digest(const experiment::Experiment& ex) {
-  std::uint64_t hash = 14695981039346656037ull;
-  const auto add = [&hash](const void* data, size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (size_t k = 0; k < size; ++k) hash = (hash ^ bytes[k]) * 1099511628211ull;
-  };
-  const auto add_experiment = [&](const experiment::Experiment& e) {
-    const std::string resolved = e.resolved.dump();
-    add(resolved.data(), resolved.size());
-    if (e.kind() != experiment::Experiment::Kind::Simulate) return;
-    for (const experiment::Case& c : e.simulation().cases) {
-      add(c.model.surface.V.data(), sizeof(double) * static_cast<size_t>(c.model.surface.V.size()));
-      add(c.model.surface.F.data(), sizeof(int) * static_cast<size_t>(c.model.surface.F.size()));
-    }
-  };
-  add_experiment(ex);
-  if (ex.kind() == experiment::Experiment::Kind::Calibration)
-    for (const experiment::Experiment& specimen : ex.calibration().specimens)
-      add_experiment(specimen);
-  return std::to_string(hash);
-}
-
 // Every rank must run what rank 0 runs: started with other files (mpirun's
 // "A : B" form), a rank computed B's variants under A's record, or waited
 // for ever when B had fewer (issue 43). Refused on every rank, naming them.
 void require_one_experiment(const fiberfluid::parallel::Ranks& ranks,
                             const experiment::Experiment& ex, const std::string& path) {
-  const std::vector<int> differing = ranks.differing_from_root(experiment_digest(ex));
+  const std::vector<int> differing = ranks.differing_from_root(experiment::experiment_digest(ex));
   if (differing.empty()) return;
   std::string which;
   for (int r : differing) which += (which.empty() ? "" : ", ") + std::to_string(r);

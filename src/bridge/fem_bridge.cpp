@@ -2,15 +2,19 @@
 #include "fiberfluid/bridge/fem_bridge.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <map>
+#include <sstream>
 #include <vector>
 
 #include "fiberfluid/fem/mesh_tools.hpp"
+#include "fiberfluid/fem/setup_diagnosis.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/geom/target.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::bridge {
 namespace {
@@ -39,9 +43,7 @@ struct PosedFem {
 
 PosedFem pose_fem(const model::Model& m, int steps, const fem::TetMeshOptions& mesh_options,
                   int order) {
-  if (m.dim() != 3) fail("needs a closed 3D surface (this one is 2D)");
-  if (!m.paddles.empty())
-    fail("paddles (contact) are not supported: use supports, prescribed displacements and loads");
+  if (const Status posable = check_fem_posable(m); !posable.ok) fail(posable.message);
   PosedFem posed;
   const auto start = std::chrono::steady_clock::now();
   posed.mesh = fem::tetrahedralize(m.surface, mesh_options);
@@ -141,7 +143,45 @@ void finish(const PosedFem& posed, const Eigen::VectorXd& u, FemOfModel* out) {
   out->deformed_boundary = fem::boundary(posed.mesh, posed.mesh.nodes + out->displacement).surface;
 }
 
+// A solve that failed: stopped by a request, or a numerical failure named
+// with what in the setup likely caused it.
+[[noreturn]] void solve_failed(const PosedFem& posed, double poisson, const Status& status) {
+  throw_if_cancelled("the FEM reference");
+  std::string why = status.message;
+  const Status setup = fem::diagnose_singular_setup(posed.mesh, poisson, posed.state(1).held.dofs);
+  if (!setup.ok) why += " (likely cause: " + setup.message + ")";
+  throw FemSolveFailure(why);
+}
+
+// Displacements that are not finite, or a hundred times the body's size,
+// are no result (a modulus so small that the loads overflow them): a
+// failure, never a success with empty or absurd figures.
+void check_displacements(const PosedFem& posed, double poisson, const Eigen::VectorXd& u) {
+  const Eigen::MatrixXd& nodes = posed.mesh.nodes;
+  const double size = (nodes.colwise().maxCoeff() - nodes.colwise().minCoeff()).norm();
+  const double largest =
+      u.allFinite() ? fem::displacement_rows(u, 3).rowwise().norm().maxCoeff() : HUGE_VAL;
+  if (!std::isfinite(largest))
+    solve_failed(posed, poisson,
+                 Status::failure("the displacements are not finite (a modulus too small for "
+                                 "the loads?)"));
+  if (largest > 100.0 * size) {
+    std::ostringstream why;
+    why << "the largest displacement, " << largest << " m, is " << largest / size
+        << " times the body's size (a modulus too small for the loads?)";
+    solve_failed(posed, poisson, Status::failure(why.str()));
+  }
+}
+
 }  // namespace
+
+Status check_fem_posable(const model::Model& m) {
+  if (m.dim() != 3) return Status::failure("needs a closed 3D surface (this one is 2D)");
+  if (!m.paddles.empty())
+    return Status::failure(
+        "paddles (contact) are not supported: use supports, prescribed displacements and loads");
+  return {};
+}
 
 FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Material& material,
                               const fem::TetMeshOptions& mesh_options, int order) {
@@ -159,13 +199,14 @@ FemOfModel solve_fem_of_model(const model::Model& m, int steps, const fem::Mater
     fem::HyperelasticSolution solution;
     const linalg::Status status =
         fem::solve_small_strain(posed.mesh, solid, last, options, &solution);
-    if (!status.ok) fail(status.message);
+    if (!status.ok) solve_failed(posed, material.poisson, status);
     u = solution.u;
   } else {
     const linalg::Status status =
         fem::solve_static(fem::stiffness_matrix(posed.mesh, material), last.forces, last.held, &u);
-    if (!status.ok) fail(status.message);
+    if (!status.ok) solve_failed(posed, material.poisson, status);
   }
+  check_displacements(posed, material.poisson, u);
   out.solve_seconds = seconds_since(solve_start);
   finish(posed, u, &out);
   out.path.push_back(out.displacement);
@@ -184,7 +225,8 @@ FemOfModel solve_hyperelastic_fem_of_model(const model::Model& m, int steps,
   fem::HyperelasticSolution solution;
   const linalg::Status status =
       fem::solve_hyperelastic(posed.mesh, material, posed.state, options, &solution);
-  if (!status.ok) fail(status.message);
+  if (!status.ok) solve_failed(posed, material.poisson, status);
+  check_displacements(posed, material.poisson, solution.u);
   out.solve_seconds = seconds_since(solve_start);
   out.newton_iterations = solution.newton_iterations;
   finish(posed, solution.u, &out);

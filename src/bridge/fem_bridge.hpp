@@ -17,6 +17,8 @@
 // the node nearest its vertex; gravity is a body force of the load's density.
 
 #include <Eigen/Core>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "fiberfluid/fem/fem.hpp"
@@ -24,6 +26,7 @@
 #include "fiberfluid/fem/tet_mesher.hpp"
 #include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/status.hpp"
 
 namespace fiberfluid::bridge {
 
@@ -36,9 +39,23 @@ struct FemOfModel {
   double mesh_seconds = 0.0, solve_seconds = 0.0;
 };
 
+// A FEM that could be posed but not solved: a singular stiffness, a load step
+// that would not converge, non-finite displacements. Not bad input: the
+// message names the failure and, when the setup shows one, its likely cause
+// (fem::diagnose_singular_setup). A requested stop throws Interrupted instead.
+class FemSolveFailure : public std::runtime_error {
+ public:
+  explicit FemSolveFailure(const std::string& why) : std::runtime_error(why) {}
+};
+
+// Why a model's body has no FEM here (a 2D surface, paddles): checked before
+// any run, so that a failure to pose never comes after a finished fiber run.
+Status check_fem_posable(const model::Model& model);
+
 // The FEM of a model's body with every load and prescribed value at its
 // factor after step `steps` of `steps`. Throws InputError for what it cannot
-// pose (a 2D surface, paddles, a load of an unknown kind, a singular setup).
+// pose (check_fem_posable, a load of an unknown kind) and FemSolveFailure
+// for what it cannot solve.
 // `order` 1: linear tetrahedra, 2: quadratic ones (fem::to_quadratic; their
 // boundary nodes are held and loaded as the corners are) with a linear
 // pressure on their corners (the mixed form, which does not lock as nu ->
@@ -47,10 +64,10 @@ FemOfModel solve_fem_of_model(const model::Model& model, int steps, const fem::M
                               const fem::TetMeshOptions& mesh_options, int order = 1);
 // The same body of neo-Hookean tetrahedra, solved along the model's `steps`
 // load steps (each load's schedule, each prescribed motion's); a step that
-// fails (after options.max_step_cuts halvings) throws InputError naming it.
+// fails (after options.max_step_cuts halvings) throws FemSolveFailure naming it.
 FemOfModel solve_hyperelastic_fem_of_model(const model::Model& model, int steps,
                                            const fem::HyperelasticMaterial& material,
-                                           const fem::TetMeshOptions& mesh_options,
-                                           int order = 2, fem::HyperelasticOptions options = {});
+                                           const fem::TetMeshOptions& mesh_options, int order = 2,
+                                           fem::HyperelasticOptions options = {});
 
 }  // namespace fiberfluid::bridge

@@ -2,11 +2,16 @@
 #include "fiberfluid/experiment/experiment.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <utility>
 
+#include "fiberfluid/bridge/fem_bridge.hpp"
 #include "fiberfluid/experiment/run/case_builder.hpp"
 #include "fiberfluid/experiment/write/output_folder.hpp"
 #include "fiberfluid/util/error.hpp"
@@ -72,12 +77,33 @@ void build_simulation(Simulation& sim, const geom::Surface* surface,
   }
 }
 
+// Every file a resolved experiment names: the readers resolve each file they
+// will read (a mesh, a fit's targets and force curves, a material test, a
+// specimen, start_from) to an absolute path, so these are the strings that
+// name an existing regular file by an absolute path.
+void for_each_named_file(const json& node,
+                         const std::function<void(const std::filesystem::path&)>& visit) {
+  if (node.is_object() || node.is_array()) {
+    for (const json& child : node) for_each_named_file(child, visit);
+  } else if (node.is_string()) {
+    const std::filesystem::path path(node.get<std::string>());
+    std::error_code error;
+    if (path.is_absolute() && std::filesystem::is_regular_file(path, error)) visit(path);
+  }
+}
+
 }  // namespace
 
 void build_experiment(Experiment& ex, const geom::Surface* surface) {
   switch (ex.kind()) {
     case Experiment::Kind::Simulate:
       build_simulation(ex.simulation(), surface, ex.warnings);
+      // A FEM reference that cannot be posed is refused now, not after the run.
+      if (ex.simulation().fem_reference && !ex.simulation().cases.empty())
+        if (const Status posable = bridge::check_fem_posable(ex.simulation().cases.front().model);
+            !posable.ok)
+          throw InputError((ex.source.empty() ? ex.name : ex.source.string()) +
+                           ": fem_reference: " + posable.message);
       break;
     case Experiment::Kind::Areas: {
       AreaStudy& areas = ex.areas();
@@ -110,6 +136,35 @@ Experiment load_experiment(const std::filesystem::path& path) {
   Experiment ex = parse_experiment(document, path.parent_path(), path.string());
   ex.source = path;
   return ex;
+}
+
+std::string experiment_digest(const Experiment& ex) {
+  std::uint64_t hash = 14695981039346656037ull;
+  const auto add = [&hash](const void* data, size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t k = 0; k < size; ++k) hash = (hash ^ bytes[k]) * 1099511628211ull;
+  };
+  const auto add_file = [&](const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string marker = in.bad() ? "unreadable" : "";
+    add(marker.data(), marker.size());
+    add(bytes.data(), bytes.size());
+  };
+  const auto add_experiment = [&](const Experiment& e) {
+    const std::string resolved = e.resolved.dump();
+    add(resolved.data(), resolved.size());
+    for_each_named_file(e.resolved, add_file);
+    if (e.kind() != Experiment::Kind::Simulate) return;
+    for (const Case& c : e.simulation().cases) {
+      add(c.model.surface.V.data(), sizeof(double) * static_cast<size_t>(c.model.surface.V.size()));
+      add(c.model.surface.F.data(), sizeof(int) * static_cast<size_t>(c.model.surface.F.size()));
+    }
+  };
+  add_experiment(ex);
+  if (ex.kind() == Experiment::Kind::Calibration)
+    for (const Experiment& specimen : ex.calibration().specimens) add_experiment(specimen);
+  return std::to_string(hash);
 }
 
 }  // namespace fiberfluid::experiment

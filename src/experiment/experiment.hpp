@@ -32,4 +32,13 @@ Experiment parse_experiment(const nlohmann::json& document, const std::filesyste
 // documents without a "surface": a program's own mesh).
 void build_experiment(Experiment& experiment, const geom::Surface* surface = nullptr);
 
+// A digest of what a built experiment will run: the resolved document, every
+// case's surface and the bytes of every file it names, a calibration's
+// specimens with theirs (FNV-1a, 64 bits). MPI ranks compare it before they
+// work: a file read later (a fit's target.obj, a force curve) counts as much
+// as the mesh, or a rank with another one would decide a multi-start fit
+// silently. The readers resolve every file they read to an absolute path;
+// that is how the digest finds them.
+std::string experiment_digest(const Experiment& experiment);
+
 }  // namespace fiberfluid::experiment

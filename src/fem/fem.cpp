@@ -302,10 +302,8 @@ linalg::Status solve_static(const Eigen::SparseMatrix<double>& K, const Eigen::V
   cholesky.analyze_pattern(Kff);
   const linalg::Status status = cholesky.factorize(Kff);
   if (!status.ok)
-    return linalg::Status::failure(
-        "fem: the stiffness is singular on the free unknowns (too few "
-        "supports?): " +
-        status.message);
+    return linalg::Status::failure("fem: the stiffness is singular on the free unknowns: " +
+                                   status.message);
   *u = fixed;
   split.scatter(cholesky.solve(rhs), *u);
   return {};

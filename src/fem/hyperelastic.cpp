@@ -12,6 +12,7 @@
 #include "fiberfluid/fem/tetrahedra.hpp"
 #include "fiberfluid/linalg/sparse_cholesky.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::fem {
 namespace {
@@ -331,7 +332,7 @@ linalg::Status solve_tangent(const Eigen::SparseMatrix<double>& K, const Eigen::
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
   lu.compute(scaled);
   if (lu.info() != Eigen::Success)
-    return linalg::Status::failure("the tangent stiffness is singular (too few supports?)");
+    return linalg::Status::failure("the tangent stiffness is singular");
   *x = scale.asDiagonal() * lu.solve(scale.asDiagonal() * b);
   return {};
 }
@@ -391,6 +392,7 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
       internal->head(n) += state.forces;
       return {};
     }
+    if (cancel_requested()) return "interrupted";
     if (it == options.max_iterations) {
       std::ostringstream out;
       out << "no convergence in " << it << " Newton iterations (relative residual " << norm << ")";
@@ -426,6 +428,7 @@ std::string newton(const Discretization& d, const LoadState& state, const FreeUn
         R = R_trial;
         break;
       }
+      if (cancel_requested()) return "interrupted";
       if (halving == 30)
         return by_energy ? "the line search found no decrease of the energy"
                          : "the line search found no decrease of the residual";
@@ -563,7 +566,7 @@ linalg::Status solve_hyperelastic(const Mesh& mesh, const HyperelasticMaterial& 
         reached = s;
         continue;
       }
-      if (cuts == options.max_step_cuts)
+      if (cuts == options.max_step_cuts || cancel_requested())
         return linalg::Status::failure("fem: step " + std::to_string(step) + ": " + why +
                                        "; the step was halved " + std::to_string(cuts) + " times");
       ++cuts;

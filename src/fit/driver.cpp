@@ -157,7 +157,7 @@ std::optional<Eigen::VectorXd> FitDriver::stiffer_start(const Eigen::VectorXd& s
     for (int k : stiffness) {
       const Parameter& p = parameters[static_cast<size_t>(k)];
       const double value = s * start[k];
-      const double wanted = p.log_scale ? std::log(value) : value;
+      const double wanted = p.to_phi(value);
       phi[k] = std::min(wanted, upper[k]);
       moved |= phi[k] > start_phi[k];
     }
@@ -279,7 +279,7 @@ Eigen::VectorXd FitDriver::scaled_start(const Eigen::VectorXd& phi, bool with_se
   Eigen::VectorXd scaled = phi;
   for (int k : stiffness) {
     const double value = s * values[k];
-    const double wanted = parameters[static_cast<size_t>(k)].log_scale ? std::log(value) : value;
+    const double wanted = parameters[static_cast<size_t>(k)].to_phi(value);
     scaled[k] = std::clamp(wanted, lower[k], upper[k]);
   }
   const Evaluation& at = evaluations.at(scaled, with_sensitivities);

@@ -73,7 +73,8 @@ JointCalibration::JointCalibration(std::vector<std::string> specimen_names,
                          "\", which is shared: add it to the specimen's fit.parameters");
       const Parameter &p = specimens_[s]->parameters().parameters()[static_cast<size_t>(k)],
                       &q = specimens_[0]->parameters().parameters()[static_cast<size_t>(first)];
-      if (p.lower != q.lower || p.upper != q.upper || p.log_scale != q.log_scale)
+      if (p.lower != q.lower || p.upper != q.upper || p.log_scale != q.log_scale ||
+          p.scale != q.scale)
         throw InputError("specimen \"" + specimen_names_[s] + "\": the shared \"" + name +
                          "\" has other bounds or another scale than in specimen \"" +
                          specimen_names_[0] + "\": a shared parameter is one variable");

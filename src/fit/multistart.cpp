@@ -39,7 +39,7 @@ double radical_inverse(long long i, int b) {
 Eigen::VectorXd phi_of(const ParameterMap& map, const Eigen::VectorXd& values) {
   Eigen::VectorXd phi = values;
   for (int k = 0; k < map.size(); ++k)
-    if (map.parameters()[static_cast<size_t>(k)].log_scale) phi[k] = std::log(values[k]);
+    phi[k] = map.parameters()[static_cast<size_t>(k)].to_phi(values[k]);
   return phi;
 }
 

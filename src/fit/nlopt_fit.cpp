@@ -126,8 +126,8 @@ nlopt_result minimise(nlopt_algorithm algorithm, const FitProblem& fit_problem,
   for (int k = 0; k < P; ++k) {
     const Parameter& p = map.parameters()[static_cast<size_t>(k)];
     step[k] = p.log_scale                            ? 0.3
-              : p.name.rfind("rotation_", 0) == 0    ? 0.05
-              : p.name.rfind("translation_", 0) == 0 ? 0.05 * fit_problem.body_length()
+              : p.name.rfind("rotation_", 0) == 0    ? 0.05 / p.scale
+              : p.name.rfind("translation_", 0) == 0 ? 0.05 * fit_problem.body_length() / p.scale
                                                      : 0.1 * std::max(std::abs(phi[k]), 1e-3);
     if (std::isfinite(lower[k]) && std::isfinite(upper[k]))
       step[k] = std::min(step[k], 0.25 * (upper[k] - lower[k]));

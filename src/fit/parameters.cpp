@@ -113,7 +113,7 @@ Eigen::VectorXd Variables::initial_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
-    phi[k] = p.log_scale ? std::log(p.initial) : p.initial;
+    phi[k] = p.to_phi(p.initial);
   }
   return phi;
 }
@@ -122,7 +122,7 @@ Eigen::VectorXd Variables::lower_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
-    phi[k] = p.log_scale ? (p.lower > 0.0 ? std::log(p.lower) : -HUGE_VAL) : p.lower;
+    phi[k] = p.log_scale && !(p.lower > 0.0) ? -HUGE_VAL : p.to_phi(p.lower);
   }
   return phi;
 }
@@ -131,22 +131,21 @@ Eigen::VectorXd Variables::upper_phi() const {
   Eigen::VectorXd phi(size());
   for (int k = 0; k < size(); ++k) {
     const Parameter& p = parameters_[static_cast<size_t>(k)];
-    phi[k] = p.log_scale ? std::log(p.upper) : p.upper;
+    phi[k] = p.to_phi(p.upper);
   }
   return phi;
 }
 
 Eigen::VectorXd Variables::values(const Eigen::VectorXd& phi) const {
   Eigen::VectorXd v(size());
-  for (int k = 0; k < size(); ++k)
-    v[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : phi[k];
+  for (int k = 0; k < size(); ++k) v[k] = parameters_[static_cast<size_t>(k)].to_value(phi[k]);
   return v;
 }
 
 Eigen::VectorXd Variables::value_derivatives(const Eigen::VectorXd& phi) const {
   Eigen::VectorXd d(size());
   for (int k = 0; k < size(); ++k)
-    d[k] = parameters_[static_cast<size_t>(k)].log_scale ? std::exp(phi[k]) : 1.0;
+    d[k] = parameters_[static_cast<size_t>(k)].value_derivative(phi[k]);
   return d;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
@@ -24,6 +25,18 @@ struct Parameter {
   // Fitted as log(value): for positive parameters (moduli, gamma, factors)
   // whose scale is unknown; the bounds must then be positive too.
   bool log_scale = false;
+  // A linear parameter is fitted as value / scale (1: in its own units).
+  // A scale from the start's size was tried for issue 59's "scale linear
+  // variables" and left at 1: it made Treloar's three-term Ogden fit end in
+  // a worse valley (9.4% rms in 629 iterations against 5.7% in 217).
+  double scale = 1.0;
+
+  // The fitted variable phi of a value, and back: log(value) in log scale,
+  // value / scale otherwise. Every conversion goes through these.
+  double to_phi(double value) const { return log_scale ? std::log(value) : value / scale; }
+  double to_value(double phi) const { return log_scale ? std::exp(phi) : phi * scale; }
+  // d value / d phi at phi.
+  double value_derivative(double phi) const { return log_scale ? std::exp(phi) : scale; }
 };
 
 bool is_alignment_parameter(const std::string& name);

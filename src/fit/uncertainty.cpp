@@ -53,10 +53,10 @@ void describe_estimates(const Variables& map, const Eigen::VectorXd& phi,
     if (on_bound(phi[k], lower[k], upper[k]))
       continue;  // a bound is no estimate: no standard error
     const double sigma = std::sqrt(std::max(0.0, scaled(k, k)));
-    const bool log = map.parameters()[static_cast<size_t>(k)].log_scale;
-    result.standard_errors[k] = log ? result.values[k] * sigma : sigma;
-    result.lower_95[k] = log ? std::exp(phi[k] - 1.96 * sigma) : phi[k] - 1.96 * sigma;
-    result.upper_95[k] = log ? std::exp(phi[k] + 1.96 * sigma) : phi[k] + 1.96 * sigma;
+    const Parameter& p = map.parameters()[static_cast<size_t>(k)];
+    result.standard_errors[k] = p.value_derivative(phi[k]) * sigma;
+    result.lower_95[k] = p.to_value(phi[k] - 1.96 * sigma);
+    result.upper_95[k] = p.to_value(phi[k] + 1.96 * sigma);
   }
 }
 
@@ -155,7 +155,7 @@ void check_interval_ends(EvaluationCache& evaluations, const FitProblem& m,
     const double half = 1.96 * std::sqrt(std::max(0.0, variance * covariance(k, k)));
     if (on_bound(phi[k], lower[k], upper[k]) || !(half > kSmallest) || !(level > 0.0)) continue;
     const Eigen::VectorXd path = covariance.col(k) / covariance(k, k);  // the linearised profile
-    auto value = [&](double phi_k) { return parameter.log_scale ? std::exp(phi_k) : phi_k; };
+    auto value = [&](double phi_k) { return parameter.to_value(phi_k); };
     std::ostringstream note;
     for (const int side : {-1, 1}) {
       const double farthest = side < 0 ? lower[k] - phi[k] : upper[k] - phi[k];

@@ -69,6 +69,9 @@ enum Tag : int {
   kAsk = 1,     // worker to rank 0: nothing yet, give me an item
   kResult = 2,  // worker to rank 0: an item's index, then its bytes; give me the next
   kItem = 3,    // rank 0 to worker: the next index, or -1: no more
+  // worker to rank 0: asked to stop (a signal on this rank alone) while
+  // computing an item, whose result is therefore not one: the job stops.
+  kInterrupted = 4,
 };
 
 // Waiting on a message by polling with a sleep: a blocking MPI call spins
@@ -98,6 +101,10 @@ void work(const WorkCompute& compute) {
     std::string message(sizeof item, '\0');
     std::memcpy(message.data(), &item, sizeof item);
     message += compute(static_cast<size_t>(item));
+    if (cancel_requested()) {  // the result was cut short: it is no result
+      MPI_Send(nullptr, 0, MPI_BYTE, 0, kInterrupted, MPI_COMM_WORLD);
+      continue;
+    }
     if (message.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
       throw std::length_error("a work item's result is over 2 GiB, more than one MPI message");
     MPI_Send(message.data(), static_cast<int>(message.size()), MPI_BYTE, 0, kResult,
@@ -150,6 +157,9 @@ class Dealer {
         std::memcpy(&item, message.data(), sizeof item);
         deliver(static_cast<size_t>(item), status.MPI_SOURCE, message.substr(sizeof item));
       }
+      // One rank stopped is the whole job stopped, as Ctrl-C on rank 0 is:
+      // no rank's cut-short work is reported as a failure of its own.
+      if (status.MPI_TAG == kInterrupted) request_cancel();
       const std::int64_t item = next();
       MPI_Send(&item, 1, MPI_INT64_T, status.MPI_SOURCE, kItem, MPI_COMM_WORLD);
       if (item < 0) --left;

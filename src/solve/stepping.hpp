@@ -208,7 +208,10 @@ struct SteppingSummary {
   Scheme scheme = Scheme::Incremental;
   SolverKind solver = SolverKind::Auto;  // the backend that ran (newton: the preconditioner's)
   TangentSolver tangent = TangentSolver::Auto;  // newton: how the tangent was solved
-  int newton_iterations = 0;                    // newton: over all steps
+  // Newton: "" or, when the tangent chosen stalled on pieces of steps that
+  // the exact one then solved, how many, and where and why it first stalled.
+  std::string tangent_fallback;
+  int newton_iterations = 0;  // newton: over all steps
   // Newton: the final step was solved from SteppingOptions::warm_start alone
   // (steps holds step n only); false when there was none or it failed and
   // the path was walked.

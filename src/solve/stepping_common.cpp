@@ -186,6 +186,7 @@ std::string SteppingSummary::BriefReport() const {
     out << "newton (" << to_string(tangent);
     if (tangent == TangentSolver::Krylov) out << ", preconditioner " << to_string(solver);
     out << "), " << steps.size() << " steps, " << newton_iterations << " newton iterations";
+    if (!tangent_fallback.empty()) out << " (" << tangent_fallback << ")";
     if (tangent == TangentSolver::Krylov || tangent == TangentSolver::Reused)
       out << ", " << krylov_iterations << " gmres iterations, " << factorizations
           << (tangent == TangentSolver::Reused ? " tangent LU" : " preconditioner")

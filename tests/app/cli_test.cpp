@@ -154,6 +154,57 @@ TEST(Cli, SingularSetupIsAFailureStatusNotACrash) {
   EXPECT_NE(o.output.find("no supports"), std::string::npos) << o.output;
 }
 
+// Issue 59, class 2: a FEM reference that fails after the fiber run keeps
+// the run in DIR.failed with the reason, exit 2 (it was "bad input", exit 1,
+// and the run was lost).
+TEST(Cli, AFemReferenceThatFailsKeepsTheFinishedRun) {
+  ScratchDir dir;
+  const auto config = dir.write("column.json", R"({"name": "column",
+    "surface": {"generator": "box", "min": [0, 0, 0], "max": [0.1, 0.1, 0.2], "segments": [2, 2, 4]},
+    "material": {"Y": 1000, "gamma": 0}, "supports": [{"where": "z <= 0"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81], "density": 1}],
+    "stepping": {"steps": 1}, "fem_reference": {"E": 1000, "nu": 0.4999999999999999, "size": 0.04}})");
+  const Outcome o = run_cli("run " + config.string() + " -o " + (dir.path() / "out").string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("error: fem_reference: "), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("likely cause: nu = 0.49999999999999989"), std::string::npos) << o.output;
+  const std::filesystem::path kept = dir.path() / "out.failed";
+  EXPECT_TRUE(std::filesystem::exists(kept / "steps.csv"));
+  EXPECT_TRUE(std::filesystem::exists(kept / "final.obj"));
+  std::ifstream failed(kept / "FAILED");
+  const std::string why((std::istreambuf_iterator<char>(failed)), std::istreambuf_iterator<char>());
+  EXPECT_NE(why.find("fem_reference: "), std::string::npos) << why;
+}
+
+// Issue 59, class 1: a gauge holds a rotation nothing else holds, checked on
+// the loads at their full factors. Two loads on one vertex that cancel only
+// at the last step turn the body before it: the gauge carried 0.09 N at step
+// 1 and the run succeeded. Its reaction is now checked after every step.
+TEST(Cli, AGaugeThatCarriesAForceIsNoEquilibrium) {
+  ScratchDir dir;
+  const std::string base = R"({"name": "gauge",
+    "surface": {"generator": "cylinder", "radius": 0.025, "length": 0.03, "segments": [3, 12]},
+    "material": {"Y": 30000, "gamma": 0.001}, "fibers": {"kinematics": "central"},
+    "supports": [{"label": "centre", "box": {"min": [-1e-7, -1e-7, -1e-7], "max": [1e-7, 1e-7, 1e-7]}}],
+    "paddles": [{"label": "lower", "axis": "x", "side": "below", "travel": 0},
+                {"label": "upper", "axis": "x", "side": "above", "travel": -0.003}],
+    "stepping": {"scheme": "newton", "steps": 4},
+    "loads": [{"type": "point", "vertex": 5, "force": [0, 0, 0.5], "schedule": "ramp"},
+              {"type": "point", "vertex": 5, "force": [0, 0, -0.5], "schedule": "SCHEDULE"}]})";
+  const auto with = [&](const std::string& schedule) {
+    std::string text = base;
+    text.replace(text.find("SCHEDULE"), 8, schedule);
+    return dir.write(schedule + ".json", text);
+  };
+  Outcome o = run_cli("run " + with("final").string() + " -o " + (dir.path() / "a").string());
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("step 1: the gauge (group \"gauge\") carries "), std::string::npos)
+      << o.output;
+  // The same loads cancelling at every step: the gauge carries nothing.
+  o = run_cli("run " + with("ramp").string() + " -o " + (dir.path() / "b").string());
+  EXPECT_EQ(o.status, 0) << o.output;
+}
+
 TEST(Cli, ARunawayStopsWithStatus2NamingTheStep) {
   ScratchDir dir;
   // The sphere experiment with a fluid 1e9 times too heavy.

@@ -5,9 +5,11 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <string>
 
 #include "fiberfluid/geom/generators.hpp"
 #include "fiberfluid/model/model.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::bridge {
 namespace {
@@ -36,6 +38,15 @@ model::Model clamped_cylinder(bool turning) {
   return m;
 }
 
+// The body's fluid weighing as water under 9.81 m/s^2, down z.
+model::Load water_weight() {
+  model::Load gravity;
+  gravity.kind = model::Load::Kind::Hydrostatic;
+  gravity.density = 1000.0;
+  gravity.acceleration = Eigen::Vector3d(0.0, 0.0, -9.81);
+  return gravity;
+}
+
 fem::TetMeshOptions mesh_options() {
   fem::TetMeshOptions o;
   o.size = 0.005;
@@ -53,11 +64,7 @@ fem::HyperelasticMaterial solid(double young) {
 // the linear FEM of the same mesh (the same loads and supports).
 TEST(FemBridge, ASmallLoadGivesTheLinearAnswer) {
   model::Model m = clamped_cylinder(false);
-  model::Load gravity;
-  gravity.kind = model::Load::Kind::Hydrostatic;
-  gravity.density = 1000.0;
-  gravity.acceleration = Eigen::Vector3d(0.0, 0.0, -9.81);
-  m.loads.push_back(gravity);
+  m.loads.push_back(water_weight());
   fem::Material linear;
   linear.young = 1e9;
   linear.poisson = 0.4;
@@ -102,6 +109,40 @@ TEST(FemBridge, AClampTurnedByNinetyDegreesTurnsTheSolidRigidly) {
         std::max(linear_worst, (s + small.displacement.row(v).transpose() - R * s).norm());
   }
   EXPECT_GT(linear_worst, 0.01);  // centimetres off the rotation
+}
+
+// Issue 59, class 3: a stop requested during the nonlinear FEM ends it at its
+// next Newton iteration as an interruption, not as a failed solve.
+TEST(FemBridge, AStopRequestedDuringTheFemInterruptsIt) {
+  const model::Model m = clamped_cylinder(true);
+  request_cancel();
+  EXPECT_THROW(solve_hyperelastic_fem_of_model(m, 6, solid(1e5), mesh_options(), 1), Interrupted);
+  clear_cancel();
+  EXPECT_NO_THROW(solve_hyperelastic_fem_of_model(m, 1, solid(1e5), mesh_options(), 1));
+}
+
+// A body held at one point: the failure names the cause (FemSolveFailure,
+// not bad input: the setup could be posed; fem/setup_diagnosis's own tests
+// name each cause).
+TEST(FemBridge, ASingularFemNamesItsLikelyCause) {
+  model::Model m = clamped_cylinder(false);
+  // Held at the clamp face's centre only: one vertex, three unknowns.
+  m.constraints.clear();
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (m.surface.V.row(v).norm() < 1e-9)
+      for (int a = 0; a < 3; ++a) m.constraints.push_back(model::Constraint{v, a, 0.0, {}, 0});
+  ASSERT_EQ(m.constraints.size(), 3u);
+  m.loads.push_back(water_weight());
+  fem::Material linear;
+  linear.young = 1e6;
+  try {
+    solve_fem_of_model(m, 1, linear, mesh_options(), 1);
+    ADD_FAILURE() << "a body free to spin was solved";
+  } catch (const FemSolveFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("likely cause: too few supports: 3 unknowns held"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

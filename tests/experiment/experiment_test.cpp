@@ -1159,3 +1159,87 @@ TEST(ExperimentPhases, AProgramGivesTheSurface) {
 }
 
 }  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+namespace {
+
+// Issue 59, class 4: MPI ranks compare this digest before they work. It
+// covers the bytes of every file the experiment names, not only its text and
+// mesh: a rank with another target.obj or force curve would decide a fit.
+TEST(ExperimentDigest, CoversEveryFileTheExperimentReads) {
+  testing::ScratchDir dir;
+  const auto octahedron = [](double x) {
+    return "v " + std::to_string(x) +
+           " 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+           "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+  };
+  dir.write("target.obj", octahedron(1.0));
+  dir.write("stress.csv", "test,stretch,nominal_stress_Pa\nuniaxial,1.5,100000\n");
+  const auto config = dir.write("fit.json", R"({"name": "digest",
+    "surface": {"generator": "icosphere", "subdivisions": 1},
+    "material": {"law": {"type": "neo_hookean", "mu": 1000}},
+    "supports": [{"where": "z >= 0.9"}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81], "density": 10}],
+    "fit": {"targets": [{"type": "surface", "file": "target.obj"},
+                        {"type": "material_test", "file": "stress.csv"}],
+            "parameters": [{"name": "mu"}]}})");
+  const std::string first = experiment_digest(load_experiment(config));
+  EXPECT_EQ(experiment_digest(load_experiment(config)), first);  // the same files: the same
+  dir.write("target.obj", octahedron(1.001));                    // the scan, a vertex moved
+  const std::string moved = experiment_digest(load_experiment(config));
+  EXPECT_NE(moved, first);
+  dir.write("stress.csv", "test,stretch,nominal_stress_Pa\nuniaxial,1.5,100001\n");
+  EXPECT_NE(experiment_digest(load_experiment(config)), moved);  // a material test's stress
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment
+
+namespace fiberfluid::experiment {
+namespace {
+
+// Issue 59, class 7: GMRES tangents (reused, krylov) on a poor preconditioner
+// stall where the exact tangent runs on. A cantilever of a table stiffening
+// 400 times past 1% strain under its weight: the reused tangent no longer
+// converges at step 1, its steps halved to the end, where the dense tangent
+// runs all 4. Now the exact tangent takes over a piece before its step is
+// cut (then hands back); the answer is the dense run's, and the summary says
+// which stalled, where and why.
+TEST(TangentFallback, AStalledGmresTangentGivesWayToTheExactOne) {
+  const double Y = 1e5, r = 400.0;
+  const nlohmann::json stress = {-(0.01 + 0.49 * r) * Y, -0.01 * Y, 0.0, 0.01 * Y,
+                                 (0.01 + 0.49 * r) * Y};
+  nlohmann::json document = {
+      {"name", "stiffening_cantilever"},
+      {"surface",
+       {{"generator", "cylinder"}, {"radius", 0.01}, {"length", 0.1}, {"segments", {6, 16}}}},
+      {"material",
+       {{"law",
+         {{"type", "tabulated"}, {"strain", {-0.5, -0.01, 0, 0.01, 0.5}}, {"stress", stress}}},
+        {"gamma", 0}}},
+      {"fibers", {{"kinematics", "central"}}},
+      {"supports", {{{"where", "x <= 0"}}}},
+      {"loads", {{{"type", "gravity"}, {"acceleration", {0, 0, -9.81}}, {"density", 8000}}}},
+      {"stepping", {{"scheme", "newton"}, {"steps", 4}}}};
+  const auto run = [&](const char* tangent) {
+    nlohmann::json d = document;
+    d["stepping"]["newton"] = {{"tangent", tangent}};
+    return run_experiment(parse_experiment(d, ".", "cantilever.json")).runs.front().summary;
+  };
+  const solve::SteppingSummary dense = run("dense");
+  ASSERT_TRUE(dense.success) << dense.message;
+  EXPECT_TRUE(dense.tangent_fallback.empty());
+  const solve::SteppingSummary reused = run("reused");
+  ASSERT_TRUE(reused.success) << reused.message;
+  EXPECT_EQ(reused.tangent, solve::TangentSolver::Reused);
+  EXPECT_EQ(reused.tangent_fallback.rfind("the exact dense tangent took ", 0), 0u)
+      << reused.tangent_fallback;
+  EXPECT_NE(reused.tangent_fallback.find("where the reused one stalled, first at step 1: newton: "),
+            std::string::npos)
+      << reused.tangent_fallback;
+  EXPECT_NE(reused.BriefReport().find(reused.tangent_fallback), std::string::npos);
+  EXPECT_LT((reused.unknowns - dense.unknowns).norm(), 1e-7 * dense.unknowns.norm());
+}
+
+}  // namespace
+}  // namespace fiberfluid::experiment

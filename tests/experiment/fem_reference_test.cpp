@@ -106,8 +106,50 @@ TEST(FemReference, WhatItCannotPoseIsAnError) {
   d.erase("prescribed");
   d["loads"] = {{{"type", "point"}, {"vertex", 0}, {"force", {0, 0, -1}}}};
   d["fem_reference"]["E"] = 5000;
-  // No supports: the fiber model's own check refuses it first, or the FEM's.
-  EXPECT_THROW(run_experiment(parse_experiment(d, ".", "column.json")), InputError);
+  // No supports: the fiber run fails, and so does the FEM, naming the cause.
+  const ExperimentResult unsupported = run_experiment(parse_experiment(d, ".", "column.json"));
+  EXPECT_FALSE(unsupported.runs_succeeded());
+  EXPECT_NE(unsupported.failure.find("likely cause: too few supports"), std::string::npos)
+      << unsupported.failure;
+  // Paddles have no FEM here: refused when the file is built, before any run.
+  d = column(0.3, {0, 0, 0.01});
+  d.erase("prescribed");
+  d["paddles"] = {{{"axis", "z"}, {"side", "above"}, {"travel", -0.01}}};
+  d["stepping"] = {{"scheme", "newton"}, {"steps", 1}};
+  try {
+    parse_experiment(d, ".", "column.json");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("column: fem_reference: paddles"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Class 1 and 2 of issue 59: a FEM that cannot be solved after a finished
+// fiber run is a failure of the experiment (the run kept, DIR.failed), never
+// a success with empty figures and never bad input that loses the run.
+TEST(FemReference, AFemThatFailsKeepsTheFiberRunAndSaysWhy) {
+  // A modulus of 1e-300 Pa under a load: the displacements overflow.
+  nlohmann::json d = column(0.3, {0, 0, 0.01});
+  d.erase("prescribed");
+  d["loads"] = {{{"type", "gravity"}, {"acceleration", {0, 0, -9.81}}, {"density", 1}}};
+  d["fem_reference"]["E"] = 1e-300;
+  ExperimentResult result = run_experiment(parse_experiment(d, ".", "column.json"));
+  ASSERT_TRUE(result.runs.front().summary.success) << result.runs.front().summary.message;
+  EXPECT_FALSE(result.fem_reference);
+  EXPECT_NE(result.failure.find("(a modulus too small for the loads?)"), std::string::npos)
+      << result.failure;
+  EXPECT_EQ(result.figures.count("fem_reference.max_displacement"), 0u);
+
+  // nu at 1/2 to rounding: the stiffness is singular in double precision,
+  // and the message names nu as the likely cause (not "too few supports").
+  d = column(0.3, {0, 0, 0.01});
+  d.erase("prescribed");
+  d["loads"] = {{{"type", "gravity"}, {"acceleration", {0, 0, -9.81}}, {"density", 1}}};
+  d["fem_reference"]["nu"] = 0.4999999999999999;
+  result = run_experiment(parse_experiment(d, ".", "column.json"));
+  EXPECT_TRUE(result.runs.front().summary.success);
+  EXPECT_NE(result.failure.find("likely cause: nu = "), std::string::npos) << result.failure;
 }
 
 }  // namespace

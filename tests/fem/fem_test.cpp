@@ -2,6 +2,7 @@
 // The finite elements verified without the benchmarks paper: the patch
 // test, the mass, and a cantilever against beam theory under refinement.
 #include "fiberfluid/fem/fem.hpp"
+#include "fiberfluid/fem/setup_diagnosis.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -202,7 +203,11 @@ TEST(Fem, TooFewSupportsIsAStatus) {
   const linalg::Status s = solve_static(stiffness_matrix(mesh, Material{}),
                                         Eigen::VectorXd::Ones(mesh.num_dofs()), Constraints{}, &u);
   EXPECT_FALSE(s.ok);
-  EXPECT_NE(s.message.find("too few supports"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("singular"), std::string::npos) << s.message;
+  // The cause is told from the setup (the solver sees only its factor fail).
+  const Status cause = diagnose_singular_setup(mesh, 0.3, {});
+  EXPECT_NE(cause.message.find("too few supports: 0 unknowns held"), std::string::npos)
+      << cause.message;
 }
 
 // A small 2D cantilever (clamped at x = 0) as a dynamic system.

@@ -546,3 +546,4 @@ TEST(Calibration, BadFitsAreNamed) {
 
 }  // namespace
 }  // namespace fiberfluid::fit
+

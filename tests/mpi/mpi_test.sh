@@ -91,6 +91,27 @@ interrupted)
   [ $took -le 20 ] || fail "the ranks took $took s to stop"
   grep -q "interrupted" "$work/err" || fail "rank 0 did not say it was interrupted: $(cat "$work/err")"
   [ "$(ls -A "$work" | tr '\n' ' ')" = "err " ] || fail "left behind: $(ls -A "$work")"
+  # A signal to one worker rank alone (issue 59, class 4) stops the whole
+  # job the same way: its cut-short variant is no failure of its own, so no
+  # DIR.failed listing variants as "interrupted".
+  "${mpirun[@]}" -np 2 "$fiberfluid" run "$sweep" -q -o "$work/out" >/dev/null 2>"$work/err" &
+  launcher=$!
+  worker=""
+  for _ in $(seq 1 100); do  # until rank 1 runs (up to 10 s)
+    for pid in $(pgrep -f -- "^$fiberfluid run $sweep"); do
+      tr '\0' '\n' <"/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" &&
+        worker=$pid
+    done
+    [ -n "$worker" ] && break
+    sleep 0.1
+  done
+  [ -n "$worker" ] || fail "no rank 1 to interrupt"
+  sleep 1
+  kill -INT "$worker"
+  wait $launcher
+  status=$?
+  [ $status -eq 130 ] || fail "rank 1 alone: status $status (expected 130): $(cat "$work/err")"
+  [ "$(ls -A "$work" | tr '\n' ' ')" = "err " ] || fail "rank 1 alone: left $(ls -A "$work")"
   ;;
 multistart)
   # fit_synthetic_liver from 8 starts, dealt over two ranks: the single

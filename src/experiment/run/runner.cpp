@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "fiberfluid/bridge/fem_bridge.hpp"
+#include "fiberfluid/experiment/run/fem_reference.hpp"
 #include "fiberfluid/experiment/run/run_archive.hpp"
 #include "fiberfluid/experiment/spec/figures.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
@@ -288,6 +290,29 @@ void run_dealt_cases(const Experiment& ex, const RunObserver& observer, const Wo
       });
 }
 
+// The FEM reference after the fiber runs. A FEM that fails keeps the runs:
+// the folder becomes DIR.failed with the reason (exit 2), never bad input.
+void add_fem_reference(const Experiment& ex, ExperimentResult& result) {
+  report_progress("FEM reference", 0.0, 1.0);
+  std::shared_ptr<FemReferenceResult> reference;
+  try {
+    reference = std::make_shared<FemReferenceResult>(solve_fem_reference(
+        ex.simulation().cases.front(), result.runs.front(), *ex.fem_reference()));
+  } catch (const bridge::FemSolveFailure& e) {
+    result.failure = std::string("fem_reference: ") + e.what();
+    return;
+  }
+  report_progress("FEM reference", 1.0, 1.0);
+  for (const auto& [name, value] : reference->figures) {
+    if (!std::isfinite(value)) {
+      result.failure = "fem_reference: its figure " + name + " is not finite";
+      return;
+    }
+    result.figures[name] = value;
+  }
+  result.fem_reference = reference;
+}
+
 }  // namespace
 
 void serve_cases(const Experiment& ex, const WorkDealer& dealer) {
@@ -323,12 +348,7 @@ ExperimentResult run_experiment(const Experiment& ex, const RunObserver& observe
     else
       run_local_cases(ex, observer, options, result);
     if (ex.fem_reference() && !ex.simulation().cases.empty()) {
-      report_progress("FEM reference", 0.0, 1.0);
-      auto reference = std::make_shared<FemReferenceResult>(solve_fem_reference(
-          ex.simulation().cases.front(), result.runs.front(), *ex.fem_reference()));
-      report_progress("FEM reference", 1.0, 1.0);
-      for (const auto& [name, value] : reference->figures) result.figures[name] = value;
-      result.fem_reference = reference;
+      add_fem_reference(ex, result);
     }
     const FiberReport& fibers = ex.simulation().cases.front().fibers;
     result.figures["fibers.in_all"] = static_cast<double>(fibers.pairs);

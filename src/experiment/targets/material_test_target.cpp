@@ -115,6 +115,7 @@ FitKindTargetSpec read_material_test_target(Fields& t, const std::filesystem::pa
   MaterialTestSpec m;
   const FieldName field = t.field();
   m.file = folder / t.string("file");
+  t.resolve("file", absolute_path(m.file));  // absolute, as every file a reader reads
   m.weight = t.positive("weight", 1.0);
   m.label = t.string("label", m.file.filename().string());
   t.finish();

@@ -157,6 +157,8 @@ json run_json(const Case& c, const ExperimentResult& result, const RunResult& ru
           {"patch", c.patch},
           {"paddle_axes", paddle_axes},
           {"solver", solve::to_string(run.summary.solver)},
+          {"tangent", solve::to_string(run.summary.tangent)},
+          {"tangent_fallback", run.summary.tangent_fallback},
           {"pcg_iterations", run.summary.solver_statistics.iterations},
           {"factorization_flops", run.summary.solver_statistics.factorization_flops},
           {"stepping", stepping_json(c.stepping)},

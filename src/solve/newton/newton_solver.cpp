@@ -27,6 +27,7 @@ double forcing_term(double norm, const NewtonOptions& options) {
 NewtonSolver::NewtonSolver(const model::Model& model, const SteppingOptions& options,
                            SteppingSummary& summary)
     : model_(model),
+      options_(options),
       newton_(options.newton),
       summary_(summary),
       equilibrium_(std::make_shared<const model::Equilibrium>(model)),
@@ -37,9 +38,38 @@ NewtonSolver::NewtonSolver(const model::Model& model, const SteppingOptions& opt
   const TangentSolver kind =
       choose_tangent(newton_.tangent, supports_.num_reduced(), model.material.kinematics,
                      equilibrium_->sparse_fibers());
-  tangent_ = make_tangent_solve(equilibrium_, options, kind);
+  chosen_ = make_tangent_solve(equilibrium_, options, kind);
+  tangent_ = chosen_;
+  tangent_kind_ = chosen_kind_ = kind;
   summary_.tangent = kind;
   summary_.solver = tangent_->preconditioner_kind();
+}
+
+std::string NewtonSolver::tangent_name() const {
+  return std::string("the ") + to_string(tangent_kind_) + " tangent";
+}
+
+bool NewtonSolver::use_exact_tangent(const std::string& why) {
+  if (tangent_kind_ == TangentSolver::Dense || tangent_kind_ == TangentSolver::Sparse) return false;
+  const TangentSolver exact =
+      equilibrium_->sparse_fibers() ? TangentSolver::Sparse : TangentSolver::Dense;
+  const double n = supports_.num_reduced() + 1.0;
+  if (exact == TangentSolver::Dense && 16.0 * n * n > memory_budget_bytes()) return false;
+  if (!exact_) exact_ = make_tangent_solve(equilibrium_, options_, exact);
+  tangent_ = exact_;
+  tangent_kind_ = exact;
+  if (first_stall_.empty())
+    first_stall_ = "step " + std::to_string(summary_.steps.size() + 1) + ": " + why;
+  ++exact_pieces_;
+  summary_.tangent_fallback = "the exact " + std::string(to_string(exact)) + " tangent took " +
+                              std::to_string(exact_pieces_) + " piece(s) where the " +
+                              to_string(chosen_kind_) + " one stalled, first at " + first_stall_;
+  return true;
+}
+
+void NewtonSolver::use_chosen_tangent() {
+  tangent_ = chosen_;
+  tangent_kind_ = chosen_kind_;
 }
 
 // The tangent solve prepared at x (the solution), for the summary.
@@ -164,14 +194,15 @@ std::string NewtonSolver::newton(const LoadPoint& at, const model::DofMap& dofs,
     if (it == newton_.max_iterations) {
       std::ostringstream out;
       out << "newton: no convergence in " << it << " iterations (relative residual " << norm
-          << ", newton.residual_tolerance " << newton_.residual_tolerance << ")";
+          << ", newton.residual_tolerance " << newton_.residual_tolerance << ", " << tangent_name()
+          << ")";
       return out.str();
     }
     Eigen::VectorXd dx;
     const double forcing = forcing_term(norm, newton_);
     tangent_->set_added_tangent(contacts_.friction_tangent(x, R));
     const Status status = prepare_and_solve(x, at.factors, dofs, -r, forcing, record, &dx);
-    if (!status.ok) return status.message;
+    if (!status.ok) return status.message + " (" + tangent_name() + ")";
     // Backtracking: halve the step until the residual falls (Armijo).
     Eigen::VectorXd step = Eigen::VectorXd::Zero(x.size());
     dofs.scatter(dx, step);
@@ -187,7 +218,7 @@ std::string NewtonSolver::newton(const LoadPoint& at, const model::DofMap& dofs,
         break;
       if (halving == 12)
         return "newton: the line search found no decrease of the residual (relative " +
-               std::to_string(norm) + ")";
+               std::to_string(norm) + ", " + tangent_name() + ")";
       alpha *= 0.5;
       ++record.line_search_halvings;
     }
@@ -218,9 +249,9 @@ Status NewtonSolver::prepare_and_solve(const Eigen::VectorXd& x, const std::vect
                                        double forcing, StepRecord& record, Eigen::VectorXd* y) {
   Status status = tangent_->prepare(x, factors, dofs, &supports_);
   if (status.ok) status = solve_prepared(b, forcing, record, y);
-  summary_.factorizations = tangent_->factorizations();
-  summary_.single_precision_factorizations = tangent_->single_precision_factorizations();
-  summary_.solver = tangent_->preconditioner_kind();
+  summary_.factorizations = chosen_->factorizations() + (exact_ ? exact_->factorizations() : 0);
+  summary_.single_precision_factorizations = chosen_->single_precision_factorizations();
+  summary_.solver = chosen_->preconditioner_kind();
   return status;
 }
 

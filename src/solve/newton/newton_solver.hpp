@@ -71,6 +71,19 @@ class NewtonSolver {
   void touch_planes(const LoadPoint& at, const Eigen::VectorXd& x) {
     contacts_.touch_planes(at, x);
   }
+  // Where the tangent chosen is inexact (GMRES: krylov, reused) and the
+  // exact one affordable: switches to the exact LU (sparse for a horizon's
+  // lists, else dense) until use_chosen_tangent, counting it in
+  // summary.tangent_fallback. False when the exact tangent is in use already
+  // or the dense LU would not fit the memory budget. A piece of a step that
+  // failed is tried again so before the step is cut: GMRES on a poor
+  // preconditioner can stall a line search that the exact tangent passes
+  // (issue 59, class 7).
+  bool use_exact_tangent(const std::string& why);
+  // Back to the tangent chosen (after a piece the exact one solved).
+  void use_chosen_tangent();
+  // "the reused tangent": the tangent strategy now in use, for messages.
+  std::string tangent_name() const;
   // Snapshot and restore of the contact state, for a step that is cut.
   using ContactState = ContactSet::State;
   ContactState contact_state() const { return contacts_.state(); }
@@ -109,6 +122,7 @@ class NewtonSolver {
                        Eigen::VectorXd* x, double* t, StepRecord& record);
 
   const model::Model& model_;
+  const SteppingOptions& options_;
   const NewtonOptions& newton_;
   SteppingSummary& summary_;
   std::shared_ptr<const model::Equilibrium> equilibrium_;
@@ -117,7 +131,12 @@ class NewtonSolver {
   Eigen::VectorXd residual_;
   double diagonal_ = 1.0;  // the body's bounding-box diagonal
   ResidualGauge gauge_;
-  std::shared_ptr<TangentSolve> tangent_;
+  std::shared_ptr<TangentSolve> tangent_;             // in use: chosen_ or exact_
+  std::shared_ptr<TangentSolve> chosen_, exact_;      // exact_: made on first use
+  TangentSolver tangent_kind_ = TangentSolver::Auto;  // tangent_'s
+  TangentSolver chosen_kind_ = TangentSolver::Auto;
+  int exact_pieces_ = 0;     // pieces the exact tangent took over
+  std::string first_stall_;  // where and why the chosen one first stalled
 };
 
 }  // namespace fiberfluid::solve

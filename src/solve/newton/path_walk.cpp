@@ -48,6 +48,7 @@ std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double
     const size_t norms_before = record.residual_norms.size();
     const std::string why = solver.solve(at(target), x, record);
     if (why.empty()) {
+      solver.use_chosen_tangent();  // after a piece the exact tangent took over
       reached = target;
       ++record.pieces;
       predictor.add(reached, x);
@@ -66,6 +67,7 @@ std::string walk_step(NewtonSolver& solver, const std::function<LoadPoint(double
       predict = false;
       continue;
     }
+    if (solver.use_exact_tangent(why)) continue;  // the same piece, on the exact tangent
     const bool stalled = why.rfind("newton: the line search found no decrease", 0) == 0 &&
                          record.residual_norms.size() > norms_before;
     if (stalled) {

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "fiberfluid/geom/area_vectors.hpp"
 #include "fiberfluid/model/assembly.hpp"
@@ -28,7 +30,12 @@ StepFinisher::StepFinisher(const model::Model& model, const SteppingOptions& opt
       summary_(summary),
       reference_volume_(solver.equilibrium().reference_volume()),
       last_face_areas_(geom::face_area_vectors(model.surface.V, model.surface.F)),
-      groups_(std::max<size_t>(1, model.constraint_groups.size())) {}
+      groups_(std::max<size_t>(1, model.constraint_groups.size())) {
+  const auto gauge = std::find(model.constraint_groups.begin(), model.constraint_groups.end(),
+                               std::string("gauge"));
+  if (gauge != model.constraint_groups.end())
+    gauge_group_ = static_cast<int>(gauge - model.constraint_groups.begin());
+}
 
 void StepFinisher::compare_with(const Eigen::VectorXd& x) {
   last_face_areas_ = geom::face_area_vectors(model::positions(model_, x), model_.surface.F);
@@ -59,6 +66,24 @@ std::string StepFinisher::finish(const LoadPoint& at, const Eigen::VectorXd& x,
   // A clamp's mirror layer holds the body through its fibers, not its rows.
   const std::vector<Eigen::Vector3d> layers = solver_.equilibrium().support_forces(x);
   for (size_t g = 0; g < layers.size(); ++g) record.reactions[g % groups_] += layers[g];
+  // A gauge holds a rotation that nothing else holds, and is free of force
+  // only where the loads do not turn the body about it. The set-up checks the
+  // loads at their full factors on the rest shape; at this step's factors
+  // and shape they may (two loads that cancel only at the last step, an
+  // anisotropic body): a gauge that carries a force means no equilibrium.
+  if (gauge_group_ >= 0) {
+    const double carried = record.reactions[static_cast<size_t>(gauge_group_)].norm();
+    const double scale = F.lpNorm<1>() + R.head(static_cast<Eigen::Index>(dim) * nv).lpNorm<1>();
+    if (carried > 1e-6 * scale) {
+      std::ostringstream why;
+      why << "step " << k << ": the gauge (group \"gauge\") carries " << carried << " N, "
+          << carried / scale
+          << " of the forces on the body: the loads turn it about the rotation the supports "
+             "leave free, so there is no equilibrium without a support that holds it (hold a "
+             "vertex away from the axis, or make the paddles \"sticking\")";
+      return why.str();
+    }
+  }
   record.paddles.resize(model_.paddles.size());
   for (size_t p = 0; p < model_.paddles.size(); ++p) {
     record.paddles[p].plane = at.planes[p];

@@ -44,6 +44,7 @@ class StepFinisher {
   double reference_volume_;
   Eigen::MatrixXd last_face_areas_;
   size_t groups_;
+  int gauge_group_ = -1;  // the group "gauge" (case_builder's free-rotation holds), or -1
 };
 
 }  // namespace fiberfluid::solve
