@@ -121,6 +121,10 @@ TEST(ExperimentConfig, BadFieldsAreNamed) {
   c["stepping"]["control"] = "arc_length";
   expect_config_error(dir, c, "stepping.control: arc-length control needs \"scheme\"");
   c = base_config();
+  c["stepping"] = {{"scheme", "newton"}, {"control", "arc_length"}};
+  c["paddles"] = {{{"axis", "z"}, {"side", "above"}, {"travel", -0.01}}};
+  expect_config_error(dir, c, "stepping.control: arc length follows the loads' factor");
+  c = base_config();
   c["fem_reference"] = {{"E", 1000}, {"nu", 0.3}, {"material", "mooney"}};
   expect_config_error(dir, c, "fem_reference.material: ");
   c = base_config();

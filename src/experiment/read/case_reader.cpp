@@ -455,6 +455,11 @@ CaseSpec read_case(Fields& root, const std::filesystem::path& folder,
     root.fail("paddles",
               "paddles need \"stepping\": {\"scheme\": \"newton\"} (contact is "
               "an active set inside the equilibrium iterations)");
+  // Refused here, not at the run's start (issue 59, class 5).
+  if (!c.paddles.empty() && c.stepping.newton.control == solve::NewtonOptions::Control::ArcLength)
+    root.fail("stepping.control",
+              "arc length follows the loads' factor, and paddles move the body by "
+              "displacement, which load control already follows: use \"control\": \"load\"");
   if (!c.material.material.law.is_constant() && c.stepping.scheme == solve::Scheme::Incremental &&
       !c.stepping.rebuild_matrix && warnings != nullptr)
     warnings->push_back(
