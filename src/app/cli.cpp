@@ -2,13 +2,9 @@
 #include "fiberfluid/app/cli.hpp"
 
 #include <csignal>
-#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <functional>
 #include <iostream>
-#include <iterator>
 #include <string>
 #include <system_error>
 

@@ -11,6 +11,7 @@
 #include "fiberfluid/fem/mesh_tools.hpp"
 #include "fiberfluid/fem/setup_diagnosis.hpp"
 #include "fiberfluid/geom/area_vectors.hpp"
+#include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/geom/target.hpp"
 #include "fiberfluid/model/boundary_conditions.hpp"
 #include "fiberfluid/util/error.hpp"
@@ -157,8 +158,7 @@ void finish(const PosedFem& posed, const Eigen::VectorXd& u, FemOfModel* out) {
 // are no result (a modulus so small that the loads overflow them): a
 // failure, never a success with empty or absurd figures.
 void check_displacements(const PosedFem& posed, double poisson, const Eigen::VectorXd& u) {
-  const Eigen::MatrixXd& nodes = posed.mesh.nodes;
-  const double size = (nodes.colwise().maxCoeff() - nodes.colwise().minCoeff()).norm();
+  const double size = geom::bounding_box_diagonal(posed.mesh.nodes);
   const double largest =
       u.allFinite() ? fem::displacement_rows(u, 3).rowwise().norm().maxCoeff() : HUGE_VAL;
   if (!std::isfinite(largest))

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include "fiberfluid/geom/surface.hpp"
+
 namespace fiberfluid::fem {
 namespace {
 
@@ -76,7 +78,7 @@ Status diagnose_singular_setup(const Mesh& mesh, double poisson,
   }
   const Eigen::MatrixXd R = held_rigid_modes(mesh, held);
   // Scale-free: rotations are in lengths, so compare against the body's size.
-  const double size = (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
+  const double size = geom::bounding_box_diagonal(mesh.nodes);
   Eigen::MatrixXd scaled = R;
   scaled.rightCols(modes - mesh.dim) /= size > 0.0 ? size : 1.0;
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullV);
