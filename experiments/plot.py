@@ -129,13 +129,13 @@ def plot_study(study, png_path):
     rows = (n + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows), squeeze=False)
     for ax, (name, f) in zip(axes.flat, sorted(figures.items())):
-        ax.plot(h, f["values"], "o-", label="levels")
-        if f["monotone"] and f["observed_order"] is not None:
+        ax.plot(h[: len(f["values"])], f["values"], "o-", label="levels")
+        if f.get("observed_order") is not None:
             x = f["extrapolated"]
             ax.plot([0.0], [x], "s", color="C3", label=f"extrapolated (order {f['observed_order']:.2f})")
             ax.axhspan(x - f["error_estimate"], x + f["error_estimate"], color="C3", alpha=0.15)
         else:
-            ax.set_title("not monotone: no order", fontsize=8, loc="right")
+            ax.set_title((f["trend"] or "fewer than 3 levels") + ": no order", fontsize=8, loc="right")
         ax.set_xlim(left=-0.04)
         ax.set_xlabel("element size, relative to the coarsest")
         ax.set_ylabel(name, fontsize=8)

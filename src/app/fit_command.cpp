@@ -189,6 +189,10 @@ int calibrate_specimens(const experiment::Experiment& ex, const experiment::Join
 // warning where the mesh moves it further than the data pin it.
 void print_mesh_check(const fiberfluid::fit::FitResult& fitted,
                       const experiment::MeshCheck& check) {
+  if (!check.failure.empty()) {  // said as the fit's failure too
+    std::cout << "  mesh check (" << check.resolution << "): failed\n";
+    return;
+  }
   std::cout << "  mesh check (" << check.resolution << ", "
             << fiberfluid::fit::to_string(check.fitted.status) << "):\n";
   for (size_t k = 0; k < fitted.names.size() && k < check.fitted.names.size(); ++k) {

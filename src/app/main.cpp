@@ -30,11 +30,32 @@ struct StudyFlags {
   double ratio = 1.5;
   std::vector<std::string> figures;
   bool plot = false;
+  RunFlags budgets;  // --max-memory and --max-time, over every level's runs and FEM
 };
+
+// One figure's row: its values, then its order and extrapolation or why it has none.
+void print_studied_figure(const experiment::StudiedFigure& f, size_t levels) {
+  std::printf("%-40s", f.name.c_str());
+  for (double v : f.values) std::printf(" %14.7g", v);
+  for (size_t k = f.values.size(); k < levels; ++k) std::printf(" %14s", "-");
+  const fiberfluid::metrics::RichardsonEstimate& e = f.estimate;
+  if (!f.estimated)
+    std::printf(" %8s %14s\n", "-", "(< 3 levels)");
+  else if (std::isfinite(e.order))
+    std::printf(" %8.2f %14.7g %11.3g\n", e.order, e.extrapolated, e.error);
+  else if (e.trend == fiberfluid::metrics::Trend::Oscillating)
+    std::printf(" %8s %14s %11.3g\n", "-", "(oscillating)", e.error);
+  else
+    std::printf(" %8s %14s\n", "-",
+                ("(" + std::string(fiberfluid::metrics::trend_name(e.trend)) + ")").c_str());
+}
 
 // fiberfluid study mesh: the levels' values, observed orders and
 // extrapolations as a table, and study.csv / study.json in the output folder.
+// A level that fails after others ran keeps theirs in DIR.failed (exit 2).
 int study_command(const StudyFlags& flags) {
+  fiberfluid::set_memory_budget(flags.budgets.max_memory);
+  fiberfluid::set_time_budget(flags.budgets.max_time);
   experiment::MeshStudySpec spec;
   spec.mesh = flags.fem ? experiment::StudiedMesh::FemReference : experiment::StudiedMesh::Surface;
   spec.levels = flags.levels;
@@ -49,29 +70,35 @@ int study_command(const StudyFlags& flags) {
   const experiment::MeshStudy study = experiment::run_mesh_study(
       flags.experiment, spec, [](const std::string& line) { std::cerr << line << "\n"; });
   std::printf("%-40s", "figure");
-  for (size_t k = 0; k < study.resolutions.size(); ++k)
+  for (int k = 0; k < spec.levels; ++k)
     std::printf(" %14s", ("level " + std::to_string(k + 1)).c_str());
   std::printf(" %8s %14s %11s\n", "order", "extrapolated", "error est.");
-  for (const experiment::StudiedFigure& f : study.figures) {
-    std::printf("%-40s", f.name.c_str());
-    for (double v : f.values) std::printf(" %14.7g", v);
-    if (f.estimate.monotone && std::isfinite(f.estimate.order))
-      std::printf(" %8.2f %14.7g %11.3g\n", f.estimate.order, f.estimate.extrapolated,
-                  f.estimate.error);
-    else
-      std::printf(" %8s %14s %11.3g\n", "-", "(not monotone)", f.estimate.error);
-  }
+  for (const experiment::StudiedFigure& f : study.figures)
+    print_studied_figure(f, static_cast<size_t>(spec.levels));
   for (size_t k = 0; k < study.resolutions.size(); ++k)
     std::printf("level %zu: %s, relative size %.4g, %.1f s\n", k + 1, study.resolutions[k].c_str(),
                 study.sizes[k], study.seconds[k]);
+  for (const std::string& w : study.warnings) std::cerr << "warning: " << w << "\n";
   const std::filesystem::path staging = experiment::create_staging_folder(output, name);
   fiberfluid::geom::write_text_file(staging / "study.csv", experiment::mesh_study_csv(study));
   fiberfluid::geom::write_text_file(staging / "study.json",
                                     experiment::mesh_study_json(study).dump(2) + "\n");
+  std::filesystem::path placed = output;
+  if (!study.failure.empty()) {
+    fiberfluid::geom::write_text_file(
+        staging / experiment::kFailedMark,
+        "this study failed at level " + std::to_string(study.resolutions.size() + 1) +
+            "; the levels before it are in study.csv and study.json\n" + study.failure + "\n");
+    placed += ".failed";
+  }
   std::vector<std::string> warnings;
-  experiment::move_into_place(staging, output, &warnings);
+  experiment::move_into_place(staging, placed, &warnings);
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
-  std::printf("wrote %s and %s\n", (output / "study.csv").c_str(), (output / "study.json").c_str());
+  std::printf("wrote %s and %s\n", (placed / "study.csv").c_str(), (placed / "study.json").c_str());
+  if (!study.failure.empty()) {
+    std::cerr << "error: " << study.failure << "\n";
+    return kSolverFailed;
+  }
   if (flags.plot) draw_plot(output, "study.json");
   return kOk;
 }
@@ -332,6 +359,7 @@ void define_commands(CLI::App& cli, Commands& c) {
   c.mesh_study->add_flag("--plot", c.study_flags.plot,
                          "Also draw DIR/plot.png: each figure against the element size, with its "
                          "extrapolation (python3 with matplotlib)");
+  add_resource_limits(c.mesh_study, c.study_flags.budgets);
 
   c.schema = cli.add_subcommand(
       "schema",

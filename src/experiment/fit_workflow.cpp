@@ -22,6 +22,12 @@ FitOutcome run_fit(const Experiment& ex, const FitSetup& setup, const std::files
                    const WorkDealer& dealer, const FitHooks& hooks) {
   const fit::Calibration& calibration = *setup.calibration;
   FitOutcome out;
+  // A mesh check that cannot be posed (its mesh lacks a point the experiment
+  // names, its fibers refuse it) is bad input before the fit, not after it.
+  if (ex.fit()->mesh_check != "none") {
+    std::string resolution;
+    mesh_check_experiment(ex, &resolution);
+  }
   if (ex.fit()->multistart) {
     out.search = fit::run_multistart(calibration, *ex.fit()->multistart, dealer, hooks.on_start);
     out.fitted = out.search->best();
@@ -59,8 +65,9 @@ FitOutcome run_fit(const Experiment& ex, const FitSetup& setup, const std::files
         hooks.on_phase("mesh check: the fit again on a " + ex.fit()->mesh_check + " mesh");
       out.mesh_check = run_mesh_check(at_fit);
       throw_if_cancelled("the mesh check");
-      for (const auto& [name, value] : mesh_check_figures(fitted, *out.mesh_check))
-        result.figures[name] = value;
+      if (out.mesh_check->failure.empty())
+        for (const auto& [name, value] : mesh_check_figures(fitted, *out.mesh_check))
+          result.figures[name] = value;
     }
     if (out.search)
       for (const auto& [name, value] : multistart_figures(*out.search))
@@ -68,8 +75,12 @@ FitOutcome run_fit(const Experiment& ex, const FitSetup& setup, const std::files
     result.checks = check_expected(at_fit, result);
   }
   result.failure = ending("the fit", fitted.status, fitted.message, fitted.status_detail);
+  // A check that failed keeps the fit: DIR.failed with the check's reason.
+  if (result.failure.empty() && out.mesh_check && !out.mesh_check->failure.empty())
+    result.failure = "the mesh check failed: " + out.mesh_check->failure;
+  const MeshCheck* check = out.mesh_check ? &*out.mesh_check : nullptr;
   writer.finish(result, [&](const std::filesystem::path& dir) {
-    write_fit_files(dir, at_fit, setup, fitted, result, searched);
+    write_fit_files(dir, at_fit, setup, fitted, result, searched, check);
   });
   out.folder = writer.folder();
   out.warnings = writer.warnings();

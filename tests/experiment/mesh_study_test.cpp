@@ -3,8 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <fstream>
+#include <thread>
 
 #include "../app/cli_support.hpp"
 #include "../test_support.hpp"
@@ -35,8 +38,203 @@ TEST(MeshStudy, RichardsonFindsTheOrderAndTheLimitOfASmoothSequence) {
   // Changes of both signs have no order: the last change is the estimate.
   const RichardsonEstimate oscillating = richardson(1.0, 1.1, 1.05, 1.0, 0.5, 0.25);
   EXPECT_FALSE(oscillating.monotone);
+  EXPECT_EQ(oscillating.trend, metrics::Trend::Oscillating);
   EXPECT_TRUE(std::isnan(oscillating.order));
   EXPECT_NEAR(oscillating.error, 0.05, 1e-12);
+}
+
+// Issue 59, class 1 ("no success without a result"): a figure that does not
+// change has no order (it was "order 0.00"); changes that grow are not
+// converging, whatever Celik's absolute value makes of them (a diverging
+// figure was "order 7.31" with an extrapolation); and the trend is over
+// every level, not the three finest.
+TEST(MeshStudy, NoOrderWithoutConvergence) {
+  const RichardsonEstimate constant = richardson(0.001, 0.001, 0.001, 1.0, 0.5, 0.25);
+  EXPECT_EQ(constant.trend, metrics::Trend::Constant);
+  EXPECT_TRUE(std::isnan(constant.order));
+  EXPECT_EQ(constant.extrapolated, 0.001);
+  EXPECT_EQ(constant.error, 0.0);
+  // 1e-16 apart: rounding, still constant.
+  EXPECT_EQ(richardson(0.3, 0.1 + 0.2, 0.3, 1.0, 0.5, 0.25).trend, metrics::Trend::Constant);
+
+  // Changes of one sign that grow: 1, 1.1, 1.3 (0.1, then 0.2).
+  const RichardsonEstimate growing = richardson(1.0, 1.1, 1.3, 1.0, 0.5, 0.25);
+  EXPECT_EQ(growing.trend, metrics::Trend::NotConverging);
+  EXPECT_TRUE(growing.monotone);
+  EXPECT_TRUE(std::isnan(growing.order));
+  EXPECT_TRUE(std::isnan(growing.extrapolated));
+  EXPECT_TRUE(std::isnan(growing.error));
+  // Equal changes do not shrink either.
+  EXPECT_EQ(richardson(1.0, 1.5, 2.0, 1.0, 0.5, 0.25).trend, metrics::Trend::NotConverging);
+
+  // The organ of the issue: -3.5%, +10.8%, +0.09% over four levels. Its three
+  // finest alone look monotone with an order; over every level it oscillates.
+  std::vector<double> organ = {1.0};
+  for (double change : {-0.035, 0.108, 0.0009}) organ.push_back(organ.back() * (1.0 + change));
+  const std::vector<double> sizes = {1.0, 1.0 / 1.5, 1.0 / 2.25, 1.0 / 3.375};
+  ASSERT_TRUE(
+      std::isfinite(richardson(organ[1], organ[2], organ[3], sizes[1], sizes[2], sizes[3]).order));
+  const RichardsonEstimate whole = richardson(organ, sizes);
+  EXPECT_EQ(whole.trend, metrics::Trend::Oscillating);
+  EXPECT_TRUE(std::isnan(whole.order));
+  // A cylinder whose last change is larger than the one before: 0.010, 0.004, 0.006.
+  const RichardsonEstimate cylinder = richardson({0.150, 0.140, 0.136, 0.130}, sizes);
+  EXPECT_EQ(cylinder.trend, metrics::Trend::NotConverging);
+  EXPECT_TRUE(std::isnan(cylinder.order));
+  // Shrinking over all four: the order from the three finest, as before.
+  const auto f = [](double h) { return 2.0 + 0.3 * h * h; };
+  const RichardsonEstimate smooth =
+      richardson({f(sizes[0]), f(sizes[1]), f(sizes[2]), f(sizes[3])}, sizes);
+  EXPECT_EQ(smooth.trend, metrics::Trend::Converging);
+  EXPECT_NEAR(smooth.order, 2.0, 1e-9);
+  EXPECT_NEAR(smooth.extrapolated, 2.0, 1e-12);
+}
+
+// A small box, clamped at x = 0, one vertex pulled 1 mm up by index.
+json pulled_box(const std::vector<int>& segments) {
+  return {
+      {"name", "box"},
+      {"surface",
+       {{"generator", "box"},
+        {"min", {0, 0, 0}},
+        {"max", {0.04, 0.02, 0.02}},
+        {"segments", segments}}},
+      {"material", {{"Y", 100000}, {"gamma", 0}}},
+      {"supports", {{{"label", "clamp"}, {"where", "x <= 0"}}}},
+      {"prescribed", {{{"label", "pull"}, {"vertices", {30}}, {"displacement", {0, 0, 0.001}}}}},
+      {"stepping", {{"steps", 2}}}};
+}
+
+std::string refusal_of(const std::filesystem::path& file, const MeshStudySpec& spec) {
+  try {
+    run_mesh_study(file, spec);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Issue 59, class 1: an index names another point at each level (a box's
+// vertex 30 landed on the clamp at [16, 8, 8]). Every index the experiment
+// names is mapped to the same point of each level: the pulled vertex's
+// displacement is its prescribed 1 mm at every level, and the vertex 30 of
+// the coarsest, at (0.02, 0.02, 0), is some other index at the finer ones.
+// Where a level lacks the point, the study is refused naming the field.
+TEST(MeshStudy, AVertexIndexNamesTheSamePointAtEveryLevel) {
+  const testing::ScratchDir dir;
+  const auto file = dir.write("box.json", pulled_box({4, 2, 2}).dump());
+  MeshStudySpec spec;
+  spec.ratio = 2.0;
+  spec.figures = {"displacement.30.z", "position.30.x", "position.30.y"};
+  const MeshStudy study = run_mesh_study(file, spec);
+  ASSERT_EQ(study.figures.size(), 3u);
+  EXPECT_EQ(study.figures[0].values, std::vector<double>(3, 0.001));
+  EXPECT_EQ(study.figures[0].estimate.trend, metrics::Trend::Constant);
+  for (double x : study.figures[1].values) EXPECT_NEAR(x, 0.02, 1e-15);
+  for (double y : study.figures[2].values) EXPECT_NEAR(y, 0.02, 1e-15);
+  ASSERT_EQ(study.sizes.size(), 3u);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(study.sizes[k], std::pow(0.5, k), 1e-14);
+
+  spec.ratio = 1.5;  // [9, 5, 5] at level 3: x = 0.02 is no vertex
+  const std::string refused = refusal_of(file, spec);
+  EXPECT_NE(refused.find("prescribed[0].vertices[0]: input vertex 30 at (0.02, 0.02, 0) is no "
+                         "vertex of level 3 (segments [9, 5, 5])"),
+            std::string::npos)
+      << refused;
+  // A figure that is none, or a fit's: refused before any level runs.
+  spec.ratio = 2.0;
+  spec.figures = {"max_displacemnt"};
+  EXPECT_NE(refusal_of(file, spec).find("--figure: no figure \"max_displacemnt\""),
+            std::string::npos);
+  spec.figures = {"fit.cost"};
+  EXPECT_NE(refusal_of(file, spec).find("not its fit"), std::string::npos);
+}
+
+// Issue 59, class 1: levels that rounding leaves identical gave an error of
+// 0, and sizes came from the first segment count alone ([5, 3, 3] ->
+// [6, 3, 3] refined along x only, reported uniform). Every count must grow,
+// and the size is the surface's mean element size.
+TEST(MeshStudy, EveryLevelRefinesEveryDirection) {
+  const testing::ScratchDir dir;
+  MeshStudySpec spec;
+  spec.ratio = 1.1;
+  json box = pulled_box({5, 3, 3});
+  box["prescribed"][0].erase("vertices");
+  box["prescribed"][0]["where"] = "x >= 0.04";
+  std::string refused = refusal_of(dir.write("b533.json", box.dump()), spec);
+  EXPECT_NE(refused.find("surface.segments: a ratio of 1.1 refines segments [5, 3, 3] to segments "
+                         "[6, 3, 3] at level 2, leaving a count as it was"),
+            std::string::npos)
+      << refused;
+  EXPECT_NE(refused.find("at least 1.23"), std::string::npos) << refused;
+  box["surface"]["segments"] = {5, 5, 5};
+  refused = refusal_of(dir.write("b555.json", box.dump()), spec);
+  EXPECT_NE(refused.find("--ratio: a ratio of 1.1 leaves level 3 as level 2 (segments [6, 6, 6])"),
+            std::string::npos)
+      << refused;
+  // [4, 2, 2] by 1.5: [6, 3, 3], [9, 5, 5]; the size is sqrt(area / faces),
+  // not 4 / 9 from the first count.
+  box["surface"]["segments"] = {4, 2, 2};
+  spec.ratio = 1.5;
+  spec.figures = {"max_displacement"};
+  const MeshStudy study = run_mesh_study(dir.write("b422.json", box.dump()), spec);
+  const auto h = [](double faces) { return std::sqrt(0.0040 / faces); };
+  const double faces[] = {2 * (8 + 8 + 4), 2 * (18 + 18 + 9), 2 * (45 + 45 + 25)};
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(study.sizes[k], h(faces[k]) / h(faces[0]), 1e-12) << k;
+}
+
+// Issue 59, class 2: a level that fails keeps the levels before it (a fourth
+// level failing after 9.5 minutes left nothing of the first three), in
+// DIR.failed with the reason, exit 2; --max-memory covers every level.
+TEST(MeshStudy, ALevelThatFailsKeepsTheLevelsBeforeIt) {
+  const testing::ScratchDir dir;
+  std::ifstream in(testing::experiment_file("sphere.json"));
+  json sphere = json::parse(in);
+  sphere.erase("expected");
+  sphere["surface"]["subdivisions"] = 1;
+  const auto file = dir.write("sphere.json", sphere.dump());
+  // Dense LU: about 20 MiB at subdivisions 1 and 2, 48 MiB at 3.
+  const testing::Outcome outcome =
+      testing::run_cli("study mesh " + file.string() +
+                       " --ratio 2 --levels 4 --figure max_displacement --max-memory 40M -o " +
+                       (dir.path() / "study").string());
+  EXPECT_EQ(outcome.status, 2) << outcome.output;
+  EXPECT_NE(outcome.output.find("level 3, subdivisions 3]: this case needs about"),
+            std::string::npos)
+      << outcome.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
+  std::ifstream study_file(dir.path() / "study.failed" / "study.json");
+  const json study = json::parse(study_file);
+  EXPECT_EQ(study["levels"], 4);
+  EXPECT_EQ(study["levels_run"], 2);
+  EXPECT_EQ(study["figures"]["max_displacement"]["values"].size(), 2u);
+  EXPECT_TRUE(study["figures"]["max_displacement"]["trend"].is_null());
+  EXPECT_NE(study["failure"].get<std::string>().find("--max-memory"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "study.failed" / "FAILED"));
+}
+
+// Issue 59, class 2: Ctrl-C during a study exits 130 (it was 1, "the run
+// failed") and writes nothing.
+TEST(MeshStudy, CtrlCStopsTheStudy) {
+  const testing::ScratchDir dir;
+  json box = pulled_box({4, 2, 2});
+  box["stepping"]["steps"] = 4000;
+  const auto file = dir.write("box.json", box.dump());
+  const pid_t pid = testing::start_cli(
+      {"study", "mesh", file.string(), "--ratio", "2", "-o", (dir.path() / "study").string()},
+      dir.path() / "study.log");
+  for (int wait = 0; wait < 600; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (testing::read_file(dir.path() / "study.log").find("level 2 of 3") != std::string::npos)
+      break;
+  }
+  ASSERT_NE(testing::read_file(dir.path() / "study.log").find("level 2 of 3"), std::string::npos);
+  kill(pid, SIGINT);
+  double seconds = 0.0;
+  EXPECT_EQ(testing::wait_for(pid, &seconds), 130) << testing::read_file(dir.path() / "study.log");
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "study.failed"));
 }
 
 TEST(MeshStudy, RefinesWhatTheFileGivesAndNamesWhatItLacks) {
@@ -100,6 +298,7 @@ TEST(MeshStudy, TheCommandPrintsTheOrderAndWritesTheStudy) {
   const json& figure = study["figures"]["max_displacement"];
   ASSERT_EQ(figure["values"].size(), 3u);
   EXPECT_TRUE(figure["monotone"].get<bool>());
+  EXPECT_EQ(figure["trend"], "converging");
   EXPECT_GT(figure["observed_order"].get<double>(), 1.0);  // the paper's sphere: about 1.6
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "study.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / "plot.png")) << outcome.output;
@@ -218,6 +417,29 @@ TEST(FitMeshCheck, AFitReportsHowFarItsParametersMoveOnACoarserMesh) {
   EXPECT_GT(std::abs(shift), 10.0);
   EXPECT_NEAR(figures["fit.mesh_check.gamma"].get<double>(),
               figures["fit.gamma"].get<double>() + shift, 1e-9);
+  // fit.json records the check: its mesh, how its fit ended, the values there.
+  std::ifstream report_file(dir.path() / "out" / "fit.json");
+  const json check = json::parse(report_file)["mesh_check"];
+  EXPECT_EQ(check["mesh"], "coarser");
+  EXPECT_EQ(check["resolution"], "subdivisions 1");
+  EXPECT_FALSE(check["status"].get<std::string>().empty());
+  EXPECT_NEAR(check["parameters"]["gamma"]["shift"].get<double>(), shift, 1e-9);
+
+  // Issue 59, class 2: a check whose mesh is refused threw away the
+  // converged fit (exit 1, nothing written). It is posed before the fit now:
+  // the pull on vertex 100, which the coarser icosphere (42 vertices) lacks,
+  // is refused naming the field before any fitting. Vertex 0 is the same
+  // point on both meshes, so the check above pulls where the fit does.
+  fit["loads"][1]["vertex"] = 100;
+  const testing::Outcome refused =
+      testing::run_cli("fit " + dir.write("fit100.json", fit.dump()).string() + " -o " +
+                       (dir.path() / "out100").string());
+  EXPECT_EQ(refused.status, 1) << refused.output;
+  EXPECT_NE(refused.output.find("fit.mesh_check: "), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("loads[1].vertex: input vertex 100 at"), std::string::npos)
+      << refused.output;
+  EXPECT_EQ(refused.output.find("iteration"), std::string::npos) << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out100"));
 }
 
 }  // namespace

@@ -194,7 +194,7 @@ Eigen::MatrixXd refined_statics(const BenchmarkSpec& spec, const fem::Scene& sce
     const metrics::RichardsonEstimate e = metrics::richardson(
         largest[n - 3], largest[n - 2], largest[n - 1], sizes[n - 3], sizes[n - 2], sizes[n - 1]);
     figures["static.monotone"] = e.monotone ? 1.0 : 0.0;
-    if (e.monotone) {
+    if (std::isfinite(e.order)) {
       figures["static.order"] = e.order;
       figures["static.extrapolated_max_displacement"] = e.extrapolated;
       figures["static.gci"] = e.gci;

@@ -16,6 +16,7 @@
 #include "fiberfluid/model/assembly.hpp"
 #include "fiberfluid/model/equilibrium.hpp"
 #include "fiberfluid/util/error.hpp"
+#include "fiberfluid/util/run_control.hpp"
 
 namespace fiberfluid::experiment {
 namespace {
@@ -220,12 +221,12 @@ std::map<std::string, double> fit_figures(const fit::FitResult& r) {
   return figures;
 }
 
-MeshCheck run_mesh_check(const Experiment& at_fit) {
-  if (!at_fit.fit() || at_fit.fit()->mesh_check == "none")
-    throw std::logic_error("run_mesh_check: the fit asks for no mesh check");
-  // The fit as resolved, at the fitted material: Levenberg-Marquardt from
-  // there (a multi-start search has found its optimum), nothing checked.
-  json document = at_fit.resolved;
+Experiment mesh_check_experiment(const Experiment& ex, std::string* resolution) {
+  if (!ex.fit() || ex.fit()->mesh_check == "none")
+    throw std::logic_error("mesh_check_experiment: the fit asks for no mesh check");
+  // The fit as resolved: Levenberg-Marquardt from its values (a multi-start
+  // search has found its optimum), nothing checked.
+  json document = ex.resolved;
   document.erase("expected");
   json& fit_section = document["fit"];
   fit_section["mesh_check"] = "none";
@@ -235,20 +236,38 @@ MeshCheck run_mesh_check(const Experiment& at_fit) {
   const bool by_halves =
       document.contains("surface") && document["surface"].contains("subdivisions");
   const double ratio = by_halves ? 2.0 : 1.5;
-  const double factor = at_fit.fit()->mesh_check == "coarser" ? 1.0 / ratio : ratio;
-  MeshCheck check;
-  double actual = 0.0;
-  json refined;
+  const double factor = ex.fit()->mesh_check == "coarser" ? 1.0 / ratio : ratio;
+  const std::filesystem::path folder = ex.source.parent_path();
   try {
-    refined = refined_document(document, StudiedMesh::Surface, factor, &check.resolution, &actual);
+    double actual = 0.0;
+    json other = refined_document(document, StudiedMesh::Surface, factor, resolution, &actual);
+    const std::string label = ex.source.string() + " [mesh check, " + *resolution + "]";
+    const geom::Surface given = ex.built() ? ex.simulation().cases.front().input_surface
+                                           : surface_of(document, folder, ex.source.string());
+    other = with_same_vertices(document, given, other, surface_of(other, folder, label),
+                               "the " + ex.fit()->mesh_check + " mesh (" + *resolution + ")",
+                               /*with_fit=*/true);
+    return parse_experiment(other, folder, label);
   } catch (const InputError& e) {
     throw InputError("fit.mesh_check: " + std::string(e.what()));
   }
-  const Experiment other =
-      parse_experiment(refined, at_fit.source.parent_path(),
-                       at_fit.source.string() + " [mesh check, " + check.resolution + "]");
-  FitSetup setup = setup_fit(other, {});
-  check.fitted = setup.calibration->run();
+}
+
+MeshCheck run_mesh_check(const Experiment& at_fit) {
+  MeshCheck check;
+  try {
+    const Experiment other = mesh_check_experiment(at_fit, &check.resolution);
+    FitSetup setup = setup_fit(other, {});
+    check.fitted = setup.calibration->run();
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    check.failure = e.what();
+  }
+  if (check.failure.empty() && check.fitted.status == fit::FitStatus::Interrupted)
+    throw Interrupted("interrupted during the mesh check");
+  if (check.failure.empty() && check.fitted.status == fit::FitStatus::StartFailed)
+    check.failure = "its fit could not start: " + check.fitted.message;
   return check;
 }
 

@@ -46,24 +46,36 @@ std::map<std::string, double> fit_figures(const fit::FitResult& result);
 // fit.best_optimum_starts (how many starts reached the best one).
 std::map<std::string, double> multistart_figures(const fit::MultistartResult& search);
 
-// The experiment with the fitted material (to run and write as usual).
 // fit.mesh_check: the same fit on the surface one step coarser or finer
 // (mesh_study.hpp's refinement: 1.5 for segments and remesh_vertices, 2 for
 // subdivisions), from the fitted values (`at_fit`: with_fitted_material's).
 // Its parameters' shifts from the fit are the mesh's share of their
 // uncertainty: what the data pin is one mesh's model, and this says how far
-// the material moves with the mesh. Throws InputError naming the field when
-// the surface has no resolution to change.
+// the material moves with the mesh.
 struct MeshCheck {
   std::string resolution;  // the other mesh's, e.g. "segments [12, 11]"
-  fit::FitResult fitted;   // on it
+  fit::FitResult fitted;   // on it (its status says whether it converged)
+  std::string failure;     // why the check could not fit at all ("": `fitted` holds)
 };
+
+// The experiment's fit on the other mesh, built, every vertex index it
+// names mapped to the same point there (mesh_study.hpp). Throws InputError
+// naming fit.mesh_check when it cannot be: no resolution to change, a point
+// the other mesh lacks, a mesh its fibers refuse. A fit checks this before
+// it starts, so that a check that cannot run costs no fit.
+Experiment mesh_check_experiment(const Experiment& experiment, std::string* resolution);
+
+// The check's fit from the fitted values. A failure on the other mesh (a
+// run that fails there) is the check's `failure`, never the fit's loss;
+// Ctrl-C throws Interrupted.
 MeshCheck run_mesh_check(const Experiment& at_fit);
 
 // The mesh check's figures: fit.mesh_check.NAME (the value on the other mesh)
 // and fit.mesh_shift.NAME (that less the fit's).
 std::map<std::string, double> mesh_check_figures(const fit::FitResult& fitted,
                                                  const MeshCheck& check);
+
+// The experiment with the fitted material (to run and write as usual).
 
 Experiment with_fitted_material(const Experiment& experiment, const fit::Calibration& calibration,
                                 const fit::FitResult& result);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "fiberfluid/geom/surface.hpp"
 #include "fiberfluid/metrics/convergence.hpp"
 
 namespace fiberfluid::experiment {
@@ -37,16 +38,23 @@ using metrics::RichardsonEstimate;
 struct StudiedFigure {
   std::string name;
   std::vector<double> values;   // per level, coarse to fine
-  RichardsonEstimate estimate;  // from the three finest
+  bool estimated = false;       // three levels or more ran: `estimate` holds
+  RichardsonEstimate estimate;  // the order from the three finest, the trend over all
 };
 
 struct MeshStudy {
   std::string experiment;
   StudiedMesh mesh = StudiedMesh::Surface;
   std::vector<std::string> resolutions;  // per level: "segments [18, 16]", "size 0.005"
-  std::vector<double> sizes;             // per level: the element size relative to the coarsest
+  // per level: the surface's mean element size (Celik et al.'s h: the
+  // square root of the area per face), or the FEM's size asked for,
+  // relative to the coarsest
+  std::vector<double> sizes;
   std::vector<double> seconds;
   std::vector<StudiedFigure> figures;
+  int planned_levels = 0;
+  std::string failure;  // the level that failed and why; the levels before it ran
+  std::vector<std::string> warnings;
 };
 
 // The experiment document refined by `factor` (> 1: finer): its surface's
@@ -56,8 +64,30 @@ struct MeshStudy {
 nlohmann::json refined_document(const nlohmann::json& document, StudiedMesh mesh, double factor,
                                 std::string* resolution, double* actual_factor);
 
-// Runs the levels one after another (progress: "level k of n: ..." lines);
-// a level that fails throws InputError naming it.
+// The surface an experiment document makes (its generator run, its file
+// read and remeshed), without building the case.
+geom::Surface surface_of(const nlohmann::json& document, const std::filesystem::path& folder,
+                         const std::string& label);
+
+// `other` (the document on another mesh, `other_surface`) with every input
+// vertex index that `document` names on `surface` -- a point load's or a
+// marker's "vertex", a selection's "vertices"; the fit section's too with
+// `with_fit` -- mapped to the vertex at the same point. An index names
+// another point on another mesh: where `other_surface` has no vertex there,
+// InputError names the field, the point and `what` (the other mesh).
+nlohmann::json with_same_vertices(const nlohmann::json& document, const geom::Surface& surface,
+                                  nlohmann::json other, const geom::Surface& other_surface,
+                                  const std::string& what, bool with_fit);
+
+// Plans every level before any runs: each level's surface must refine every
+// direction (a generator's counts all grow) and differ from the one before;
+// every vertex index the experiment names (a point load's "vertex", a
+// selection's "vertices", a vertex figure) is mapped to the same point of
+// each level, or the study is refused naming the field; the figures asked
+// for are checked. Then runs the levels one after another (progress: "level
+// k of n: ..." lines). Bad input throws InputError before anything runs; a
+// level that fails after others ran ends the study with `failure` set and
+// the finished levels kept; Ctrl-C throws Interrupted.
 MeshStudy run_mesh_study(const std::filesystem::path& experiment_file, const MeshStudySpec& spec,
                          const std::function<void(const std::string&)>& progress = {});
 

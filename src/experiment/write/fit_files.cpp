@@ -204,8 +204,31 @@ json force_curves_json(const Experiment& ex, const FitSetup& setup, const fit::C
 
 }  // namespace
 
+// fit.mesh_check: the other mesh, how its fit ended, and each parameter
+// there beside the fit's (its values stand however its fit ended: the status
+// says whether they are an optimum).
+json mesh_check_json(const Experiment& ex, const fit::FitResult& r, const MeshCheck& check) {
+  json out = {{"mesh", ex.fit()->mesh_check}, {"resolution", check.resolution}};
+  if (!check.failure.empty()) {
+    out["status"] = "failed";
+    out["failure"] = check.failure;
+    return out;
+  }
+  out["status"] = fit::to_string(check.fitted.status);
+  out["message"] = check.fitted.message;
+  json values = json::object();
+  for (size_t k = 0; k < r.names.size() && k < check.fitted.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    values[r.names[k]] = {{"value", finite_or_null(check.fitted.values[i])},
+                          {"shift", finite_or_null(check.fitted.values[i] - r.values[i])}};
+  }
+  out["parameters"] = values;
+  return out;
+}
+
 json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult& r,
-              const ExperimentResult& run, const fit::MultistartResult* search) {
+              const ExperimentResult& run, const fit::MultistartResult* search,
+              const MeshCheck* mesh_check) {
   const fit::Calibration& c = *setup.calibration;
   json iterations = json::array();
   for (const fit::IterationRecord& it : r.iterations)
@@ -292,14 +315,15 @@ json fit_json(const Experiment& ex, const FitSetup& setup, const fit::FitResult&
     doc["method"] = "multistart";
     doc["multistart"] = multistart_json(*search, r.names);
   }
+  if (mesh_check != nullptr) doc["mesh_check"] = mesh_check_json(ex, r, *mesh_check);
   return doc;
 }
 
 void write_fit_files(const std::filesystem::path& folder, const Experiment& ex,
                      const FitSetup& setup, const fit::FitResult& r, const ExperimentResult& run,
-                     const fit::MultistartResult* search) {
+                     const fit::MultistartResult* search, const MeshCheck* mesh_check) {
   geom::write_text_file(folder / fit_files::kReport,
-                        fit_json(ex, setup, r, run, search).dump(2) + "\n");
+                        fit_json(ex, setup, r, run, search, mesh_check).dump(2) + "\n");
   if (search != nullptr) {
     std::ostringstream starts;
     starts.precision(12);

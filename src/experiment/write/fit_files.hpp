@@ -20,7 +20,8 @@ namespace fiberfluid::experiment {
 // multi-start search, its starts and the optima they reached.
 nlohmann::json fit_json(const Experiment& experiment, const FitSetup& setup,
                         const fit::FitResult& result, const ExperimentResult& run,
-                        const fit::MultistartResult* search = nullptr);
+                        const fit::MultistartResult* search = nullptr,
+                        const MeshCheck* mesh_check = nullptr);
 
 // Writes, into `folder`: fit.json, fit_iterations.csv, fit_distances.csv and
 // fit_target_K.vtu (the simulated surface at the target's step, with the
@@ -29,7 +30,8 @@ nlohmann::json fit_json(const Experiment& experiment, const FitSetup& setup,
 // optimum it reached, the rank that ran it).
 void write_fit_files(const std::filesystem::path& folder, const Experiment& experiment,
                      const FitSetup& setup, const fit::FitResult& result,
-                     const ExperimentResult& run, const fit::MultistartResult* search = nullptr);
+                     const ExperimentResult& run, const fit::MultistartResult* search = nullptr,
+                     const MeshCheck* mesh_check = nullptr);
 
 // Writes calibration.json (the shared parameters with their intervals, each
 // specimen's own and its distance statistics, the iterations, the checks),
